@@ -1,0 +1,419 @@
+/*
+ * radiosity.h - the public API of the radiosity library.
+ *
+ * This header is the manual. The library computes diffuse global illumination by the
+ * radiosity method: a scene is split into patches, form factors between patches are
+ * computed with visibility, the radiosity system B = E + diag(rho) F B is solved, and the
+ * answer is reconstructed smoothly and rendered from a camera.
+ *
+ * The pipeline, one stage per section below:
+ *   scene (import or built-in) -> mesh of patches -> tracer (ray queries) ->
+ *   form factors -> solve -> reconstruct + render -> image / view-factor output.
+ *
+ * Conventions shared by every function (see shared/docs/METHOD.md):
+ *   - F_ij is the fraction of the energy leaving patch i that arrives at patch j.
+ *   - Albedo rho is linear RGB in [0,1]; emission is given as emitted RADIANCE L_e; the
+ *     exitance that enters the radiosity equation is E = pi * L_e. Radiosity B is an
+ *     exitance (same unit as E); an image pixel holds radiance L = B / pi.
+ *   - Surfaces are one-sided: the front is the side from which a triangle's vertices run
+ *     counter-clockwise. Every surface blocks rays from both sides.
+ *
+ * Errors: fallible functions return rad_status and, when the caller passes a rad_error,
+ * fill it with a one-line message of the form "file:line: what is wrong" (the file and line
+ * are left out when they are not known). Warnings go to the rad_log callback of the options
+ * that take one; a NULL callback drops them. No function prints or exits.
+ *
+ * Ownership: every *_create / *_load / *_build returns an object the caller frees with the
+ * matching *_destroy; passing NULL to a *_destroy is harmless.
+ *
+ * Threads: functions that take a `threads` field run in parallel with OpenMP (0 means all
+ * cores). Results do not depend on the thread count: every random number is derived from
+ * the seed and the item being computed, never from the thread that computes it.
+ */
+#ifndef RADIOSITY_H
+#define RADIOSITY_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------------------ */
+/* Errors and logging                                                                    */
+
+typedef enum rad_status {
+    RAD_OK = 0,
+    RAD_ERR_IO,          /* a file could not be opened, read or written */
+    RAD_ERR_PARSE,       /* a file was read but its content is malformed */
+    RAD_ERR_INVALID,     /* an argument or a scene value is out of its domain */
+    RAD_ERR_NOMEM,       /* an allocation failed or a size overflowed */
+    RAD_ERR_UNSUPPORTED, /* a valid request this build cannot serve */
+    RAD_ERR_INTERNAL     /* a bug: an invariant did not hold */
+} rad_status;
+
+enum { RAD_ERROR_MESSAGE_MAX = 1024 };
+
+typedef struct rad_error {
+    rad_status status;
+    char message[RAD_ERROR_MESSAGE_MAX]; /* "file:line: message", no trailing newline */
+} rad_error;
+
+/* A short English name for a status ("I/O error", ...). Never NULL. */
+const char *rad_status_name(rad_status status);
+
+/* Receives one warning line (no trailing newline). */
+typedef void (*rad_log_fn)(void *user, const char *message);
+
+/* Receives the progress of a long phase: fraction in [0,1]. Called from one thread only. */
+typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
+
+/* ------------------------------------------------------------------------------------ */
+/* Small value types                                                                     */
+
+typedef struct rad_vec3 {
+    double x, y, z;
+} rad_vec3;
+
+typedef struct rad_rgb {
+    double r, g, b;
+} rad_rgb;
+
+/* A pinhole camera. fov_degrees is the VERTICAL field of view. */
+typedef struct rad_camera {
+    rad_vec3 eye;
+    rad_vec3 target;
+    rad_vec3 up;
+    double fov_degrees;
+} rad_camera;
+
+/* ------------------------------------------------------------------------------------ */
+/* Scene: triangles with materials, grouped into named surfaces                          */
+
+typedef struct rad_material {
+    char name[128];
+    rad_rgb albedo;   /* diffuse reflectance rho, linear RGB in [0,1] (MTL Kd) */
+    rad_rgb emission; /* emitted radiance L_e, linear RGB >= 0 (MTL Ke) */
+} rad_material;
+
+/* A surface is what the user named: an OBJ object (o) or group (g). Its triangles are the
+ * contiguous range [first_triangle, first_triangle + triangle_count). */
+typedef struct rad_surface {
+    char name[128];
+    uint32_t first_triangle;
+    uint32_t triangle_count;
+} rad_surface;
+
+typedef struct rad_triangle {
+    uint32_t vertex[3]; /* indices into rad_scene.positions, counter-clockwise = front */
+    uint32_t material;  /* index into rad_scene.materials */
+    uint32_t surface;   /* index into rad_scene.surfaces */
+} rad_triangle;
+
+/* Plain data, owned by the library; read it freely, change it only through the functions
+ * below. After a successful load every triangle is non-degenerate, every coordinate is
+ * finite, every index is in range and every albedo is in [0,1]. */
+typedef struct rad_scene {
+    rad_vec3 *positions;
+    uint32_t position_count;
+    rad_triangle *triangles;
+    uint32_t triangle_count;
+    rad_material *materials;
+    uint32_t material_count;
+    rad_surface *surfaces;
+    uint32_t surface_count;
+    bool has_camera;   /* the file (or the built-in scene) defines a camera */
+    rad_camera camera; /* valid when has_camera */
+    char source[512];  /* file the scene came from, or "(built-in Cornell box)" */
+} rad_scene;
+
+typedef struct rad_load_options {
+    rad_log_fn log; /* warnings: skipped degenerate triangles, missing emitters, ... */
+    void *log_user;
+} rad_load_options;
+
+/* Reads a scene file through Assimp (OBJ + MTL and the other formats Assimp reads).
+ * Degenerate triangles are skipped with a warning; non-finite coordinates, a missing
+ * material library, unreadable or empty files are errors. */
+rad_status rad_scene_load(const char *path, const rad_load_options *options,
+                          rad_scene **out, rad_error *error);
+
+/* The Cornell box of the Cornell University Program of Computer Graphics (millimetres,
+ * y up), with its official camera. Same geometry and materials as
+ * shared/scenes/cornell-box.obj. */
+rad_status rad_scene_cornell_box(rad_scene **out, rad_error *error);
+
+void rad_scene_destroy(rad_scene *scene);
+
+/* Total area of the scene's triangles, and its bounding box. */
+double rad_scene_area(const rad_scene *scene);
+void rad_scene_bounds(const rad_scene *scene, rad_vec3 *lo, rad_vec3 *hi);
+
+/* True when some material with triangles has non-zero emission. */
+bool rad_scene_has_emitter(const rad_scene *scene);
+
+/* A camera that frames the whole scene from the front (-z side, looking +z, y up). */
+rad_camera rad_scene_default_camera(const rad_scene *scene);
+
+/* ------------------------------------------------------------------------------------ */
+/* Mesh: the scene split into patches                                                    */
+
+/* A patch is a planar triangle (vertex_count 3) or convex quadrilateral (vertex_count 4),
+ * counter-clockwise seen from its front. */
+typedef struct rad_patch {
+    uint32_t vertex[4];   /* indices into rad_mesh.vertices; vertex[3] unused for triangles */
+    uint32_t vertex_count; /* 3 or 4 */
+    uint32_t surface;     /* index into the scene's surfaces */
+    uint32_t material;    /* index into the scene's materials */
+    double area;          /* scene units squared */
+    rad_vec3 normal;      /* unit front normal */
+    rad_vec3 centroid;
+} rad_patch;
+
+/* Vertices are shared by the patches of one smooth region (coplanar input triangles of one
+ * surface and one material), so values reconstructed at vertices interpolate without seams
+ * inside a region and keep creases sharp between regions. */
+typedef struct rad_mesh {
+    rad_vec3 *vertices;
+    uint32_t vertex_count;
+    rad_patch *patches;
+    uint32_t patch_count;
+    double patch_size; /* the longest-edge limit the mesh was built with */
+} rad_mesh;
+
+/* A patch size that gives roughly `target_patches` patches for the scene's area. */
+double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patches);
+
+/* Splits every triangle (pairs of triangles forming a convex quadrilateral are merged
+ * first) into patches whose edges are no longer than patch_size. */
+rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **out,
+                          rad_error *error);
+
+void rad_mesh_destroy(rad_mesh *mesh);
+
+/* ------------------------------------------------------------------------------------ */
+/* Tracer: ray queries against a triangle set                                            */
+
+typedef enum rad_tracer_backend {
+    RAD_TRACER_EMBREE = 0, /* Embree 3 BVH: the default */
+    RAD_TRACER_BRUTE_FORCE /* tests every triangle: a test oracle, slow */
+} rad_tracer_backend;
+
+/* A ray or segment: points origin + t * direction for t in [t_near, t_far]. direction
+ * need not be unit length; t is measured in units of it. */
+typedef struct rad_ray {
+    float origin[3];
+    float t_near;
+    float direction[3];
+    float t_far;
+} rad_ray;
+
+#define RAD_NO_HIT UINT32_MAX
+
+typedef struct rad_hit {
+    uint32_t triangle; /* index of the triangle hit, or RAD_NO_HIT */
+    float t;           /* ray parameter of the hit */
+    float u, v;        /* barycentric: point = (1-u-v) p0 + u p1 + v p2 */
+    bool front;        /* the ray hit the triangle's front (counter-clockwise) side */
+} rad_hit;
+
+typedef struct rad_tracer rad_tracer;
+
+/* Builds the acceleration structure over `triangle_count` triangles given as vertex
+ * indices into `positions`. The tracer copies what it needs. */
+rad_status rad_tracer_create(rad_tracer_backend backend, const rad_vec3 *positions,
+                             uint32_t position_count, const uint32_t (*triangles)[3],
+                             uint32_t triangle_count, rad_tracer **out, rad_error *error);
+
+/* A tracer over every triangle of the scene (the occluders for form factors). */
+rad_status rad_tracer_create_for_scene(rad_tracer_backend backend, const rad_scene *scene,
+                                       rad_tracer **out, rad_error *error);
+
+void rad_tracer_destroy(rad_tracer *tracer);
+
+/* For each ray, occluded[k] = 1 when any triangle is hit for t in [t_near, t_far].
+ * Hot path: no argument checks. Safe to call from several threads at once. */
+void rad_tracer_occluded(const rad_tracer *tracer, const rad_ray *rays, uint32_t count,
+                         uint8_t *occluded);
+
+/* Closest hit for each ray. Safe to call from several threads at once. */
+void rad_tracer_intersect(const rad_tracer *tracer, const rad_ray *rays, uint32_t count,
+                          rad_hit *hits);
+
+/* ------------------------------------------------------------------------------------ */
+/* Form factors                                                                          */
+
+typedef struct rad_formfactor_options {
+    uint32_t quadrature;     /* each patch is split m x m for the analytic part; 0 = 1 */
+    uint32_t visibility_rays; /* rays per patch pair (rounded to a square); 0 = 16 */
+    uint64_t seed;            /* seeds the stratified sample points */
+    int threads;              /* 0 = all cores */
+    rad_progress_fn progress;
+    void *progress_user;
+} rad_formfactor_options;
+
+/* Counts what a form-factor computation did. */
+typedef struct rad_formfactor_report {
+    uint64_t pairs;            /* patch pairs considered (i < j) */
+    uint64_t pairs_facing;     /* pairs that face each other and needed work */
+    uint64_t rays;             /* occlusion rays cast */
+    double seconds;
+} rad_formfactor_report;
+
+/* The dense n x n matrix, row-major: F[i * n + j] = F_ij. Reciprocity holds exactly by
+ * construction (A_i F_ij = A_j F_ji up to float rounding). */
+typedef struct rad_formfactors {
+    uint32_t n;
+    float *F;
+} rad_formfactors;
+
+/* Computes every F_ij of the mesh. `occluders` is a tracer over the scene's triangles (any
+ * backend). The unoccluded point-to-patch factor is analytic (Lambert's contour formula,
+ * integrated over each patch by an m x m midpoint rule, averaged over both directions);
+ * visibility is the fraction of unoccluded rays between stratified points of the two
+ * patches. */
+rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occluders,
+                                   const rad_formfactor_options *options,
+                                   rad_formfactors **out, rad_formfactor_report *report,
+                                   rad_error *error);
+
+void rad_formfactors_destroy(rad_formfactors *formfactors);
+
+/* Largest |A_i F_ij - A_j F_ji| / max(A_i F_ij, A_j F_ji) over pairs with a factor above
+ * 1e-6, and largest |sum_j F_ij - 1| over patches (meaningful for closed scenes). */
+void rad_formfactors_check(const rad_formfactors *formfactors, const rad_mesh *mesh,
+                           double *reciprocity_residual, double *closure_residual);
+
+/* The surface-to-surface view-factor matrix: F_IJ = sum over patches i of I, j of J of
+ * A_i F_ij / A_I, computed pair by pair without storing the patch matrix. `matrix` receives
+ * surface_count^2 values, row-major; `areas` (optional) the surface areas. */
+rad_status rad_viewfactors_compute(const rad_scene *scene, const rad_mesh *mesh,
+                                   const rad_tracer *occluders,
+                                   const rad_formfactor_options *options, double *matrix,
+                                   double *areas, rad_formfactor_report *report,
+                                   rad_error *error);
+
+/* ------------------------------------------------------------------------------------ */
+/* Solvers for (I - diag(rho) F) B = E                                                   */
+
+typedef enum rad_solver {
+    RAD_SOLVER_JACOBI = 0,   /* gathering: every patch from the previous iterate */
+    RAD_SOLVER_GAUSS_SEIDEL, /* gathering with the newest values */
+    RAD_SOLVER_SHOOT,        /* progressive refinement: most unshot power first */
+    RAD_SOLVER_DIRECT        /* LU factorisation, O(n^3): small scenes and tests only */
+} rad_solver;
+
+/* The linear system. Exitance E_i = pi * L_e of patch i's material. */
+typedef struct rad_system {
+    uint32_t n;
+    const float *F;          /* n x n row-major, F_ij */
+    const double *area;      /* A_i */
+    const rad_rgb *albedo;   /* rho_i */
+    const rad_rgb *exitance; /* E_i */
+} rad_system;
+
+typedef struct rad_solve_options {
+    rad_solver solver;
+    double tolerance;        /* relative residual (gathering) or unshot fraction (shooting);
+                                0 = 1e-4 */
+    uint32_t max_iterations; /* sweeps (gathering) or shots (shooting); 0 = no limit but
+                                n * 1000 shots or 10000 sweeps */
+    bool ambient;            /* shooting: add the ambient term for the unshot energy */
+    int threads;
+    rad_progress_fn progress;
+    void *progress_user;
+} rad_solve_options;
+
+typedef struct rad_solve_report {
+    uint32_t iterations;     /* sweeps, or shots for the shooting solver */
+    double criterion;        /* the solver's own stopping value at the end */
+    double residual;         /* sum_i A_i |B - E - rho F B|_1 / sum_i A_i |E|_1, all solvers */
+    bool converged;          /* criterion <= tolerance */
+    double seconds;
+} rad_solve_report;
+
+/* Fills B (n values, exitance). */
+rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
+                     rad_rgb *B, rad_solve_report *report, rad_error *error);
+
+/* The relative residual used by every solver's report. */
+double rad_system_residual(const rad_system *system, const rad_rgb *B);
+
+/* Fills the system's per-patch arrays from a mesh and its scene (caller owns them). */
+rad_status rad_system_from_mesh(const rad_scene *scene, const rad_mesh *mesh,
+                                const rad_formfactors *formfactors, rad_system *system,
+                                rad_error *error);
+void rad_system_free_arrays(rad_system *system);
+
+/* ------------------------------------------------------------------------------------ */
+/* Images                                                                                */
+
+/* Linear RGB radiance, row-major from the top-left pixel. */
+typedef struct rad_image {
+    uint32_t width, height;
+    float *rgb; /* width * height * 3 */
+} rad_image;
+
+rad_status rad_image_create(uint32_t width, uint32_t height, rad_image **out,
+                            rad_error *error);
+void rad_image_destroy(rad_image *image);
+
+typedef struct rad_image_write_options {
+    double exposure; /* PNG only: radiance is multiplied by 2^exposure; NAN = automatic */
+} rad_image_write_options;
+
+/* Writes by the extension of path: .png (exposure, tone map, sRGB, 8-bit), .hdr (Radiance
+ * RGBE), .pfm (portable float map). Writes to a temporary name in the same folder and
+ * renames it, so a failed write leaves no file. */
+rad_status rad_image_write(const rad_image *image, const char *path,
+                           const rad_image_write_options *options, rad_error *error);
+
+/* Reads a .pfm or .hdr written by rad_image_write (tests and tools). */
+rad_status rad_image_read(const char *path, rad_image **out, rad_error *error);
+
+/* ------------------------------------------------------------------------------------ */
+/* Rendering                                                                             */
+
+typedef struct rad_render_options {
+    uint32_t width, height;     /* 0 = 512 */
+    uint32_t samples_per_pixel; /* rounded to a square, stratified, box filter; 0 = 4 */
+    uint64_t seed;
+    int threads;
+    rad_progress_fn progress;
+    void *progress_user;
+} rad_render_options;
+
+/* Radiance at every mesh vertex: the area-weighted average of B/pi over the patches that
+ * share the vertex. `vertex_radiance` receives mesh->vertex_count values. */
+void rad_reconstruct_vertices(const rad_mesh *mesh, const rad_rgb *B,
+                              rad_rgb *vertex_radiance);
+
+/* Renders the mesh lit by the solution B (per patch exitance) through the camera: primary
+ * rays hit the patches, radiance is interpolated from vertex values; back faces and misses
+ * are black. Fills `image` (its size decides the resolution). */
+rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
+                      const rad_render_options *options, rad_image *image,
+                      rad_error *error);
+
+/* ------------------------------------------------------------------------------------ */
+/* Output files                                                                          */
+
+/* Writes the view-factor matrix as CSV: header "surface,NAME1,...", then one row per
+ * surface. Atomic like rad_image_write. */
+rad_status rad_viewfactors_write_csv(const rad_scene *scene, const double *matrix,
+                                     const char *path, rad_error *error);
+
+/* Writes `size` bytes to path atomically (temporary name, then rename). */
+rad_status rad_write_file_atomic(const char *path, const void *data, size_t size,
+                                 rad_error *error);
+
+/* Peak resident memory of this process so far, in bytes. */
+uint64_t rad_peak_memory_bytes(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RADIOSITY_H */

@@ -1,0 +1,48 @@
+/*
+ * random.h - deterministic, stateless random numbers.
+ *
+ * Every random number is a hash of (seed, what is being computed, sample index), never a
+ * stream shared between threads, so results do not depend on the thread count or on the
+ * order in which work is done.
+ */
+#ifndef RAD_CORE_RANDOM_H
+#define RAD_CORE_RANDOM_H
+
+#include <stdint.h>
+
+/* SplitMix64 finaliser: a bijective 64-bit mix. */
+static inline uint64_t rad_mix64(uint64_t x)
+{
+    x += 0x9E3779B97F4A7C15ull;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+}
+
+/* A small generator for a short sequence of numbers, seeded from a hash. */
+typedef struct rad_rng {
+    uint64_t state;
+} rad_rng;
+
+static inline rad_rng rad_rng_seed(uint64_t a, uint64_t b, uint64_t c)
+{
+    rad_rng rng = {rad_mix64(a ^ rad_mix64(b ^ rad_mix64(c)))};
+    return rng;
+}
+
+static inline uint64_t rad_rng_next(rad_rng *rng)
+{
+    rng->state += 0x9E3779B97F4A7C15ull;
+    uint64_t z = rng->state;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* Uniform in [0, 1). */
+static inline double rad_rng_uniform(rad_rng *rng)
+{
+    return (double)(rad_rng_next(rng) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+#endif

@@ -1,0 +1,28 @@
+/*
+ * tolerance.h - every tolerance of the library, named once with its unit and reason.
+ */
+#ifndef RAD_CORE_TOLERANCE_H
+#define RAD_CORE_TOLERANCE_H
+
+/* A triangle is degenerate when twice its area is at most this times its longest edge
+ * squared (dimensionless): collinear or repeated corners, whatever the scene's unit. */
+#define RAD_DEGENERATE_RELATIVE_AREA 1e-9
+
+/* Two triangles are coplanar (one smooth region) when their unit normals differ by less
+ * than this (dimensionless, about 0.06 degrees) ... */
+#define RAD_COPLANAR_NORMAL 1e-3
+/* ... and their plane offsets by less than this times the scene's bounding-box diagonal. */
+#define RAD_COPLANAR_OFFSET 1e-6
+
+/* Occlusion segments between two patches stop this far (as a fraction of the segment)
+ * from each end, so that the patches' own triangles never count as occluders. */
+#define RAD_SEGMENT_END_EPSILON 1e-4f
+
+/* A point is in front of a plane when its signed distance exceeds this times the scene's
+ * bounding-box diagonal (scene units; guards coplanar and touching patches). */
+#define RAD_PLANE_EPSILON 1e-7
+
+/* Camera rays start this far from the eye, as a fraction of the scene diagonal. */
+#define RAD_CAMERA_NEAR 1e-6
+
+#endif

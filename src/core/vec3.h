@@ -1,0 +1,34 @@
+/*
+ * vec3.h - double-precision 3-vector arithmetic on rad_vec3, all inline.
+ */
+#ifndef RAD_CORE_VEC3_H
+#define RAD_CORE_VEC3_H
+
+#include <math.h>
+
+#include "radiosity.h"
+
+#define RAD_PI 3.14159265358979323846
+
+static inline rad_vec3 v3(double x, double y, double z) { return (rad_vec3){x, y, z}; }
+static inline rad_vec3 v3_add(rad_vec3 a, rad_vec3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline rad_vec3 v3_sub(rad_vec3 a, rad_vec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline rad_vec3 v3_scale(rad_vec3 a, double s) { return v3(a.x * s, a.y * s, a.z * s); }
+static inline double v3_dot(rad_vec3 a, rad_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline rad_vec3 v3_cross(rad_vec3 a, rad_vec3 b)
+{
+    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline double v3_length(rad_vec3 a) { return sqrt(v3_dot(a, a)); }
+static inline rad_vec3 v3_normalize(rad_vec3 a)
+{
+    double l = v3_length(a);
+    return l > 0 ? v3_scale(a, 1.0 / l) : a;
+}
+static inline rad_vec3 v3_lerp(rad_vec3 a, rad_vec3 b, double t)
+{
+    return v3(a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t, a.z + (b.z - a.z) * t);
+}
+static inline int v3_is_finite(rad_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+#endif

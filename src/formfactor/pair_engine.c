@@ -1,0 +1,339 @@
+/*
+ * pair_engine.c - the form-factor kernel: analytic transfer times sampled visibility.
+ *
+ * For a pair (i, j), i < j, of patches that face each other:
+ *   - the unoccluded transfer is estimated from both sides with Lambert's contour formula
+ *     (contour.c) at the midpoints of an m x m split of each patch, and averaged:
+ *       G_ij = (A_i Fhat_ij + A_j Fhat_ji) / 2;
+ *   - visibility is the fraction of K segments between jittered stratified points of the
+ *     two patches that no triangle of the scene blocks.
+ * Pairs where either patch is wholly behind the other's plane need no work (G = 0).
+ *
+ * Random numbers come from (seed, i, j), so the result is the same for any thread count.
+ * Rays are batched per thread and traced with rad_tracer_occluded; the hot loop allocates
+ * nothing.
+ */
+#include "formfactor/pair_engine.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/random.h"
+#include "core/tolerance.h"
+#include "core/vec3.h"
+#include "formfactor/contour.h"
+
+#define DEFAULT_VISIBILITY_RAYS 16u
+#define MAX_QUADRATURE 8u
+#define MAX_STRATA 16u             /* at most 16 x 16 = 256 rays per pair */
+#define BATCH_RAYS 4096u           /* rays traced per call */
+
+/* Everything the kernel needs about one patch, precomputed. */
+typedef struct patch_geometry {
+    rad_vec3 corner[4];
+    unsigned corner_count;
+    rad_vec3 normal;
+    double area;
+} patch_geometry;
+
+typedef struct pending_pair {
+    uint32_t j;
+    uint32_t first_ray, ray_count;
+    double unoccluded; /* G before visibility */
+} pending_pair;
+
+typedef struct engine {
+    const rad_mesh *mesh;
+    const rad_tracer *occluders;
+    patch_geometry *geometry;
+    rad_vec3 *quadrature_points; /* m*m per patch */
+    double *quadrature_weights;  /* m*m per patch, sum to 1 */
+    unsigned quadrature_count;
+    unsigned strata;             /* k: k*k rays per pair */
+    uint64_t seed;
+    double plane_epsilon;
+    pair_sink_fn sink;
+    void *sink_data;
+} engine;
+
+int pair_engine_threads(const rad_formfactor_options *options)
+{
+    int threads = options && options->threads > 0 ? options->threads : omp_get_max_threads();
+    return threads < 1 ? 1 : threads;
+}
+
+/* Point of the patch at unit-square coordinates (s, t): bilinear for quads, an
+ * area-preserving warp for triangles. */
+static rad_vec3 patch_point(const patch_geometry *g, double s, double t)
+{
+    const rad_vec3 *c = g->corner;
+    if (g->corner_count == 4)
+        return v3_lerp(v3_lerp(c[0], c[1], s), v3_lerp(c[3], c[2], s), t);
+    double r = sqrt(s);
+    double u = 1 - r, v = t * r;
+    return v3_add(c[0], v3_add(v3_scale(v3_sub(c[1], c[0]), 1 - u - v),
+                               v3_scale(v3_sub(c[2], c[0]), v)));
+}
+
+/* Midpoint rule on an m x m split: sub-cell centres (quads) or sub-triangle centroids. */
+static void quadrature_for(const patch_geometry *g, unsigned m, rad_vec3 *points,
+                           double *weights)
+{
+    unsigned q = 0;
+    if (g->corner_count == 4) {
+        double total = 0;
+        for (unsigned j = 0; j < m; j++)
+            for (unsigned i = 0; i < m; i++) {
+                rad_vec3 a = patch_point(g, (double)i / m, (double)j / m);
+                rad_vec3 b = patch_point(g, (double)(i + 1) / m, (double)j / m);
+                rad_vec3 c = patch_point(g, (double)(i + 1) / m, (double)(j + 1) / m);
+                rad_vec3 d = patch_point(g, (double)i / m, (double)(j + 1) / m);
+                double area = 0.5 * v3_length(v3_cross(v3_sub(c, a), v3_sub(d, b)));
+                points[q] = v3_scale(v3_add(v3_add(a, b), v3_add(c, d)), 0.25);
+                weights[q++] = area;
+                total += area;
+            }
+        for (unsigned k = 0; k < q; k++)
+            weights[k] = total > 0 ? weights[k] / total : 1.0 / q;
+        return;
+    }
+    /* triangle: m^2 similar sub-triangles of equal area */
+    rad_vec3 a = g->corner[0], ab = v3_sub(g->corner[1], a), ac = v3_sub(g->corner[2], a);
+    for (unsigned j = 0; j < m; j++)
+        for (unsigned i = 0; i + j < m; i++) {
+            double u = (i + 1.0 / 3.0) / m, v = (j + 1.0 / 3.0) / m;
+            points[q] = v3_add(a, v3_add(v3_scale(ab, u), v3_scale(ac, v)));
+            weights[q++] = 1.0 / ((double)m * m);
+            if (i + j + 1 < m) {
+                u = (i + 2.0 / 3.0) / m;
+                v = (j + 2.0 / 3.0) / m;
+                points[q] = v3_add(a, v3_add(v3_scale(ab, u), v3_scale(ac, v)));
+                weights[q++] = 1.0 / ((double)m * m);
+            }
+        }
+}
+
+/* True when some corner of b lies in front of a's plane. */
+static bool any_in_front(const patch_geometry *a, const patch_geometry *b, double epsilon)
+{
+    for (unsigned k = 0; k < b->corner_count; k++)
+        if (v3_dot(a->normal, v3_sub(b->corner[k], a->corner[0])) > epsilon)
+            return true;
+    return false;
+}
+
+/* Area-weighted unoccluded factor from patch a to patch b: A_a * Fhat_ab. */
+static double transfer(const engine *e, uint32_t a, uint32_t b)
+{
+    const patch_geometry *ga = &e->geometry[a], *gb = &e->geometry[b];
+    const rad_vec3 *points = &e->quadrature_points[(size_t)a * e->quadrature_count];
+    const double *weights = &e->quadrature_weights[(size_t)a * e->quadrature_count];
+    double sum = 0;
+    for (unsigned q = 0; q < e->quadrature_count; q++)
+        sum += weights[q] * contour_point_to_polygon(points[q], ga->normal, gb->corner,
+                                                     gb->corner_count, gb->normal,
+                                                     e->plane_epsilon);
+    return ga->area * sum;
+}
+
+/* Fills k*k segments from stratified points of i to stratified points of j. */
+static void make_segments(const engine *e, uint32_t i, uint32_t j, rad_ray *rays)
+{
+    unsigned k = e->strata, count = k * k;
+    rad_rng rng = rad_rng_seed(e->seed, i, j);
+    uint8_t order[MAX_STRATA * MAX_STRATA];
+    for (unsigned s = 0; s < count; s++)
+        order[s] = (uint8_t)s;
+    for (unsigned s = count; s > 1; s--) { /* shuffle which stratum of j pairs with which of i */
+        unsigned r = (unsigned)(rad_rng_next(&rng) % s);
+        uint8_t swap = order[s - 1];
+        order[s - 1] = order[r];
+        order[r] = swap;
+    }
+    for (unsigned s = 0; s < count; s++) {
+        unsigned si = s % k, ti = s / k, sj = order[s] % k, tj = order[s] / k;
+        rad_vec3 p = patch_point(&e->geometry[i], (si + rad_rng_uniform(&rng)) / k,
+                                 (ti + rad_rng_uniform(&rng)) / k);
+        rad_vec3 q = patch_point(&e->geometry[j], (sj + rad_rng_uniform(&rng)) / k,
+                                 (tj + rad_rng_uniform(&rng)) / k);
+        rad_ray *ray = &rays[s];
+        ray->origin[0] = (float)p.x;
+        ray->origin[1] = (float)p.y;
+        ray->origin[2] = (float)p.z;
+        ray->direction[0] = (float)(q.x - p.x);
+        ray->direction[1] = (float)(q.y - p.y);
+        ray->direction[2] = (float)(q.z - p.z);
+        ray->t_near = RAD_SEGMENT_END_EPSILON;
+        ray->t_far = 1.0f - RAD_SEGMENT_END_EPSILON;
+    }
+}
+
+typedef struct thread_work {
+    rad_ray *rays;
+    uint8_t *occluded;
+    pending_pair *pending;
+    uint32_t ray_count, pending_count;
+    uint64_t rays_cast, pairs_facing;
+} thread_work;
+
+static void flush(const engine *e, thread_work *w, int thread, uint32_t i)
+{
+    if (w->ray_count)
+        rad_tracer_occluded(e->occluders, w->rays, w->ray_count, w->occluded);
+    for (uint32_t p = 0; p < w->pending_count; p++) {
+        const pending_pair *pair = &w->pending[p];
+        uint32_t visible = 0;
+        for (uint32_t r = 0; r < pair->ray_count; r++)
+            visible += !w->occluded[pair->first_ray + r];
+        if (visible)
+            e->sink(e->sink_data, thread, i, pair->j,
+                    pair->unoccluded * visible / pair->ray_count);
+    }
+    w->rays_cast += w->ray_count;
+    w->ray_count = 0;
+    w->pending_count = 0;
+}
+
+static void row(const engine *e, thread_work *w, int thread, uint32_t i)
+{
+    const patch_geometry *gi = &e->geometry[i];
+    uint32_t n = e->mesh->patch_count;
+    unsigned per_pair = e->strata * e->strata;
+    for (uint32_t j = i + 1; j < n; j++) {
+        const patch_geometry *gj = &e->geometry[j];
+        if (!any_in_front(gi, gj, e->plane_epsilon) || !any_in_front(gj, gi, e->plane_epsilon))
+            continue;
+        double G = 0.5 * (transfer(e, i, j) + transfer(e, j, i));
+        if (!(G > 0))
+            continue;
+        w->pairs_facing++;
+        if (w->ray_count + per_pair > BATCH_RAYS)
+            flush(e, w, thread, i);
+        pending_pair *pair = &w->pending[w->pending_count++];
+        pair->j = j;
+        pair->first_ray = w->ray_count;
+        pair->ray_count = per_pair;
+        pair->unoccluded = G;
+        make_segments(e, i, j, &w->rays[w->ray_count]);
+        w->ray_count += per_pair;
+    }
+    flush(e, w, thread, i);
+}
+
+static unsigned strata_for(uint32_t rays)
+{
+    if (rays == 0)
+        rays = DEFAULT_VISIBILITY_RAYS;
+    unsigned k = (unsigned)lround(sqrt((double)rays));
+    return k < 1 ? 1 : k > MAX_STRATA ? MAX_STRATA : k;
+}
+
+rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
+                           const rad_formfactor_options *options, pair_sink_fn sink,
+                           void *sink_data, rad_formfactor_report *report, rad_error *error)
+{
+    rad_formfactor_options defaults = {0};
+    if (!options)
+        options = &defaults;
+    uint32_t n = mesh->patch_count;
+    unsigned m = options->quadrature ? options->quadrature : 1;
+    if (m > MAX_QUADRATURE)
+        return rad_fail(error, RAD_ERR_INVALID, "quadrature %u is above the limit %u", m,
+                        MAX_QUADRATURE);
+    engine e = {0};
+    e.mesh = mesh;
+    e.occluders = occluders;
+    e.quadrature_count = m * m;
+    e.strata = strata_for(options->visibility_rays);
+    e.seed = options->seed;
+    e.sink = sink;
+    e.sink_data = sink_data;
+    rad_vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        rad_vec3 p = mesh->vertices[v];
+        lo = v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
+        hi = v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
+    }
+    e.plane_epsilon = mesh->vertex_count ? RAD_PLANE_EPSILON * v3_length(v3_sub(hi, lo)) : 0;
+
+    int threads = pair_engine_threads(options);
+    rad_status status = RAD_OK;
+    thread_work *work = rad_alloc_array((size_t)threads, sizeof(*work));
+    e.geometry = rad_alloc_array(n, sizeof(*e.geometry));
+    e.quadrature_points = rad_alloc_array((size_t)n * e.quadrature_count, sizeof(rad_vec3));
+    e.quadrature_weights = rad_alloc_array((size_t)n * e.quadrature_count, sizeof(double));
+    if (!work || !e.geometry || !e.quadrature_points || !e.quadrature_weights)
+        goto nomem;
+    for (int t = 0; t < threads; t++) {
+        work[t].rays = rad_alloc_array(BATCH_RAYS, sizeof(*work[t].rays));
+        work[t].occluded = rad_alloc_array(BATCH_RAYS, sizeof(*work[t].occluded));
+        work[t].pending = rad_alloc_array(BATCH_RAYS, sizeof(*work[t].pending));
+        if (!work[t].rays || !work[t].occluded || !work[t].pending)
+            goto nomem;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        const rad_patch *patch = &mesh->patches[i];
+        patch_geometry *g = &e.geometry[i];
+        g->corner_count = patch->vertex_count;
+        for (unsigned k = 0; k < patch->vertex_count; k++)
+            g->corner[k] = mesh->vertices[patch->vertex[k]];
+        g->normal = patch->normal;
+        g->area = patch->area;
+        quadrature_for(g, m, &e.quadrature_points[(size_t)i * e.quadrature_count],
+                       &e.quadrature_weights[(size_t)i * e.quadrature_count]);
+    }
+
+    struct timespec start, end;
+    clock_gettime(CLOCK_MONOTONIC, &start);
+    double total_pairs = (double)n * (n - 1) / 2;
+    uint64_t rows_done = 0;
+#pragma omp parallel num_threads(threads)
+    {
+        int thread = omp_get_thread_num();
+#pragma omp for schedule(dynamic, 1)
+        for (uint32_t i = 0; i < n; i++) {
+            row(&e, &work[thread], thread, i);
+            uint64_t done;
+#pragma omp atomic capture
+            done = ++rows_done;
+            if (thread == 0 && options->progress) {
+                /* pairs done when the first `done` rows are finished (rows go in order) */
+                double pairs_done = (double)done * n - (double)done * (done + 1) / 2;
+                options->progress(options->progress_user, "form factors",
+                                  total_pairs > 0 ? pairs_done / total_pairs : 1);
+            }
+        }
+    }
+    clock_gettime(CLOCK_MONOTONIC, &end);
+    if (report) {
+        memset(report, 0, sizeof(*report));
+        report->pairs = (uint64_t)total_pairs;
+        for (int t = 0; t < threads; t++) {
+            report->rays += work[t].rays_cast;
+            report->pairs_facing += work[t].pairs_facing;
+        }
+        report->seconds = (double)(end.tv_sec - start.tv_sec) + 1e-9 * (double)(end.tv_nsec - start.tv_nsec);
+    }
+    if (options->progress)
+        options->progress(options->progress_user, "form factors", 1);
+    goto done;
+nomem:
+    status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for form factors of %u patches", n);
+done:
+    if (work)
+        for (int t = 0; t < threads; t++) {
+            free(work[t].rays);
+            free(work[t].occluded);
+            free(work[t].pending);
+        }
+    free(work);
+    free(e.geometry);
+    free(e.quadrature_points);
+    free(e.quadrature_weights);
+    return status;
+}

@@ -1,0 +1,83 @@
+/*
+ * tonemap.c - exposure and the sRGB curve for PNG output; see tonemap.h.
+ *
+ * Not a tone-mapping operator in the Reinhard sense: values above white are clipped. The
+ * automatic exposure is a plain percentile so that a few very bright pixels (the light
+ * source) do not darken the rest of the picture.
+ */
+#include "image/tonemap.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/alloc.h"
+
+/* Below this linear value the sRGB curve is the straight line 12.92 x (IEC 61966-2-1). */
+#define SRGB_LINEAR_KNEE 0.0031308
+
+double rad_tonemap_luminance(double r, double g, double b)
+{
+    return 0.2126 * r + 0.7152 * g + 0.0722 * b;
+}
+
+double rad_tonemap_srgb_encode(double linear)
+{
+    if (!(linear > 0)) /* also NaN */
+        return 0;
+    if (linear >= 1)
+        return 1;
+    if (linear < SRGB_LINEAR_KNEE)
+        return 12.92 * linear;
+    return 1.055 * pow(linear, 1 / 2.4) - 0.055;
+}
+
+uint8_t rad_tonemap_srgb8(double linear)
+{
+    return (uint8_t)(rad_tonemap_srgb_encode(linear) * 255 + 0.5);
+}
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The automatic multiplier; see rad_tonemap_scale. */
+static rad_status auto_scale(const rad_image *image, double *scale)
+{
+    size_t pixels = (size_t)image->width * image->height; /* fits: the image exists */
+    double *lit = rad_alloc_array(pixels, sizeof(*lit));
+    if (!lit)
+        return RAD_ERR_NOMEM;
+    size_t count = 0;
+    for (size_t i = 0; i < pixels; i++) {
+        const float *p = image->rgb + 3 * i;
+        double y = rad_tonemap_luminance(p[0], p[1], p[2]);
+        if (y > 0 && isfinite(y))
+            lit[count++] = y;
+    }
+    *scale = 1;
+    if (count > 0) {
+        qsort(lit, count, sizeof(*lit), compare_doubles);
+        double position = RAD_TONEMAP_AUTO_PERCENTILE * (double)(count - 1);
+        size_t below = (size_t)position;
+        double fraction = position - (double)below;
+        double quantile = lit[below];
+        if (below + 1 < count)
+            quantile += fraction * (lit[below + 1] - lit[below]);
+        *scale = RAD_TONEMAP_AUTO_TARGET / quantile;
+    }
+    free(lit);
+    return RAD_OK;
+}
+
+rad_status rad_tonemap_scale(const rad_image *image, const rad_image_write_options *options,
+                             double *scale)
+{
+    if (!options || isnan(options->exposure))
+        return auto_scale(image, scale);
+    if (!isfinite(options->exposure))
+        return RAD_ERR_INVALID;
+    *scale = exp2(options->exposure);
+    return RAD_OK;
+}

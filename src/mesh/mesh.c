@@ -1,0 +1,442 @@
+/*
+ * mesh.c - splitting the scene into patches.
+ *
+ * Three steps:
+ *   1. Regions: triangles that share an edge, a surface, a material and a plane form one
+ *      smooth region (union-find over shared edges). Values are interpolated across patch
+ *      boundaries inside a region and kept apart between regions, so creases stay sharp.
+ *   2. Quads: two triangles of one region whose longest edges are the same edge (a quad
+ *      split along its diagonal, as exporters do) are merged back into a convex quad,
+ *      which subdivides into a regular grid of quad patches.
+ *   3. Subdivision: a quad into nu x nv bilinear cells, a triangle into n^2 similar
+ *      triangles, each edge no longer than the patch size. Points on an input edge are
+ *      computed from that edge's lower-numbered end, so two polygons that split a shared
+ *      edge into the same count produce bitwise-identical points, which the weld table
+ *      then merges into shared vertices.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/tolerance.h"
+#include "core/vec3.h"
+#include "core/weld.h"
+
+/* Refuse meshes beyond this many patches: the dense form-factor matrix would not fit. */
+#define MESH_MAX_PATCHES 50000000u
+
+typedef struct edge_slot {
+    uint64_t key;       /* (low vertex << 32) | high vertex; 0 with triangle UINT32_MAX = empty */
+    uint32_t triangle;  /* first triangle on the edge */
+    uint32_t other;     /* second triangle, or UINT32_MAX */
+    uint32_t count;     /* triangles on the edge */
+} edge_slot;
+
+typedef struct edge_table {
+    edge_slot *slots;
+    size_t mask;
+} edge_table;
+
+static uint64_t edge_key(uint32_t a, uint32_t b)
+{
+    return a < b ? ((uint64_t)a << 32) | b : ((uint64_t)b << 32) | a;
+}
+
+static uint64_t mix(uint64_t x)
+{
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdull;
+    x ^= x >> 33;
+    return x;
+}
+
+static edge_slot *edge_find(edge_table *table, uint64_t key)
+{
+    size_t s = mix(key) & table->mask;
+    while (table->slots[s].triangle != UINT32_MAX && table->slots[s].key != key)
+        s = (s + 1) & table->mask;
+    return &table->slots[s];
+}
+
+static uint32_t find_root(uint32_t *parent, uint32_t x)
+{
+    while (parent[x] != x) {
+        parent[x] = parent[parent[x]];
+        x = parent[x];
+    }
+    return x;
+}
+
+typedef struct mesh_input {
+    const rad_scene *scene;
+    rad_vec3 *normal; /* per triangle */
+    double *offset;   /* plane offset n . p per triangle */
+    double diagonal;  /* scene bounding-box diagonal */
+} mesh_input;
+
+static bool coplanar(const mesh_input *in, uint32_t a, uint32_t b)
+{
+    const rad_triangle *ta = &in->scene->triangles[a], *tb = &in->scene->triangles[b];
+    return ta->surface == tb->surface && ta->material == tb->material &&
+           v3_length(v3_sub(in->normal[a], in->normal[b])) < RAD_COPLANAR_NORMAL &&
+           fabs(in->offset[a] - in->offset[b]) < RAD_COPLANAR_OFFSET * in->diagonal;
+}
+
+/* The corner index (0..2) at which triangle t's longest edge starts. */
+static int longest_edge(const rad_scene *scene, uint32_t t)
+{
+    const uint32_t *v = scene->triangles[t].vertex;
+    int best = 0;
+    double best_length = -1;
+    for (int k = 0; k < 3; k++) {
+        rad_vec3 e = v3_sub(scene->positions[v[(k + 1) % 3]], scene->positions[v[k]]);
+        double length = v3_dot(e, e);
+        if (length > best_length) {
+            best_length = length;
+            best = k;
+        }
+    }
+    return best;
+}
+
+static bool convex_quad(const rad_vec3 *p, rad_vec3 normal)
+{
+    for (int k = 0; k < 4; k++) {
+        rad_vec3 e0 = v3_sub(p[(k + 1) % 4], p[k]);
+        rad_vec3 e1 = v3_sub(p[(k + 2) % 4], p[(k + 1) % 4]);
+        if (v3_dot(v3_cross(e0, e1), normal) <= 0)
+            return false;
+    }
+    return true;
+}
+
+/* A polygon to subdivide: 3 or 4 scene vertex indices, counter-clockwise. */
+typedef struct polygon {
+    uint32_t vertex[4];
+    uint32_t count;
+    uint32_t triangle; /* a source triangle: surface, material, normal */
+    uint32_t region;
+} polygon;
+
+typedef struct mesh_output {
+    const mesh_input *in;
+    rad_weld weld;
+    rad_patch *patches;
+    size_t patch_count, patch_capacity;
+} mesh_output;
+
+/* Point k/n of the way along the input edge (a, b), computed from its lower-numbered end. */
+static rad_vec3 edge_point(const rad_scene *scene, uint32_t a, uint32_t b, uint32_t k,
+                           uint32_t n)
+{
+    if (a > b) {
+        uint32_t swap = a;
+        a = b;
+        b = swap;
+        k = n - k;
+    }
+    if (k == 0)
+        return scene->positions[a];
+    if (k == n)
+        return scene->positions[b];
+    return v3_lerp(scene->positions[a], scene->positions[b], (double)k / n);
+}
+
+static int add_patch(mesh_output *out, const polygon *poly, const rad_vec3 *p, uint32_t count)
+{
+    if (!rad_grow_array((void **)&out->patches, &out->patch_capacity, out->patch_count + 1,
+                        sizeof(*out->patches)))
+        return 0;
+    rad_patch *patch = &out->patches[out->patch_count++];
+    memset(patch, 0, sizeof(*patch));
+    const rad_triangle *source = &out->in->scene->triangles[poly->triangle];
+    patch->vertex_count = count;
+    patch->surface = source->surface;
+    patch->material = source->material;
+    patch->normal = out->in->normal[poly->triangle];
+    for (uint32_t k = 0; k < count; k++) {
+        patch->vertex[k] = rad_weld_insert(&out->weld, poly->region, p[k]);
+        if (patch->vertex[k] == UINT32_MAX)
+            return 0;
+    }
+    double a0 = 0.5 * v3_length(v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0])));
+    rad_vec3 c0 = v3_scale(v3_add(v3_add(p[0], p[1]), p[2]), 1.0 / 3.0);
+    if (count == 3) {
+        patch->area = a0;
+        patch->centroid = c0;
+    } else {
+        double a1 = 0.5 * v3_length(v3_cross(v3_sub(p[2], p[0]), v3_sub(p[3], p[0])));
+        rad_vec3 c1 = v3_scale(v3_add(v3_add(p[0], p[2]), p[3]), 1.0 / 3.0);
+        patch->area = a0 + a1;
+        patch->centroid = patch->area > 0
+                              ? v3_scale(v3_add(v3_scale(c0, a0), v3_scale(c1, a1)), 1.0 / patch->area)
+                              : c0;
+    }
+    return 1;
+}
+
+static uint32_t divisions(double length, double patch_size)
+{
+    double n = ceil(length / patch_size - 1e-9);
+    return n < 1 ? 1 : n > 65535 ? 65535 : (uint32_t)n;
+}
+
+static int subdivide_triangle(mesh_output *out, const polygon *poly, double patch_size)
+{
+    const rad_scene *scene = out->in->scene;
+    const uint32_t *v = poly->vertex;
+    rad_vec3 a = scene->positions[v[0]], b = scene->positions[v[1]], c = scene->positions[v[2]];
+    double longest = fmax(v3_length(v3_sub(b, a)),
+                          fmax(v3_length(v3_sub(c, b)), v3_length(v3_sub(a, c))));
+    uint32_t n = divisions(longest, patch_size);
+    /* grid point (i, j): a + i/n (b - a) + j/n (c - a), i + j <= n */
+#define GRID(i, j)                                                                          \
+    ((j) == 0           ? edge_point(scene, v[0], v[1], (i), n)                             \
+     : (i) == 0         ? edge_point(scene, v[0], v[2], (j), n)                             \
+     : (i) + (j) == n   ? edge_point(scene, v[1], v[2], (j), n)                             \
+                        : v3_add(a, v3_add(v3_scale(v3_sub(b, a), (double)(i) / n),          \
+                                           v3_scale(v3_sub(c, a), (double)(j) / n))))
+    for (uint32_t j = 0; j < n; j++)
+        for (uint32_t i = 0; i + j < n; i++) {
+            rad_vec3 up[3] = {GRID(i, j), GRID(i + 1, j), GRID(i, j + 1)};
+            if (!add_patch(out, poly, up, 3))
+                return 0;
+            if (i + j + 1 < n) {
+                rad_vec3 down[3] = {GRID(i + 1, j), GRID(i + 1, j + 1), GRID(i, j + 1)};
+                if (!add_patch(out, poly, down, 3))
+                    return 0;
+            }
+        }
+#undef GRID
+    return 1;
+}
+
+static int subdivide_quad(mesh_output *out, const polygon *poly, double patch_size)
+{
+    const rad_scene *scene = out->in->scene;
+    const uint32_t *v = poly->vertex;
+    rad_vec3 q[4];
+    for (int k = 0; k < 4; k++)
+        q[k] = scene->positions[v[k]];
+    uint32_t nu = divisions(fmax(v3_length(v3_sub(q[1], q[0])), v3_length(v3_sub(q[2], q[3]))),
+                            patch_size);
+    uint32_t nv = divisions(fmax(v3_length(v3_sub(q[3], q[0])), v3_length(v3_sub(q[2], q[1]))),
+                            patch_size);
+    /* grid point (i, j) at s = i/nu, t = j/nv of the bilinear map over q0 q1 q2 q3 */
+#define GRID(i, j)                                                                          \
+    ((j) == 0    ? edge_point(scene, v[0], v[1], (i), nu)                                   \
+     : (j) == nv ? edge_point(scene, v[3], v[2], (i), nu)                                   \
+     : (i) == 0  ? edge_point(scene, v[0], v[3], (j), nv)                                   \
+     : (i) == nu ? edge_point(scene, v[1], v[2], (j), nv)                                   \
+                 : v3_lerp(v3_lerp(q[0], q[1], (double)(i) / nu),                           \
+                           v3_lerp(q[3], q[2], (double)(i) / nu), (double)(j) / nv))
+    for (uint32_t j = 0; j < nv; j++)
+        for (uint32_t i = 0; i < nu; i++) {
+            rad_vec3 cell[4] = {GRID(i, j), GRID(i + 1, j), GRID(i + 1, j + 1), GRID(i, j + 1)};
+            if (!add_patch(out, poly, cell, 4))
+                return 0;
+        }
+#undef GRID
+    return 1;
+}
+
+double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patches)
+{
+    double area = rad_scene_area(scene);
+    if (target_patches == 0)
+        target_patches = 1;
+    return sqrt(area / target_patches);
+}
+
+void rad_mesh_destroy(rad_mesh *mesh)
+{
+    if (!mesh)
+        return;
+    free(mesh->vertices);
+    free(mesh->patches);
+    free(mesh);
+}
+
+/* Patches a polygon will make, for the size check before subdividing. */
+static double patch_estimate(const rad_scene *scene, const polygon *poly, double patch_size)
+{
+    double longest = 0;
+    for (uint32_t k = 0; k < poly->count; k++) {
+        rad_vec3 e = v3_sub(scene->positions[poly->vertex[(k + 1) % poly->count]],
+                            scene->positions[poly->vertex[k]]);
+        longest = fmax(longest, v3_length(e));
+    }
+    double n = ceil(longest / patch_size);
+    return n * n;
+}
+
+rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **out,
+                          rad_error *error)
+{
+    rad_status status = RAD_OK;
+    uint32_t T = scene->triangle_count;
+    mesh_input in = {scene, NULL, NULL, 0};
+    mesh_output result = {&in, {0}, NULL, 0, 0};
+    edge_table edges = {NULL, 0};
+    uint32_t *parent = NULL, *partner = NULL, *region_of_root = NULL;
+    polygon *polygons = NULL;
+    rad_mesh *mesh = NULL;
+    *out = NULL;
+
+    if (!(patch_size > 0) || !isfinite(patch_size))
+        return rad_fail(error, RAD_ERR_INVALID, "patch size must be a positive number");
+
+    rad_vec3 lo, hi;
+    rad_scene_bounds(scene, &lo, &hi);
+    in.diagonal = v3_length(v3_sub(hi, lo));
+    in.normal = rad_alloc_array(T, sizeof(*in.normal));
+    in.offset = rad_alloc_array(T, sizeof(*in.offset));
+    parent = rad_alloc_array(T, sizeof(*parent));
+    partner = rad_alloc_array(T, sizeof(*partner));
+    region_of_root = rad_alloc_array(T, sizeof(*region_of_root));
+    polygons = rad_alloc_array(T, sizeof(*polygons));
+    size_t edge_slots = 64;
+    while (edge_slots < 6 * (size_t)T)
+        edge_slots *= 2;
+    edges.slots = rad_alloc_array(edge_slots, sizeof(*edges.slots));
+    edges.mask = edge_slots - 1;
+    mesh = calloc(1, sizeof(*mesh));
+    if (!in.normal || !in.offset || !parent || !partner || !region_of_root || !polygons ||
+        !edges.slots || !mesh || !rad_weld_init(&result.weld, 16))
+        goto nomem;
+
+    for (uint32_t t = 0; t < T; t++) {
+        const uint32_t *v = scene->triangles[t].vertex;
+        rad_vec3 n = v3_normalize(v3_cross(v3_sub(scene->positions[v[1]], scene->positions[v[0]]),
+                                           v3_sub(scene->positions[v[2]], scene->positions[v[0]])));
+        in.normal[t] = n;
+        in.offset[t] = v3_dot(n, scene->positions[v[0]]);
+        parent[t] = t;
+        partner[t] = UINT32_MAX;
+    }
+    for (size_t s = 0; s <= edges.mask; s++)
+        edges.slots[s].triangle = UINT32_MAX;
+
+    /* 1. regions: union triangles across shared edges */
+    for (uint32_t t = 0; t < T; t++) {
+        const uint32_t *v = scene->triangles[t].vertex;
+        for (int k = 0; k < 3; k++) {
+            uint64_t key = edge_key(v[k], v[(k + 1) % 3]);
+            edge_slot *slot = edge_find(&edges, key);
+            if (slot->triangle == UINT32_MAX) {
+                slot->key = key;
+                slot->triangle = t;
+                slot->other = UINT32_MAX;
+                slot->count = 1;
+                continue;
+            }
+            if (slot->count++ == 1)
+                slot->other = t;
+            if (coplanar(&in, slot->triangle, t)) {
+                uint32_t ra = find_root(parent, slot->triangle), rb = find_root(parent, t);
+                if (ra != rb)
+                    parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+            }
+        }
+    }
+    uint32_t region_count = 0;
+    for (uint32_t t = 0; t < T; t++)
+        region_of_root[t] = UINT32_MAX;
+    for (uint32_t t = 0; t < T; t++) {
+        uint32_t root = find_root(parent, t);
+        if (region_of_root[root] == UINT32_MAX)
+            region_of_root[root] = region_count++;
+    }
+
+    /* 2. quads: pair triangles across a shared longest edge */
+    for (uint32_t t = 0; t < T; t++) {
+        if (partner[t] != UINT32_MAX)
+            continue;
+        const uint32_t *v = scene->triangles[t].vertex;
+        int k = longest_edge(scene, t);
+        edge_slot *slot = edge_find(&edges, edge_key(v[k], v[(k + 1) % 3]));
+        if (slot->count != 2)
+            continue;
+        uint32_t u = slot->triangle == t ? slot->other : slot->triangle;
+        if (partner[u] != UINT32_MAX || find_root(parent, u) != find_root(parent, t))
+            continue;
+        const uint32_t *w = scene->triangles[u].vertex;
+        int m = longest_edge(scene, u);
+        /* u must run the edge the other way: b -> a */
+        if (w[m] != v[(k + 1) % 3] || w[(m + 1) % 3] != v[k])
+            continue;
+        polygon quad = {{v[k], w[(m + 2) % 3], v[(k + 1) % 3], v[(k + 2) % 3]}, 4, t, 0};
+        rad_vec3 corner[4];
+        for (int c = 0; c < 4; c++)
+            corner[c] = scene->positions[quad.vertex[c]];
+        if (!convex_quad(corner, in.normal[t]))
+            continue;
+        partner[t] = u;
+        partner[u] = t;
+    }
+
+    /* 3. subdivide every polygon */
+    size_t polygon_count = 0;
+    double estimate = 0;
+    for (uint32_t t = 0; t < T; t++) {
+        polygon *poly = &polygons[polygon_count];
+        const uint32_t *v = scene->triangles[t].vertex;
+        poly->triangle = t;
+        poly->region = region_of_root[find_root(parent, t)];
+        if (partner[t] == UINT32_MAX) {
+            poly->count = 3;
+            memcpy(poly->vertex, v, 3 * sizeof(*v));
+        } else if (partner[t] > t) {
+            const uint32_t *w = scene->triangles[partner[t]].vertex;
+            int k = longest_edge(scene, t), m = longest_edge(scene, partner[t]);
+            poly->count = 4;
+            poly->vertex[0] = v[k];
+            poly->vertex[1] = w[(m + 2) % 3];
+            poly->vertex[2] = v[(k + 1) % 3];
+            poly->vertex[3] = v[(k + 2) % 3];
+        } else {
+            continue;
+        }
+        estimate += patch_estimate(scene, poly, patch_size);
+        polygon_count++;
+    }
+    if (estimate > MESH_MAX_PATCHES) {
+        status = rad_fail(error, RAD_ERR_INVALID,
+                          "patch size %g would make about %.0f patches (limit %u): use a "
+                          "larger --patch-size",
+                          patch_size, estimate, MESH_MAX_PATCHES);
+        goto done;
+    }
+    for (size_t p = 0; p < polygon_count; p++) {
+        int ok = polygons[p].count == 3 ? subdivide_triangle(&result, &polygons[p], patch_size)
+                                        : subdivide_quad(&result, &polygons[p], patch_size);
+        if (!ok)
+            goto nomem;
+    }
+
+    mesh->patch_count = (uint32_t)result.patch_count;
+    mesh->patches = result.patches;
+    result.patches = NULL;
+    mesh->vertex_count = result.weld.count;
+    mesh->vertices = rad_weld_take_positions(&result.weld);
+    mesh->patch_size = patch_size;
+    *out = mesh;
+    mesh = NULL;
+    goto done;
+nomem:
+    status = rad_fail(error, RAD_ERR_NOMEM, "out of memory while building patches");
+done:
+    rad_weld_free(&result.weld);
+    free(result.patches);
+    free(in.normal);
+    free(in.offset);
+    free(parent);
+    free(partner);
+    free(region_of_root);
+    free(polygons);
+    free(edges.slots);
+    rad_mesh_destroy(mesh);
+    return status;
+}

@@ -1,0 +1,39 @@
+/*
+ * scene_builder.h - assembling a rad_scene from any source (file importer, built-in).
+ *
+ * A source adds materials, named surfaces and triangles with raw positions; finish() then
+ * checks every coordinate, welds identical positions, drops degenerate triangles (with a
+ * warning naming how many and in which surface), orders triangles by surface and drops
+ * surfaces left empty. Sources never touch rad_scene arrays directly.
+ */
+#ifndef RAD_SCENE_BUILDER_H
+#define RAD_SCENE_BUILDER_H
+
+#include "radiosity.h"
+
+typedef struct scene_builder scene_builder;
+
+rad_status scene_builder_create(const char *source, const rad_load_options *options,
+                                scene_builder **out, rad_error *error);
+
+/* Index of the material (name, albedo, emitted radiance), or UINT32_MAX when out of
+ * memory. Materials are kept even when no triangle uses them. */
+uint32_t scene_builder_material(scene_builder *builder, const char *name, rad_rgb albedo,
+                                rad_rgb emission);
+
+/* Index of the surface with this name, created on first use; UINT32_MAX when out of
+ * memory. Triangles added under the same name from several places join one surface. */
+uint32_t scene_builder_surface(scene_builder *builder, const char *name);
+
+/* Adds a triangle by corner positions, front = counter-clockwise. */
+rad_status scene_builder_triangle(scene_builder *builder, uint32_t surface, uint32_t material,
+                                  rad_vec3 a, rad_vec3 b, rad_vec3 c, rad_error *error);
+
+void scene_builder_set_camera(scene_builder *builder, const rad_camera *camera);
+
+/* Validates and hands over the scene; the builder is freed in every case. */
+rad_status scene_builder_finish(scene_builder *builder, rad_scene **out, rad_error *error);
+
+void scene_builder_destroy(scene_builder *builder);
+
+#endif

@@ -1,0 +1,174 @@
+/*
+ * solve.c - rad_solve: the front door of the solvers.
+ *
+ * Validates the system and the options, applies the defaults, times the solver (the final
+ * residual is not included in report->seconds), dispatches to one solver (solve_jacobi.c, solve_gauss_seidel.c, solve_shoot.c, solve_direct.c) and
+ * measures the relative residual of the answer the same way for all of them. It does not
+ * iterate itself. Validation is O(n) (the per-patch arrays); F is trusted.
+ */
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "core/error.h"
+#include "solve/solve_internal.h"
+
+/* Defaults for the zero values of rad_solve_options (see radiosity.h). */
+#define SOLVE_DEFAULT_TOLERANCE 1e-4 /* relative residual / unshot fraction */
+enum { SOLVE_DEFAULT_SWEEPS = 10000, SOLVE_DEFAULT_SHOTS_PER_PATCH = 1000 };
+
+/* Progress is reported only when the fraction grew by at least this much. */
+#define SOLVE_PROGRESS_STEP 0.01
+
+static double wall_seconds(void)
+{
+#ifdef _OPENMP
+    return omp_get_wtime();
+#else
+    struct timespec now;
+    if (!timespec_get(&now, TIME_UTC))
+        return 0;
+    return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
+#endif
+}
+
+static bool rgb_finite(rad_rgb c) { return isfinite(c.r) && isfinite(c.g) && isfinite(c.b); }
+
+static rad_status check_system(const rad_system *system, rad_error *error)
+{
+    if (!system)
+        return rad_fail(error, RAD_ERR_INVALID, "rad_solve: no system given");
+    if (system->n == 0)
+        return rad_fail(error, RAD_ERR_INVALID, "rad_solve: the system has no patches");
+    if (!system->F || !system->area || !system->albedo || !system->exitance)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "rad_solve: the system lacks its form factors, areas, albedos or "
+                        "exitances");
+    for (uint32_t i = 0; i < system->n; i++) {
+        double a = system->area[i];
+        rad_rgb rho = system->albedo[i];
+        rad_rgb e = system->exitance[i];
+        if (!(isfinite(a) && a > 0))
+            return rad_fail(error, RAD_ERR_INVALID,
+                            "rad_solve: patch %u has area %g (must be finite and > 0)", i, a);
+        if (!(rgb_finite(rho) && rho.r >= 0 && rho.r <= 1 && rho.g >= 0 && rho.g <= 1 &&
+              rho.b >= 0 && rho.b <= 1))
+            return rad_fail(error, RAD_ERR_INVALID,
+                            "rad_solve: patch %u has albedo (%g, %g, %g) outside [0,1]", i,
+                            rho.r, rho.g, rho.b);
+        if (!(rgb_finite(e) && e.r >= 0 && e.g >= 0 && e.b >= 0))
+            return rad_fail(error, RAD_ERR_INVALID,
+                            "rad_solve: patch %u has exitance (%g, %g, %g) (must be finite "
+                            "and >= 0)",
+                            i, e.r, e.g, e.b);
+    }
+    return RAD_OK;
+}
+
+static rad_status resolve_options(const rad_solve_options *options, uint32_t n,
+                                  solve_params *params, rad_error *error)
+{
+    rad_solve_options zero = {0};
+    const rad_solve_options *o = options ? options : &zero;
+
+    if (o->solver != RAD_SOLVER_JACOBI && o->solver != RAD_SOLVER_GAUSS_SEIDEL &&
+        o->solver != RAD_SOLVER_SHOOT && o->solver != RAD_SOLVER_DIRECT)
+        return rad_fail(error, RAD_ERR_INVALID, "rad_solve: unknown solver %d",
+                        (int)o->solver);
+    if (!(o->tolerance >= 0 && isfinite(o->tolerance)))
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "rad_solve: tolerance %g (must be finite and >= 0)", o->tolerance);
+    if (o->threads < 0)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "rad_solve: threads %d (must be >= 0; 0 = all cores)", o->threads);
+
+    memset(params, 0, sizeof(*params));
+    params->tolerance = o->tolerance > 0 ? o->tolerance : SOLVE_DEFAULT_TOLERANCE;
+    params->max_iterations = o->max_iterations;
+    if (params->max_iterations == 0) {
+        if (o->solver == RAD_SOLVER_SHOOT) {
+            uint64_t shots = (uint64_t)n * SOLVE_DEFAULT_SHOTS_PER_PATCH;
+            params->max_iterations = shots > UINT32_MAX ? UINT32_MAX : (uint32_t)shots;
+        } else {
+            params->max_iterations = SOLVE_DEFAULT_SWEEPS;
+        }
+    }
+    params->ambient = o->ambient;
+    params->threads = o->threads;
+#ifdef _OPENMP
+    if (params->threads == 0)
+        params->threads = omp_get_max_threads();
+#endif
+    if (params->threads <= 0)
+        params->threads = 1;
+    params->progress = o->progress;
+    params->progress_user = o->progress_user;
+    params->progress_sent = -1;
+    return RAD_OK;
+}
+
+void solve_progress(solve_params *params, double criterion)
+{
+    if (!params->progress)
+        return;
+    double fraction = 1;
+    if (criterion > params->tolerance) {
+        /* criterion starts near 1 and falls geometrically towards the tolerance */
+        fraction = criterion >= 1 ? 0 : log(criterion) / log(params->tolerance);
+        if (!(fraction >= 0))
+            fraction = 0;
+        if (fraction > 1)
+            fraction = 1;
+    }
+    if (fraction >= params->progress_sent + SOLVE_PROGRESS_STEP ||
+        (fraction == 1 && params->progress_sent < 1)) {
+        params->progress_sent = fraction;
+        params->progress(params->progress_user, "solve", fraction);
+    }
+}
+
+rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
+                     rad_rgb *B, rad_solve_report *report, rad_error *error)
+{
+    rad_solve_report local;
+    if (!report)
+        report = &local;
+    memset(report, 0, sizeof(*report));
+
+    rad_status status = check_system(system, error);
+    if (status != RAD_OK)
+        return status;
+    if (!B)
+        return rad_fail(error, RAD_ERR_INVALID, "rad_solve: no output array B given");
+    solve_params params;
+    status = resolve_options(options, system->n, &params, error);
+    if (status != RAD_OK)
+        return status;
+
+    double start = wall_seconds();
+    switch (options ? options->solver : RAD_SOLVER_JACOBI) {
+    case RAD_SOLVER_JACOBI:
+        status = solve_jacobi(system, &params, B, report, error);
+        break;
+    case RAD_SOLVER_GAUSS_SEIDEL:
+        status = solve_gauss_seidel(system, &params, B, report, error);
+        break;
+    case RAD_SOLVER_SHOOT:
+        status = solve_shoot(system, &params, B, report, error);
+        break;
+    case RAD_SOLVER_DIRECT:
+        status = solve_direct(system, &params, B, report, error);
+        break;
+    }
+    if (status != RAD_OK)
+        return status;
+
+    report->seconds = wall_seconds() - start;
+    report->residual = solve_residual(system, B, params.threads);
+    solve_progress(&params, 0);
+    return RAD_OK;
+}

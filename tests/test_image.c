@@ -1,0 +1,548 @@
+/*
+ * test_image.c - the image module: PFM/HDR round trips and orientation, hand-made RLE and
+ * big-endian files, the sRGB curve and exposure, PNG pixels decoded with libpng, and the
+ * error paths (missing folder, failed rename, unknown extension, truncated files).
+ *
+ * Not tested here: rendering into images (test_render) or the CLI's use of them.
+ */
+#include <math.h>
+#include <png.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "image/tonemap.h"
+#include "testlib.h"
+
+/* RGBE keeps 8 bits for the largest channel; the decoder returns the centre of the
+ * truncation step, so every channel is within 1/256 of the pixel's largest channel. */
+#define RGBE_RELATIVE_PRECISION (1.0 / 256)
+
+static rad_image *new_image(uint32_t width, uint32_t height)
+{
+    rad_image *image = NULL;
+    rad_error error;
+    if (rad_image_create(width, height, &image, &error) != RAD_OK) {
+        fprintf(stderr, "rad_image_create: %s\n", error.message);
+        exit(1);
+    }
+    return image;
+}
+
+static float *pixel(const rad_image *image, uint32_t x, uint32_t y)
+{
+    return image->rgb + ((size_t)y * image->width + x) * 3;
+}
+
+static void set_pixel(rad_image *image, uint32_t x, uint32_t y, double r, double g, double b)
+{
+    float *p = pixel(image, x, y);
+    p[0] = (float)r;
+    p[1] = (float)g;
+    p[2] = (float)b;
+}
+
+/* A smooth gradient: red grows left to right, green top to bottom, blue is constant. */
+static rad_image *gradient(uint32_t width, uint32_t height)
+{
+    rad_image *image = new_image(width, height);
+    for (uint32_t y = 0; y < height; y++)
+        for (uint32_t x = 0; x < width; x++)
+            set_pixel(image, x, y, (double)x / (width - 1), (double)y / (height - 1), 0.25);
+    return image;
+}
+
+static size_t read_bytes(const char *path, uint8_t *buffer, size_t capacity)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 0;
+    size_t n = fread(buffer, 1, capacity, f);
+    fclose(f);
+    return n;
+}
+
+static const char *write_bytes(const char *name, const void *bytes, size_t size)
+{
+    const char *path = test_path(name);
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(bytes, 1, size, f) != size || fclose(f) != 0) {
+        fprintf(stderr, "cannot write %s\n", path);
+        exit(1);
+    }
+    return path;
+}
+
+static void put_float_be(uint8_t *out, float value)
+{
+    uint32_t bits;
+    memcpy(&bits, &value, sizeof(bits));
+    out[0] = (uint8_t)(bits >> 24);
+    out[1] = (uint8_t)(bits >> 16);
+    out[2] = (uint8_t)(bits >> 8);
+    out[3] = (uint8_t)bits;
+}
+
+/* The number of entries in the scratch folder (including "." and ".."). */
+static int scratch_entries(void)
+{
+    return test_count_files("");
+}
+
+/* ----------------------------------------------------------------------------------- */
+
+static void test_create(void)
+{
+    rad_image *image = NULL;
+    rad_error error;
+    CHECK(rad_image_create(0, 5, &image, &error) == RAD_ERR_INVALID);
+    CHECK(image == NULL);
+    CHECK(rad_image_create(5, 0, &image, NULL) == RAD_ERR_INVALID);
+    CHECK(rad_image_create(UINT32_MAX, UINT32_MAX, &image, &error) == RAD_ERR_NOMEM);
+    CHECK(image == NULL);
+    CHECK(rad_image_create(3, 2, &image, &error) == RAD_OK);
+    CHECK(image && image->width == 3 && image->height == 2);
+    if (image) {
+        int zero = 1;
+        for (size_t i = 0; i < 3 * 2 * 3; i++)
+            zero &= image->rgb[i] == 0;
+        CHECK(zero);
+    }
+    rad_image_destroy(image);
+    rad_image_destroy(NULL);
+}
+
+static void test_srgb_curve(void)
+{
+    CHECK_ABS(rad_tonemap_srgb_encode(0), 0, 1e-15);
+    CHECK_ABS(rad_tonemap_srgb_encode(1), 1, 1e-12);
+    CHECK_ABS(rad_tonemap_srgb_encode(0.0031308), 0.04045, 1e-6);
+    CHECK_ABS(rad_tonemap_srgb_encode(0.5), 0.735357, 1e-5);
+    CHECK_ABS(rad_tonemap_srgb_encode(0.001), 0.01292, 1e-12); /* linear segment */
+    CHECK_ABS(rad_tonemap_srgb_encode(-3), 0, 0);
+    CHECK_ABS(rad_tonemap_srgb_encode(7), 1, 0);
+    CHECK_ABS(rad_tonemap_srgb_encode(NAN), 0, 0);
+    /* Both pieces meet at the knee (continuity within the curve's 4-digit constants). */
+    CHECK_ABS(rad_tonemap_srgb_encode(0.0031308 * (1 + 1e-9)),
+              rad_tonemap_srgb_encode(0.0031308 * (1 - 1e-9)), 1e-7);
+    CHECK(rad_tonemap_srgb8(0.5) == 188);   /* 187.516 */
+    CHECK(rad_tonemap_srgb8(0.2) == 124);   /* 123.555 */
+    CHECK(rad_tonemap_srgb8(0.0031308) == 10);
+    CHECK(rad_tonemap_srgb8(1) == 255);
+    CHECK_NEAR(rad_tonemap_luminance(1, 0, 0), 0.2126, 1e-12);
+    CHECK_NEAR(rad_tonemap_luminance(0, 1, 0), 0.7152, 1e-12);
+    CHECK_NEAR(rad_tonemap_luminance(0, 0, 1), 0.0722, 1e-12);
+}
+
+static void test_exposure(void)
+{
+    /* 100 lit grey pixels of luminance 1..100 and 10 black ones. The 95th percentile of
+     * the lit ones sits at position 0.95 * 99 = 94.05 between 95 and 96. */
+    rad_image *image = new_image(11, 10);
+    for (uint32_t i = 0; i < 100; i++)
+        set_pixel(image, i % 10, i / 10, i + 1.0, i + 1.0, i + 1.0);
+    double scale = 0;
+    CHECK(rad_tonemap_scale(image, NULL, &scale) == RAD_OK);
+    CHECK_NEAR(scale, 0.9 / 95.05, 1e-9);
+    rad_image_write_options automatic = {.exposure = NAN};
+    scale = 0;
+    CHECK(rad_tonemap_scale(image, &automatic, &scale) == RAD_OK);
+    CHECK_NEAR(scale, 0.9 / 95.05, 1e-9);
+    rad_image_write_options fixed = {.exposure = 2};
+    CHECK(rad_tonemap_scale(image, &fixed, &scale) == RAD_OK);
+    CHECK_NEAR(scale, 4, 1e-15);
+    fixed.exposure = INFINITY;
+    CHECK(rad_tonemap_scale(image, &fixed, &scale) == RAD_ERR_INVALID);
+
+    /* Automatic PNG: the pixel of luminance 100 becomes 100 * 0.9 / 95.05 = 0.94687,
+     * sRGB 0.97627 -> 249. */
+    const char *path = test_path("auto.png");
+    rad_error error;
+    CHECK(rad_image_write(image, path, NULL, &error) == RAD_OK);
+    png_image png = {.version = PNG_IMAGE_VERSION};
+    uint8_t decoded[11 * 10 * 3];
+    if (png_image_begin_read_from_file(&png, path)) {
+        png.format = PNG_FORMAT_RGB;
+        CHECK(png_image_finish_read(&png, NULL, decoded, 0, NULL));
+        CHECK(decoded[(9 * 11 + 9) * 3] == 249);
+        CHECK(decoded[(9 * 11 + 10) * 3] == 0);
+    } else {
+        CHECK(!"auto.png readable by libpng");
+    }
+    png_image_free(&png);
+    rad_image_destroy(image);
+
+    rad_image *black = new_image(4, 4);
+    CHECK(rad_tonemap_scale(black, NULL, &scale) == RAD_OK);
+    CHECK(scale == 1);
+    rad_image_destroy(black);
+}
+
+static void test_pfm_round_trip(void)
+{
+    const uint32_t w = 16, h = 9;
+    rad_image *image = gradient(w, h);
+    set_pixel(image, 3, 4, -2.5, 1e-30, 65504.0); /* negative, tiny, large: all exact */
+    set_pixel(image, 5, 0, 1.0 / 3.0, 0.1, 123456.789);
+    const char *path = test_path("gradient.pfm");
+    rad_error error;
+    CHECK(rad_image_write(image, path, NULL, &error) == RAD_OK);
+
+    /* The header, and the convention: the first stored pixel is the bottom-left one. */
+    static uint8_t bytes[4096];
+    size_t size = read_bytes(path, bytes, sizeof(bytes));
+    const char header[] = "PF\n16 9\n-1.0\n";
+    size_t header_size = sizeof(header) - 1;
+    CHECK(size == header_size + (size_t)w * h * 12);
+    CHECK(memcmp(bytes, header, header_size) == 0);
+    float first[3];
+    memcpy(first, bytes + header_size, sizeof(first)); /* little-endian host assumed */
+    CHECK(first[0] == 0 && first[1] == 1 && first[2] == 0.25f);
+    const uint8_t little_endian_one[4] = {0x00, 0x00, 0x80, 0x3f};
+    CHECK(memcmp(bytes + header_size + 4, little_endian_one, 4) == 0);
+
+    rad_image *back = NULL;
+    CHECK(rad_image_read(path, &back, &error) == RAD_OK);
+    CHECK(back && back->width == w && back->height == h);
+    if (back && back->width == w && back->height == h) {
+        CHECK(memcmp(back->rgb, image->rgb, (size_t)w * h * 3 * sizeof(float)) == 0);
+        /* The gradient, row 0 at the top: green is 0 on the top row, 1 on the bottom. */
+        CHECK(pixel(back, 0, 0)[1] == 0);
+        CHECK(pixel(back, 0, h - 1)[1] == 1);
+        CHECK(pixel(back, w - 1, 2)[0] == 1);
+        CHECK(pixel(back, 0, 2)[0] == 0);
+        CHECK_NEAR(pixel(back, 6, 2)[0], 6.0 / 15, 1e-7);
+        CHECK_NEAR(pixel(back, 6, 2)[1], 2.0 / 8, 1e-7);
+        CHECK(pixel(back, 3, 4)[0] == -2.5f && pixel(back, 3, 4)[2] == 65504.0f);
+    }
+    rad_image_destroy(back);
+    rad_image_destroy(image);
+}
+
+static void test_pfm_variants(void)
+{
+    /* Big-endian colour (positive scale), 1 x 2: the first stored row is the bottom one. */
+    uint8_t colour[64];
+    const char header[] = "PF\n1 2\n1.0\n";
+    size_t n = sizeof(header) - 1;
+    memcpy(colour, header, n);
+    const float values[6] = {1, 2, 3, 4, 5, 6};
+    for (int i = 0; i < 6; i++)
+        put_float_be(colour + n + 4 * i, values[i]);
+    rad_image *image = NULL;
+    rad_error error;
+    CHECK(rad_image_read(write_bytes("be.pfm", colour, n + 24), &image, &error) == RAD_OK);
+    if (image) {
+        CHECK(image->width == 1 && image->height == 2);
+        CHECK(pixel(image, 0, 1)[0] == 1 && pixel(image, 0, 1)[2] == 3);
+        CHECK(pixel(image, 0, 0)[0] == 4 && pixel(image, 0, 0)[2] == 6);
+    }
+    rad_image_destroy(image);
+
+    /* Greyscale "Pf", big-endian: read as grey RGB. */
+    uint8_t grey[64];
+    const char grey_header[] = "Pf\n2 1\n1.0\n";
+    n = sizeof(grey_header) - 1;
+    memcpy(grey, grey_header, n);
+    put_float_be(grey + n, 0.5f);
+    put_float_be(grey + n + 4, 2.0f);
+    image = NULL;
+    CHECK(rad_image_read(write_bytes("grey.pfm", grey, n + 8), &image, &error) == RAD_OK);
+    if (image) {
+        CHECK(image->width == 2 && image->height == 1);
+        CHECK(image->rgb[0] == 0.5f && image->rgb[1] == 0.5f && image->rgb[2] == 0.5f);
+        CHECK(image->rgb[3] == 2.0f && image->rgb[5] == 2.0f);
+    }
+    rad_image_destroy(image);
+}
+
+static void test_hdr_round_trip(void)
+{
+    const uint32_t w = 16, h = 9;
+    rad_image *image = gradient(w, h);
+    set_pixel(image, 1, 1, 1000.0, 1e-3, 12345.0);
+    set_pixel(image, 2, 1, 1.0, 1.0, 1.0);
+    set_pixel(image, 3, 1, 0, 0, 0);
+    set_pixel(image, 4, 1, 1e-20, 3e-21, 0);
+    const char *path = test_path("gradient.hdr");
+    rad_error error;
+    CHECK(rad_image_write(image, path, NULL, &error) == RAD_OK);
+
+    static uint8_t bytes[4096];
+    size_t size = read_bytes(path, bytes, sizeof(bytes));
+    const char header[] = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 9 +X 16\n";
+    size_t header_size = sizeof(header) - 1;
+    CHECK(size == header_size + (size_t)w * h * 4); /* flat */
+    CHECK(memcmp(bytes, header, header_size) == 0);
+
+    rad_image *back = NULL;
+    CHECK(rad_image_read(path, &back, &error) == RAD_OK);
+    CHECK(back && back->width == w && back->height == h);
+    if (back && back->width == w && back->height == h) {
+        double worst = 0; /* error / largest channel, over all pixels and channels */
+        for (uint32_t y = 0; y < h; y++)
+            for (uint32_t x = 0; x < w; x++) {
+                const float *a = pixel(image, x, y), *b = pixel(back, x, y);
+                double max = fmax(a[0], fmax(a[1], a[2]));
+                for (int c = 0; c < 3; c++) {
+                    double e = max > 0 ? fabs(b[c] - a[c]) / max : fabs(b[c]);
+                    worst = fmax(worst, e);
+                }
+            }
+        CHECK(worst <= RGBE_RELATIVE_PRECISION);
+        CHECK(pixel(back, 3, 1)[0] == 0 && pixel(back, 3, 1)[1] == 0);
+        CHECK_NEAR(pixel(back, 1, 1)[2], 12345.0, RGBE_RELATIVE_PRECISION);
+        /* The other channels share the exponent of the largest one. */
+        CHECK_ABS(pixel(back, 1, 1)[0], 1000.0, 12345.0 * RGBE_RELATIVE_PRECISION);
+        CHECK(pixel(back, 1, 1)[1] < 12345.0 * RGBE_RELATIVE_PRECISION);
+        CHECK_NEAR(pixel(back, 2, 1)[1], 1.0, RGBE_RELATIVE_PRECISION);
+        /* Orientation: top row green 0, bottom row green 1. */
+        CHECK(pixel(back, 8, 0)[1] < 0.01);
+        CHECK_NEAR(pixel(back, 8, h - 1)[1], 1.0, RGBE_RELATIVE_PRECISION);
+    }
+    rad_image_destroy(back);
+    rad_image_destroy(image);
+}
+
+/* A 10 x 2 picture as other tools write it: scanline 0 new-style run-length encoded,
+ * scanline 1 flat with an old-style repeat pixel. */
+static size_t hand_made_hdr(uint8_t *out, const char *header)
+{
+    size_t n = strlen(header);
+    memcpy(out, header, n);
+    const uint8_t rle[] = {
+        2, 2, 0, 10,                             /* new-style RLE, width 10 */
+        128 + 10, 128,                           /* R: run of 10 x 128 */
+        10, 0, 10, 20, 30, 40, 50, 60, 70, 80, 90, /* G: 10 literals */
+        128 + 5, 200, 5, 1, 2, 3, 4, 5,          /* B: run of 5 x 200, 5 literals */
+        128 + 10, 129,                           /* E: run of 10 x 129 */
+        128, 64, 32, 128, 1, 1, 1, 9,            /* flat pixel, then repeat it 9 times */
+    };
+    memcpy(out + n, rle, sizeof(rle));
+    return n + sizeof(rle);
+}
+
+static void check_hand_made(const rad_image *image, uint32_t rle_row, double exposure)
+{
+    CHECK(image->width == 10 && image->height == 2);
+    if (image->width != 10 || image->height != 2)
+        return;
+    for (uint32_t x = 0; x < 10; x++) {
+        const float *p = pixel(image, x, rle_row);
+        double unit = 1.0 / 128 / exposure; /* 2^(129 - 136) */
+        CHECK_NEAR(p[0], 128.5 * unit, 1e-7);
+        CHECK_NEAR(p[1], (10.0 * x + 0.5) * unit, 1e-7);
+        CHECK_NEAR(p[2], (x < 5 ? 200.5 : x - 4 + 0.5) * unit, 1e-7);
+        const float *q = pixel(image, x, 1 - rle_row);
+        unit = 1.0 / 256 / exposure; /* 2^(128 - 136) */
+        CHECK_NEAR(q[0], 128.5 * unit, 1e-7);
+        CHECK_NEAR(q[1], 64.5 * unit, 1e-7);
+        CHECK_NEAR(q[2], 32.5 * unit, 1e-7);
+    }
+}
+
+static void test_hdr_rle(void)
+{
+    uint8_t bytes[512];
+    rad_image *image = NULL;
+    rad_error error;
+    size_t n = hand_made_hdr(bytes, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 10\n");
+    CHECK(rad_image_read(write_bytes("rle.hdr", bytes, n), &image, &error) == RAD_OK);
+    if (image)
+        check_hand_made(image, 0, 1);
+    rad_image_destroy(image);
+
+    /* Bottom-up rows ("+Y") and an EXPOSURE line (file values = radiance * 2). */
+    n = hand_made_hdr(bytes, "#?RGBE\n# made by hand\nEXPOSURE=2\nFORMAT=32-bit_rle_rgbe\n\n"
+                             "+Y 2 +X 10\n");
+    image = NULL;
+    CHECK(rad_image_read(write_bytes("rle-up.hdr", bytes, n), &image, &error) == RAD_OK);
+    if (image)
+        check_hand_made(image, 1, 2);
+    rad_image_destroy(image);
+
+    /* Cut inside the run-length data. */
+    n = hand_made_hdr(bytes, "#?RADIANCE\n\n-Y 2 +X 10\n");
+    const char *path = write_bytes("rle-cut.hdr", bytes, n - 20);
+    image = NULL;
+    CHECK(rad_image_read(path, &image, &error) == RAD_ERR_PARSE);
+    CHECK(image == NULL);
+    CHECK(strstr(error.message, path) != NULL);
+
+    /* A run longer than the scanline. */
+    const char *plain = "#?RADIANCE\n\n-Y 2 +X 10\n";
+    n = hand_made_hdr(bytes, plain);
+    bytes[strlen(plain) + 4] = 128 + 11; /* R: run of 11 instead of 10 */
+    CHECK(rad_image_read(write_bytes("rle-long.hdr", bytes, n), &image, &error) ==
+          RAD_ERR_PARSE);
+}
+
+static void test_png(void)
+{
+    rad_image *image = new_image(2, 2);
+    set_pixel(image, 0, 0, 0, 1, 0.5);
+    set_pixel(image, 1, 0, 0.2, 0.001, 2.0);
+    set_pixel(image, 0, 1, -1, NAN, 0.0031308);
+    set_pixel(image, 1, 1, 0.25, 0.25, 0.25);
+    const char *path = test_path("pixels.png");
+    rad_error error;
+    rad_image_write_options options = {.exposure = 0};
+    CHECK(rad_image_write(image, path, &options, &error) == RAD_OK);
+
+    uint8_t decoded[2 * 2 * 3] = {0};
+    png_image png = {.version = PNG_IMAGE_VERSION};
+    CHECK(png_image_begin_read_from_file(&png, path) != 0);
+    CHECK(png.width == 2 && png.height == 2);
+    png.format = PNG_FORMAT_RGB;
+    if (png.width == 2 && png.height == 2)
+        CHECK(png_image_finish_read(&png, NULL, decoded, 0, NULL) != 0);
+    png_image_free(&png);
+    const uint8_t expected[2 * 2 * 3] = {
+        0, 255, 188, /* 0, 1, 0.5 -> sRGB 0.735357 * 255 = 187.5 */
+        124, 3, 255, /* 0.2 -> 123.55; 0.001 -> 12.92 * 0.001 * 255 = 3.29; 2 clamps */
+        0, 0, 10,    /* negative and NaN -> 0; 0.0031308 -> 0.04045 * 255 = 10.3 */
+        137, 137, 137, /* 0.25 -> 0.537099 * 255 = 136.96 */
+    };
+    for (int i = 0; i < 12; i++)
+        if (decoded[i] != expected[i])
+            test_fail(__FILE__, __LINE__, "PNG byte %d = %d, expected %d", i, decoded[i],
+                      expected[i]);
+    test_checks++;
+
+    /* Exposure +1 doubles: 0.25 -> 0.5 -> 188. Upper-case extension. */
+    options.exposure = 1;
+    path = test_path("EXPOSED.PNG");
+    CHECK(rad_image_write(image, path, &options, &error) == RAD_OK);
+    png = (png_image){.version = PNG_IMAGE_VERSION};
+    if (png_image_begin_read_from_file(&png, path)) {
+        png.format = PNG_FORMAT_RGB;
+        CHECK(png_image_finish_read(&png, NULL, decoded, 0, NULL) != 0);
+        CHECK(decoded[9] == 188 && decoded[11] == 188);
+    } else {
+        CHECK(!"EXPOSED.PNG readable by libpng");
+    }
+    png_image_free(&png);
+
+    /* An infinite exposure is refused before any file is made. */
+    options.exposure = -INFINITY;
+    int before = scratch_entries();
+    CHECK(rad_image_write(image, test_path("inf.png"), &options, &error) == RAD_ERR_INVALID);
+    CHECK(scratch_entries() == before);
+    rad_image_destroy(image);
+}
+
+static void test_write_errors(void)
+{
+    rad_image *image = gradient(4, 3);
+    rad_error error;
+    int before = scratch_entries();
+
+    /* A folder that does not exist: I/O error naming the path, nothing left behind. */
+    const char *formats[] = {"out.pfm", "out.hdr", "out.png"};
+    for (int i = 0; i < 3; i++) {
+        char path[4200];
+        snprintf(path, sizeof(path), "%s/no-such-folder/%s", test_tmpdir(), formats[i]);
+        CHECK(rad_image_write(image, path, NULL, &error) == RAD_ERR_IO);
+        CHECK(strstr(error.message, path) != NULL);
+        CHECK(strchr(error.message, '\n') == NULL);
+        CHECK(!test_file_exists(path));
+    }
+    CHECK(scratch_entries() == before);
+
+    /* The temporary file is written but the rename fails (a folder has the name): the
+     * temporary file is removed. */
+    const char *folder = test_path("taken.pfm");
+    CHECK(mkdir(folder, 0755) == 0);
+    CHECK(rad_image_write(image, folder, NULL, &error) == RAD_ERR_IO);
+    CHECK(strstr(error.message, folder) != NULL);
+    CHECK(test_count_files("taken.pfm") == 1);
+
+    /* Unknown or missing extension. */
+    before = scratch_entries();
+    const char *jpg = test_path("out.jpg");
+    CHECK(rad_image_write(image, jpg, NULL, &error) == RAD_ERR_INVALID);
+    CHECK(strstr(error.message, "unknown image format '.jpg' (use .png, .hdr or .pfm)"));
+    CHECK(strstr(error.message, jpg) == error.message);
+    CHECK(rad_image_write(image, test_path("no-extension"), NULL, &error) ==
+          RAD_ERR_INVALID);
+    CHECK(rad_image_write(image, test_path("dotted.dir/file"), NULL, &error) ==
+          RAD_ERR_INVALID);
+    CHECK(rad_image_write(NULL, test_path("null.pfm"), NULL, &error) == RAD_ERR_INVALID);
+    CHECK(scratch_entries() == before);
+
+    /* Upper-case extensions are recognised. */
+    CHECK(rad_image_write(image, test_path("UPPER.PFM"), NULL, &error) == RAD_OK);
+    CHECK(test_file_exists(test_path("UPPER.PFM")));
+    CHECK(test_count_files("UPPER.PFM") == 1); /* no temporary file left */
+    rad_image_destroy(image);
+}
+
+static void test_read_errors(void)
+{
+    rad_image *image = gradient(4, 3);
+    rad_error error;
+    const char *path = test_path("whole.pfm");
+    CHECK(rad_image_write(image, path, NULL, &error) == RAD_OK);
+    rad_image_destroy(image);
+    static uint8_t bytes[4096];
+    size_t size = read_bytes(path, bytes, sizeof(bytes));
+    CHECK(size > 20);
+
+    /* Truncated pixel data. */
+    rad_image *back = NULL;
+    const char *cut = write_bytes("cut.pfm", bytes, size - 5);
+    CHECK(rad_image_read(cut, &back, &error) == RAD_ERR_PARSE);
+    CHECK(back == NULL);
+    CHECK(strstr(error.message, cut) == error.message);
+    CHECK(strchr(error.message, '\n') == NULL);
+
+    /* Cut in the header, bad headers, not an image at all, empty, missing. */
+    CHECK(rad_image_read(write_bytes("header.pfm", bytes, 6), &back, &error) ==
+          RAD_ERR_PARSE);
+    const char *bad[] = {
+        "PF\n0 3\n-1.0\n",          "PF\n4 -3\n-1.0\n", "PF\n4 3\n0\n",
+        "PF\n4 3\nabc\n",           "PF\n99999999999 3\n-1\n", "PFX\n",
+        "PF\n4294967295 4294967295\n-1\n", "hello",
+        "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n-Y 2 +X 2\n", /* header never ends */
+        "#?RADIANCE\n\n-Y 2 +Z 2\n",       "#?RADIANCE\n\n-Y 2 +Y 2\n",
+        "#?RADIANCE\n\n-Y 2 +X 2\n\x80\x80\x80\x80", /* one pixel of four */
+        "#?RADIANCE\n\n-Y 100000 +X 100000\n\x80\x80\x80\x80",
+        "#?RADIANCE\nFORMAT=32-bit_rle_jpeg\n\n-Y 1 +X 1\n\x80\x80\x80\x80",
+        "#?RADIANCE\nEXPOSURE=-1\n\n-Y 1 +X 1\n\x80\x80\x80\x80",
+        "#?RADIANCE\n\n-Y 1 +X 2\n\x01\x01\x01\x01\x80\x80\x80\x80", /* repeat first */
+        "",
+    };
+    for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+        back = NULL;
+        const char *file = test_write_file("bad.img", bad[i]);
+        rad_status status = rad_image_read(file, &back, &error);
+        if (status != RAD_ERR_PARSE)
+            test_fail(__FILE__, __LINE__, "bad file %zu: status %d (%s), expected parse error",
+                      i, (int)status, rad_status_name(status));
+        test_checks++;
+        CHECK(back == NULL);
+        rad_image_destroy(back);
+    }
+    CHECK(rad_image_read(test_write_file("xyze.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n"
+                                                     "-Y 1 +X 1\n\x80\x80\x80\x80"),
+                         &back, &error) == RAD_ERR_UNSUPPORTED);
+    const char *missing = test_path("missing.pfm");
+    CHECK(rad_image_read(missing, &back, &error) == RAD_ERR_IO);
+    CHECK(strstr(error.message, missing) == error.message);
+}
+
+int main(void)
+{
+    test_create();
+    test_srgb_curve();
+    test_exposure();
+    test_pfm_round_trip();
+    test_pfm_variants();
+    test_hdr_round_trip();
+    test_hdr_rle();
+    test_png();
+    test_write_errors();
+    test_read_errors();
+    return test_finish("test_image");
+}

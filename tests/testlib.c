@@ -1,0 +1,114 @@
+/*
+ * testlib.c - see testlib.h.
+ */
+#include "testlib.h"
+
+#include <dirent.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+int test_failures;
+int test_checks;
+
+void test_fail(const char *file, int line, const char *format, ...)
+{
+    va_list args;
+    va_start(args, format);
+    fprintf(stderr, "%s:%d: ", file, line);
+    vfprintf(stderr, format, args);
+    fputc('\n', stderr);
+    va_end(args);
+    test_failures++;
+}
+
+int test_finish(const char *name)
+{
+    printf("%s: %d checks, %d failed\n", name, test_checks, test_failures);
+    return test_failures == 0 && test_checks > 0 ? 0 : 1;
+}
+
+const char *test_tmpdir(void)
+{
+    static bool made;
+    if (!made) {
+        char command[4200];
+        snprintf(command, sizeof(command), "rm -rf '%s' && mkdir -p '%s'", RAD_TEST_TMP,
+                 RAD_TEST_TMP);
+        if (system(command) != 0) {
+            fprintf(stderr, "cannot create %s\n", RAD_TEST_TMP);
+            exit(1);
+        }
+        made = true;
+    }
+    return RAD_TEST_TMP;
+}
+
+const char *test_path(const char *name)
+{
+    static char buffers[8][4200];
+    static int next;
+    char *buffer = buffers[next++ % 8];
+    snprintf(buffer, sizeof(buffers[0]), "%s/%s", test_tmpdir(), name);
+    return buffer;
+}
+
+const char *test_write_file(const char *name, const char *text)
+{
+    const char *path = test_path(name);
+    FILE *f = fopen(path, "wb");
+    if (!f || fputs(text, f) < 0 || fclose(f) != 0) {
+        fprintf(stderr, "cannot write %s\n", path);
+        exit(1);
+    }
+    return path;
+}
+
+int test_run_tool(const char *arguments)
+{
+    char command[16384];
+    char out[4200], err[4200];
+    snprintf(out, sizeof(out), "%s", test_path("stdout.txt"));
+    snprintf(err, sizeof(err), "%s", test_path("stderr.txt"));
+    snprintf(command, sizeof(command), "cd '%s' && '%s' %s >'%s' 2>'%s' </dev/null",
+             test_tmpdir(), RAD_TOOL, arguments, out, err);
+    int status = system(command);
+    if (status == -1 || !WIFEXITED(status))
+        return -1;
+    return WEXITSTATUS(status);
+}
+
+const char *test_read_text(const char *path)
+{
+    static char buffer[1 << 20];
+    buffer[0] = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return buffer;
+    size_t n = fread(buffer, 1, sizeof(buffer) - 1, f);
+    buffer[n] = 0;
+    fclose(f);
+    return buffer;
+}
+
+bool test_file_exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+int test_count_files(const char *prefix)
+{
+    DIR *dir = opendir(test_tmpdir());
+    int count = 0;
+    if (!dir)
+        return 0;
+    for (struct dirent *entry; (entry = readdir(dir));)
+        if (strncmp(entry->d_name, prefix, strlen(prefix)) == 0)
+            count++;
+    closedir(dir);
+    return count;
+}

@@ -1,0 +1,75 @@
+/*
+ * testlib.h - the project's small test helper.
+ *
+ * CHECK(cond) and CHECK_NEAR(value, expected, relative) record a failure with file:line and
+ * go on; test_finish() prints a summary and returns the process exit code. Helpers for CLI
+ * tests run the tool, write scene files, and read outputs in a per-test scratch folder.
+ */
+#ifndef RAD_TESTLIB_H
+#define RAD_TESTLIB_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "radiosity.h"
+
+extern int test_failures;
+extern int test_checks;
+
+void test_fail(const char *file, int line, const char *format, ...)
+    __attribute__((format(printf, 3, 4)));
+
+#define CHECK(cond)                                                                        \
+    do {                                                                                   \
+        test_checks++;                                                                     \
+        if (!(cond))                                                                       \
+            test_fail(__FILE__, __LINE__, "CHECK(%s) failed", #cond);                      \
+    } while (0)
+
+/* |value - expected| <= relative * |expected| (or <= relative when expected is 0). */
+#define CHECK_NEAR(value, expected, relative)                                              \
+    do {                                                                                   \
+        double v_ = (value), e_ = (expected), r_ = (relative);                             \
+        test_checks++;                                                                     \
+        double tol_ = e_ != 0 ? r_ * (e_ < 0 ? -e_ : e_) : r_;                             \
+        double d_ = v_ - e_;                                                               \
+        if (!(d_ <= tol_ && -d_ <= tol_))                                                  \
+            test_fail(__FILE__, __LINE__, "%s = %.9g, expected %.9g within %.3g%s", #value, \
+                      v_, e_, r_, e_ != 0 ? " relative" : "");                            \
+    } while (0)
+
+/* Absolute tolerance. */
+#define CHECK_ABS(value, expected, tolerance)                                              \
+    do {                                                                                   \
+        double v_ = (value), e_ = (expected), t_ = (tolerance);                            \
+        test_checks++;                                                                     \
+        if (!(v_ - e_ <= t_ && e_ - v_ <= t_))                                             \
+            test_fail(__FILE__, __LINE__, "%s = %.9g, expected %.9g within %.3g", #value,  \
+                      v_, e_, t_);                                                         \
+    } while (0)
+
+/* Prints "name: N checks, M failed" and returns 0 when nothing failed. */
+int test_finish(const char *name);
+
+/* Creates (empty) the scratch folder RAD_TEST_TMP and returns its path. */
+const char *test_tmpdir(void);
+
+/* Path inside the scratch folder (static buffer rotated among 8). */
+const char *test_path(const char *name);
+
+/* Writes text to a file in the scratch folder; returns its path. */
+const char *test_write_file(const char *name, const char *text);
+
+/* Runs the radiosity tool with the given argument string (shell syntax); stderr and stdout
+ * are captured to test_path("stderr.txt") / ("stdout.txt"). Returns the exit code. */
+int test_run_tool(const char *arguments);
+
+/* Reads a whole small file into a static buffer ("" if missing). */
+const char *test_read_text(const char *path);
+
+bool test_file_exists(const char *path);
+
+/* Counts the files in the scratch folder whose name starts with prefix. */
+int test_count_files(const char *prefix);
+
+#endif

@@ -1,0 +1,294 @@
+/*
+ * cli.c - argument parsing, messages, progress and the --stats report, see cli.h.
+ */
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+void cli_error(const char *format, ...)
+{
+    cli_progress_end();
+    va_list args;
+    va_start(args, format);
+    fputs("radiosity: ", stderr);
+    vfprintf(stderr, format, args);
+    fputc('\n', stderr);
+    va_end(args);
+}
+
+void cli_log(void *user, const char *message)
+{
+    (void)user;
+    cli_progress_end();
+    fprintf(stderr, "radiosity: warning: %s\n", message);
+}
+
+static int find_option(const cli_option *options, int count, const char *name, char short_name)
+{
+    for (int k = 0; k < count; k++)
+        if ((name && strcmp(options[k].name, name) == 0) ||
+            (!name && short_name && options[k].short_name == short_name))
+            return k;
+    return -1;
+}
+
+bool cli_parse(const char *command, int argc, char **argv, const cli_option *options,
+               int option_count, cli_args *args)
+{
+    memset(args, 0, sizeof(*args));
+    for (int a = 0; a < argc; a++) {
+        const char *arg = argv[a];
+        if (arg[0] != '-' || arg[1] == 0) {
+            if (args->positional_count == (int)(sizeof(args->positional) / sizeof(args->positional[0]))) {
+                cli_error("%s: too many arguments (see 'radiosity %s --help')", command, command);
+                return false;
+            }
+            args->positional[args->positional_count++] = arg;
+            continue;
+        }
+        int k;
+        const char *inline_value = NULL;
+        char name[64];
+        if (arg[1] == '-') {
+            const char *eq = strchr(arg + 2, '=');
+            size_t length = eq ? (size_t)(eq - arg - 2) : strlen(arg + 2);
+            if (length >= sizeof(name))
+                length = sizeof(name) - 1;
+            memcpy(name, arg + 2, length);
+            name[length] = 0;
+            inline_value = eq ? eq + 1 : NULL;
+            k = find_option(options, option_count, name, 0);
+        } else {
+            snprintf(name, sizeof(name), "%s", arg + 1);
+            k = arg[2] == 0 ? find_option(options, option_count, NULL, arg[1]) : -1;
+        }
+        if (k < 0) {
+            cli_error("%s: unknown option '%s' (see 'radiosity %s --help')", command, arg,
+                      command);
+            return false;
+        }
+        if (!options[k].takes_value) {
+            if (inline_value) {
+                cli_error("%s: option '--%s' takes no value", command, options[k].name);
+                return false;
+            }
+            args->value[k] = "";
+            continue;
+        }
+        if (!inline_value) {
+            if (a + 1 >= argc) {
+                cli_error("%s: option '%s' needs a value (see 'radiosity %s --help')", command,
+                          arg, command);
+                return false;
+            }
+            inline_value = argv[++a];
+        }
+        args->value[k] = inline_value;
+    }
+    return true;
+}
+
+bool cli_parse_double(const char *name, const char *text, double *out)
+{
+    char *end;
+    errno = 0;
+    double value = strtod(text, &end);
+    if (end == text || *end != 0 || errno != 0 || !isfinite(value)) {
+        cli_error("--%s: '%s' is not a number", name, text);
+        return false;
+    }
+    *out = value;
+    return true;
+}
+
+bool cli_parse_uint(const char *name, const char *text, unsigned long max, unsigned long *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long value = strtoul(text, &end, 10);
+    if (end == text || *end != 0 || errno != 0 || text[0] == '-' || value > max) {
+        cli_error("--%s: '%s' is not a whole number from 0 to %lu", name, text, max);
+        return false;
+    }
+    *out = value;
+    return true;
+}
+
+bool cli_parse_vec3(const char *name, const char *text, rad_vec3 *out)
+{
+    double v[3];
+    const char *cursor = text;
+    for (int k = 0; k < 3; k++) {
+        char *end;
+        errno = 0;
+        v[k] = strtod(cursor, &end);
+        if (end == cursor || errno != 0 || !isfinite(v[k]) || *end != (k < 2 ? ',' : 0)) {
+            cli_error("--%s: '%s' is not X,Y,Z", name, text);
+            return false;
+        }
+        cursor = end + 1;
+    }
+    *out = (rad_vec3){v[0], v[1], v[2]};
+    return true;
+}
+
+bool cli_parse_size(const char *name, const char *text, uint32_t *width, uint32_t *height)
+{
+    char *end;
+    errno = 0;
+    unsigned long w = strtoul(text, &end, 10);
+    if (end == text || (*end != 'x' && *end != 'X') || text[0] == '-')
+        goto bad;
+    const char *rest = end + 1;
+    unsigned long h = strtoul(rest, &end, 10);
+    if (end == rest || *end != 0 || errno != 0 || rest[0] == '-' || w == 0 || h == 0 ||
+        w > 32768 || h > 32768)
+        goto bad;
+    *width = (uint32_t)w;
+    *height = (uint32_t)h;
+    return true;
+bad:
+    cli_error("--%s: '%s' is not WIDTHxHEIGHT (1 to 32768 each)", name, text);
+    return false;
+}
+
+double cli_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Progress: one line rewritten in place, at most ~10 times a second. */
+static struct {
+    int enabled; /* -1 unknown, 0 no, 1 yes */
+    bool line_open;
+    double last_time;
+    char phase[64];
+    double phase_start;
+} progress = {-1, false, 0, "", 0};
+
+bool cli_progress_enabled(void)
+{
+    if (progress.enabled < 0)
+        progress.enabled = isatty(STDERR_FILENO) ? 1 : 0;
+    return progress.enabled == 1;
+}
+
+void cli_progress(void *user, const char *phase, double fraction)
+{
+    (void)user;
+    if (!cli_progress_enabled())
+        return;
+    double now = cli_now();
+    if (strcmp(phase, progress.phase) != 0) {
+        snprintf(progress.phase, sizeof(progress.phase), "%s", phase);
+        progress.phase_start = now;
+        progress.last_time = 0;
+    }
+    if (fraction < 1 && now - progress.last_time < 0.1)
+        return;
+    progress.last_time = now;
+    double elapsed = now - progress.phase_start;
+    if (fraction > 0.02 && fraction < 1)
+        fprintf(stderr, "\r%-14s %5.1f%%  %6.1f s left   ", phase, 100 * fraction,
+                elapsed * (1 - fraction) / fraction);
+    else
+        fprintf(stderr, "\r%-14s %5.1f%%                 ", phase, 100 * fraction);
+    progress.line_open = true;
+    if (fraction >= 1)
+        cli_progress_end();
+}
+
+void cli_progress_end(void)
+{
+    if (progress.line_open) {
+        fputc('\n', stderr);
+        progress.line_open = false;
+    }
+}
+
+void stats_begin(cli_stats *stats)
+{
+    stats->length = (size_t)snprintf(stats->text, sizeof(stats->text), "{\n");
+}
+
+static void stats_key(cli_stats *stats, const char *key)
+{
+    if (stats->length >= sizeof(stats->text))
+        return;
+    stats->length += (size_t)snprintf(stats->text + stats->length,
+                                      sizeof(stats->text) - stats->length, "%s  \"%s\": ",
+                                      stats->length > 2 ? ",\n" : "", key);
+}
+
+static void stats_append(cli_stats *stats, const char *format, ...)
+    __attribute__((format(printf, 2, 3)));
+static void stats_append(cli_stats *stats, const char *format, ...)
+{
+    if (stats->length >= sizeof(stats->text))
+        return;
+    va_list args;
+    va_start(args, format);
+    stats->length += (size_t)vsnprintf(stats->text + stats->length,
+                                       sizeof(stats->text) - stats->length, format, args);
+    va_end(args);
+}
+
+void stats_number(cli_stats *stats, const char *key, double value)
+{
+    stats_key(stats, key);
+    if (isfinite(value))
+        stats_append(stats, "%.9g", value);
+    else
+        stats_append(stats, "null");
+}
+
+void stats_integer(cli_stats *stats, const char *key, unsigned long long value)
+{
+    stats_key(stats, key);
+    stats_append(stats, "%llu", value);
+}
+
+void stats_bool(cli_stats *stats, const char *key, bool value)
+{
+    stats_key(stats, key);
+    stats_append(stats, "%s", value ? "true" : "false");
+}
+
+void stats_string(cli_stats *stats, const char *key, const char *value)
+{
+    stats_key(stats, key);
+    stats_append(stats, "\"");
+    for (; *value; value++) {
+        unsigned char c = (unsigned char)*value;
+        if (c == '"' || c == '\\')
+            stats_append(stats, "\\%c", c);
+        else if (c < 0x20)
+            stats_append(stats, "\\u%04x", c);
+        else
+            stats_append(stats, "%c", c);
+    }
+    stats_append(stats, "\"");
+}
+
+bool stats_write(cli_stats *stats, const char *path)
+{
+    stats_append(stats, "\n}\n");
+    if (stats->length >= sizeof(stats->text)) {
+        cli_error("%s: statistics too long", path);
+        return false;
+    }
+    rad_error error;
+    if (rad_write_file_atomic(path, stats->text, stats->length, &error) != RAD_OK) {
+        cli_error("%s", error.message);
+        return false;
+    }
+    return true;
+}

@@ -1,0 +1,70 @@
+/*
+ * cli.h - shared pieces of the radiosity command-line tool: argument parsing, messages,
+ * progress on a terminal, and the --stats report. The tool is a thin client of the
+ * library's public API (include/radiosity.h); nothing here computes light.
+ */
+#ifndef RAD_TOOLS_CLI_H
+#define RAD_TOOLS_CLI_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "radiosity.h"
+
+enum { EXIT_OK = 0, EXIT_ERROR = 1, EXIT_USAGE = 2 };
+
+/* An option the parser accepts: name without dashes, short letter or 0, and whether it
+ * takes a value. */
+typedef struct cli_option {
+    const char *name;
+    char short_name;
+    bool takes_value;
+} cli_option;
+
+/* A parsed command line: the values by option index, and positional arguments. */
+typedef struct cli_args {
+    const char *value[64]; /* NULL = not given; "" for a flag given */
+    const char *positional[8];
+    int positional_count;
+} cli_args;
+
+/* Parses argv against options; on a usage error prints "radiosity: ..." plus a hint to
+ * run `radiosity COMMAND --help` and returns false. */
+bool cli_parse(const char *command, int argc, char **argv, const cli_option *options,
+               int option_count, cli_args *args);
+
+/* Value parsers: print "radiosity: --NAME: ..." and return false on a bad value. */
+bool cli_parse_double(const char *name, const char *text, double *out);
+bool cli_parse_uint(const char *name, const char *text, unsigned long max, unsigned long *out);
+bool cli_parse_vec3(const char *name, const char *text, rad_vec3 *out);
+bool cli_parse_size(const char *name, const char *text, uint32_t *width, uint32_t *height);
+
+void cli_error(const char *format, ...) __attribute__((format(printf, 1, 2)));
+void cli_log(void *user, const char *message);
+
+/* Progress on stderr when it is a terminal (user: NULL). */
+void cli_progress(void *user, const char *phase, double fraction);
+void cli_progress_end(void);
+bool cli_progress_enabled(void);
+
+/* Seconds on a monotonic clock. */
+double cli_now(void);
+
+/* The --stats report: a flat JSON object built up field by field. */
+typedef struct cli_stats {
+    char text[8192];
+    size_t length;
+} cli_stats;
+
+void stats_begin(cli_stats *stats);
+void stats_number(cli_stats *stats, const char *key, double value);
+void stats_integer(cli_stats *stats, const char *key, unsigned long long value);
+void stats_string(cli_stats *stats, const char *key, const char *value);
+void stats_bool(cli_stats *stats, const char *key, bool value);
+/* Closes the object and writes it atomically; false (after printing) on failure. */
+bool stats_write(cli_stats *stats, const char *path);
+
+int command_render(int argc, char **argv);
+int command_viewfactors(int argc, char **argv);
+
+#endif

@@ -1,0 +1,362 @@
+/*
+ * cmd_render.c - `radiosity render [SCENE] -o OUT [options]`: the whole pipeline, from a
+ * scene (or the built-in Cornell box) to an image.
+ */
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+
+#include "cli.h"
+
+static const char usage[] =
+    "usage: radiosity render [SCENE] -o OUT [options]\n"
+    "\n"
+    "Solves the radiosity of SCENE (an OBJ+MTL or any file Assimp reads; none = the\n"
+    "built-in Cornell box with its official camera) and renders it to OUT. OUT's extension\n"
+    "picks the format: .png (exposure, tone map, sRGB 8-bit), .hdr (Radiance RGBE) or .pfm\n"
+    "(portable float map); .hdr and .pfm hold linear radiance.\n"
+    "\n"
+    "Camera (default: the scene's camera, or a view of the whole scene from -z):\n"
+    "  --eye X,Y,Z  --target X,Y,Z  --up X,Y,Z  --fov DEG (vertical)   --size WxH (512x512)\n"
+    "  --spp N              samples per pixel, stratified, box filter (default 4)\n"
+    "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"
+    "Solution:\n"
+    "  --solver NAME        gather (Jacobi, default), gauss-seidel, shoot, or direct (LU,\n"
+    "                       small scenes only)\n"
+    "  --tolerance X        relative residual, or unshot fraction for shoot (default 1e-4)\n"
+    "  --max-iterations N   sweeps, or shots for shoot (default: until the tolerance)\n"
+    "  --patch-size L       longest patch edge in scene units (default: about 3000 patches)\n"
+    "  --visibility-rays N  occlusion rays per patch pair (default 16)\n"
+    "  --quadrature M       M x M points per patch for the analytic form factor (default 1)\n"
+    "  --threads N          worker threads (default: all cores)\n"
+    "  --seed N             seed of every random choice (default 1)\n"
+    "  --stats FILE.json    write counts, times, residuals and peak memory\n"
+    "  -h, --help           this text\n";
+
+enum {
+    OPT_OUTPUT, OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE,
+    OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS,
+    OPT_QUADRATURE, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_HELP, OPT_COUNT
+};
+
+static const cli_option options[OPT_COUNT] = {
+    [OPT_OUTPUT] = {"output", 'o', true},
+    [OPT_EYE] = {"eye", 0, true},
+    [OPT_TARGET] = {"target", 0, true},
+    [OPT_UP] = {"up", 0, true},
+    [OPT_FOV] = {"fov", 0, true},
+    [OPT_SIZE] = {"size", 0, true},
+    [OPT_SPP] = {"spp", 0, true},
+    [OPT_EXPOSURE] = {"exposure", 0, true},
+    [OPT_SOLVER] = {"solver", 0, true},
+    [OPT_TOLERANCE] = {"tolerance", 0, true},
+    [OPT_MAX_ITERATIONS] = {"max-iterations", 0, true},
+    [OPT_PATCH_SIZE] = {"patch-size", 0, true},
+    [OPT_VISIBILITY_RAYS] = {"visibility-rays", 0, true},
+    [OPT_QUADRATURE] = {"quadrature", 0, true},
+    [OPT_THREADS] = {"threads", 0, true},
+    [OPT_SEED] = {"seed", 0, true},
+    [OPT_STATS] = {"stats", 0, true},
+    [OPT_HELP] = {"help", 'h', false},
+};
+
+/* Patches the default patch size aims at. */
+#define DEFAULT_TARGET_PATCHES 3000u
+
+static bool image_extension_ok(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    return dot && (strcasecmp(dot, ".png") == 0 || strcasecmp(dot, ".hdr") == 0 ||
+                   strcasecmp(dot, ".pfm") == 0);
+}
+
+/* The folder of path must exist and be writable: checked before hours of work. */
+bool cli_output_writable(const char *path);
+bool cli_output_writable(const char *path)
+{
+    char folder[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(folder, sizeof(folder), ".");
+    else if (slash == path)
+        snprintf(folder, sizeof(folder), "/");
+    else
+        snprintf(folder, sizeof(folder), "%.*s", (int)(slash - path), path);
+    if (access(folder, W_OK) != 0) {
+        cli_error("%s: cannot write: folder '%s' does not exist or is not writable", path,
+                  folder);
+        return false;
+    }
+    return true;
+}
+
+typedef struct render_settings {
+    const char *scene_path, *output, *stats_path;
+    rad_camera camera;
+    bool has_eye, has_target, has_up, has_fov;
+    uint32_t width, height;
+    rad_render_options render;
+    rad_image_write_options write;
+    rad_solve_options solve;
+    rad_formfactor_options formfactor;
+    double patch_size;
+    unsigned long seed;
+} render_settings;
+
+static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_code)
+{
+    cli_args args;
+    *exit_code = EXIT_USAGE;
+    if (!cli_parse("render", argc, argv, options, OPT_COUNT, &args))
+        return false;
+    if (args.value[OPT_HELP]) {
+        fputs(usage, stdout);
+        *exit_code = EXIT_OK;
+        return false;
+    }
+    memset(s, 0, sizeof(*s));
+    s->width = s->height = 512;
+    s->write.exposure = NAN;
+    s->seed = 1;
+    if (args.positional_count > 1) {
+        cli_error("render: one scene at most (see 'radiosity render --help')");
+        return false;
+    }
+    s->scene_path = args.positional_count ? args.positional[0] : NULL;
+    s->output = args.value[OPT_OUTPUT];
+    if (!s->output) {
+        cli_error("render: no output file: give -o OUT.png, .hdr or .pfm");
+        return false;
+    }
+    if (!image_extension_ok(s->output)) {
+        cli_error("%s: unknown image format (use .png, .hdr or .pfm)", s->output);
+        return false;
+    }
+    s->stats_path = args.value[OPT_STATS];
+    unsigned long value;
+    double number;
+    if ((args.value[OPT_EYE] && !cli_parse_vec3("eye", args.value[OPT_EYE], &s->camera.eye)) ||
+        (args.value[OPT_TARGET] &&
+         !cli_parse_vec3("target", args.value[OPT_TARGET], &s->camera.target)) ||
+        (args.value[OPT_UP] && !cli_parse_vec3("up", args.value[OPT_UP], &s->camera.up)) ||
+        (args.value[OPT_FOV] &&
+         !cli_parse_double("fov", args.value[OPT_FOV], &s->camera.fov_degrees)) ||
+        (args.value[OPT_SIZE] &&
+         !cli_parse_size("size", args.value[OPT_SIZE], &s->width, &s->height)))
+        return false;
+    s->has_eye = args.value[OPT_EYE] != NULL;
+    s->has_target = args.value[OPT_TARGET] != NULL;
+    s->has_up = args.value[OPT_UP] != NULL;
+    s->has_fov = args.value[OPT_FOV] != NULL;
+    if (s->has_fov && !(s->camera.fov_degrees > 0 && s->camera.fov_degrees < 180)) {
+        cli_error("--fov: must be between 0 and 180 degrees");
+        return false;
+    }
+    if (args.value[OPT_SPP]) {
+        if (!cli_parse_uint("spp", args.value[OPT_SPP], 256, &value) || value == 0) {
+            if (value == 0)
+                cli_error("--spp: must be at least 1");
+            return false;
+        }
+        s->render.samples_per_pixel = (uint32_t)value;
+    }
+    if (args.value[OPT_EXPOSURE] &&
+        !cli_parse_double("exposure", args.value[OPT_EXPOSURE], &s->write.exposure))
+        return false;
+    const char *solver = args.value[OPT_SOLVER] ? args.value[OPT_SOLVER] : "gather";
+    if (strcmp(solver, "gather") == 0 || strcmp(solver, "jacobi") == 0)
+        s->solve.solver = RAD_SOLVER_JACOBI;
+    else if (strcmp(solver, "gauss-seidel") == 0)
+        s->solve.solver = RAD_SOLVER_GAUSS_SEIDEL;
+    else if (strcmp(solver, "shoot") == 0)
+        s->solve.solver = RAD_SOLVER_SHOOT;
+    else if (strcmp(solver, "direct") == 0)
+        s->solve.solver = RAD_SOLVER_DIRECT;
+    else {
+        cli_error("--solver: '%s' is not gather, gauss-seidel, shoot or direct", solver);
+        return false;
+    }
+    s->solve.ambient = true;
+    if (args.value[OPT_TOLERANCE]) {
+        if (!cli_parse_double("tolerance", args.value[OPT_TOLERANCE], &number))
+            return false;
+        if (!(number > 0)) {
+            cli_error("--tolerance: must be positive");
+            return false;
+        }
+        s->solve.tolerance = number;
+    }
+    if (args.value[OPT_MAX_ITERATIONS]) {
+        if (!cli_parse_uint("max-iterations", args.value[OPT_MAX_ITERATIONS], UINT32_MAX, &value))
+            return false;
+        s->solve.max_iterations = (uint32_t)value;
+    }
+    if (args.value[OPT_PATCH_SIZE]) {
+        if (!cli_parse_double("patch-size", args.value[OPT_PATCH_SIZE], &s->patch_size))
+            return false;
+        if (!(s->patch_size > 0)) {
+            cli_error("--patch-size: must be positive");
+            return false;
+        }
+    }
+    if (args.value[OPT_VISIBILITY_RAYS]) {
+        if (!cli_parse_uint("visibility-rays", args.value[OPT_VISIBILITY_RAYS], 256, &value))
+            return false;
+        s->formfactor.visibility_rays = (uint32_t)value;
+    }
+    if (args.value[OPT_QUADRATURE]) {
+        if (!cli_parse_uint("quadrature", args.value[OPT_QUADRATURE], 8, &value))
+            return false;
+        s->formfactor.quadrature = (uint32_t)value;
+    }
+    if (args.value[OPT_THREADS]) {
+        if (!cli_parse_uint("threads", args.value[OPT_THREADS], 1024, &value))
+            return false;
+        s->formfactor.threads = s->solve.threads = s->render.threads = (int)value;
+    }
+    if (args.value[OPT_SEED] && !cli_parse_uint("seed", args.value[OPT_SEED], ULONG_MAX, &s->seed))
+        return false;
+    s->formfactor.seed = s->render.seed = s->seed;
+    s->formfactor.progress = s->solve.progress = s->render.progress = cli_progress;
+    s->render.width = s->width;
+    s->render.height = s->height;
+    *exit_code = EXIT_OK;
+    return true;
+}
+
+int command_render(int argc, char **argv)
+{
+    render_settings s;
+    int exit_code;
+    if (!parse_settings(argc, argv, &s, &exit_code))
+        return exit_code;
+    if (!cli_output_writable(s.output) || (s.stats_path && !cli_output_writable(s.stats_path)))
+        return EXIT_ERROR;
+
+    rad_error error = {0};
+    rad_status status;
+    rad_scene *scene = NULL;
+    rad_mesh *mesh = NULL;
+    rad_tracer *occluders = NULL;
+    rad_formfactors *ff = NULL;
+    rad_system system = {0};
+    rad_rgb *B = NULL;
+    rad_image *image = NULL;
+    rad_formfactor_report ff_report = {0};
+    rad_solve_report solve_report = {0};
+    double reciprocity = 0, closure = 0;
+    double t0 = cli_now(), t_load, t_mesh, t_ff, t_solve, t_render, t_write;
+
+    rad_load_options load = {cli_log, NULL};
+    status = s.scene_path ? rad_scene_load(s.scene_path, &load, &scene, &error)
+                          : rad_scene_cornell_box(&scene, &error);
+    if (status != RAD_OK)
+        goto fail;
+    t_load = cli_now();
+
+    rad_camera camera = scene->has_camera ? scene->camera : rad_scene_default_camera(scene);
+    if (s.has_eye)
+        camera.eye = s.camera.eye;
+    if (s.has_target)
+        camera.target = s.camera.target;
+    if (s.has_up)
+        camera.up = s.camera.up;
+    if (s.has_fov)
+        camera.fov_degrees = s.camera.fov_degrees;
+
+    double patch_size = s.patch_size > 0 ? s.patch_size
+                                         : rad_mesh_default_patch_size(scene, DEFAULT_TARGET_PATCHES);
+    status = rad_mesh_build(scene, patch_size, &mesh, &error);
+    if (status != RAD_OK)
+        goto fail;
+    t_mesh = cli_now();
+
+    status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &occluders, &error);
+    if (status != RAD_OK)
+        goto fail;
+    status = rad_formfactors_compute(mesh, occluders, &s.formfactor, &ff, &ff_report, &error);
+    if (status != RAD_OK)
+        goto fail;
+    rad_formfactors_check(ff, mesh, &reciprocity, &closure);
+    t_ff = cli_now();
+
+    status = rad_system_from_mesh(scene, mesh, ff, &system, &error);
+    if (status != RAD_OK)
+        goto fail;
+    B = calloc(mesh->patch_count, sizeof(*B));
+    if (!B) {
+        status = RAD_ERR_NOMEM;
+        snprintf(error.message, sizeof(error.message), "out of memory");
+        goto fail;
+    }
+    status = rad_solve(&system, &s.solve, B, &solve_report, &error);
+    if (status != RAD_OK)
+        goto fail;
+    cli_progress_end();
+    if (!solve_report.converged)
+        cli_log(NULL, "the solver stopped at its iteration limit before the tolerance");
+    t_solve = cli_now();
+
+    status = rad_image_create(s.width, s.height, &image, &error);
+    if (status == RAD_OK)
+        status = rad_render(mesh, B, &camera, &s.render, image, &error);
+    if (status != RAD_OK)
+        goto fail;
+    t_render = cli_now();
+    status = rad_image_write(image, s.output, &s.write, &error);
+    if (status != RAD_OK)
+        goto fail;
+    t_write = cli_now();
+
+    if (s.stats_path) {
+        cli_stats stats;
+        stats_begin(&stats);
+        stats_string(&stats, "scene", scene->source);
+        stats_integer(&stats, "triangles", scene->triangle_count);
+        stats_integer(&stats, "patches", mesh->patch_count);
+        stats_number(&stats, "patch_size", mesh->patch_size);
+        stats_integer(&stats, "patch_pairs", ff_report.pairs);
+        stats_integer(&stats, "patch_pairs_facing", ff_report.pairs_facing);
+        stats_integer(&stats, "rays_cast", ff_report.rays);
+        stats_number(&stats, "rays_per_second",
+                     ff_report.seconds > 0 ? ff_report.rays / ff_report.seconds : 0);
+        stats_number(&stats, "seconds_load", t_load - t0);
+        stats_number(&stats, "seconds_mesh", t_mesh - t_load);
+        stats_number(&stats, "seconds_form_factors", t_ff - t_mesh);
+        stats_number(&stats, "seconds_solve", t_solve - t_ff);
+        stats_number(&stats, "seconds_render", t_render - t_solve);
+        stats_number(&stats, "seconds_write", t_write - t_render);
+        stats_number(&stats, "seconds_total", t_write - t0);
+        stats_string(&stats, "solver", s.solve.solver == RAD_SOLVER_JACOBI ? "gather"
+                                       : s.solve.solver == RAD_SOLVER_GAUSS_SEIDEL ? "gauss-seidel"
+                                       : s.solve.solver == RAD_SOLVER_SHOOT ? "shoot" : "direct");
+        stats_integer(&stats, "iterations", solve_report.iterations);
+        stats_number(&stats, "solver_criterion", solve_report.criterion);
+        stats_number(&stats, "final_residual", solve_report.residual);
+        stats_bool(&stats, "converged", solve_report.converged);
+        stats_number(&stats, "reciprocity_residual", reciprocity);
+        stats_number(&stats, "closure_residual", closure);
+        stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
+        stats_integer(&stats, "width", s.width);
+        stats_integer(&stats, "height", s.height);
+        if (!stats_write(&stats, s.stats_path))
+            exit_code = EXIT_ERROR;
+    }
+    goto done;
+fail:
+    cli_error("%s", error.message);
+    exit_code = EXIT_ERROR;
+done:
+    cli_progress_end();
+    rad_image_destroy(image);
+    free(B);
+    rad_system_free_arrays(&system);
+    rad_formfactors_destroy(ff);
+    rad_tracer_destroy(occluders);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+    return exit_code;
+}
