@@ -247,7 +247,8 @@ void rad_tracer_intersect(const rad_tracer *tracer, const rad_ray *rays, uint32_
 
 typedef struct rad_formfactor_options {
     uint32_t quadrature;     /* each patch is split m x m for the analytic part; 0 = 1 */
-    uint32_t visibility_rays; /* rays per patch pair (rounded to a square); 0 = 16 */
+    uint32_t visibility_rays; /* most rays per patch pair (rounded to a square); 0 = 16.
+                                 4 go first; only pairs they find partly occluded get all */
     uint64_t seed;            /* seeds the stratified sample points */
     int threads;              /* 0 = all cores */
     rad_progress_fn progress;
@@ -258,6 +259,7 @@ typedef struct rad_formfactor_options {
 typedef struct rad_formfactor_report {
     uint64_t pairs;            /* patch pairs considered (i < j) */
     uint64_t pairs_facing;     /* pairs that face each other and needed work */
+    uint64_t pairs_refined;    /* pairs the first 2 x 2 segments found partly occluded */
     uint64_t rays;             /* occlusion rays cast */
     double seconds;
 } rad_formfactor_report;
@@ -273,7 +275,7 @@ typedef struct rad_formfactors {
  * backend). The unoccluded point-to-patch factor is analytic (Lambert's contour formula,
  * integrated over each patch by an m x m midpoint rule, averaged over both directions);
  * visibility is the fraction of unoccluded rays between stratified points of the two
- * patches. */
+ * patches (4 first, the full count where those 4 disagree). */
 rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occluders,
                                    const rad_formfactor_options *options,
                                    rad_formfactors **out, rad_formfactor_report *report,

@@ -22,6 +22,17 @@ void cli_error(const char *format, ...)
     va_end(args);
 }
 
+void cli_warn(const char *format, ...)
+{
+    cli_progress_end();
+    va_list args;
+    va_start(args, format);
+    fputs("radiosity: warning: ", stderr);
+    vfprintf(stderr, format, args);
+    fputc('\n', stderr);
+    va_end(args);
+}
+
 void cli_log(void *user, const char *message)
 {
     (void)user;

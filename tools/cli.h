@@ -40,6 +40,8 @@ bool cli_parse_vec3(const char *name, const char *text, rad_vec3 *out);
 bool cli_parse_size(const char *name, const char *text, uint32_t *width, uint32_t *height);
 
 void cli_error(const char *format, ...) __attribute__((format(printf, 1, 2)));
+void cli_warn(const char *format, ...) __attribute__((format(printf, 1, 2)));
+/* A rad_log_fn printing "radiosity: warning: message". */
 void cli_log(void *user, const char *message);
 
 /* Progress on stderr when it is a terminal (user: NULL). */

@@ -29,7 +29,8 @@ static const char usage[] =
     "  --tolerance X        relative residual, or unshot fraction for shoot (default 1e-4)\n"
     "  --max-iterations N   sweeps, or shots for shoot (default: until the tolerance)\n"
     "  --patch-size L       longest patch edge in scene units (default: about 3000 patches)\n"
-    "  --visibility-rays N  occlusion rays per patch pair (default 16)\n"
+    "  --visibility-rays N  most occlusion rays per patch pair (default 16; 4 first,\n"
+    "                       all N only where those 4 disagree)\n"
     "  --quadrature M       M x M points per patch for the analytic form factor (default 1)\n"
     "  --threads N          worker threads (default: all cores)\n"
     "  --seed N             seed of every random choice (default 1)\n"
@@ -256,6 +257,10 @@ int command_render(int argc, char **argv)
     if (status != RAD_OK)
         goto fail;
     t_load = cli_now();
+    if (!rad_scene_has_emitter(scene))
+        cli_warn("%s: no surface emits light (no material with non-zero Ke): the image will "
+                 "be black",
+                 scene->source);
 
     rad_camera camera = scene->has_camera ? scene->camera : rad_scene_default_camera(scene);
     if (s.has_eye)
@@ -297,7 +302,9 @@ int command_render(int argc, char **argv)
         goto fail;
     cli_progress_end();
     if (!solve_report.converged)
-        cli_log(NULL, "the solver stopped at its iteration limit before the tolerance");
+        cli_warn("the solver stopped at its iteration limit (%u) with residual %.3g, above the "
+                 "tolerance",
+                 solve_report.iterations, solve_report.criterion);
     t_solve = cli_now();
 
     status = rad_image_create(s.width, s.height, &image, &error);
@@ -320,6 +327,7 @@ int command_render(int argc, char **argv)
         stats_number(&stats, "patch_size", mesh->patch_size);
         stats_integer(&stats, "patch_pairs", ff_report.pairs);
         stats_integer(&stats, "patch_pairs_facing", ff_report.pairs_facing);
+        stats_integer(&stats, "patch_pairs_refined", ff_report.pairs_refined);
         stats_integer(&stats, "rays_cast", ff_report.rays);
         stats_number(&stats, "rays_per_second",
                      ff_report.seconds > 0 ? ff_report.rays / ff_report.seconds : 0);

@@ -20,7 +20,7 @@ static const char usage[] =
     "A summary (reciprocity and row sums) goes to stderr.\n"
     "\n"
     "  -o, --output FILE    write the CSV here (atomically)\n"
-    "  --patch-size L       longest patch edge in scene units (default: about 4000 patches)\n"
+    "  --patch-size L       longest patch edge in scene units (default: about 1500 patches)\n"
     "  --visibility-rays N  occlusion rays per patch pair (default 16)\n"
     "  --quadrature M       M x M points per patch for the analytic part (default 3)\n"
     "  --threads N          worker threads (default: all cores)\n"
@@ -44,7 +44,7 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_HELP] = {"help", 'h', false},
 };
 
-#define DEFAULT_TARGET_PATCHES 4000u
+#define DEFAULT_TARGET_PATCHES 1500u
 #define DEFAULT_QUADRATURE 3u
 
 bool cli_output_writable(const char *path);

@@ -5,8 +5,9 @@
  *   - the unoccluded transfer is estimated from both sides with Lambert's contour formula
  *     (contour.c) at the midpoints of an m x m split of each patch, and averaged:
  *       G_ij = (A_i Fhat_ij + A_j Fhat_ji) / 2;
- *   - visibility is the fraction of K segments between jittered stratified points of the
- *     two patches that no triangle of the scene blocks.
+ *   - visibility is the fraction of segments between jittered stratified points of the
+ *     two patches that no triangle of the scene blocks: 2 x 2 segments first; when they
+ *     disagree (a shadow boundary crosses the pair) the full k x k set decides.
  * Pairs where either patch is wholly behind the other's plane need no work (G = 0).
  *
  * Random numbers come from (seed, i, j), so the result is the same for any thread count.
@@ -32,6 +33,7 @@
 #define MAX_QUADRATURE 8u
 #define MAX_STRATA 16u             /* at most 16 x 16 = 256 rays per pair */
 #define BATCH_RAYS 4096u           /* rays traced per call */
+#define FIRST_STRATA 2u            /* first pass: 2 x 2 segments per pair */
 
 /* Everything the kernel needs about one patch, precomputed. */
 typedef struct patch_geometry {
@@ -54,7 +56,8 @@ typedef struct engine {
     rad_vec3 *quadrature_points; /* m*m per patch */
     double *quadrature_weights;  /* m*m per patch, sum to 1 */
     unsigned quadrature_count;
-    unsigned strata;             /* k: k*k rays per pair */
+    unsigned strata;             /* k: at most k*k segments per pair */
+    unsigned first_strata;       /* the first pass casts first_strata^2 segments */
     uint64_t seed;
     double plane_epsilon;
     pair_sink_fn sink;
@@ -141,11 +144,13 @@ static double transfer(const engine *e, uint32_t a, uint32_t b)
     return ga->area * sum;
 }
 
-/* Fills k*k segments from stratified points of i to stratified points of j. */
-static void make_segments(const engine *e, uint32_t i, uint32_t j, rad_ray *rays)
+/* Fills k*k segments from stratified points of i to stratified points of j; `round`
+ * tells the first pass (0) from the refining pass (1) so they draw different points. */
+static void make_segments(const engine *e, uint32_t i, uint32_t j, unsigned k, unsigned round,
+                          rad_ray *rays)
 {
-    unsigned k = e->strata, count = k * k;
-    rad_rng rng = rad_rng_seed(e->seed, i, j);
+    unsigned count = k * k;
+    rad_rng rng = rad_rng_seed(e->seed + round, i, j);
     uint8_t order[MAX_STRATA * MAX_STRATA];
     for (unsigned s = 0; s < count; s++)
         order[s] = (uint8_t)s;
@@ -173,37 +178,87 @@ static void make_segments(const engine *e, uint32_t i, uint32_t j, rad_ray *rays
     }
 }
 
-typedef struct thread_work {
+/* A batch of pairs waiting for their segments to be traced. */
+typedef struct batch {
     rad_ray *rays;
     uint8_t *occluded;
     pending_pair *pending;
     uint32_t ray_count, pending_count;
-    uint64_t rays_cast, pairs_facing;
+} batch;
+
+typedef struct thread_work {
+    batch first;  /* every facing pair, first_strata^2 segments */
+    batch refine; /* pairs the first pass found partly visible, strata^2 segments */
+    uint64_t rays_cast, pairs_facing, pairs_refined;
 } thread_work;
 
-static void flush(const engine *e, thread_work *w, int thread, uint32_t i)
+static void batch_add(const engine *e, batch *b, uint32_t i, uint32_t j, double G, unsigned k,
+                      unsigned round)
 {
-    if (w->ray_count)
-        rad_tracer_occluded(e->occluders, w->rays, w->ray_count, w->occluded);
-    for (uint32_t p = 0; p < w->pending_count; p++) {
-        const pending_pair *pair = &w->pending[p];
-        uint32_t visible = 0;
-        for (uint32_t r = 0; r < pair->ray_count; r++)
-            visible += !w->occluded[pair->first_ray + r];
+    pending_pair *pair = &b->pending[b->pending_count++];
+    pair->j = j;
+    pair->first_ray = b->ray_count;
+    pair->ray_count = k * k;
+    pair->unoccluded = G;
+    make_segments(e, i, j, k, round, &b->rays[b->ray_count]);
+    b->ray_count += k * k;
+}
+
+static uint32_t visible_count(const batch *b, const pending_pair *pair)
+{
+    uint32_t visible = 0;
+    for (uint32_t r = 0; r < pair->ray_count; r++)
+        visible += !b->occluded[pair->first_ray + r];
+    return visible;
+}
+
+static void flush_refine(const engine *e, thread_work *w, int thread, uint32_t i)
+{
+    batch *b = &w->refine;
+    if (b->ray_count)
+        rad_tracer_occluded(e->occluders, b->rays, b->ray_count, b->occluded);
+    for (uint32_t p = 0; p < b->pending_count; p++) {
+        const pending_pair *pair = &b->pending[p];
+        uint32_t visible = visible_count(b, pair);
         if (visible)
             e->sink(e->sink_data, thread, i, pair->j,
                     pair->unoccluded * visible / pair->ray_count);
     }
-    w->rays_cast += w->ray_count;
-    w->ray_count = 0;
-    w->pending_count = 0;
+    w->rays_cast += b->ray_count;
+    b->ray_count = b->pending_count = 0;
+}
+
+/* Traces the first pass; pairs seen wholly visible or wholly hidden are done, the others
+ * go to the refining pass with the full number of segments. */
+static void flush_first(const engine *e, thread_work *w, int thread, uint32_t i)
+{
+    batch *b = &w->first;
+    unsigned full = e->strata * e->strata;
+    if (b->ray_count)
+        rad_tracer_occluded(e->occluders, b->rays, b->ray_count, b->occluded);
+    for (uint32_t p = 0; p < b->pending_count; p++) {
+        const pending_pair *pair = &b->pending[p];
+        uint32_t visible = visible_count(b, pair);
+        if (visible == pair->ray_count || pair->ray_count >= full) {
+            if (visible)
+                e->sink(e->sink_data, thread, i, pair->j,
+                        pair->unoccluded * visible / pair->ray_count);
+            continue;
+        }
+        if (w->refine.ray_count + full > BATCH_RAYS)
+            flush_refine(e, w, thread, i);
+        batch_add(e, &w->refine, i, pair->j, pair->unoccluded, e->strata, 1);
+        w->pairs_refined++;
+    }
+    w->rays_cast += b->ray_count;
+    b->ray_count = b->pending_count = 0;
 }
 
 static void row(const engine *e, thread_work *w, int thread, uint32_t i)
 {
     const patch_geometry *gi = &e->geometry[i];
     uint32_t n = e->mesh->patch_count;
-    unsigned per_pair = e->strata * e->strata;
+    unsigned k = e->first_strata;
     for (uint32_t j = i + 1; j < n; j++) {
         const patch_geometry *gj = &e->geometry[j];
         if (!any_in_front(gi, gj, e->plane_epsilon) || !any_in_front(gj, gi, e->plane_epsilon))
@@ -212,17 +267,12 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
         if (!(G > 0))
             continue;
         w->pairs_facing++;
-        if (w->ray_count + per_pair > BATCH_RAYS)
-            flush(e, w, thread, i);
-        pending_pair *pair = &w->pending[w->pending_count++];
-        pair->j = j;
-        pair->first_ray = w->ray_count;
-        pair->ray_count = per_pair;
-        pair->unoccluded = G;
-        make_segments(e, i, j, &w->rays[w->ray_count]);
-        w->ray_count += per_pair;
+        if (w->first.ray_count + k * k > BATCH_RAYS)
+            flush_first(e, w, thread, i);
+        batch_add(e, &w->first, i, j, G, k, 0);
     }
-    flush(e, w, thread, i);
+    flush_first(e, w, thread, i);
+    flush_refine(e, w, thread, i);
 }
 
 static unsigned strata_for(uint32_t rays)
@@ -250,6 +300,7 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
     e.occluders = occluders;
     e.quadrature_count = m * m;
     e.strata = strata_for(options->visibility_rays);
+    e.first_strata = e.strata < FIRST_STRATA ? e.strata : FIRST_STRATA;
     e.seed = options->seed;
     e.sink = sink;
     e.sink_data = sink_data;
@@ -270,11 +321,14 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
     if (!work || !e.geometry || !e.quadrature_points || !e.quadrature_weights)
         goto nomem;
     for (int t = 0; t < threads; t++) {
-        work[t].rays = rad_alloc_array(BATCH_RAYS, sizeof(*work[t].rays));
-        work[t].occluded = rad_alloc_array(BATCH_RAYS, sizeof(*work[t].occluded));
-        work[t].pending = rad_alloc_array(BATCH_RAYS, sizeof(*work[t].pending));
-        if (!work[t].rays || !work[t].occluded || !work[t].pending)
-            goto nomem;
+        batch *b[2] = {&work[t].first, &work[t].refine};
+        for (int k = 0; k < 2; k++) {
+            b[k]->rays = rad_alloc_array(BATCH_RAYS, sizeof(*b[k]->rays));
+            b[k]->occluded = rad_alloc_array(BATCH_RAYS, sizeof(*b[k]->occluded));
+            b[k]->pending = rad_alloc_array(BATCH_RAYS, sizeof(*b[k]->pending));
+            if (!b[k]->rays || !b[k]->occluded || !b[k]->pending)
+                goto nomem;
+        }
     }
     for (uint32_t i = 0; i < n; i++) {
         const rad_patch *patch = &mesh->patches[i];
@@ -316,6 +370,7 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
         for (int t = 0; t < threads; t++) {
             report->rays += work[t].rays_cast;
             report->pairs_facing += work[t].pairs_facing;
+            report->pairs_refined += work[t].pairs_refined;
         }
         report->seconds = (double)(end.tv_sec - start.tv_sec) + 1e-9 * (double)(end.tv_nsec - start.tv_nsec);
     }
@@ -327,9 +382,12 @@ nomem:
 done:
     if (work)
         for (int t = 0; t < threads; t++) {
-            free(work[t].rays);
-            free(work[t].occluded);
-            free(work[t].pending);
+            batch *b[2] = {&work[t].first, &work[t].refine};
+            for (int k = 0; k < 2; k++) {
+                free(b[k]->rays);
+                free(b[k]->occluded);
+                free(b[k]->pending);
+            }
         }
     free(work);
     free(e.geometry);

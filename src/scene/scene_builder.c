@@ -277,11 +277,6 @@ rad_status scene_builder_finish(scene_builder *b, rad_scene **out, rad_error *er
         status = rad_fail(error, RAD_ERR_PARSE, "%s: the scene has no triangles", b->source);
         goto done;
     }
-    if (!rad_scene_has_emitter(scene))
-        rad_warn(b->options.log, b->options.log_user,
-                 "%s: no surface emits light (no material with non-zero Ke): the result "
-                 "will be black",
-                 b->source);
     *out = scene;
     scene = NULL;
     goto done;

@@ -1,10 +1,11 @@
 /*
  * solve.c - rad_solve: the front door of the solvers.
  *
- * Validates the system and the options, applies the defaults, times the solver (the final
- * residual is not included in report->seconds), dispatches to one solver (solve_jacobi.c, solve_gauss_seidel.c, solve_shoot.c, solve_direct.c) and
- * measures the relative residual of the answer the same way for all of them. It does not
- * iterate itself. Validation is O(n) (the per-patch arrays); F is trusted.
+ * Validates the system and the options, applies the defaults, dispatches to one solver
+ * (solve_jacobi.c, solve_gauss_seidel.c, solve_shoot.c, solve_direct.c), times it (the
+ * final residual is not included in report->seconds) and measures the relative residual
+ * of the answer the same way for all of them. It does not iterate itself. Validation is
+ * O(n) (the per-patch arrays); F is trusted, never scanned.
  */
 #include <math.h>
 #include <string.h>

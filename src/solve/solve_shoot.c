@@ -28,6 +28,11 @@
  * bounds the factor at 100. */
 #define SHOOT_AMBIENT_ALBEDO_MAX 0.99
 
+/* A shot costs a few nanoseconds per patch and a parallel region a few microseconds (far
+ * more when the cores are shared), and there are thousands of shots: below this many
+ * patches the shots run on one thread. */
+enum { SHOOT_PARALLEL_MIN = 16384 };
+
 /* What one block of patches contributes to the choice of the next shooter. */
 typedef struct shoot_block {
     double unshot;  /* sum of A_j |dB_j|_1 over the block, in order */
@@ -159,7 +164,7 @@ rad_status solve_shoot(const rad_system *system, solve_params *params, rad_rgb *
         const rad_rgb power = {a * d.r, a * d.g, a * d.b};
         dB[shooter] = (rad_rgb){0, 0, 0};
         const float *row = F + (size_t)shooter * n;
-#pragma omp parallel for schedule(static) num_threads(threads) if (n >= SOLVE_PARALLEL_MIN)
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= SHOOT_PARALLEL_MIN)
         for (uint32_t b = 0; b < blocks; b++)
             block[b] = shoot_range(row, power, w, area, B, dB, solve_block_begin(n, blocks, b),
                                    solve_block_begin(n, blocks, b + 1));
