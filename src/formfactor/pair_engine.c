@@ -3,7 +3,8 @@
  *
  * For a pair (i, j), i < j, of patches that face each other:
  *   - the unoccluded transfer is estimated from both sides with Lambert's contour formula
- *     (contour.c) at the midpoints of an m x m split of each patch, and averaged:
+ *     (contour.c) at the midpoints of an m x m split of each patch (finer for pairs close
+ *     to each other), and averaged:
  *       G_ij = (A_i Fhat_ij + A_j Fhat_ji) / 2;
  *   - visibility is the fraction of segments between jittered stratified points of the
  *     two patches that no triangle of the scene blocks: 2 x 2 segments first; when they
@@ -34,12 +35,18 @@
 #define MAX_STRATA 16u             /* at most 16 x 16 = 256 rays per pair */
 #define BATCH_RAYS 4096u           /* rays traced per call */
 #define FIRST_STRATA 2u            /* first pass: 2 x 2 segments per pair */
+/* Pairs closer than NEAR_DISTANCE x (sum of their radii) get NEAR_QUADRATURE^2 points:
+ * the midpoint rule is worst where the kernel varies fastest, next to a shared edge. */
+#define NEAR_DISTANCE 3.0
+#define NEAR_QUADRATURE 4u
 
 /* Everything the kernel needs about one patch, precomputed. */
 typedef struct patch_geometry {
     rad_vec3 corner[4];
     unsigned corner_count;
     rad_vec3 normal;
+    rad_vec3 centroid;
+    double radius; /* largest distance from the centroid to a corner */
     double area;
 } patch_geometry;
 
@@ -56,6 +63,9 @@ typedef struct engine {
     rad_vec3 *quadrature_points; /* m*m per patch */
     double *quadrature_weights;  /* m*m per patch, sum to 1 */
     unsigned quadrature_count;
+    rad_vec3 *near_points;       /* the same with NEAR_QUADRATURE, for close pairs */
+    double *near_weights;
+    unsigned near_count;
     unsigned strata;             /* k: at most k*k segments per pair */
     unsigned first_strata;       /* the first pass casts first_strata^2 segments */
     uint64_t seed;
@@ -131,13 +141,14 @@ static bool any_in_front(const patch_geometry *a, const patch_geometry *b, doubl
 }
 
 /* Area-weighted unoccluded factor from patch a to patch b: A_a * Fhat_ab. */
-static double transfer(const engine *e, uint32_t a, uint32_t b)
+static double transfer(const engine *e, uint32_t a, uint32_t b, bool near)
 {
     const patch_geometry *ga = &e->geometry[a], *gb = &e->geometry[b];
-    const rad_vec3 *points = &e->quadrature_points[(size_t)a * e->quadrature_count];
-    const double *weights = &e->quadrature_weights[(size_t)a * e->quadrature_count];
+    unsigned count = near ? e->near_count : e->quadrature_count;
+    const rad_vec3 *points = (near ? e->near_points : e->quadrature_points) + (size_t)a * count;
+    const double *weights = (near ? e->near_weights : e->quadrature_weights) + (size_t)a * count;
     double sum = 0;
-    for (unsigned q = 0; q < e->quadrature_count; q++)
+    for (unsigned q = 0; q < count; q++)
         sum += weights[q] * contour_point_to_polygon(points[q], ga->normal, gb->corner,
                                                      gb->corner_count, gb->normal,
                                                      e->plane_epsilon);
@@ -263,7 +274,9 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
         const patch_geometry *gj = &e->geometry[j];
         if (!any_in_front(gi, gj, e->plane_epsilon) || !any_in_front(gj, gi, e->plane_epsilon))
             continue;
-        double G = 0.5 * (transfer(e, i, j) + transfer(e, j, i));
+        bool near = v3_length(v3_sub(gi->centroid, gj->centroid)) <
+                    NEAR_DISTANCE * (gi->radius + gj->radius);
+        double G = 0.5 * (transfer(e, i, j, near) + transfer(e, j, i, near));
         if (!(G > 0))
             continue;
         w->pairs_facing++;
@@ -299,6 +312,8 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
     e.mesh = mesh;
     e.occluders = occluders;
     e.quadrature_count = m * m;
+    unsigned m_near = m > NEAR_QUADRATURE ? m : NEAR_QUADRATURE;
+    e.near_count = m_near * m_near;
     e.strata = strata_for(options->visibility_rays);
     e.first_strata = e.strata < FIRST_STRATA ? e.strata : FIRST_STRATA;
     e.seed = options->seed;
@@ -318,7 +333,10 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
     e.geometry = rad_alloc_array(n, sizeof(*e.geometry));
     e.quadrature_points = rad_alloc_array((size_t)n * e.quadrature_count, sizeof(rad_vec3));
     e.quadrature_weights = rad_alloc_array((size_t)n * e.quadrature_count, sizeof(double));
-    if (!work || !e.geometry || !e.quadrature_points || !e.quadrature_weights)
+    e.near_points = rad_alloc_array((size_t)n * e.near_count, sizeof(rad_vec3));
+    e.near_weights = rad_alloc_array((size_t)n * e.near_count, sizeof(double));
+    if (!work || !e.geometry || !e.quadrature_points || !e.quadrature_weights ||
+        !e.near_points || !e.near_weights)
         goto nomem;
     for (int t = 0; t < threads; t++) {
         batch *b[2] = {&work[t].first, &work[t].refine};
@@ -338,8 +356,14 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
             g->corner[k] = mesh->vertices[patch->vertex[k]];
         g->normal = patch->normal;
         g->area = patch->area;
+        g->centroid = patch->centroid;
+        g->radius = 0;
+        for (unsigned k = 0; k < patch->vertex_count; k++)
+            g->radius = fmax(g->radius, v3_length(v3_sub(g->corner[k], g->centroid)));
         quadrature_for(g, m, &e.quadrature_points[(size_t)i * e.quadrature_count],
                        &e.quadrature_weights[(size_t)i * e.quadrature_count]);
+        quadrature_for(g, m_near, &e.near_points[(size_t)i * e.near_count],
+                       &e.near_weights[(size_t)i * e.near_count]);
     }
 
     struct timespec start, end;
@@ -393,5 +417,7 @@ done:
     free(e.geometry);
     free(e.quadrature_points);
     free(e.quadrature_weights);
+    free(e.near_points);
+    free(e.near_weights);
     return status;
 }

@@ -1,0 +1,121 @@
+/*
+ * test_cornell.c - the built-in Cornell box rendered at its official camera to .pfm, then
+ * read back and probed at scene points projected with the test's own pinhole model
+ * (eye (278, 273, -800), looking +z, vertical fov 2 atan(12.5/35); +x is on the image's
+ * left). What any correct radiance image of this scene shows (VALIDATION.md section 4):
+ *   - the light shows its emitted radiance Ke (17, 12, 4), plus at most what it reflects;
+ *   - colour bleeding: the floor near the red wall is redder than near the green wall,
+ *     and the reverse;
+ *   - the blocks' shadows are darker than open floor at the mirror-image point.
+ * It also checks that 1 and 2 threads give the same image.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "testlib.h"
+
+enum { SIZE = 256 };
+
+typedef struct rgb3 {
+    double r, g, b;
+} rgb3;
+
+/* Mean radiance over a (2h+1)^2 pixel block around the projection of scene point p. */
+static rgb3 probe(const rad_image *image, double x, double y, double z, int h)
+{
+    double tan_half = 12.5 / 35.0; /* half the film over the focal length */
+    double dx = x - 278, dy = y - 273, dz = z + 800;
+    double ndc_x = -dx / dz / tan_half, ndc_y = dy / dz / tan_half;
+    int px = (int)floor((ndc_x + 1) / 2 * image->width);
+    int py = (int)floor((1 - ndc_y) / 2 * image->height);
+    rgb3 sum = {0, 0, 0};
+    int count = 0;
+    for (int v = py - h; v <= py + h; v++)
+        for (int u = px - h; u <= px + h; u++) {
+            if (u < 0 || v < 0 || u >= (int)image->width || v >= (int)image->height)
+                continue;
+            const float *p = &image->rgb[((size_t)v * image->width + u) * 3];
+            sum.r += p[0];
+            sum.g += p[1];
+            sum.b += p[2];
+            count++;
+        }
+    if (count) {
+        sum.r /= count;
+        sum.g /= count;
+        sum.b /= count;
+    }
+    return sum;
+}
+
+static double luminance(rgb3 c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+
+static rad_image *render(const char *name, const char *options)
+{
+    char command[512];
+    snprintf(command, sizeof(command), "render -o %s --size %dx%d %s", name, SIZE, SIZE, options);
+    int code = test_run_tool(command);
+    CHECK(code == 0);
+    if (code != 0) {
+        fprintf(stderr, "%s\n", test_read_text(test_path("stderr.txt")));
+        return NULL;
+    }
+    rad_image *image = NULL;
+    rad_error error;
+    CHECK(rad_image_read(test_path(name), &image, &error) == RAD_OK);
+    return image;
+}
+
+int main(void)
+{
+    rad_image *image = render("cornell.pfm", "--threads 2");
+    if (!image)
+        return test_finish("test_cornell");
+
+    /* the light: Ke <= L <= Ke + albedo 0.78 x the brightest non-emitting radiance seen */
+    rgb3 light = probe(image, 278, 548.7, 279.5, 2);
+    double brightest = 0;
+    for (size_t k = 0; k < (size_t)SIZE * SIZE * 3; k++)
+        if (image->rgb[k] < 3.5) /* below any light channel */
+            brightest = fmax(brightest, image->rgb[k]);
+    printf("light %.4f %.4f %.4f; brightest other %.4f\n", light.r, light.g, light.b, brightest);
+    CHECK(light.r >= 17 && light.r <= 17 + 0.78 * brightest);
+    CHECK(light.g >= 12 && light.g <= 12 + 0.78 * brightest);
+    CHECK(light.b >= 4 && light.b <= 4 + 0.78 * brightest);
+    CHECK_NEAR(light.r, 17, 0.05);
+    CHECK_NEAR(light.g, 12, 0.05);
+
+    /* colour bleeding at mirror points 242 mm from the centre line, clear of the blocks */
+    rgb3 near_red = probe(image, 520, 0, 100, 2), near_green = probe(image, 36, 0, 100, 2);
+    printf("floor near red %.4f %.4f %.4f, near green %.4f %.4f %.4f\n", near_red.r,
+           near_red.g, near_red.b, near_green.r, near_green.g, near_green.b);
+    CHECK(near_red.r / near_red.g > 1.1 * (near_green.r / near_green.g));
+    CHECK(near_green.g / near_green.r > 1.1 * (near_red.g / near_red.r));
+    /* the walls themselves: red on the left, green on the right */
+    rgb3 left = probe(image, 554, 274, 300, 2), right = probe(image, 0, 274, 300, 2);
+    CHECK(left.r > 3 * left.g);
+    CHECK(right.g > 2 * right.r);
+
+    /* shadow: (180, 0, 50) sees the light's centre through the short block; its mirror
+     * (376, 0, 50) sees it past both blocks */
+    rgb3 shadow = probe(image, 180, 0, 50, 1), open = probe(image, 376, 0, 50, 1);
+    printf("shadow %.4f, open floor %.4f\n", luminance(shadow), luminance(open));
+    CHECK(luminance(shadow) < 0.8 * luminance(open));
+    /* the ceiling is lit only indirectly: far darker than the light, but not black */
+    rgb3 ceiling = probe(image, 450, 548.8, 450, 1);
+    CHECK(luminance(ceiling) > 0.05 && luminance(ceiling) < 0.1 * luminance(light));
+
+    /* the same answer for any thread count */
+    rad_image *one = render("cornell-1.pfm", "--threads 1");
+    if (one) {
+        size_t differ = 0;
+        for (size_t k = 0; k < (size_t)SIZE * SIZE * 3; k++)
+            differ += one->rgb[k] != image->rgb[k];
+        printf("pixels differing between 1 and 2 threads: %zu\n", differ);
+        CHECK(differ == 0);
+    }
+    rad_image_destroy(one);
+    rad_image_destroy(image);
+    return test_finish("test_cornell");
+}

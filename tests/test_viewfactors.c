@@ -1,0 +1,227 @@
+/*
+ * test_viewfactors.c - `radiosity viewfactors` on OBJ files against the closed forms of
+ * shared/docs/VALIDATION.md: parallel opposed rectangles and perpendicular rectangles with
+ * a common edge at several sizes and distances (0.5 %), F_ii = 0, reciprocity, a closed
+ * unit cube (catalogue values, rows summing to 1), and occluders that hide all or half.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testlib.h"
+
+static const double pi = 3.14159265358979323846;
+
+static double parallel_rectangles(double a, double b, double c)
+{
+    double X = a / c, Y = b / c;
+    return 2 / (pi * X * Y) *
+           (log(sqrt((1 + X * X) * (1 + Y * Y) / (1 + X * X + Y * Y))) +
+            X * sqrt(1 + Y * Y) * atan(X / sqrt(1 + Y * Y)) +
+            Y * sqrt(1 + X * X) * atan(Y / sqrt(1 + X * X)) - X * atan(X) - Y * atan(Y));
+}
+
+/* surface 1 is w x l, surface 2 is h x l, common edge l */
+static double perpendicular_rectangles(double w, double h, double l)
+{
+    double W = w / l, H = h / l, W2 = W * W, H2 = H * H;
+    double a = (1 + W2) * (1 + H2) / (1 + W2 + H2);
+    double b = pow(W2 * (1 + W2 + H2) / ((1 + W2) * (W2 + H2)), W2);
+    double c = pow(H2 * (1 + W2 + H2) / ((1 + H2) * (W2 + H2)), H2);
+    return 1 / (pi * W) *
+           (W * atan(1 / W) + H * atan(1 / H) - sqrt(H2 + W2) * atan(1 / sqrt(H2 + W2)) +
+            0.25 * log(a * b * c));
+}
+
+/* Appends a quad "o NAME" with corners p0..p3 (counter-clockwise seen from the front). */
+static void add_quad(char *obj, size_t size, int *vertices, const char *name, const double p[4][3])
+{
+    size_t n = strlen(obj);
+    n += (size_t)snprintf(obj + n, size - n, "o %s\n", name);
+    for (int k = 0; k < 4; k++)
+        n += (size_t)snprintf(obj + n, size - n, "v %.17g %.17g %.17g\n", p[k][0], p[k][1], p[k][2]);
+    snprintf(obj + n, size - n, "f %d %d %d %d\n", *vertices + 1, *vertices + 2, *vertices + 3,
+             *vertices + 4);
+    *vertices += 4;
+}
+
+/* The value at row `from`, column `to` of a view-factor CSV; NAN when absent. */
+static double csv_value(const char *csv, const char *from, const char *to)
+{
+    const char *line = csv;
+    int column = -1, k = 0;
+    /* header: find the column */
+    for (const char *cell = line; *cell && *cell != '\n'; k++) {
+        size_t len = strcspn(cell, ",\n");
+        if (strlen(to) == len && strncmp(cell, to, len) == 0 && k > 0)
+            column = k;
+        cell += len;
+        if (*cell == ',')
+            cell++;
+    }
+    if (column < 0)
+        return NAN;
+    for (line = strchr(csv, '\n'); line && line[1]; line = strchr(line + 1, '\n')) {
+        const char *row = line + 1;
+        size_t len = strcspn(row, ",");
+        if (strlen(from) != len || strncmp(row, from, len) != 0)
+            continue;
+        const char *cell = row;
+        for (int c = 0; c < column; c++) {
+            cell = strchr(cell, ',');
+            if (!cell)
+                return NAN;
+            cell++;
+        }
+        return strtod(cell, NULL);
+    }
+    return NAN;
+}
+
+static char obj[1 << 16];
+
+/* Runs viewfactors on `obj` and returns the CSV text (static). */
+static const char *run_viewfactors(const char *name, const char *options)
+{
+    char file[256], command[1024];
+    snprintf(file, sizeof(file), "%s.obj", name);
+    test_write_file(file, obj);
+    snprintf(command, sizeof(command), "viewfactors %s.obj -o %s.csv %s", name, name, options);
+    int code = test_run_tool(command);
+    if (code != 0) {
+        fprintf(stderr, "%s: exit %d: %s\n", name, code, test_read_text(test_path("stderr.txt")));
+        test_fail(__FILE__, __LINE__, "viewfactors failed on %s", name);
+    }
+    snprintf(file, sizeof(file), "%s.csv", name);
+    return test_read_text(test_path(file));
+}
+
+static void check_parallel(double a, double b, double c)
+{
+    int v = 0;
+    obj[0] = 0;
+    const double bottom[4][3] = {{0, 0, 0}, {a, 0, 0}, {a, b, 0}, {0, b, 0}};
+    const double top[4][3] = {{0, 0, c}, {0, b, c}, {a, b, c}, {a, 0, c}};
+    add_quad(obj, sizeof(obj), &v, "one", bottom);
+    add_quad(obj, sizeof(obj), &v, "two", top);
+    const char *csv = run_viewfactors("parallel", "");
+    double expected = parallel_rectangles(a, b, c);
+    printf("parallel %gx%g at %g: F12 %.7f F21 %.7f expected %.7f\n", a, b, c,
+           csv_value(csv, "one", "two"), csv_value(csv, "two", "one"), expected);
+    CHECK_NEAR(csv_value(csv, "one", "two"), expected, 0.005);
+    CHECK_NEAR(csv_value(csv, "two", "one"), expected, 0.005);
+    CHECK(csv_value(csv, "one", "one") == 0);
+    CHECK(csv_value(csv, "two", "two") == 0);
+}
+
+static void check_perpendicular(double w, double h, double l)
+{
+    int v = 0;
+    obj[0] = 0;
+    /* surface one in z = 0 (w along y) facing +z; surface two in y = 0 (h along z) facing +y */
+    const double one[4][3] = {{0, 0, 0}, {l, 0, 0}, {l, w, 0}, {0, w, 0}};
+    const double two[4][3] = {{0, 0, 0}, {0, 0, h}, {l, 0, h}, {l, 0, 0}};
+    add_quad(obj, sizeof(obj), &v, "one", one);
+    add_quad(obj, sizeof(obj), &v, "two", two);
+    const char *csv = run_viewfactors("perpendicular", "");
+    double f12 = csv_value(csv, "one", "two"), f21 = csv_value(csv, "two", "one");
+    double expected = perpendicular_rectangles(w, h, l);
+    printf("perpendicular w=%g h=%g l=%g: F12 %.7f expected %.7f\n", w, h, l, f12, expected);
+    CHECK_NEAR(f12, expected, 0.005);
+    /* reciprocity: A1 F12 = A2 F21, and F21 against its own closed form */
+    CHECK_NEAR(w * l * f12, h * l * f21, 1e-6);
+    CHECK_NEAR(f21, perpendicular_rectangles(h, w, l), 0.005);
+    CHECK(csv_value(csv, "one", "one") == 0);
+}
+
+static void check_cube(void)
+{
+    int v = 0;
+    obj[0] = 0;
+    /* inward-facing unit cube */
+    const double faces[6][4][3] = {
+        {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}},  /* z = 0, faces +z */
+        {{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}},  /* z = 1, faces -z */
+        {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}},  /* x = 0, faces +x */
+        {{1, 0, 0}, {1, 0, 1}, {1, 1, 1}, {1, 1, 0}},  /* x = 1, faces -x */
+        {{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}},  /* y = 0, faces +y */
+        {{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}},  /* y = 1, faces -y */
+    };
+    const char *names[6] = {"zlo", "zhi", "xlo", "xhi", "ylo", "yhi"};
+    for (int f = 0; f < 6; f++)
+        add_quad(obj, sizeof(obj), &v, names[f], faces[f]);
+    const char *csv = run_viewfactors("cube", "");
+    double opposite = parallel_rectangles(1, 1, 1), adjacent = perpendicular_rectangles(1, 1, 1);
+    CHECK_NEAR(opposite, 0.1998249, 1e-6);
+    CHECK_NEAR(adjacent, 0.2000438, 1e-6);
+    for (int i = 0; i < 6; i++) {
+        double row = 0;
+        for (int j = 0; j < 6; j++) {
+            double F = csv_value(csv, names[i], names[j]);
+            row += F;
+            if (i == j)
+                CHECK(F == 0);
+            else if (i / 2 == j / 2)
+                CHECK_NEAR(F, opposite, 0.005);
+            else
+                CHECK_NEAR(F, adjacent, 0.005);
+        }
+        CHECK_NEAR(row, 1.0, 0.005);
+    }
+}
+
+/* Two unit plates 1 apart; a blocker at mid-height either covers everything or, by
+ * symmetry, exactly half: a segment from p to q is blocked iff its midpoint is in the
+ * blocker, and the point reflection through the centre maps blocked to unblocked. */
+static void check_occluders(void)
+{
+    const double bottom[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    const double top[4][3] = {{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}};
+    const double everything[4][3] = {{-2, -2, 0.5}, {3, -2, 0.5}, {3, 3, 0.5}, {-2, 3, 0.5}};
+    const double half[4][3] = {{-2, -2, 0.5}, {0.5, -2, 0.5}, {0.5, 3, 0.5}, {-2, 3, 0.5}};
+    double unoccluded = parallel_rectangles(1, 1, 1);
+    int v = 0;
+    obj[0] = 0;
+    add_quad(obj, sizeof(obj), &v, "one", bottom);
+    add_quad(obj, sizeof(obj), &v, "two", top);
+    add_quad(obj, sizeof(obj), &v, "blocker", everything);
+    const char *csv = run_viewfactors("hidden", "");
+    CHECK(csv_value(csv, "one", "two") == 0);
+    CHECK(csv_value(csv, "two", "one") == 0);
+
+    v = 0;
+    obj[0] = 0;
+    add_quad(obj, sizeof(obj), &v, "one", bottom);
+    add_quad(obj, sizeof(obj), &v, "two", top);
+    add_quad(obj, sizeof(obj), &v, "blocker", half);
+    csv = run_viewfactors("half", "");
+    printf("half blocker: F12 %.7f, half of unoccluded %.7f\n", csv_value(csv, "one", "two"),
+           unoccluded / 2);
+    CHECK_NEAR(csv_value(csv, "one", "two"), unoccluded / 2, 0.02);
+    CHECK_NEAR(csv_value(csv, "two", "one"), unoccluded / 2, 0.02);
+    /* obstructed never above unobstructed, and the blocker's front (facing +z) sees plate two */
+    CHECK(csv_value(csv, "one", "two") <= unoccluded);
+    CHECK(csv_value(csv, "blocker", "two") > 0);
+}
+
+int main(void)
+{
+    CHECK_NEAR(parallel_rectangles(1, 1, 1), 0.1998249, 1e-6);
+    CHECK_NEAR(parallel_rectangles(0.1, 0.1, 1), 0.00316206, 1e-5);
+    CHECK_NEAR(parallel_rectangles(2, 1, 1), 0.2858754, 1e-6);
+    CHECK_NEAR(perpendicular_rectangles(2, 1, 1), 0.1164263, 1e-6);
+    CHECK_NEAR(perpendicular_rectangles(1, 2, 1), 0.2328526, 1e-6);
+
+    check_parallel(1, 1, 1);
+    check_parallel(0.1, 0.1, 1);
+    check_parallel(2, 1, 1);
+    check_parallel(3, 0.5, 0.25);
+    check_parallel(1, 1, 10);
+    check_perpendicular(1, 1, 1);
+    check_perpendicular(2, 1, 1);
+    check_perpendicular(1, 2, 1);
+    check_perpendicular(0.2, 3, 1.5);
+    check_cube();
+    check_occluders();
+    return test_finish("test_viewfactors");
+}
