@@ -227,6 +227,17 @@ rad_status scene_builder_finish(scene_builder *b, rad_scene **out, rad_error *er
             b->triangles[kept++] = b->triangles[t];
     }
     qsort(b->triangles, kept, sizeof(*b->triangles), compare_surface);
+    if (kept == 0) {
+        size_t degenerate = b->triangle_count;
+        status = degenerate ? rad_fail(error, RAD_ERR_PARSE,
+                                       "%s: the scene has no usable triangles (%zu degenerate "
+                                       "triangle%s skipped)",
+                                       b->source, degenerate, degenerate == 1 ? "" : "s")
+                            : rad_fail(error, RAD_ERR_PARSE,
+                                       "%s: the scene has no triangles (is it a scene file?)",
+                                       b->source);
+        goto done;
+    }
 
     scene->triangles = rad_alloc_array(kept, sizeof(*scene->triangles));
     scene->surfaces = rad_alloc_array(b->surface_count, sizeof(*scene->surfaces));
@@ -273,10 +284,6 @@ rad_status scene_builder_finish(scene_builder *b, rad_scene **out, rad_error *er
     scene->camera = b->camera;
     snprintf(scene->source, sizeof(scene->source), "%s", b->source);
 
-    if (scene->triangle_count == 0) {
-        status = rad_fail(error, RAD_ERR_PARSE, "%s: the scene has no triangles", b->source);
-        goto done;
-    }
     *out = scene;
     scene = NULL;
     goto done;

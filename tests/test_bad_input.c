@@ -1,0 +1,118 @@
+/*
+ * test_bad_input.c - what a user sees when the input is wrong: one test per case. Every
+ * error is one line on stderr, "radiosity: FILE[:LINE]: message", with a non-zero exit,
+ * and no output file (nor temporary file) is left behind. Warnings keep the run going.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "testlib.h"
+
+static const char *triangle_mtl = "newmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
+
+static int count_lines(const char *text)
+{
+    int lines = 0;
+    for (; *text; text++)
+        lines += *text == '\n';
+    return lines;
+}
+
+/* Runs the tool; checks exit code, a one-line error naming `names` (and `line_tag` when
+ * given, e.g. "bad.obj:3:"), and that no file starting with "out" was left. */
+static void expect_error(const char *case_name, const char *arguments, int exit_code,
+                         const char *names)
+{
+    int code = test_run_tool(arguments);
+    const char *err = test_read_text(test_path("stderr.txt"));
+    if (code != exit_code || count_lines(err) != 1 || strstr(err, names) == NULL ||
+        strncmp(err, "radiosity: ", 11) != 0)
+        fprintf(stderr, "[%s] exit %d, stderr: %s", case_name, code, err);
+    CHECK(code == exit_code);
+    CHECK(count_lines(err) == 1);
+    CHECK(strncmp(err, "radiosity: ", 11) == 0);
+    CHECK(strstr(err, names) != NULL);
+    CHECK(test_count_files("out") == 0);
+}
+
+int main(void)
+{
+    test_write_file("lamp.mtl", triangle_mtl);
+
+    /* a missing scene file */
+    expect_error("missing file", "render missing.obj -o out.png", 1, "missing.obj: cannot open");
+
+    /* a garbled OBJ: binary noise */
+    test_write_file("garbled.obj", "\x01\x02\x03garbage\xff\xfe\n\x7f" "ELF\n#\n");
+    expect_error("garbled", "render garbled.obj -o out.png", 1, "garbled.obj:");
+
+    /* a face that names a vertex that does not exist */
+    test_write_file("badindex.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n");
+    expect_error("index", "render badindex.obj -o out.png", 1, "badindex.obj:");
+
+    /* a material library that is not there: file and line */
+    test_write_file("nomtl.obj", "# a comment\nmtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    expect_error("missing mtl", "render nomtl.obj -o out.png", 1, "nomtl.obj:2: material library 'nowhere.mtl'");
+
+    /* NaN and infinite coordinates: file and line */
+    test_write_file("nan.obj", "mtllib lamp.mtl\nv 0 0 0\nv 1 nan 0\nv 0 1 0\nusemtl lamp\nf 1 2 3\n");
+    expect_error("nan", "render nan.obj -o out.png", 1, "nan.obj:3:");
+    test_write_file("inf.obj", "mtllib lamp.mtl\nv 0 0 0\nv 1 0 0\nv 0 -inf 0\nusemtl lamp\nf 1 2 3\n");
+    expect_error("inf", "render inf.obj -o out.png", 1, "inf.obj:4:");
+
+    /* an unknown option is a usage error */
+    expect_error("unknown option", "render --brightness 3 -o out.png", 2, "--brightness");
+    expect_error("unknown command", "paint -o out.png", 2, "paint");
+    expect_error("bad value", "render -o out.png --size 12by4", 2, "--size");
+
+    /* an output path that cannot be written: checked before any work, nothing left */
+    expect_error("unwritable", "render -o no/such/folder/out.png", 1, "no/such/folder/out.png");
+    expect_error("unknown format", "render -o out.jpg", 2, "out.jpg");
+
+    /* no emitter: a warning, a black image, success */
+    test_write_file("dark.mtl", "newmtl grey\nKd 0.5 0.5 0.5\n");
+    test_write_file("dark.obj", "mtllib dark.mtl\nusemtl grey\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    int code = test_run_tool("render dark.obj -o dark.pfm --size 16x16 --eye 0.3,0.3,1 "
+                             "--target 0.3,0.3,0");
+    CHECK(code == 0);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "warning: dark.obj: no surface emits") != NULL);
+    rad_image *image = NULL;
+    rad_error error;
+    CHECK(rad_image_read(test_path("dark.pfm"), &image, &error) == RAD_OK);
+    if (image) {
+        int lit = 0;
+        for (size_t k = 0; k < (size_t)image->width * image->height * 3; k++)
+            lit += image->rgb[k] != 0;
+        CHECK(lit == 0);
+        rad_image_destroy(image);
+    }
+
+    /* degenerate triangles: skipped with a warning naming how many and where */
+    test_write_file("degenerate.obj",
+                    "mtllib lamp.mtl\nusemtl lamp\no panel\n"
+                    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\n"
+                    "f 1 2 3\nf 1 3 4\nf 1 2 5\nf 2 2 3\n");
+    code = test_run_tool("render degenerate.obj -o degenerate.pfm --size 16x16 "
+                         "--eye 0.5,0.5,1 --target 0.5,0.5,0");
+    CHECK(code == 0);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")),
+                 "degenerate.obj: surface 'panel': 2 degenerate triangles skipped") != NULL);
+    image = NULL;
+    CHECK(rad_image_read(test_path("degenerate.pfm"), &image, &error) == RAD_OK);
+    if (image) {
+        /* the panel itself still renders: the centre pixel shows its emission (1) at least */
+        float centre = image->rgb[((size_t)8 * 16 + 8) * 3];
+        CHECK(centre >= 1.0f);
+        rad_image_destroy(image);
+    }
+
+    /* a scene with nothing but degenerate triangles is an error */
+    test_write_file("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+    expect_error("all degenerate", "render flat.obj -o out.png", 1, "flat.obj:");
+
+    /* viewfactors: the same discipline */
+    expect_error("viewfactors missing", "viewfactors missing.obj -o out.csv", 1, "missing.obj");
+    expect_error("viewfactors unwritable", "viewfactors nan.obj -o no/dir/out.csv", 1,
+                 "no/dir/out.csv");
+    return test_finish("test_bad_input");
+}
