@@ -212,6 +212,7 @@ typedef struct rad_ray {
 
 #define RAD_NO_HIT UINT32_MAX
 
+/* A miss is {RAD_NO_HIT, t = INFINITY, u = v = 0, front = false}. */
 typedef struct rad_hit {
     uint32_t triangle; /* index of the triangle hit, or RAD_NO_HIT */
     float t;           /* ray parameter of the hit */
@@ -222,7 +223,9 @@ typedef struct rad_hit {
 typedef struct rad_tracer rad_tracer;
 
 /* Builds the acceleration structure over `triangle_count` triangles given as vertex
- * indices into `positions`. The tracer copies what it needs. */
+ * indices into `positions`. The tracer copies what it needs. RAD_ERR_INVALID for an index
+ * out of range or a position that is not finite or does not fit a float. Zero triangles
+ * is allowed: every ray misses. */
 rad_status rad_tracer_create(rad_tracer_backend backend, const rad_vec3 *positions,
                              uint32_t position_count, const uint32_t (*triangles)[3],
                              uint32_t triangle_count, rad_tracer **out, rad_error *error);
@@ -233,8 +236,12 @@ rad_status rad_tracer_create_for_scene(rad_tracer_backend backend, const rad_sce
 
 void rad_tracer_destroy(rad_tracer *tracer);
 
+/* The query contract (hot path: nothing is checked): every ray has finite values, a
+ * non-zero direction and 0 <= t_near; t_near > t_far means nothing can be hit. Both sides
+ * of every triangle count. Pass a few hundred rays or more per call for full speed. */
+
 /* For each ray, occluded[k] = 1 when any triangle is hit for t in [t_near, t_far].
- * Hot path: no argument checks. Safe to call from several threads at once. */
+ * Safe to call from several threads at once. */
 void rad_tracer_occluded(const rad_tracer *tracer, const rad_ray *rays, uint32_t count,
                          uint8_t *occluded);
 
@@ -320,8 +327,8 @@ typedef struct rad_solve_options {
     rad_solver solver;
     double tolerance;        /* relative residual (gathering) or unshot fraction (shooting);
                                 0 = 1e-4 */
-    uint32_t max_iterations; /* sweeps (gathering) or shots (shooting); 0 = no limit but
-                                n * 1000 shots or 10000 sweeps */
+    uint32_t max_iterations; /* sweeps (gathering) or shots (shooting); 0 = 10000 sweeps
+                                or 1000 n shots */
     bool ambient;            /* shooting: add the ambient term for the unshot energy */
     int threads;
     rad_progress_fn progress;
@@ -336,7 +343,12 @@ typedef struct rad_solve_report {
     double seconds;
 } rad_solve_report;
 
-/* Fills B (n values, exitance). */
+/* Fills B (n values, exitance). options NULL = all defaults. RAD_ERR_INVALID for a
+ * negative thread count, a non-positive area, an albedo outside [0,1] or a negative
+ * exitance; the direct solver refuses more than 4096 patches (RAD_ERR_UNSUPPORTED) and a
+ * singular system (RAD_ERR_INVALID), and reports iterations 0. Shooting derives F_ji from
+ * F_ij by reciprocity, so its residual levels off near float precision (about 1e-7). With
+ * the ambient term on, `residual` measures B including it. */
 rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
                      rad_rgb *B, rad_solve_report *report, rad_error *error);
 
@@ -362,17 +374,22 @@ rad_status rad_image_create(uint32_t width, uint32_t height, rad_image **out,
                             rad_error *error);
 void rad_image_destroy(rad_image *image);
 
+/* Zero-initialised (or NULL) means automatic exposure. */
 typedef struct rad_image_write_options {
-    double exposure; /* PNG only: radiance is multiplied by 2^exposure; NAN = automatic */
+    bool fixed_exposure; /* PNG only: false = automatic (the 95th percentile of the lit
+                            pixels' luminance is scaled to 0.9), true = use `exposure` */
+    double exposure;     /* PNG only: radiance is multiplied by 2^exposure */
 } rad_image_write_options;
 
 /* Writes by the extension of path: .png (exposure, tone map, sRGB, 8-bit), .hdr (Radiance
- * RGBE), .pfm (portable float map). Writes to a temporary name in the same folder and
- * renames it, so a failed write leaves no file. */
+ * RGBE; negative and NaN values are written as 0), .pfm (portable float map). Writes to a
+ * temporary name in the same folder and renames it, so a failed write leaves no file. */
 rad_status rad_image_write(const rad_image *image, const char *path,
                            const rad_image_write_options *options, rad_error *error);
 
-/* Reads a .pfm or .hdr written by rad_image_write (tests and tools). */
+/* Reads a .pfm (colour or grey, either byte order) or a Radiance .hdr (flat or
+ * run-length encoded RGBE; EXPOSURE lines undone; XYZE is RAD_ERR_UNSUPPORTED), whatever
+ * its name; row 0 of the result is the top. */
 rad_status rad_image_read(const char *path, rad_image **out, rad_error *error);
 
 /* ------------------------------------------------------------------------------------ */

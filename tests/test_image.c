@@ -145,11 +145,11 @@ static void test_exposure(void)
     double scale = 0;
     CHECK(rad_tonemap_scale(image, NULL, &scale) == RAD_OK);
     CHECK_NEAR(scale, 0.9 / 95.05, 1e-9);
-    rad_image_write_options automatic = {.exposure = NAN};
+    rad_image_write_options automatic = {0};
     scale = 0;
     CHECK(rad_tonemap_scale(image, &automatic, &scale) == RAD_OK);
     CHECK_NEAR(scale, 0.9 / 95.05, 1e-9);
-    rad_image_write_options fixed = {.exposure = 2};
+    rad_image_write_options fixed = {.fixed_exposure = true, .exposure = 2};
     CHECK(rad_tonemap_scale(image, &fixed, &scale) == RAD_OK);
     CHECK_NEAR(scale, 4, 1e-15);
     fixed.exposure = INFINITY;
@@ -387,7 +387,7 @@ static void test_png(void)
     set_pixel(image, 1, 1, 0.25, 0.25, 0.25);
     const char *path = test_path("pixels.png");
     rad_error error;
-    rad_image_write_options options = {.exposure = 0};
+    rad_image_write_options options = {.fixed_exposure = true, .exposure = 0};
     CHECK(rad_image_write(image, path, &options, &error) == RAD_OK);
 
     uint8_t decoded[2 * 2 * 3] = {0};

@@ -120,7 +120,6 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
     }
     memset(s, 0, sizeof(*s));
     s->width = s->height = 512;
-    s->write.exposure = NAN;
     s->seed = 1;
     if (args.positional_count > 1) {
         cli_error("render: one scene at most (see 'radiosity render --help')");
@@ -164,9 +163,11 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
         }
         s->render.samples_per_pixel = (uint32_t)value;
     }
-    if (args.value[OPT_EXPOSURE] &&
-        !cli_parse_double("exposure", args.value[OPT_EXPOSURE], &s->write.exposure))
-        return false;
+    if (args.value[OPT_EXPOSURE]) {
+        if (!cli_parse_double("exposure", args.value[OPT_EXPOSURE], &s->write.exposure))
+            return false;
+        s->write.fixed_exposure = true;
+    }
     const char *solver = args.value[OPT_SOLVER] ? args.value[OPT_SOLVER] : "gather";
     if (strcmp(solver, "gather") == 0 || strcmp(solver, "jacobi") == 0)
         s->solve.solver = RAD_SOLVER_JACOBI;

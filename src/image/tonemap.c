@@ -74,7 +74,7 @@ static rad_status auto_scale(const rad_image *image, double *scale)
 rad_status rad_tonemap_scale(const rad_image *image, const rad_image_write_options *options,
                              double *scale)
 {
-    if (!options || isnan(options->exposure))
+    if (!options || !options->fixed_exposure)
         return auto_scale(image, scale);
     if (!isfinite(options->exposure))
         return RAD_ERR_INVALID;

@@ -28,7 +28,7 @@ double rad_tonemap_srgb_encode(double linear);
 /* Clamp, sRGB encode, round to the nearest of 0..255. */
 uint8_t rad_tonemap_srgb8(double linear);
 
-/* The multiplier 2^exposure, or, with options NULL or options->exposure NaN, the automatic
+/* The multiplier 2^exposure, or, with options NULL or not fixed_exposure, the automatic
  * one: RAD_TONEMAP_AUTO_TARGET / (the RAD_TONEMAP_AUTO_PERCENTILE quantile of the finite
  * luminances > 0, linearly interpolated between order statistics); 1 when no pixel has
  * luminance > 0. Returns RAD_ERR_INVALID for an infinite exposure and RAD_ERR_NOMEM
