@@ -226,7 +226,6 @@ rad_status scene_builder_finish(scene_builder *b, rad_scene **out, rad_error *er
         else
             b->triangles[kept++] = b->triangles[t];
     }
-    qsort(b->triangles, kept, sizeof(*b->triangles), compare_surface);
     if (kept == 0) {
         size_t degenerate = b->triangle_count;
         status = degenerate ? rad_fail(error, RAD_ERR_PARSE,
@@ -238,6 +237,7 @@ rad_status scene_builder_finish(scene_builder *b, rad_scene **out, rad_error *er
                                        b->source);
         goto done;
     }
+    qsort(b->triangles, kept, sizeof(*b->triangles), compare_surface);
 
     scene->triangles = rad_alloc_array(kept, sizeof(*scene->triangles));
     scene->surfaces = rad_alloc_array(b->surface_count, sizeof(*scene->surfaces));
