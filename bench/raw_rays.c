@@ -33,6 +33,7 @@
 enum { BATCH = 4096 };
 
 #define SEGMENT_EPSILON 1e-4f
+#define USAGE "usage: raw_rays [--patch-size MM] [--rays N] [--repeats R] [--threads T[,T...]]"
 
 typedef struct settings {
     double patch_size;
@@ -50,7 +51,7 @@ static void die(const char *what)
 
 static void usage_error(void)
 {
-    die("usage: raw_rays [--patch-size MM] [--rays N] [--repeats R] [--threads T[,T...]]");
+    die(USAGE);
 }
 
 static void parse_arguments(int argc, char **argv, settings *s)
@@ -62,6 +63,10 @@ static void parse_arguments(int argc, char **argv, settings *s)
     s->threads[1] = 2;
     s->thread_count = 2;
     for (int a = 1; a < argc; a++) {
+        if (strcmp(argv[a], "--help") == 0 || strcmp(argv[a], "-h") == 0) {
+            puts(USAGE);
+            exit(0);
+        }
         if (a + 1 >= argc)
             usage_error();
         const char *value = argv[++a];

@@ -8,11 +8,10 @@
  * squared (dimensionless): collinear or repeated corners, whatever the scene's unit. */
 #define RAD_DEGENERATE_RELATIVE_AREA 1e-9
 
-/* Two triangles are coplanar (one smooth region) when their unit normals differ by less
- * than this (dimensionless, about 0.06 degrees) ... */
-#define RAD_COPLANAR_NORMAL 1e-3
-/* ... and their plane offsets by less than this times the scene's bounding-box diagonal. */
-#define RAD_COPLANAR_OFFSET 1e-6
+/* Two triangles sharing an edge belong to one smooth region when their unit normals differ
+ * by less than this (dimensionless: 2 sin(0.5 deg), a 1 degree crease). Real data is not
+ * exactly planar: the Cornell box's left wall folds by 0.47 degrees along its diagonal. */
+#define RAD_REGION_NORMAL 0.01745
 
 /* Occlusion segments between two patches stop this far (as a fraction of the segment)
  * from each end, so that the patches' own triangles never count as occluders. */

@@ -223,6 +223,33 @@ static uint32_t visible_count(const batch *b, const pending_pair *pair)
     return visible;
 }
 
+/* The visible fraction of a partly occluded pair, each segment weighted by the transfer
+ * kernel cos(theta_i) cos(theta_j) / r^2 at its ends: a shadow over the part of the pair
+ * that exchanges the most light (the near ends of two patches meeting at a corner) counts
+ * for more, so that visibility and the analytic factor are not treated as independent.
+ * r^2 is kept above a quarter of the smaller patch's radius squared so that one segment
+ * next to a shared edge cannot take all the weight. */
+static double weighted_visibility(const engine *e, const batch *b, const pending_pair *pair,
+                                  uint32_t i)
+{
+    const patch_geometry *gi = &e->geometry[i], *gj = &e->geometry[pair->j];
+    double floor_r = 0.5 * fmin(gi->radius, gj->radius);
+    double floor_r2 = floor_r * floor_r;
+    double total = 0, visible = 0;
+    for (uint32_t r = 0; r < pair->ray_count; r++) {
+        const rad_ray *ray = &b->rays[pair->first_ray + r];
+        rad_vec3 d = v3(ray->direction[0], ray->direction[1], ray->direction[2]);
+        double r2 = v3_dot(d, d);
+        double length = sqrt(r2);
+        double ci = v3_dot(gi->normal, d) / length, cj = -v3_dot(gj->normal, d) / length;
+        double kernel = fmax(ci, 0) * fmax(cj, 0) / fmax(r2, floor_r2);
+        total += kernel;
+        if (!b->occluded[pair->first_ray + r])
+            visible += kernel;
+    }
+    return total > 0 ? visible / total : (double)visible_count(b, pair) / pair->ray_count;
+}
+
 static void flush_refine(const engine *e, thread_work *w, int thread, uint32_t i)
 {
     batch *b = &w->refine;
@@ -231,9 +258,11 @@ static void flush_refine(const engine *e, thread_work *w, int thread, uint32_t i
     for (uint32_t p = 0; p < b->pending_count; p++) {
         const pending_pair *pair = &b->pending[p];
         uint32_t visible = visible_count(b, pair);
-        if (visible)
+        if (visible == pair->ray_count)
+            e->sink(e->sink_data, thread, i, pair->j, pair->unoccluded);
+        else if (visible)
             e->sink(e->sink_data, thread, i, pair->j,
-                    pair->unoccluded * visible / pair->ray_count);
+                    pair->unoccluded * weighted_visibility(e, b, pair, i));
     }
     w->rays_cast += b->ray_count;
     b->ray_count = b->pending_count = 0;
@@ -250,16 +279,19 @@ static void flush_first(const engine *e, thread_work *w, int thread, uint32_t i)
     for (uint32_t p = 0; p < b->pending_count; p++) {
         const pending_pair *pair = &b->pending[p];
         uint32_t visible = visible_count(b, pair);
-        if (visible == pair->ray_count || pair->ray_count >= full) {
-            if (visible)
-                e->sink(e->sink_data, thread, i, pair->j,
-                        pair->unoccluded * visible / pair->ray_count);
+        if (visible == pair->ray_count) {
+            e->sink(e->sink_data, thread, i, pair->j, pair->unoccluded);
+        } else if (visible == 0) {
             continue;
+        } else if (pair->ray_count >= full) {
+            e->sink(e->sink_data, thread, i, pair->j,
+                    pair->unoccluded * weighted_visibility(e, b, pair, i));
+        } else {
+            if (w->refine.ray_count + full > BATCH_RAYS)
+                flush_refine(e, w, thread, i);
+            batch_add(e, &w->refine, i, pair->j, pair->unoccluded, e->strata, 1);
+            w->pairs_refined++;
         }
-        if (w->refine.ray_count + full > BATCH_RAYS)
-            flush_refine(e, w, thread, i);
-        batch_add(e, &w->refine, i, pair->j, pair->unoccluded, e->strata, 1);
-        w->pairs_refined++;
     }
     w->rays_cast += b->ray_count;
     b->ray_count = b->pending_count = 0;
@@ -276,7 +308,10 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
             continue;
         bool near = v3_length(v3_sub(gi->centroid, gj->centroid)) <
                     NEAR_DISTANCE * (gi->radius + gj->radius);
-        double G = 0.5 * (transfer(e, i, j, near) + transfer(e, j, i, near));
+        /* both one-sided estimates, the smaller patch's trusted more: its quadrature
+         * points are finer relative to the distance between the two */
+        double wi = 1.0 / (gi->radius * gi->radius), wj = 1.0 / (gj->radius * gj->radius);
+        double G = (wi * transfer(e, i, j, near) + wj * transfer(e, j, i, near)) / (wi + wj);
         if (!(G > 0))
             continue;
         w->pairs_facing++;

@@ -2,8 +2,8 @@
  * mesh.c - splitting the scene into patches.
  *
  * Three steps:
- *   1. Regions: triangles that share an edge, a surface, a material and a plane form one
- *      smooth region (union-find over shared edges). Values are interpolated across patch
+ *   1. Regions: triangles that share an edge, a surface, a material and (within a degree)
+ *      a plane form one smooth region (union-find over shared edges). Values are interpolated across patch
  *      boundaries inside a region and kept apart between regions, so creases stay sharp.
  *   2. Quads: two triangles of one region whose longest edges are the same edge (a quad
  *      split along its diagonal, as exporters do) are merged back into a convex quad,
@@ -72,16 +72,14 @@ static uint32_t find_root(uint32_t *parent, uint32_t x)
 typedef struct mesh_input {
     const rad_scene *scene;
     rad_vec3 *normal; /* per triangle */
-    double *offset;   /* plane offset n . p per triangle */
-    double diagonal;  /* scene bounding-box diagonal */
 } mesh_input;
 
-static bool coplanar(const mesh_input *in, uint32_t a, uint32_t b)
+/* Triangles a and b share an edge: are they one smooth region? */
+static bool smooth_neighbours(const mesh_input *in, uint32_t a, uint32_t b)
 {
     const rad_triangle *ta = &in->scene->triangles[a], *tb = &in->scene->triangles[b];
     return ta->surface == tb->surface && ta->material == tb->material &&
-           v3_length(v3_sub(in->normal[a], in->normal[b])) < RAD_COPLANAR_NORMAL &&
-           fabs(in->offset[a] - in->offset[b]) < RAD_COPLANAR_OFFSET * in->diagonal;
+           v3_length(v3_sub(in->normal[a], in->normal[b])) < RAD_REGION_NORMAL;
 }
 
 /* The corner index (0..2) at which triangle t's longest edge starts. */
@@ -155,7 +153,6 @@ static int add_patch(mesh_output *out, const polygon *poly, const rad_vec3 *p, u
     patch->vertex_count = count;
     patch->surface = source->surface;
     patch->material = source->material;
-    patch->normal = out->in->normal[poly->triangle];
     for (uint32_t k = 0; k < count; k++) {
         patch->vertex[k] = rad_weld_insert(&out->weld, poly->region, p[k]);
         if (patch->vertex[k] == UINT32_MAX)
@@ -166,7 +163,10 @@ static int add_patch(mesh_output *out, const polygon *poly, const rad_vec3 *p, u
     if (count == 3) {
         patch->area = a0;
         patch->centroid = c0;
+        patch->normal = v3_normalize(v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0])));
     } else {
+        /* the diagonals' cross product: the mean normal of a slightly folded quad */
+        patch->normal = v3_normalize(v3_cross(v3_sub(p[2], p[0]), v3_sub(p[3], p[1])));
         double a1 = 0.5 * v3_length(v3_cross(v3_sub(p[2], p[0]), v3_sub(p[3], p[0])));
         rad_vec3 c1 = v3_scale(v3_add(v3_add(p[0], p[2]), p[3]), 1.0 / 3.0);
         patch->area = a0 + a1;
@@ -277,7 +277,7 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
 {
     rad_status status = RAD_OK;
     uint32_t T = scene->triangle_count;
-    mesh_input in = {scene, NULL, NULL, 0};
+    mesh_input in = {scene, NULL};
     mesh_output result = {&in, {0}, NULL, 0, 0};
     edge_table edges = {NULL, 0};
     uint32_t *parent = NULL, *partner = NULL, *region_of_root = NULL;
@@ -288,11 +288,7 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
     if (!(patch_size > 0) || !isfinite(patch_size))
         return rad_fail(error, RAD_ERR_INVALID, "patch size must be a positive number");
 
-    rad_vec3 lo, hi;
-    rad_scene_bounds(scene, &lo, &hi);
-    in.diagonal = v3_length(v3_sub(hi, lo));
     in.normal = rad_alloc_array(T, sizeof(*in.normal));
-    in.offset = rad_alloc_array(T, sizeof(*in.offset));
     parent = rad_alloc_array(T, sizeof(*parent));
     partner = rad_alloc_array(T, sizeof(*partner));
     region_of_root = rad_alloc_array(T, sizeof(*region_of_root));
@@ -303,7 +299,7 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
     edges.slots = rad_alloc_array(edge_slots, sizeof(*edges.slots));
     edges.mask = edge_slots - 1;
     mesh = calloc(1, sizeof(*mesh));
-    if (!in.normal || !in.offset || !parent || !partner || !region_of_root || !polygons ||
+    if (!in.normal || !parent || !partner || !region_of_root || !polygons ||
         !edges.slots || !mesh || !rad_weld_init(&result.weld, 16))
         goto nomem;
 
@@ -312,7 +308,6 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
         rad_vec3 n = v3_normalize(v3_cross(v3_sub(scene->positions[v[1]], scene->positions[v[0]]),
                                            v3_sub(scene->positions[v[2]], scene->positions[v[0]])));
         in.normal[t] = n;
-        in.offset[t] = v3_dot(n, scene->positions[v[0]]);
         parent[t] = t;
         partner[t] = UINT32_MAX;
     }
@@ -334,7 +329,7 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
             }
             if (slot->count++ == 1)
                 slot->other = t;
-            if (coplanar(&in, slot->triangle, t)) {
+            if (smooth_neighbours(&in, slot->triangle, t)) {
                 uint32_t ra = find_root(parent, slot->triangle), rb = find_root(parent, t);
                 if (ra != rb)
                     parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
@@ -431,7 +426,6 @@ done:
     rad_weld_free(&result.weld);
     free(result.patches);
     free(in.normal);
-    free(in.offset);
     free(parent);
     free(partner);
     free(region_of_root);
