@@ -20,19 +20,26 @@ double contour_point_to_polygon(rad_vec3 p, rad_vec3 n, const rad_vec3 *polygon,
     double height[CONTOUR_MAX_VERTICES];
     unsigned in_front = 0;
     for (unsigned k = 0; k < count; k++) {
-        height[k] = v3_dot(n, v3_sub(polygon[k], p));
+        clipped[k] = v3_sub(polygon[k], p);
+        height[k] = v3_dot(n, clipped[k]);
         in_front += height[k] > 0;
     }
     if (in_front == 0)
         return 0;
-    for (unsigned k = 0; k < count; k++) {
-        unsigned next = (k + 1) % count;
-        rad_vec3 r = v3_sub(polygon[k], p);
-        if (height[k] >= 0)
-            clipped[kept++] = r;
-        if ((height[k] > 0 && height[next] < 0) || (height[k] < 0 && height[next] > 0)) {
-            double t = height[k] / (height[k] - height[next]);
-            clipped[kept++] = v3_lerp(r, v3_sub(polygon[next], p), t);
+    if (in_front == count) {
+        kept = count; /* the common case: wholly in front, nothing to clip */
+    } else {
+        rad_vec3 relative[CONTOUR_MAX_VERTICES];
+        for (unsigned k = 0; k < count; k++)
+            relative[k] = clipped[k];
+        for (unsigned k = 0; k < count; k++) {
+            unsigned next = (k + 1) % count;
+            if (height[k] >= 0)
+                clipped[kept++] = relative[k];
+            if ((height[k] > 0 && height[next] < 0) || (height[k] < 0 && height[next] > 0)) {
+                double t = height[k] / (height[k] - height[next]);
+                clipped[kept++] = v3_lerp(relative[k], relative[next], t);
+            }
         }
     }
 

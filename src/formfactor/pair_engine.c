@@ -2,10 +2,10 @@
  * pair_engine.c - the form-factor kernel: analytic transfer times sampled visibility.
  *
  * For a pair (i, j), i < j, of patches that face each other:
- *   - the unoccluded transfer is estimated from both sides with Lambert's contour formula
- *     (contour.c) at the midpoints of an m x m split of each patch (finer for pairs close
- *     to each other), and averaged:
- *       G_ij = (A_i Fhat_ij + A_j Fhat_ji) / 2;
+ *   - the unoccluded transfer G_ij = A_i Fhat_ij is Lambert's contour formula (contour.c)
+ *     integrated over the smaller patch by the midpoint rule on an m x m split; for pairs
+ *     close to each other the split is finer and the estimates from both sides are
+ *     averaged, weighted towards the smaller patch;
  *   - visibility is the fraction of segments between jittered stratified points of the
  *     two patches that no triangle of the scene blocks: 2 x 2 segments first; when they
  *     disagree (a shadow boundary crosses the pair) the full k x k set decides.
@@ -308,10 +308,17 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
             continue;
         bool near = v3_length(v3_sub(gi->centroid, gj->centroid)) <
                     NEAR_DISTANCE * (gi->radius + gj->radius);
-        /* both one-sided estimates, the smaller patch's trusted more: its quadrature
-         * points are finer relative to the distance between the two */
-        double wi = 1.0 / (gi->radius * gi->radius), wj = 1.0 / (gj->radius * gj->radius);
-        double G = (wi * transfer(e, i, j, near) + wj * transfer(e, j, i, near)) / (wi + wj);
+        double G;
+        if (near) {
+            /* both one-sided estimates, the smaller patch's trusted more: its quadrature
+             * points are finer relative to the distance between the two */
+            double wi = 1.0 / (gi->radius * gi->radius), wj = 1.0 / (gj->radius * gj->radius);
+            G = (wi * transfer(e, i, j, true) + wj * transfer(e, j, i, true)) / (wi + wj);
+        } else {
+            /* far apart, the two estimates agree to the midpoint rule's small error: one
+             * suffices, from the smaller patch */
+            G = gi->radius <= gj->radius ? transfer(e, i, j, false) : transfer(e, j, i, false);
+        }
         if (!(G > 0))
             continue;
         w->pairs_facing++;
