@@ -183,7 +183,8 @@ static struct {
     double last_time;
     char phase[64];
     double phase_start;
-} progress = {-1, false, 0, "", 0};
+    double last_fraction;
+} progress = {-1, false, 0, "", 0, 0};
 
 bool cli_progress_enabled(void)
 {
@@ -202,12 +203,18 @@ void cli_progress(void *user, const char *phase, double fraction)
         snprintf(progress.phase, sizeof(progress.phase), "%s", phase);
         progress.phase_start = now;
         progress.last_time = 0;
+        progress.last_fraction = 0;
+    } else if (progress.last_fraction >= 1) {
+        return; /* this phase's closing line is already out */
     }
     if (fraction < 1 && now - progress.last_time < 0.1)
         return;
     progress.last_time = now;
+    progress.last_fraction = fraction;
     double elapsed = now - progress.phase_start;
-    if (fraction > 0.02 && fraction < 1)
+    if (fraction >= 1)
+        fprintf(stderr, "\r%-14s done in %.2f s            ", phase, elapsed);
+    else if (fraction > 0.02)
         fprintf(stderr, "\r%-14s %5.1f%%  %6.1f s left   ", phase, 100 * fraction,
                 elapsed * (1 - fraction) / fraction);
     else
