@@ -268,7 +268,9 @@ typedef struct rad_formfactor_report {
     uint64_t pairs_facing;     /* pairs that face each other and needed work */
     uint64_t pairs_refined;    /* pairs the first 2 x 2 segments found partly occluded */
     uint64_t rays;             /* occlusion rays cast */
-    double seconds;
+    double seconds;            /* wall-clock time of the whole computation */
+    double tracing_seconds;    /* time spent tracing, summed over threads */
+    int threads;               /* threads used */
 } rad_formfactor_report;
 
 /* The dense n x n matrix, row-major: F[i * n + j] = F_ij. Reciprocity holds exactly by

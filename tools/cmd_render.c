@@ -332,6 +332,12 @@ int command_render(int argc, char **argv)
         stats_integer(&stats, "rays_cast", ff_report.rays);
         stats_number(&stats, "rays_per_second",
                      ff_report.seconds > 0 ? ff_report.rays / ff_report.seconds : 0);
+        /* the tracer's own rate: rays per second of tracing per thread, times threads */
+        stats_integer(&stats, "threads", (unsigned long long)ff_report.threads);
+        stats_number(&stats, "tracing_rays_per_second",
+                     ff_report.tracing_seconds > 0
+                         ? ff_report.rays / (ff_report.tracing_seconds / ff_report.threads)
+                         : 0);
         stats_number(&stats, "seconds_load", t_load - t0);
         stats_number(&stats, "seconds_mesh", t_mesh - t_load);
         stats_number(&stats, "seconds_form_factors", t_ff - t_mesh);
