@@ -292,10 +292,18 @@ rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occlu
 
 void rad_formfactors_destroy(rad_formfactors *formfactors);
 
-/* Largest |A_i F_ij - A_j F_ji| / max(A_i F_ij, A_j F_ji) over pairs with a factor above
- * 1e-6, and largest |sum_j F_ij - 1| over patches (meaningful for closed scenes). */
+/* The physical invariants of a form-factor matrix, measured. */
+typedef struct rad_formfactor_check {
+    double reciprocity;     /* largest |A_i F_ij - A_j F_ji| / max(A_i F_ij, A_j F_ji) over
+                               pairs with a factor above 1e-6 */
+    double largest_row_sum; /* max_i sum_j F_ij: above 1 means a row creates energy */
+    double closure;         /* max_i |sum_j F_ij - 1|: meaningful for closed scenes only */
+    double largest_factor;  /* max F_ij */
+    uint32_t empty_rows;    /* patches that see nothing (hidden, or facing out of the scene) */
+} rad_formfactor_check;
+
 void rad_formfactors_check(const rad_formfactors *formfactors, const rad_mesh *mesh,
-                           double *reciprocity_residual, double *closure_residual);
+                           rad_formfactor_check *check);
 
 /* The surface-to-surface view-factor matrix: F_IJ = sum over patches i of I, j of J of
  * A_i F_ij / A_I, computed pair by pair without storing the patch matrix. `matrix` receives

@@ -249,7 +249,8 @@ int command_render(int argc, char **argv)
     rad_image *image = NULL;
     rad_formfactor_report ff_report = {0};
     rad_solve_report solve_report = {0};
-    double reciprocity = 0, closure = 0;
+    rad_formfactor_check check = {0};
+    double t_check = 0;
     double t0 = cli_now(), t_load, t_mesh, t_ff, t_solve, t_render, t_write;
 
     rad_load_options load = {cli_log, NULL};
@@ -286,8 +287,9 @@ int command_render(int argc, char **argv)
     status = rad_formfactors_compute(mesh, occluders, &s.formfactor, &ff, &ff_report, &error);
     if (status != RAD_OK)
         goto fail;
-    rad_formfactors_check(ff, mesh, &reciprocity, &closure);
     t_ff = cli_now();
+    rad_formfactors_check(ff, mesh, &check);
+    t_check = cli_now() - t_ff;
 
     status = rad_system_from_mesh(scene, mesh, ff, &system, &error);
     if (status != RAD_OK)
@@ -341,7 +343,7 @@ int command_render(int argc, char **argv)
         stats_number(&stats, "seconds_load", t_load - t0);
         stats_number(&stats, "seconds_mesh", t_mesh - t_load);
         stats_number(&stats, "seconds_form_factors", t_ff - t_mesh);
-        stats_number(&stats, "seconds_solve", t_solve - t_ff);
+        stats_number(&stats, "seconds_solve", t_solve - t_ff - t_check);
         stats_number(&stats, "seconds_render", t_render - t_solve);
         stats_number(&stats, "seconds_write", t_write - t_render);
         stats_number(&stats, "seconds_total", t_write - t0);
@@ -352,8 +354,12 @@ int command_render(int argc, char **argv)
         stats_number(&stats, "solver_criterion", solve_report.criterion);
         stats_number(&stats, "final_residual", solve_report.residual);
         stats_bool(&stats, "converged", solve_report.converged);
-        stats_number(&stats, "reciprocity_residual", reciprocity);
-        stats_number(&stats, "closure_residual", closure);
+        stats_number(&stats, "seconds_check", t_check);
+        stats_number(&stats, "reciprocity_residual", check.reciprocity);
+        stats_number(&stats, "largest_row_sum", check.largest_row_sum);
+        stats_number(&stats, "closure_residual", check.closure);
+        stats_number(&stats, "largest_form_factor", check.largest_factor);
+        stats_integer(&stats, "patches_seeing_nothing", check.empty_rows);
         stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
         stats_integer(&stats, "width", s.width);
         stats_integer(&stats, "height", s.height);

@@ -68,28 +68,47 @@ void rad_formfactors_destroy(rad_formfactors *formfactors)
     free(formfactors);
 }
 
+/* Pairs are compared tile by tile so that both F_ij and F_ji are read from cache. */
+#define CHECK_TILE 64u
+
 void rad_formfactors_check(const rad_formfactors *ff, const rad_mesh *mesh,
-                           double *reciprocity_residual, double *closure_residual)
+                           rad_formfactor_check *check)
 {
     size_t n = ff->n;
-    double reciprocity = 0, closure = 0;
-    for (size_t i = 0; i < n; i++) {
-        double row = 0;
-        for (size_t j = 0; j < n; j++) {
-            double fij = ff->F[i * n + j];
-            row += fij;
-            if (j <= i)
-                continue;
-            double a = mesh->patches[i].area * fij;
-            double b = mesh->patches[j].area * ff->F[j * n + i];
-            double larger = fmax(a, b);
-            if (fmax(fij, ff->F[j * n + i]) > 1e-6 && larger > 0)
-                reciprocity = fmax(reciprocity, fabs(a - b) / larger);
+    const float *F = ff->F;
+    double reciprocity = 0, largest_row = 0, closure = 0, largest = 0;
+    uint32_t empty = 0;
+    long long tiles = (long long)((n + CHECK_TILE - 1) / CHECK_TILE);
+#pragma omp parallel for schedule(dynamic, 1) reduction(max : reciprocity)
+    for (long long ti = 0; ti < tiles; ti++) {
+        size_t i0 = (size_t)ti * CHECK_TILE, i1 = i0 + CHECK_TILE < n ? i0 + CHECK_TILE : n;
+        for (size_t j0 = i0; j0 < n; j0 += CHECK_TILE) {
+            size_t j1 = j0 + CHECK_TILE < n ? j0 + CHECK_TILE : n;
+            for (size_t i = i0; i < i1; i++)
+                for (size_t j = j0 > i + 1 ? j0 : i + 1; j < j1; j++) {
+                    double fij = F[i * n + j], fji = F[j * n + i];
+                    if (fmax(fij, fji) <= 1e-6)
+                        continue;
+                    double a = mesh->patches[i].area * fij, b = mesh->patches[j].area * fji;
+                    reciprocity = fmax(reciprocity, fabs(a - b) / fmax(a, b));
+                }
         }
-        closure = fmax(closure, fabs(row - 1));
     }
-    if (reciprocity_residual)
-        *reciprocity_residual = reciprocity;
-    if (closure_residual)
-        *closure_residual = closure;
+#pragma omp parallel for reduction(max : largest_row, closure, largest) reduction(+ : empty)
+    for (size_t i = 0; i < n; i++) {
+        double row = 0, row_largest = 0;
+        for (size_t j = 0; j < n; j++) {
+            row += F[i * n + j];
+            row_largest = fmax(row_largest, F[i * n + j]);
+        }
+        largest_row = fmax(largest_row, row);
+        closure = fmax(closure, fabs(row - 1));
+        largest = fmax(largest, row_largest);
+        empty += row == 0;
+    }
+    check->reciprocity = reciprocity;
+    check->largest_row_sum = largest_row;
+    check->closure = closure;
+    check->largest_factor = largest;
+    check->empty_rows = empty;
 }
