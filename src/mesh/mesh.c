@@ -6,8 +6,8 @@
  *      a plane form one smooth region (union-find over shared edges). Values are interpolated across patch
  *      boundaries inside a region and kept apart between regions, so creases stay sharp.
  *   2. Quads: two triangles of one region whose longest edges are the same edge (a quad
- *      split along its diagonal, as exporters do) are merged back into a convex quad,
- *      which subdivides into a regular grid of quad patches.
+ *      split along its diagonal, as exporters do) are merged back into a quad when it is
+ *      flat and convex; it subdivides into a regular grid of quad patches.
  *   3. Subdivision: a quad into nu x nv bilinear cells, a triangle into n^2 similar
  *      triangles, each edge no longer than the patch size. Points on an input edge are
  *      computed from that edge's lower-numbered end, so two polygons that split a shared
@@ -183,14 +183,31 @@ static uint32_t divisions(double length, double patch_size)
     return n < 1 ? 1 : n > 65535 ? 65535 : (uint32_t)n;
 }
 
+/* How a polygon is split: a triangle into n^2 (n returned in *nu), a quad into nu x nv. */
+static void polygon_divisions(const rad_scene *scene, const polygon *poly, double patch_size,
+                              uint32_t *nu, uint32_t *nv)
+{
+    rad_vec3 q[4];
+    for (uint32_t k = 0; k < poly->count; k++)
+        q[k] = scene->positions[poly->vertex[k]];
+    if (poly->count == 3) {
+        double longest = fmax(v3_length(v3_sub(q[1], q[0])),
+                              fmax(v3_length(v3_sub(q[2], q[1])), v3_length(v3_sub(q[0], q[2]))));
+        *nu = divisions(longest, patch_size);
+        *nv = *nu;
+        return;
+    }
+    *nu = divisions(fmax(v3_length(v3_sub(q[1], q[0])), v3_length(v3_sub(q[2], q[3]))), patch_size);
+    *nv = divisions(fmax(v3_length(v3_sub(q[3], q[0])), v3_length(v3_sub(q[2], q[1]))), patch_size);
+}
+
 static int subdivide_triangle(mesh_output *out, const polygon *poly, double patch_size)
 {
     const rad_scene *scene = out->in->scene;
     const uint32_t *v = poly->vertex;
     rad_vec3 a = scene->positions[v[0]], b = scene->positions[v[1]], c = scene->positions[v[2]];
-    double longest = fmax(v3_length(v3_sub(b, a)),
-                          fmax(v3_length(v3_sub(c, b)), v3_length(v3_sub(a, c))));
-    uint32_t n = divisions(longest, patch_size);
+    uint32_t n, unused;
+    polygon_divisions(scene, poly, patch_size, &n, &unused);
     /* grid point (i, j): a + i/n (b - a) + j/n (c - a), i + j <= n */
 #define GRID(i, j)                                                                          \
     ((j) == 0           ? edge_point(scene, v[0], v[1], (i), n)                             \
@@ -220,10 +237,8 @@ static int subdivide_quad(mesh_output *out, const polygon *poly, double patch_si
     rad_vec3 q[4];
     for (int k = 0; k < 4; k++)
         q[k] = scene->positions[v[k]];
-    uint32_t nu = divisions(fmax(v3_length(v3_sub(q[1], q[0])), v3_length(v3_sub(q[2], q[3]))),
-                            patch_size);
-    uint32_t nv = divisions(fmax(v3_length(v3_sub(q[3], q[0])), v3_length(v3_sub(q[2], q[1]))),
-                            patch_size);
+    uint32_t nu, nv;
+    polygon_divisions(scene, poly, patch_size, &nu, &nv);
     /* grid point (i, j) at s = i/nu, t = j/nv of the bilinear map over q0 q1 q2 q3 */
 #define GRID(i, j)                                                                          \
     ((j) == 0    ? edge_point(scene, v[0], v[1], (i), nu)                                   \
@@ -242,72 +257,50 @@ static int subdivide_quad(mesh_output *out, const polygon *poly, double patch_si
     return 1;
 }
 
-double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patches)
+/* The scene's polygons, ready to subdivide at any patch size. */
+typedef struct mesh_plan {
+    mesh_input in;
+    polygon *polygons;
+    size_t polygon_count;
+} mesh_plan;
+
+static void plan_free(mesh_plan *plan)
 {
-    double area = rad_scene_area(scene);
-    if (target_patches == 0)
-        target_patches = 1;
-    return sqrt(area / target_patches);
+    free(plan->in.normal);
+    free(plan->polygons);
+    memset(plan, 0, sizeof(*plan));
 }
 
-void rad_mesh_destroy(rad_mesh *mesh)
-{
-    if (!mesh)
-        return;
-    free(mesh->vertices);
-    free(mesh->patches);
-    free(mesh);
-}
-
-/* Patches a polygon will make, for the size check before subdividing. */
-static double patch_estimate(const rad_scene *scene, const polygon *poly, double patch_size)
-{
-    double longest = 0;
-    for (uint32_t k = 0; k < poly->count; k++) {
-        rad_vec3 e = v3_sub(scene->positions[poly->vertex[(k + 1) % poly->count]],
-                            scene->positions[poly->vertex[k]]);
-        longest = fmax(longest, v3_length(e));
-    }
-    double n = ceil(longest / patch_size);
-    return n * n;
-}
-
-rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **out,
-                          rad_error *error)
+/* Steps 1 and 2: regions and quads. */
+static rad_status plan_build(const rad_scene *scene, mesh_plan *plan, rad_error *error)
 {
     rad_status status = RAD_OK;
     uint32_t T = scene->triangle_count;
-    mesh_input in = {scene, NULL};
-    mesh_output result = {&in, {0}, NULL, 0, 0};
     edge_table edges = {NULL, 0};
     uint32_t *parent = NULL, *partner = NULL, *region_of_root = NULL;
-    polygon *polygons = NULL;
-    rad_mesh *mesh = NULL;
-    *out = NULL;
+    memset(plan, 0, sizeof(*plan));
+    plan->in.scene = scene;
 
-    if (!(patch_size > 0) || !isfinite(patch_size))
-        return rad_fail(error, RAD_ERR_INVALID, "patch size must be a positive number");
-
-    in.normal = rad_alloc_array(T, sizeof(*in.normal));
+    plan->in.normal = rad_alloc_array(T, sizeof(*plan->in.normal));
     parent = rad_alloc_array(T, sizeof(*parent));
     partner = rad_alloc_array(T, sizeof(*partner));
     region_of_root = rad_alloc_array(T, sizeof(*region_of_root));
-    polygons = rad_alloc_array(T, sizeof(*polygons));
+    plan->polygons = rad_alloc_array(T, sizeof(*plan->polygons));
     size_t edge_slots = 64;
     while (edge_slots < 6 * (size_t)T)
         edge_slots *= 2;
     edges.slots = rad_alloc_array(edge_slots, sizeof(*edges.slots));
     edges.mask = edge_slots - 1;
-    mesh = calloc(1, sizeof(*mesh));
-    if (!in.normal || !parent || !partner || !region_of_root || !polygons ||
-        !edges.slots || !mesh || !rad_weld_init(&result.weld, 16))
-        goto nomem;
-
+    if (!plan->in.normal || !parent || !partner || !region_of_root || !plan->polygons ||
+        !edges.slots) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory while building patches");
+        goto done;
+    }
+    mesh_input *in = &plan->in;
     for (uint32_t t = 0; t < T; t++) {
         const uint32_t *v = scene->triangles[t].vertex;
-        rad_vec3 n = v3_normalize(v3_cross(v3_sub(scene->positions[v[1]], scene->positions[v[0]]),
-                                           v3_sub(scene->positions[v[2]], scene->positions[v[0]])));
-        in.normal[t] = n;
+        in->normal[t] = v3_normalize(v3_cross(v3_sub(scene->positions[v[1]], scene->positions[v[0]]),
+                                              v3_sub(scene->positions[v[2]], scene->positions[v[0]])));
         parent[t] = t;
         partner[t] = UINT32_MAX;
     }
@@ -329,7 +322,7 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
             }
             if (slot->count++ == 1)
                 slot->other = t;
-            if (smooth_neighbours(&in, slot->triangle, t)) {
+            if (smooth_neighbours(in, slot->triangle, t)) {
                 uint32_t ra = find_root(parent, slot->triangle), rb = find_root(parent, t);
                 if (ra != rb)
                     parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
@@ -345,7 +338,9 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
             region_of_root[root] = region_count++;
     }
 
-    /* 2. quads: pair triangles across a shared longest edge */
+    /* 2. quads: pair triangles across a shared longest edge, when the four corners are
+     * flat and convex. A folded pair stays two triangles: patch points must lie on the
+     * input triangles, which are what blocks rays, or a patch would shadow itself. */
     for (uint32_t t = 0; t < T; t++) {
         if (partner[t] != UINT32_MAX)
             continue;
@@ -362,21 +357,18 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
         /* u must run the edge the other way: b -> a */
         if (w[m] != v[(k + 1) % 3] || w[(m + 1) % 3] != v[k])
             continue;
-        polygon quad = {{v[k], w[(m + 2) % 3], v[(k + 1) % 3], v[(k + 2) % 3]}, 4, t, 0};
-        rad_vec3 corner[4];
-        for (int c = 0; c < 4; c++)
-            corner[c] = scene->positions[quad.vertex[c]];
-        if (!convex_quad(corner, in.normal[t]))
+        rad_vec3 corner[4] = {scene->positions[v[k]], scene->positions[w[(m + 2) % 3]],
+                              scene->positions[v[(k + 1) % 3]], scene->positions[v[(k + 2) % 3]]};
+        double diagonal = v3_length(v3_sub(corner[2], corner[0]));
+        double lift = fabs(v3_dot(in->normal[t], v3_sub(corner[1], corner[0])));
+        if (lift > RAD_QUAD_FLATNESS * diagonal || !convex_quad(corner, in->normal[t]))
             continue;
         partner[t] = u;
         partner[u] = t;
     }
 
-    /* 3. subdivide every polygon */
-    size_t polygon_count = 0;
-    double estimate = 0;
     for (uint32_t t = 0; t < T; t++) {
-        polygon *poly = &polygons[polygon_count];
+        polygon *poly = &plan->polygons[plan->polygon_count];
         const uint32_t *v = scene->triangles[t].vertex;
         poly->triangle = t;
         poly->region = region_of_root[find_root(parent, t)];
@@ -394,23 +386,97 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
         } else {
             continue;
         }
-        estimate += patch_estimate(scene, poly, patch_size);
-        polygon_count++;
+        plan->polygon_count++;
     }
-    if (estimate > MESH_MAX_PATCHES) {
+done:
+    free(parent);
+    free(partner);
+    free(region_of_root);
+    free(edges.slots);
+    if (status != RAD_OK)
+        plan_free(plan);
+    return status;
+}
+
+/* The exact number of patches subdividing at this size makes. */
+static double plan_patch_count(const mesh_plan *plan, double patch_size)
+{
+    double count = 0;
+    for (size_t p = 0; p < plan->polygon_count; p++) {
+        uint32_t nu, nv;
+        polygon_divisions(plan->in.scene, &plan->polygons[p], patch_size, &nu, &nv);
+        count += (double)nu * nv;
+    }
+    return count;
+}
+
+double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patches)
+{
+    if (target_patches == 0)
+        target_patches = 1;
+    double fallback = sqrt(rad_scene_area(scene) / target_patches);
+    mesh_plan plan;
+    if (plan_build(scene, &plan, NULL) != RAD_OK)
+        return fallback;
+    /* the count falls as the size grows: bisect (in log space) for the size whose count is
+     * closest to the target */
+    rad_vec3 lo_corner, hi_corner;
+    rad_scene_bounds(scene, &lo_corner, &hi_corner);
+    double hi = v3_length(v3_sub(hi_corner, lo_corner)) * 2; /* one patch per polygon */
+    double lo = hi * 1e-7;
+    for (int step = 0; step < 60 && hi / lo > 1 + 1e-6; step++) {
+        double mid = sqrt(lo * hi);
+        if (plan_patch_count(&plan, mid) > target_patches)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    double below = plan_patch_count(&plan, hi), above = plan_patch_count(&plan, lo);
+    double size = fabs(above - target_patches) < fabs(below - target_patches) ? lo : hi;
+    plan_free(&plan);
+    return size > 0 ? size : fallback;
+}
+
+void rad_mesh_destroy(rad_mesh *mesh)
+{
+    if (!mesh)
+        return;
+    free(mesh->vertices);
+    free(mesh->patches);
+    free(mesh);
+}
+
+rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **out,
+                          rad_error *error)
+{
+    *out = NULL;
+    if (!(patch_size > 0) || !isfinite(patch_size))
+        return rad_fail(error, RAD_ERR_INVALID, "patch size must be a positive number");
+    mesh_plan plan;
+    rad_status status = plan_build(scene, &plan, error);
+    if (status != RAD_OK)
+        return status;
+    mesh_output result = {&plan.in, {0}, NULL, 0, 0};
+    rad_mesh *mesh = calloc(1, sizeof(*mesh));
+    if (!mesh || !rad_weld_init(&result.weld, 16))
+        goto nomem;
+
+    /* 3. subdivide every polygon */
+    double count = plan_patch_count(&plan, patch_size);
+    if (count > MESH_MAX_PATCHES) {
         status = rad_fail(error, RAD_ERR_INVALID,
-                          "patch size %g would make about %.0f patches (limit %u): use a "
-                          "larger --patch-size",
-                          patch_size, estimate, MESH_MAX_PATCHES);
+                          "patch size %g would make %.0f patches (limit %u): use a larger "
+                          "--patch-size",
+                          patch_size, count, MESH_MAX_PATCHES);
         goto done;
     }
-    for (size_t p = 0; p < polygon_count; p++) {
-        int ok = polygons[p].count == 3 ? subdivide_triangle(&result, &polygons[p], patch_size)
-                                        : subdivide_quad(&result, &polygons[p], patch_size);
+    for (size_t p = 0; p < plan.polygon_count; p++) {
+        int ok = plan.polygons[p].count == 3
+                     ? subdivide_triangle(&result, &plan.polygons[p], patch_size)
+                     : subdivide_quad(&result, &plan.polygons[p], patch_size);
         if (!ok)
             goto nomem;
     }
-
     mesh->patch_count = (uint32_t)result.patch_count;
     mesh->patches = result.patches;
     result.patches = NULL;
@@ -425,12 +491,7 @@ nomem:
 done:
     rad_weld_free(&result.weld);
     free(result.patches);
-    free(in.normal);
-    free(parent);
-    free(partner);
-    free(region_of_root);
-    free(polygons);
-    free(edges.slots);
+    plan_free(&plan);
     rad_mesh_destroy(mesh);
     return status;
 }
