@@ -27,8 +27,10 @@
  * matching *_destroy; passing NULL to a *_destroy is harmless.
  *
  * Threads: functions that take a `threads` field run in parallel with OpenMP (0 means all
- * cores). Results do not depend on the thread count: every random number is derived from
- * the seed and the item being computed, never from the thread that computes it.
+ * cores). Every random number is derived from the seed and the item being computed, never
+ * from the thread that computes it, so form-factor matrices, solutions and images are
+ * bitwise the same for any thread count; surface view factors are summed in per-thread
+ * tables and may differ in the last digits (relative 1e-15).
  */
 #ifndef RADIOSITY_H
 #define RADIOSITY_H
@@ -36,6 +38,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -433,6 +436,10 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
  * surface. Atomic like rad_image_write. */
 rad_status rad_viewfactors_write_csv(const rad_scene *scene, const double *matrix,
                                      const char *path, rad_error *error);
+
+/* The same CSV to an open stream (standard output, say). */
+rad_status rad_viewfactors_print_csv(const rad_scene *scene, const double *matrix, FILE *stream,
+                                     rad_error *error);
 
 /* Writes `size` bytes to path atomically (temporary name, then rename). */
 rad_status rad_write_file_atomic(const char *path, const void *data, size_t size,

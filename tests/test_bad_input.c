@@ -4,6 +4,7 @@
  * and no output file (nor temporary file) is left behind. Warnings keep the run going.
  */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "testlib.h"
@@ -60,6 +61,16 @@ int main(void)
     test_write_file("inf.obj", "mtllib lamp.mtl\nv 0 0 0\nv 1 0 0\nv 0 -inf 0\nusemtl lamp\nf 1 2 3\n");
     expect_error("inf", "render inf.obj -o out.png", 1, "inf.obj:4:");
 
+    /* a folder where a scene file should be */
+    expect_error("folder as scene", "render . -o out.png", 1, ".: cannot open: not a file");
+
+    /* a coordinate finite in double but not in single precision, and a scene too small to
+     * trace in single precision */
+    test_write_file("huge.obj", "v 0 0 0\nv 1e300 0 0\nv 0 1 0\nf 1 2 3\n");
+    expect_error("huge", "render huge.obj -o out.png", 1, "huge.obj:2:");
+    test_write_file("tiny.obj", "v 0 0 0\nv 1e-20 0 0\nv 0 1e-20 0\nf 1 2 3\n");
+    expect_error("tiny", "render tiny.obj -o out.png", 1, "tiny.obj: the scene spans");
+
     /* an unknown option is a usage error */
     expect_error("unknown option", "render --brightness 3 -o out.png", 2, "--brightness");
     expect_error("unknown command", "paint -o out.png", 2, "paint");
@@ -68,6 +79,10 @@ int main(void)
     /* an output path that cannot be written: checked before any work, nothing left */
     expect_error("unwritable", "render -o no/such/folder/out.png", 1, "no/such/folder/out.png");
     expect_error("unknown format", "render -o out.jpg", 2, "out.jpg");
+    if (system("mkdir -p '" RAD_TEST_TMP "/folder.png'") != 0)
+        test_fail(__FILE__, __LINE__, "mkdir failed");
+    expect_error("output is a folder", "render -o folder.png", 1, "folder.png: cannot write: it is a folder");
+    expect_error("stats is a folder", "render -o out.png --stats folder.png", 1, "folder.png");
 
     /* no emitter: a warning, a black image, success */
     test_write_file("dark.mtl", "newmtl grey\nKd 0.5 0.5 0.5\n");

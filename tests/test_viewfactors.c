@@ -204,6 +204,63 @@ static void check_occluders(void)
     CHECK(csv_value(csv, "blocker", "two") > 0);
 }
 
+/* Coaxial parallel disks as triangle fans (VALIDATION.md section 1). The fan polygon has
+ * a little less area than the disk; the disk of equal area is the reference. */
+static double coaxial_disks(double r1, double r2, double L)
+{
+    double R1 = r1 / L, R2 = r2 / L, S = 1 + (1 + R2 * R2) / (R1 * R1);
+    return 0.5 * (S - sqrt(S * S - 4 * (r2 / r1) * (r2 / r1)));
+}
+
+static void check_disks(double r1, double r2, double L)
+{
+    enum { SEGMENTS = 96 };
+    size_t n = 0;
+    obj[0] = 0;
+    /* disk one at z = 0 facing +z, disk two at z = L facing -z */
+    for (int d = 0; d < 2; d++) {
+        double r = d ? r2 : r1, z = d ? L : 0;
+        n += (size_t)snprintf(obj + n, sizeof(obj) - n, "o disk%d\nv 0 0 %.17g\n", d + 1, z);
+        for (int k = 0; k < SEGMENTS; k++) {
+            double a = 2 * pi * k / SEGMENTS;
+            n += (size_t)snprintf(obj + n, sizeof(obj) - n, "v %.17g %.17g %.17g\n", r * cos(a),
+                                  r * sin(a), z);
+        }
+        int centre = d * (SEGMENTS + 1) + 1;
+        for (int k = 0; k < SEGMENTS; k++) {
+            int a = centre + 1 + k, b = centre + 1 + (k + 1) % SEGMENTS;
+            if (d == 0)
+                n += (size_t)snprintf(obj + n, sizeof(obj) - n, "f %d %d %d\n", centre, a, b);
+            else
+                n += (size_t)snprintf(obj + n, sizeof(obj) - n, "f %d %d %d\n", centre, b, a);
+        }
+    }
+    const char *csv = run_viewfactors("disks", "");
+    double shrink = sqrt(SEGMENTS * sin(2 * pi / SEGMENTS) / (2 * pi)); /* equal-area radius */
+    double expected = coaxial_disks(r1 * shrink, r2 * shrink, L);
+    printf("coaxial disks r1=%g r2=%g L=%g: F12 %.7f expected %.7f (disk %.7f)\n", r1, r2, L,
+           csv_value(csv, "disk1", "disk2"), expected, coaxial_disks(r1, r2, L));
+    CHECK_NEAR(csv_value(csv, "disk1", "disk2"), expected, 0.005);
+    CHECK_NEAR(csv_value(csv, "disk1", "disk2"), coaxial_disks(r1, r2, L), 0.005);
+    /* reciprocity through the areas of the two fans */
+    CHECK_NEAR(r1 * r1 * csv_value(csv, "disk1", "disk2"), r2 * r2 * csv_value(csv, "disk2", "disk1"),
+               1e-6);
+}
+
+/* One-sided surfaces: plates that turn their backs on each other exchange nothing. */
+static void check_one_sided(void)
+{
+    int v = 0;
+    obj[0] = 0;
+    const double bottom[4][3] = {{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}}; /* faces -z */
+    const double top[4][3] = {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};    /* faces +z */
+    add_quad(obj, sizeof(obj), &v, "one", bottom);
+    add_quad(obj, sizeof(obj), &v, "two", top);
+    const char *csv = run_viewfactors("backs", "");
+    CHECK(csv_value(csv, "one", "two") == 0);
+    CHECK(csv_value(csv, "two", "one") == 0);
+}
+
 int main(void)
 {
     CHECK_NEAR(parallel_rectangles(1, 1, 1), 0.1998249, 1e-6);
@@ -223,5 +280,8 @@ int main(void)
     check_perpendicular(0.2, 3, 1.5);
     check_cube();
     check_occluders();
+    check_disks(1, 1, 1);
+    check_disks(0.5, 2, 1);
+    check_one_sided();
     return test_finish("test_viewfactors");
 }

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 void cli_error(const char *format, ...)
@@ -306,6 +307,31 @@ bool stats_write(cli_stats *stats, const char *path)
     rad_error error;
     if (rad_write_file_atomic(path, stats->text, stats->length, &error) != RAD_OK) {
         cli_error("%s", error.message);
+        return false;
+    }
+    return true;
+}
+
+/* The folder of path must exist and be writable, and path must not be a folder: checked
+ * before hours of work. */
+bool cli_output_writable(const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+        cli_error("%s: cannot write: it is a folder", path);
+        return false;
+    }
+    char folder[4096];
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(folder, sizeof(folder), ".");
+    else if (slash == path)
+        snprintf(folder, sizeof(folder), "/");
+    else
+        snprintf(folder, sizeof(folder), "%.*s", (int)(slash - path), path);
+    if (access(folder, W_OK) != 0) {
+        cli_error("%s: cannot write: folder '%s' does not exist or is not writable", path,
+                  folder);
         return false;
     }
     return true;

@@ -66,6 +66,9 @@ void stats_bool(cli_stats *stats, const char *key, bool value);
 /* Closes the object and writes it atomically; false (after printing) on failure. */
 bool stats_write(cli_stats *stats, const char *path);
 
+/* Prints an error and returns false when path is a folder or its folder is not writable. */
+bool cli_output_writable(const char *path);
+
 int command_render(int argc, char **argv);
 int command_viewfactors(int argc, char **argv);
 

@@ -7,7 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <unistd.h>
 
 #include "cli.h"
 
@@ -74,26 +73,6 @@ static bool image_extension_ok(const char *path)
                    strcasecmp(dot, ".pfm") == 0);
 }
 
-/* The folder of path must exist and be writable: checked before hours of work. */
-bool cli_output_writable(const char *path);
-bool cli_output_writable(const char *path)
-{
-    char folder[4096];
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        snprintf(folder, sizeof(folder), ".");
-    else if (slash == path)
-        snprintf(folder, sizeof(folder), "/");
-    else
-        snprintf(folder, sizeof(folder), "%.*s", (int)(slash - path), path);
-    if (access(folder, W_OK) != 0) {
-        cli_error("%s: cannot write: folder '%s' does not exist or is not writable", path,
-                  folder);
-        return false;
-    }
-    return true;
-}
-
 typedef struct render_settings {
     const char *scene_path, *output, *stats_path;
     rad_camera camera;
@@ -156,9 +135,10 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
         return false;
     }
     if (args.value[OPT_SPP]) {
-        if (!cli_parse_uint("spp", args.value[OPT_SPP], 256, &value) || value == 0) {
-            if (value == 0)
-                cli_error("--spp: must be at least 1");
+        if (!cli_parse_uint("spp", args.value[OPT_SPP], 256, &value))
+            return false;
+        if (value == 0) {
+            cli_error("--spp: must be at least 1");
             return false;
         }
         s->render.samples_per_pixel = (uint32_t)value;

@@ -47,8 +47,6 @@ static const cli_option options[OPT_COUNT] = {
 #define DEFAULT_TARGET_PATCHES 1500u
 #define DEFAULT_QUADRATURE 3u
 
-bool cli_output_writable(const char *path);
-
 int command_viewfactors(int argc, char **argv)
 {
     cli_args args;
@@ -157,16 +155,9 @@ int command_viewfactors(int argc, char **argv)
         if (status != RAD_OK)
             goto fail;
     } else {
-        printf("surface");
-        for (size_t j = 0; j < S; j++)
-            printf(",%s", scene->surfaces[j].name);
-        printf("\n");
-        for (size_t i = 0; i < S; i++) {
-            printf("%s", scene->surfaces[i].name);
-            for (size_t j = 0; j < S; j++)
-                printf(",%.9g", matrix[i * S + j]);
-            printf("\n");
-        }
+        status = rad_viewfactors_print_csv(scene, matrix, stdout, &error);
+        if (status != RAD_OK)
+            goto fail;
     }
     if (stats_path) {
         cli_stats stats;

@@ -8,6 +8,11 @@
  * squared (dimensionless): collinear or repeated corners, whatever the scene's unit. */
 #define RAD_DEGENERATE_RELATIVE_AREA 1e-9
 
+/* Scenes are traced in single precision: the scene must span at least this many units
+ * (squared distances of 1e-20 and below underflow) and no coordinate may exceed this. */
+#define RAD_SMALLEST_EXTENT 1e-9
+#define RAD_LARGEST_COORDINATE 1e15
+
 /* Two triangles sharing an edge belong to one smooth region when their unit normals differ
  * by less than this (dimensionless: 2 sin(0.5 deg), a 1 degree crease). Real data is not
  * exactly planar: the Cornell box's left wall folds by 0.47 degrees along its diagonal. */

@@ -10,6 +10,10 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/memory.h"
+
+/* The dense matrix may take at most this share of the machine's physical memory. */
+#define MATRIX_MEMORY_SHARE 0.75
 #include "formfactor/pair_engine.h"
 
 typedef struct dense_sink {
@@ -37,6 +41,14 @@ rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occlu
         return rad_fail(error, RAD_ERR_INVALID, "the mesh has no patches");
     if (n > SIZE_MAX / n)
         return rad_fail(error, RAD_ERR_NOMEM, "%zu patches: the matrix size overflows", n);
+    /* calloc may succeed lazily and the kernel kill the process later: refuse up front */
+    uint64_t physical = rad_physical_memory_bytes();
+    double bytes = (double)n * n * sizeof(float);
+    if (physical && bytes > MATRIX_MEMORY_SHARE * (double)physical)
+        return rad_fail(error, RAD_ERR_NOMEM,
+                        "%zu patches need a %.1f GB form-factor matrix and this machine has "
+                        "%.1f GB: use a larger --patch-size",
+                        n, bytes / 1e9, (double)physical / 1e9);
     rad_formfactors *result = calloc(1, sizeof(*result));
     float *F = rad_alloc_array(n * n, sizeof(*F));
     if (!result || !F) {

@@ -13,11 +13,13 @@
 #include <assimp/scene.h>
 #include <ctype.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 #include "core/alloc.h"
 #include "core/error.h"
@@ -61,11 +63,13 @@ static rad_status check_obj(const char *path, FILE *file, rad_error *error)
                 *--end = 0;
             char library[8192 + 4096];
             snprintf(library, sizeof(library), "%s%s", name[0] == '/' ? "" : folder, name);
-            FILE *mtl = fopen(library, "rb");
-            if (!mtl)
+            struct stat st;
+            if (stat(library, &st) != 0)
                 return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s' not found",
                                 path, number, name);
-            fclose(mtl);
+            if (!S_ISREG(st.st_mode))
+                return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s' is not a file",
+                                path, number, name);
         } else if (p[0] == 'v' && (p[1] == ' ' || p[1] == '\t')) {
             char *cursor = p + 2;
             for (int k = 0; k < 3; k++) {
@@ -77,6 +81,10 @@ static rad_status check_obj(const char *path, FILE *file, rad_error *error)
                     return rad_fail(error, RAD_ERR_PARSE,
                                     "%s:%lu: vertex coordinate is not a finite number", path,
                                     number);
+                if (fabs(value) > FLT_MAX)
+                    return rad_fail(error, RAD_ERR_PARSE,
+                                    "%s:%lu: vertex coordinate %g is beyond single precision",
+                                    path, number, value);
                 cursor = end;
             }
         }
@@ -208,6 +216,11 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
     FILE *file = fopen(path, "rb");
     if (!file)
         return rad_fail(error, RAD_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fileno(file), &st) != 0 || !S_ISREG(st.st_mode)) {
+        fclose(file);
+        return rad_fail(error, RAD_ERR_IO, "%s: cannot open: not a file", path);
+    }
     rad_status status = RAD_OK;
     if (has_extension(path, ".obj"))
         status = check_obj(path, file, error);

@@ -21,6 +21,7 @@
 typedef struct raw_triangle {
     rad_vec3 corner[3];
     uint32_t material, surface;
+    uint32_t order; /* position in the input: keeps the sort by surface stable */
 } raw_triangle;
 
 struct scene_builder {
@@ -138,6 +139,7 @@ rad_status scene_builder_triangle(scene_builder *b, uint32_t surface, uint32_t m
     t->corner[2] = c2;
     t->material = material;
     t->surface = surface;
+    t->order = (uint32_t)(b->triangle_count - 1);
     return RAD_OK;
 }
 
@@ -163,8 +165,7 @@ static int compare_surface(const void *a, const void *b)
     const raw_triangle *x = a, *y = b;
     if (x->surface != y->surface)
         return x->surface < y->surface ? -1 : 1;
-    /* stable: raw triangles are compared by address when in the same surface */
-    return (x > y) - (x < y);
+    return (x->order > y->order) - (x->order < y->order);
 }
 
 static void check_material(scene_builder *b, rad_material *m)
@@ -210,6 +211,27 @@ rad_status scene_builder_finish(scene_builder *b, rad_scene **out, rad_error *er
                                   b->source, b->surfaces[b->triangles[t].surface].name);
                 goto done;
             }
+    /* Rays are traced in single precision: squared lengths must neither underflow nor
+     * overflow. */
+    double largest = 0, lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t t = 0; t < b->triangle_count; t++)
+        for (int k = 0; k < 3; k++) {
+            const double *c = &b->triangles[t].corner[k].x;
+            for (int a = 0; a < 3; a++) {
+                largest = fmax(largest, fabs(c[a]));
+                lo[a] = fmin(lo[a], c[a]);
+                hi[a] = fmax(hi[a], c[a]);
+            }
+        }
+    double extent = b->triangle_count ? fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2])) : 1;
+    if (largest > RAD_LARGEST_COORDINATE || extent < RAD_SMALLEST_EXTENT) {
+        status = rad_fail(error, RAD_ERR_INVALID,
+                          "%s: the scene spans %g units with coordinates up to %g: beyond what "
+                          "single-precision ray tracing resolves (extent at least %g, "
+                          "coordinates at most %g); rescale it",
+                          b->source, extent, largest, RAD_SMALLEST_EXTENT, RAD_LARGEST_COORDINATE);
+        goto done;
+    }
     for (size_t m = 0; m < b->material_count; m++)
         check_material(b, &b->materials[m]);
 
