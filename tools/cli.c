@@ -4,6 +4,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -168,6 +169,45 @@ bool cli_parse_size(const char *name, const char *text, uint32_t *width, uint32_
 bad:
     cli_error("--%s: '%s' is not WIDTHxHEIGHT (1 to 32768 each)", name, text);
     return false;
+}
+
+bool cli_parse_shared(const cli_args *args, cli_shared *shared)
+{
+    unsigned long value;
+    memset(shared, 0, sizeof(*shared));
+    shared->seed = 1;
+    shared->output = args->value[OPT_OUTPUT];
+    shared->stats_path = args->value[OPT_STATS];
+    if (args->value[OPT_PATCH_SIZE]) {
+        if (!cli_parse_double("patch-size", args->value[OPT_PATCH_SIZE], &shared->patch_size))
+            return false;
+        if (!(shared->patch_size > 0)) {
+            cli_error("--patch-size: must be positive");
+            return false;
+        }
+    }
+    if (args->value[OPT_VISIBILITY_RAYS]) {
+        if (!cli_parse_uint("visibility-rays", args->value[OPT_VISIBILITY_RAYS], 256, &value))
+            return false;
+        shared->formfactor.visibility_rays = (uint32_t)value;
+    }
+    if (args->value[OPT_QUADRATURE]) {
+        if (!cli_parse_uint("quadrature", args->value[OPT_QUADRATURE], 8, &value))
+            return false;
+        shared->formfactor.quadrature = (uint32_t)value;
+    }
+    if (args->value[OPT_THREADS]) {
+        if (!cli_parse_uint("threads", args->value[OPT_THREADS], 1024, &value))
+            return false;
+        shared->threads = (int)value;
+    }
+    if (args->value[OPT_SEED] &&
+        !cli_parse_uint("seed", args->value[OPT_SEED], ULONG_MAX, &shared->seed))
+        return false;
+    shared->formfactor.threads = shared->threads;
+    shared->formfactor.seed = shared->seed;
+    shared->formfactor.progress = cli_progress;
+    return true;
 }
 
 double cli_now(void)

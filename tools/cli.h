@@ -33,6 +33,32 @@ typedef struct cli_args {
 bool cli_parse(const char *command, int argc, char **argv, const cli_option *options,
                int option_count, cli_args *args);
 
+/* The options every command that computes form factors shares. Each command's option
+ * table starts with CLI_SHARED_OPTIONS, so these indices are the same in every table. */
+enum {
+    OPT_OUTPUT, OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS, OPT_QUADRATURE, OPT_THREADS, OPT_SEED,
+    OPT_STATS, OPT_HELP, OPT_SHARED_COUNT
+};
+
+#define CLI_SHARED_OPTIONS                                                                 \
+    [OPT_OUTPUT] = {"output", 'o', true}, [OPT_PATCH_SIZE] = {"patch-size", 0, true},      \
+    [OPT_VISIBILITY_RAYS] = {"visibility-rays", 0, true},                                  \
+    [OPT_QUADRATURE] = {"quadrature", 0, true}, [OPT_THREADS] = {"threads", 0, true},      \
+    [OPT_SEED] = {"seed", 0, true}, [OPT_STATS] = {"stats", 0, true},                      \
+    [OPT_HELP] = {"help", 'h', false}
+
+/* What the shared options say; patch_size 0 = the command's default. */
+typedef struct cli_shared {
+    const char *output, *stats_path;
+    double patch_size;
+    rad_formfactor_options formfactor; /* quadrature, visibility rays, threads, seed, progress */
+    int threads;
+    unsigned long seed;
+} cli_shared;
+
+/* Parses the shared options (after cli_parse); false (after printing) on a bad value. */
+bool cli_parse_shared(const cli_args *args, cli_shared *shared);
+
 /* Value parsers: print "radiosity: --NAME: ..." and return false on a bad value. */
 bool cli_parse_double(const char *name, const char *text, double *out);
 bool cli_parse_uint(const char *name, const char *text, unsigned long max, unsigned long *out);

@@ -2,7 +2,6 @@
  * cmd_render.c - `radiosity render [SCENE] -o OUT [options]`: the whole pipeline, from a
  * scene (or the built-in Cornell box) to an image.
  */
-#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,13 +36,12 @@ static const char usage[] =
     "  -h, --help           this text\n";
 
 enum {
-    OPT_OUTPUT, OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE,
-    OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS,
-    OPT_QUADRATURE, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_HELP, OPT_COUNT
+    OPT_EYE = OPT_SHARED_COUNT, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE,
+    OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_COUNT
 };
 
 static const cli_option options[OPT_COUNT] = {
-    [OPT_OUTPUT] = {"output", 'o', true},
+    CLI_SHARED_OPTIONS,
     [OPT_EYE] = {"eye", 0, true},
     [OPT_TARGET] = {"target", 0, true},
     [OPT_UP] = {"up", 0, true},
@@ -54,13 +52,6 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_SOLVER] = {"solver", 0, true},
     [OPT_TOLERANCE] = {"tolerance", 0, true},
     [OPT_MAX_ITERATIONS] = {"max-iterations", 0, true},
-    [OPT_PATCH_SIZE] = {"patch-size", 0, true},
-    [OPT_VISIBILITY_RAYS] = {"visibility-rays", 0, true},
-    [OPT_QUADRATURE] = {"quadrature", 0, true},
-    [OPT_THREADS] = {"threads", 0, true},
-    [OPT_SEED] = {"seed", 0, true},
-    [OPT_STATS] = {"stats", 0, true},
-    [OPT_HELP] = {"help", 'h', false},
 };
 
 /* Patches the default patch size aims at. */
@@ -75,15 +66,13 @@ static bool image_extension_ok(const char *path)
 
 typedef struct render_settings {
     const char *scene_path, *output, *stats_path;
+    cli_shared shared;
     rad_camera camera;
     bool has_eye, has_target, has_up, has_fov;
     uint32_t width, height;
     rad_render_options render;
     rad_image_write_options write;
     rad_solve_options solve;
-    rad_formfactor_options formfactor;
-    double patch_size;
-    unsigned long seed;
 } render_settings;
 
 static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_code)
@@ -99,13 +88,14 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
     }
     memset(s, 0, sizeof(*s));
     s->width = s->height = 512;
-    s->seed = 1;
+    if (!cli_parse_shared(&args, &s->shared))
+        return false;
     if (args.positional_count > 1) {
         cli_error("render: one scene at most (see 'radiosity render --help')");
         return false;
     }
     s->scene_path = args.positional_count ? args.positional[0] : NULL;
-    s->output = args.value[OPT_OUTPUT];
+    s->output = s->shared.output;
     if (!s->output) {
         cli_error("render: no output file: give -o OUT.png, .hdr or .pfm");
         return false;
@@ -114,7 +104,7 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
         cli_error("%s: unknown image format (use .png, .hdr or .pfm)", s->output);
         return false;
     }
-    s->stats_path = args.value[OPT_STATS];
+    s->stats_path = s->shared.stats_path;
     unsigned long value;
     double number;
     if ((args.value[OPT_EYE] && !cli_parse_vec3("eye", args.value[OPT_EYE], &s->camera.eye)) ||
@@ -176,33 +166,9 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
             return false;
         s->solve.max_iterations = (uint32_t)value;
     }
-    if (args.value[OPT_PATCH_SIZE]) {
-        if (!cli_parse_double("patch-size", args.value[OPT_PATCH_SIZE], &s->patch_size))
-            return false;
-        if (!(s->patch_size > 0)) {
-            cli_error("--patch-size: must be positive");
-            return false;
-        }
-    }
-    if (args.value[OPT_VISIBILITY_RAYS]) {
-        if (!cli_parse_uint("visibility-rays", args.value[OPT_VISIBILITY_RAYS], 256, &value))
-            return false;
-        s->formfactor.visibility_rays = (uint32_t)value;
-    }
-    if (args.value[OPT_QUADRATURE]) {
-        if (!cli_parse_uint("quadrature", args.value[OPT_QUADRATURE], 8, &value))
-            return false;
-        s->formfactor.quadrature = (uint32_t)value;
-    }
-    if (args.value[OPT_THREADS]) {
-        if (!cli_parse_uint("threads", args.value[OPT_THREADS], 1024, &value))
-            return false;
-        s->formfactor.threads = s->solve.threads = s->render.threads = (int)value;
-    }
-    if (args.value[OPT_SEED] && !cli_parse_uint("seed", args.value[OPT_SEED], ULONG_MAX, &s->seed))
-        return false;
-    s->formfactor.seed = s->render.seed = s->seed;
-    s->formfactor.progress = s->solve.progress = s->render.progress = cli_progress;
+    s->solve.threads = s->render.threads = s->shared.threads;
+    s->render.seed = s->shared.seed;
+    s->solve.progress = s->render.progress = cli_progress;
     s->render.width = s->width;
     s->render.height = s->height;
     *exit_code = EXIT_OK;
@@ -254,7 +220,7 @@ int command_render(int argc, char **argv)
     if (s.has_fov)
         camera.fov_degrees = s.camera.fov_degrees;
 
-    double patch_size = s.patch_size > 0 ? s.patch_size
+    double patch_size = s.shared.patch_size > 0 ? s.shared.patch_size
                                          : rad_mesh_default_patch_size(scene, DEFAULT_TARGET_PATCHES);
     status = rad_mesh_build(scene, patch_size, &mesh, &error);
     if (status != RAD_OK)
@@ -264,7 +230,7 @@ int command_render(int argc, char **argv)
     status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &occluders, &error);
     if (status != RAD_OK)
         goto fail;
-    status = rad_formfactors_compute(mesh, occluders, &s.formfactor, &ff, &ff_report, &error);
+    status = rad_formfactors_compute(mesh, occluders, &s.shared.formfactor, &ff, &ff_report, &error);
     if (status != RAD_OK)
         goto fail;
     t_ff = cli_now();

@@ -2,7 +2,6 @@
  * cmd_viewfactors.c - `radiosity viewfactors SCENE [-o OUT.csv]`: the surface-to-surface
  * view-factor matrix, a surface being an OBJ object or group.
  */
-#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,21 +27,9 @@ static const char usage[] =
     "  --stats FILE.json    write counts, times and residuals\n"
     "  -h, --help           this text\n";
 
-enum {
-    OPT_OUTPUT, OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS, OPT_QUADRATURE, OPT_THREADS, OPT_SEED,
-    OPT_STATS, OPT_HELP, OPT_COUNT
-};
+enum { OPT_COUNT = OPT_SHARED_COUNT };
 
-static const cli_option options[OPT_COUNT] = {
-    [OPT_OUTPUT] = {"output", 'o', true},
-    [OPT_PATCH_SIZE] = {"patch-size", 0, true},
-    [OPT_VISIBILITY_RAYS] = {"visibility-rays", 0, true},
-    [OPT_QUADRATURE] = {"quadrature", 0, true},
-    [OPT_THREADS] = {"threads", 0, true},
-    [OPT_SEED] = {"seed", 0, true},
-    [OPT_STATS] = {"stats", 0, true},
-    [OPT_HELP] = {"help", 'h', false},
-};
+static const cli_option options[OPT_COUNT] = {CLI_SHARED_OPTIONS};
 
 #define DEFAULT_TARGET_PATCHES 1500u
 #define DEFAULT_QUADRATURE 3u
@@ -60,41 +47,14 @@ int command_viewfactors(int argc, char **argv)
         cli_error("viewfactors: give exactly one SCENE (see 'radiosity viewfactors --help')");
         return EXIT_USAGE;
     }
-    rad_formfactor_options ff = {0};
-    ff.quadrature = DEFAULT_QUADRATURE;
-    ff.seed = 1;
-    ff.progress = cli_progress;
-    double patch_size = 0;
-    unsigned long value;
-    if (args.value[OPT_PATCH_SIZE]) {
-        if (!cli_parse_double("patch-size", args.value[OPT_PATCH_SIZE], &patch_size))
-            return EXIT_USAGE;
-        if (!(patch_size > 0)) {
-            cli_error("--patch-size: must be positive");
-            return EXIT_USAGE;
-        }
-    }
-    if (args.value[OPT_VISIBILITY_RAYS]) {
-        if (!cli_parse_uint("visibility-rays", args.value[OPT_VISIBILITY_RAYS], 256, &value))
-            return EXIT_USAGE;
-        ff.visibility_rays = (uint32_t)value;
-    }
-    if (args.value[OPT_QUADRATURE]) {
-        if (!cli_parse_uint("quadrature", args.value[OPT_QUADRATURE], 8, &value))
-            return EXIT_USAGE;
-        ff.quadrature = (uint32_t)value;
-    }
-    if (args.value[OPT_THREADS]) {
-        if (!cli_parse_uint("threads", args.value[OPT_THREADS], 1024, &value))
-            return EXIT_USAGE;
-        ff.threads = (int)value;
-    }
-    if (args.value[OPT_SEED]) {
-        if (!cli_parse_uint("seed", args.value[OPT_SEED], ULONG_MAX, &value))
-            return EXIT_USAGE;
-        ff.seed = value;
-    }
-    const char *output = args.value[OPT_OUTPUT], *stats_path = args.value[OPT_STATS];
+    cli_shared shared;
+    if (!cli_parse_shared(&args, &shared))
+        return EXIT_USAGE;
+    rad_formfactor_options ff = shared.formfactor;
+    if (!args.value[OPT_QUADRATURE])
+        ff.quadrature = DEFAULT_QUADRATURE;
+    double patch_size = shared.patch_size;
+    const char *output = shared.output, *stats_path = shared.stats_path;
     if ((output && !cli_output_writable(output)) ||
         (stats_path && !cli_output_writable(stats_path)))
         return EXIT_ERROR;
