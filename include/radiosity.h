@@ -173,6 +173,10 @@ typedef struct rad_patch {
     double area;          /* scene units squared */
     rad_vec3 normal;      /* unit front normal */
     rad_vec3 centroid;
+    double bulge;         /* 0 for a planar patch; for a cell of a slightly folded quad
+                             (real data: the Cornell box's left wall folds by 0.47 degrees),
+                             how far it may lie behind the input triangles, which are what
+                             blocks rays: visibility rays leave from twice this in front */
 } rad_patch;
 
 /* Vertices are shared by the patches of one smooth region (coplanar input triangles of one

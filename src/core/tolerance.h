@@ -18,9 +18,9 @@
  * exactly planar: the Cornell box's left wall folds by 0.47 degrees along its diagonal. */
 #define RAD_REGION_NORMAL 0.01745
 
-/* Two triangles merge into a quad when the fourth corner lies within this fraction of the
- * diagonal from the first triangle's plane (dimensionless: float-rounded input data of a
- * flat quad passes, a fold does not). */
+/* A quad is flat when its fourth corner lies within this fraction of the diagonal from the
+ * first triangle's plane (dimensionless: float-rounded input data of a flat quad passes);
+ * a folded one records its bulge for the visibility rays. */
 #define RAD_QUAD_FLATNESS 1e-5
 
 /* Occlusion segments between two patches stop this far (as a fraction of the segment)

@@ -48,6 +48,10 @@ typedef struct patch_geometry {
     rad_vec3 centroid;
     double radius; /* largest distance from the centroid to a corner */
     double area;
+    /* the map from the unit square: quads P = o + s u + t v + s t w (bilinear);
+     * triangles P = o + sqrt(s) (u + t w), which is uniform in area */
+    rad_vec3 o, u, v, w;
+    rad_vec3 lift; /* added to sample points: 2 x bulge along the normal (folded quads) */
 } patch_geometry;
 
 typedef struct pending_pair {
@@ -84,13 +88,27 @@ int pair_engine_threads(const rad_formfactor_options *options)
  * area-preserving warp for triangles. */
 static rad_vec3 patch_point(const patch_geometry *g, double s, double t)
 {
-    const rad_vec3 *c = g->corner;
     if (g->corner_count == 4)
-        return v3_lerp(v3_lerp(c[0], c[1], s), v3_lerp(c[3], c[2], s), t);
+        return v3(g->o.x + s * g->u.x + t * g->v.x + s * t * g->w.x,
+                  g->o.y + s * g->u.y + t * g->v.y + s * t * g->w.y,
+                  g->o.z + s * g->u.z + t * g->v.z + s * t * g->w.z);
     double r = sqrt(s);
-    double u = 1 - r, v = t * r;
-    return v3_add(c[0], v3_add(v3_scale(v3_sub(c[1], c[0]), 1 - u - v),
-                               v3_scale(v3_sub(c[2], c[0]), v)));
+    return v3(g->o.x + r * (g->u.x + t * g->w.x), g->o.y + r * (g->u.y + t * g->w.y),
+              g->o.z + r * (g->u.z + t * g->w.z));
+}
+
+static void patch_map(patch_geometry *g)
+{
+    const rad_vec3 *c = g->corner;
+    g->o = c[0];
+    g->u = v3_sub(c[1], c[0]);
+    if (g->corner_count == 4) {
+        g->v = v3_sub(c[3], c[0]);
+        g->w = v3_add(v3_sub(c[2], c[1]), v3_sub(c[0], c[3]));
+    } else {
+        g->v = v3(0, 0, 0);
+        g->w = v3_sub(c[2], c[1]);
+    }
 }
 
 /* Midpoint rule on an m x m split: sub-cell centres (quads) or sub-triangle centroids. */
@@ -166,27 +184,35 @@ static void make_segments(const engine *e, uint32_t i, uint32_t j, unsigned k, u
     for (unsigned s = 0; s < count; s++)
         order[s] = (uint8_t)s;
     for (unsigned s = count; s > 1; s--) { /* shuffle which stratum of j pairs with which of i */
-        unsigned r = (unsigned)(rad_rng_next(&rng) % s);
+        unsigned r = (unsigned)(((rad_rng_next(&rng) >> 32) * s) >> 32); /* uniform in [0, s) */
         uint8_t swap = order[s - 1];
         order[s - 1] = order[r];
         order[r] = swap;
     }
-    for (unsigned s = 0; s < count; s++) {
-        unsigned si = s % k, ti = s / k, sj = order[s] % k, tj = order[s] / k;
-        rad_vec3 p = patch_point(&e->geometry[i], (si + rad_rng_uniform(&rng)) / k,
-                                 (ti + rad_rng_uniform(&rng)) / k);
-        rad_vec3 q = patch_point(&e->geometry[j], (sj + rad_rng_uniform(&rng)) / k,
-                                 (tj + rad_rng_uniform(&rng)) / k);
-        rad_ray *ray = &rays[s];
-        ray->origin[0] = (float)p.x;
-        ray->origin[1] = (float)p.y;
-        ray->origin[2] = (float)p.z;
-        ray->direction[0] = (float)(q.x - p.x);
-        ray->direction[1] = (float)(q.y - p.y);
-        ray->direction[2] = (float)(q.z - p.z);
-        ray->t_near = RAD_SEGMENT_END_EPSILON;
-        ray->t_far = 1.0f - RAD_SEGMENT_END_EPSILON;
-    }
+    const patch_geometry *gi = &e->geometry[i], *gj = &e->geometry[j];
+    const double inv_k = 1.0 / k, to_unit = 1.0 / 4294967296.0;
+    unsigned s = 0;
+    for (unsigned ti = 0; ti < k; ti++)
+        for (unsigned si = 0; si < k; si++, s++) {
+            /* four 32-bit jitters from two draws */
+            uint64_t a = rad_rng_next(&rng), b = rad_rng_next(&rng);
+            unsigned sj = order[s] % k, tj = order[s] / k;
+            rad_vec3 p = v3_add(patch_point(gi, (si + (double)(a >> 32) * to_unit) * inv_k,
+                                            (ti + (double)(a & 0xFFFFFFFFu) * to_unit) * inv_k),
+                                gi->lift);
+            rad_vec3 q = v3_add(patch_point(gj, (sj + (double)(b >> 32) * to_unit) * inv_k,
+                                            (tj + (double)(b & 0xFFFFFFFFu) * to_unit) * inv_k),
+                                gj->lift);
+            rad_ray *ray = &rays[s];
+            ray->origin[0] = (float)p.x;
+            ray->origin[1] = (float)p.y;
+            ray->origin[2] = (float)p.z;
+            ray->direction[0] = (float)(q.x - p.x);
+            ray->direction[1] = (float)(q.y - p.y);
+            ray->direction[2] = (float)(q.z - p.z);
+            ray->t_near = RAD_SEGMENT_END_EPSILON;
+            ray->t_far = 1.0f - RAD_SEGMENT_END_EPSILON;
+        }
 }
 
 /* A batch of pairs waiting for their segments to be traced. */
@@ -414,6 +440,8 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
             g->corner[k] = mesh->vertices[patch->vertex[k]];
         g->normal = patch->normal;
         g->area = patch->area;
+        patch_map(g);
+        g->lift = v3_scale(patch->normal, 2 * patch->bulge);
         g->centroid = patch->centroid;
         g->radius = 0;
         for (unsigned k = 0; k < patch->vertex_count; k++)

@@ -6,8 +6,8 @@
  *      a plane form one smooth region (union-find over shared edges). Values are interpolated across patch
  *      boundaries inside a region and kept apart between regions, so creases stay sharp.
  *   2. Quads: two triangles of one region whose longest edges are the same edge (a quad
- *      split along its diagonal, as exporters do) are merged back into a quad when it is
- *      flat and convex; it subdivides into a regular grid of quad patches.
+ *      split along its diagonal, as exporters do) are merged back into a convex quad,
+ *      which subdivides into a regular grid of quad patches.
  *   3. Subdivision: a quad into nu x nv bilinear cells, a triangle into n^2 similar
  *      triangles, each edge no longer than the patch size. Points on an input edge are
  *      computed from that edge's lower-numbered end, so two polygons that split a shared
@@ -115,6 +115,8 @@ typedef struct polygon {
     uint32_t vertex[4];
     uint32_t count;
     uint32_t triangle; /* a source triangle: surface, material, normal */
+    double bulge;      /* how far the quad's bilinear cells may stray from its two input
+                          triangles (0: flat) */
     uint32_t region;
 } polygon;
 
@@ -151,6 +153,7 @@ static int add_patch(mesh_output *out, const polygon *poly, const rad_vec3 *p, u
     memset(patch, 0, sizeof(*patch));
     const rad_triangle *source = &out->in->scene->triangles[poly->triangle];
     patch->vertex_count = count;
+    patch->bulge = poly->bulge;
     patch->surface = source->surface;
     patch->material = source->material;
     for (uint32_t k = 0; k < count; k++) {
@@ -278,6 +281,7 @@ static rad_status plan_build(const rad_scene *scene, mesh_plan *plan, rad_error 
     uint32_t T = scene->triangle_count;
     edge_table edges = {NULL, 0};
     uint32_t *parent = NULL, *partner = NULL, *region_of_root = NULL;
+    double *bulge = NULL;
     memset(plan, 0, sizeof(*plan));
     plan->in.scene = scene;
 
@@ -286,13 +290,14 @@ static rad_status plan_build(const rad_scene *scene, mesh_plan *plan, rad_error 
     partner = rad_alloc_array(T, sizeof(*partner));
     region_of_root = rad_alloc_array(T, sizeof(*region_of_root));
     plan->polygons = rad_alloc_array(T, sizeof(*plan->polygons));
+    bulge = rad_alloc_array(T, sizeof(*bulge));
     size_t edge_slots = 64;
     while (edge_slots < 6 * (size_t)T)
         edge_slots *= 2;
     edges.slots = rad_alloc_array(edge_slots, sizeof(*edges.slots));
     edges.mask = edge_slots - 1;
     if (!plan->in.normal || !parent || !partner || !region_of_root || !plan->polygons ||
-        !edges.slots) {
+        !bulge || !edges.slots) {
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory while building patches");
         goto done;
     }
@@ -339,8 +344,10 @@ static rad_status plan_build(const rad_scene *scene, mesh_plan *plan, rad_error 
     }
 
     /* 2. quads: pair triangles across a shared longest edge, when the four corners are
-     * flat and convex. A folded pair stays two triangles: patch points must lie on the
-     * input triangles, which are what blocks rays, or a patch would shadow itself. */
+     * convex (the region test already bounds the fold to a degree). The bilinear cells of
+     * a folded quad stray from the input triangles, which are what blocks rays, by up to a
+     * quarter of the fourth corner's lift: that is recorded so that rays can leave from in
+     * front. */
     for (uint32_t t = 0; t < T; t++) {
         if (partner[t] != UINT32_MAX)
             continue;
@@ -361,10 +368,13 @@ static rad_status plan_build(const rad_scene *scene, mesh_plan *plan, rad_error 
                               scene->positions[v[(k + 1) % 3]], scene->positions[v[(k + 2) % 3]]};
         double diagonal = v3_length(v3_sub(corner[2], corner[0]));
         double lift = fabs(v3_dot(in->normal[t], v3_sub(corner[1], corner[0])));
-        if (lift > RAD_QUAD_FLATNESS * diagonal || !convex_quad(corner, in->normal[t]))
+        if (!convex_quad(corner, in->normal[t]))
             continue;
         partner[t] = u;
         partner[u] = t;
+        /* over the unit square the bilinear surface strays at most a quarter of the lift
+         * from the two triangles' planes, at the centre */
+        bulge[t] = bulge[u] = lift > RAD_QUAD_FLATNESS * diagonal ? lift / 4 : 0;
     }
 
     for (uint32_t t = 0; t < T; t++) {
@@ -372,6 +382,7 @@ static rad_status plan_build(const rad_scene *scene, mesh_plan *plan, rad_error 
         const uint32_t *v = scene->triangles[t].vertex;
         poly->triangle = t;
         poly->region = region_of_root[find_root(parent, t)];
+        poly->bulge = bulge[t];
         if (partner[t] == UINT32_MAX) {
             poly->count = 3;
             memcpy(poly->vertex, v, 3 * sizeof(*v));
@@ -392,6 +403,7 @@ done:
     free(parent);
     free(partner);
     free(region_of_root);
+    free(bulge);
     free(edges.slots);
     if (status != RAD_OK)
         plan_free(plan);
