@@ -266,6 +266,17 @@ int command_render(int argc, char **argv)
     if (status != RAD_OK)
         goto fail;
     t_write = cli_now();
+    if (cli_progress_enabled()) { /* a summary for a person watching; quiet in scripts */
+        char solved[64];
+        if (s.solve.solver == RAD_SOLVER_DIRECT)
+            snprintf(solved, sizeof(solved), "direct solve");
+        else
+            snprintf(solved, sizeof(solved), "%u %s", solve_report.iterations,
+                     s.solve.solver == RAD_SOLVER_SHOOT ? "shots" : "sweeps");
+        fprintf(stderr, "radiosity: %u patches, %.1f M rays, %s (residual %.2g), %.2f s: wrote %s\n",
+                mesh->patch_count, ff_report.rays / 1e6, solved, solve_report.residual,
+                t_write - t0, s.output);
+    }
 
     if (s.stats_path) {
         cli_stats stats;
