@@ -23,6 +23,20 @@ int main(void)
 {
     rad_vec3 up = {0, 0, 1}, down = {0, 0, -1};
 
+    /* the edge angles span (0, pi) over a wide range of shapes: very thin, very wide and
+     * very close rectangles, seen from under a corner and from under the centre */
+    const double extents[] = {0.001, 0.01, 0.1, 0.5, 1, 3, 10, 100, 1000};
+    for (int i = 0; i < 9; i++)
+        for (int j = 0; j < 9; j++) {
+            double a = extents[i], b = extents[j];
+            rad_vec3 corner[4] = {{0, 0, 1}, {0, b, 1}, {a, b, 1}, {a, 0, 1}};
+            rad_vec3 centred[4] = {{-a, -b, 1}, {-a, b, 1}, {a, b, 1}, {a, -b, 1}};
+            CHECK_NEAR(contour_point_to_polygon((rad_vec3){0, 0, 0}, up, corner, 4, down, 0),
+                       corner_rectangle(a, b, 1), 1e-8);
+            CHECK_NEAR(contour_point_to_polygon((rad_vec3){0, 0, 0}, up, centred, 4, down, 0),
+                       4 * corner_rectangle(a, b, 1), 1e-8);
+        }
+
     /* the catalogue value: X = 2, Y = 3 gives 0.2175752 */
     CHECK_NEAR(corner_rectangle(2, 3, 1), 0.2175752, 1e-6);
 
