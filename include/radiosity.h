@@ -99,6 +99,9 @@ typedef struct rad_material {
     char name[128];
     rad_rgb albedo;   /* diffuse reflectance rho, linear RGB in [0,1] (MTL Kd) */
     rad_rgb emission; /* emitted radiance L_e, linear RGB >= 0 (MTL Ke) */
+    rad_rgb specular; /* Phong specular and mirror reflectance K_S, [0,1] (MTL Ks); radiosity
+                         ignores it, the ray tracer and `render --specular` use it */
+    double shininess; /* Phong exponent n (MTL Ns), >= 0 */
 } rad_material;
 
 /* A surface is what the user named: an OBJ object (o) or group (g). Its triangles are the

@@ -9,6 +9,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -45,7 +46,9 @@ void cli_log(void *user, const char *message)
 static int find_option(const cli_option *options, int count, const char *name, char short_name)
 {
     for (int k = 0; k < count; k++)
-        if ((name && strcmp(options[k].name, name) == 0) ||
+        if (!options[k].name)
+            continue; /* a group this command does not take */
+        else if ((name && strcmp(options[k].name, name) == 0) ||
             (!name && short_name && options[k].short_name == short_name))
             return k;
     return -1;
@@ -208,6 +211,75 @@ bool cli_parse_shared(const cli_args *args, cli_shared *shared)
     shared->formfactor.seed = shared->seed;
     shared->formfactor.progress = cli_progress;
     return true;
+}
+
+bool cli_parse_view(const cli_args *args, cli_view *view)
+{
+    unsigned long value;
+    memset(view, 0, sizeof(*view));
+    view->width = view->height = 512;
+    if ((args->value[OPT_EYE] && !cli_parse_vec3("eye", args->value[OPT_EYE], &view->camera.eye)) ||
+        (args->value[OPT_TARGET] &&
+         !cli_parse_vec3("target", args->value[OPT_TARGET], &view->camera.target)) ||
+        (args->value[OPT_UP] && !cli_parse_vec3("up", args->value[OPT_UP], &view->camera.up)) ||
+        (args->value[OPT_FOV] &&
+         !cli_parse_double("fov", args->value[OPT_FOV], &view->camera.fov_degrees)) ||
+        (args->value[OPT_SIZE] &&
+         !cli_parse_size("size", args->value[OPT_SIZE], &view->width, &view->height)))
+        return false;
+    view->has_eye = args->value[OPT_EYE] != NULL;
+    view->has_target = args->value[OPT_TARGET] != NULL;
+    view->has_up = args->value[OPT_UP] != NULL;
+    view->has_fov = args->value[OPT_FOV] != NULL;
+    if (view->has_fov && !(view->camera.fov_degrees > 0 && view->camera.fov_degrees < 180)) {
+        cli_error("--fov: must be between 0 and 180 degrees");
+        return false;
+    }
+    if (args->value[OPT_SPP]) {
+        if (!cli_parse_uint("spp", args->value[OPT_SPP], 1u << 20, &value))
+            return false;
+        if (value == 0) {
+            cli_error("--spp: must be at least 1");
+            return false;
+        }
+        view->samples_per_pixel = (uint32_t)value;
+    }
+    if (args->value[OPT_EXPOSURE]) {
+        if (!cli_parse_double("exposure", args->value[OPT_EXPOSURE], &view->write.exposure))
+            return false;
+        view->write.fixed_exposure = true;
+    }
+    return true;
+}
+
+rad_camera cli_view_camera(const cli_view *view, const rad_scene *scene)
+{
+    rad_camera camera = scene->has_camera ? scene->camera : rad_scene_default_camera(scene);
+    if (view->has_eye)
+        camera.eye = view->camera.eye;
+    if (view->has_target)
+        camera.target = view->camera.target;
+    if (view->has_up)
+        camera.up = view->camera.up;
+    if (view->has_fov)
+        camera.fov_degrees = view->camera.fov_degrees;
+    return camera;
+}
+
+bool cli_image_output_ok(const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    if (dot && (strcasecmp(dot, ".png") == 0 || strcasecmp(dot, ".hdr") == 0 ||
+                strcasecmp(dot, ".pfm") == 0))
+        return true;
+    cli_error("%s: unknown image format (use .png, .hdr or .pfm)", path);
+    return false;
+}
+
+rad_status cli_load_scene(const char *path, rad_scene **scene, rad_error *error)
+{
+    rad_load_options load = {cli_log, NULL};
+    return path ? rad_scene_load(path, &load, scene, error) : rad_scene_cornell_box(scene, error);
 }
 
 double cli_now(void)

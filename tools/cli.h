@@ -33,21 +33,34 @@ typedef struct cli_args {
 bool cli_parse(const char *command, int argc, char **argv, const cli_option *options,
                int option_count, cli_args *args);
 
-/* The options every command that computes form factors shares. Each command's option
- * table starts with CLI_SHARED_OPTIONS, so these indices are the same in every table. */
+/* Option groups shared by several commands, at fixed indices in every command's table:
+ * BASE (every command), FORMFACTOR (render, viewfactors), VIEW (commands that make an
+ * image). A command's own options start at OPT_OWN. Entries of a group a command does not
+ * include stay empty (NULL name) and are never matched. */
 enum {
-    OPT_OUTPUT, OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS, OPT_QUADRATURE, OPT_THREADS, OPT_SEED,
-    OPT_STATS, OPT_HELP, OPT_SHARED_COUNT
+    OPT_OUTPUT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_HELP,            /* BASE */
+    OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS, OPT_QUADRATURE,                /* FORMFACTOR */
+    OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE, /* VIEW */
+    OPT_OWN
 };
 
-#define CLI_SHARED_OPTIONS                                                                 \
-    [OPT_OUTPUT] = {"output", 'o', true}, [OPT_PATCH_SIZE] = {"patch-size", 0, true},      \
-    [OPT_VISIBILITY_RAYS] = {"visibility-rays", 0, true},                                  \
-    [OPT_QUADRATURE] = {"quadrature", 0, true}, [OPT_THREADS] = {"threads", 0, true},      \
+#define CLI_BASE_OPTIONS                                                                   \
+    [OPT_OUTPUT] = {"output", 'o', true}, [OPT_THREADS] = {"threads", 0, true},            \
     [OPT_SEED] = {"seed", 0, true}, [OPT_STATS] = {"stats", 0, true},                      \
     [OPT_HELP] = {"help", 'h', false}
 
-/* What the shared options say; patch_size 0 = the command's default. */
+#define CLI_FORMFACTOR_OPTIONS                                                             \
+    [OPT_PATCH_SIZE] = {"patch-size", 0, true},                                            \
+    [OPT_VISIBILITY_RAYS] = {"visibility-rays", 0, true},                                  \
+    [OPT_QUADRATURE] = {"quadrature", 0, true}
+
+#define CLI_VIEW_OPTIONS                                                                   \
+    [OPT_EYE] = {"eye", 0, true}, [OPT_TARGET] = {"target", 0, true},                      \
+    [OPT_UP] = {"up", 0, true}, [OPT_FOV] = {"fov", 0, true},                              \
+    [OPT_SIZE] = {"size", 0, true}, [OPT_SPP] = {"spp", 0, true},                          \
+    [OPT_EXPOSURE] = {"exposure", 0, true}
+
+/* What the BASE and FORMFACTOR options say; patch_size 0 = the command's default. */
 typedef struct cli_shared {
     const char *output, *stats_path;
     double patch_size;
@@ -56,8 +69,29 @@ typedef struct cli_shared {
     unsigned long seed;
 } cli_shared;
 
-/* Parses the shared options (after cli_parse); false (after printing) on a bad value. */
+/* Parses the BASE and FORMFACTOR options (after cli_parse); false (after printing) on a
+ * bad value. */
 bool cli_parse_shared(const cli_args *args, cli_shared *shared);
+
+/* What the VIEW options say. */
+typedef struct cli_view {
+    rad_camera camera;                 /* fields given on the command line */
+    bool has_eye, has_target, has_up, has_fov;
+    uint32_t width, height;            /* 512 x 512 by default */
+    uint32_t samples_per_pixel;        /* 0 = the command's default */
+    rad_image_write_options write;     /* exposure */
+} cli_view;
+
+bool cli_parse_view(const cli_args *args, cli_view *view);
+
+/* The scene's camera (or a framing default) with the command line's overrides. */
+rad_camera cli_view_camera(const cli_view *view, const rad_scene *scene);
+
+/* True for .png, .hdr and .pfm; prints the usage error otherwise. */
+bool cli_image_output_ok(const char *path);
+
+/* Loads SCENE, or the built-in Cornell box when path is NULL; warnings go to stderr. */
+rad_status cli_load_scene(const char *path, rad_scene **scene, rad_error *error);
 
 /* Value parsers: print "radiosity: --NAME: ..." and return false on a bad value. */
 bool cli_parse_double(const char *name, const char *text, double *out);

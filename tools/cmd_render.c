@@ -5,7 +5,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 #include "cli.h"
 
@@ -35,20 +34,12 @@ static const char usage[] =
     "  --stats FILE.json    write counts, times, residuals and peak memory\n"
     "  -h, --help           this text\n";
 
-enum {
-    OPT_EYE = OPT_SHARED_COUNT, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE,
-    OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_COUNT
-};
+enum { OPT_SOLVER = OPT_OWN, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_COUNT };
 
 static const cli_option options[OPT_COUNT] = {
-    CLI_SHARED_OPTIONS,
-    [OPT_EYE] = {"eye", 0, true},
-    [OPT_TARGET] = {"target", 0, true},
-    [OPT_UP] = {"up", 0, true},
-    [OPT_FOV] = {"fov", 0, true},
-    [OPT_SIZE] = {"size", 0, true},
-    [OPT_SPP] = {"spp", 0, true},
-    [OPT_EXPOSURE] = {"exposure", 0, true},
+    CLI_BASE_OPTIONS,
+    CLI_FORMFACTOR_OPTIONS,
+    CLI_VIEW_OPTIONS,
     [OPT_SOLVER] = {"solver", 0, true},
     [OPT_TOLERANCE] = {"tolerance", 0, true},
     [OPT_MAX_ITERATIONS] = {"max-iterations", 0, true},
@@ -57,21 +48,11 @@ static const cli_option options[OPT_COUNT] = {
 /* Patches the default patch size aims at. */
 #define DEFAULT_TARGET_PATCHES 3000u
 
-static bool image_extension_ok(const char *path)
-{
-    const char *dot = strrchr(path, '.');
-    return dot && (strcasecmp(dot, ".png") == 0 || strcasecmp(dot, ".hdr") == 0 ||
-                   strcasecmp(dot, ".pfm") == 0);
-}
-
 typedef struct render_settings {
     const char *scene_path, *output, *stats_path;
     cli_shared shared;
-    rad_camera camera;
-    bool has_eye, has_target, has_up, has_fov;
-    uint32_t width, height;
+    cli_view view;
     rad_render_options render;
-    rad_image_write_options write;
     rad_solve_options solve;
 } render_settings;
 
@@ -87,8 +68,7 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
         return false;
     }
     memset(s, 0, sizeof(*s));
-    s->width = s->height = 512;
-    if (!cli_parse_shared(&args, &s->shared))
+    if (!cli_parse_shared(&args, &s->shared) || !cli_parse_view(&args, &s->view))
         return false;
     if (args.positional_count > 1) {
         cli_error("render: one scene at most (see 'radiosity render --help')");
@@ -100,44 +80,12 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
         cli_error("render: no output file: give -o OUT.png, .hdr or .pfm");
         return false;
     }
-    if (!image_extension_ok(s->output)) {
-        cli_error("%s: unknown image format (use .png, .hdr or .pfm)", s->output);
+    if (!cli_image_output_ok(s->output))
         return false;
-    }
     s->stats_path = s->shared.stats_path;
     unsigned long value;
     double number;
-    if ((args.value[OPT_EYE] && !cli_parse_vec3("eye", args.value[OPT_EYE], &s->camera.eye)) ||
-        (args.value[OPT_TARGET] &&
-         !cli_parse_vec3("target", args.value[OPT_TARGET], &s->camera.target)) ||
-        (args.value[OPT_UP] && !cli_parse_vec3("up", args.value[OPT_UP], &s->camera.up)) ||
-        (args.value[OPT_FOV] &&
-         !cli_parse_double("fov", args.value[OPT_FOV], &s->camera.fov_degrees)) ||
-        (args.value[OPT_SIZE] &&
-         !cli_parse_size("size", args.value[OPT_SIZE], &s->width, &s->height)))
-        return false;
-    s->has_eye = args.value[OPT_EYE] != NULL;
-    s->has_target = args.value[OPT_TARGET] != NULL;
-    s->has_up = args.value[OPT_UP] != NULL;
-    s->has_fov = args.value[OPT_FOV] != NULL;
-    if (s->has_fov && !(s->camera.fov_degrees > 0 && s->camera.fov_degrees < 180)) {
-        cli_error("--fov: must be between 0 and 180 degrees");
-        return false;
-    }
-    if (args.value[OPT_SPP]) {
-        if (!cli_parse_uint("spp", args.value[OPT_SPP], 256, &value))
-            return false;
-        if (value == 0) {
-            cli_error("--spp: must be at least 1");
-            return false;
-        }
-        s->render.samples_per_pixel = (uint32_t)value;
-    }
-    if (args.value[OPT_EXPOSURE]) {
-        if (!cli_parse_double("exposure", args.value[OPT_EXPOSURE], &s->write.exposure))
-            return false;
-        s->write.fixed_exposure = true;
-    }
+    s->render.samples_per_pixel = s->view.samples_per_pixel;
     const char *solver = args.value[OPT_SOLVER] ? args.value[OPT_SOLVER] : "gather";
     if (strcmp(solver, "gather") == 0 || strcmp(solver, "jacobi") == 0)
         s->solve.solver = RAD_SOLVER_JACOBI;
@@ -169,8 +117,8 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
     s->solve.threads = s->render.threads = s->shared.threads;
     s->render.seed = s->shared.seed;
     s->solve.progress = s->render.progress = cli_progress;
-    s->render.width = s->width;
-    s->render.height = s->height;
+    s->render.width = s->view.width;
+    s->render.height = s->view.height;
     *exit_code = EXIT_OK;
     return true;
 }
@@ -199,9 +147,7 @@ int command_render(int argc, char **argv)
     double t_check = 0;
     double t0 = cli_now(), t_load, t_mesh, t_ff, t_solve, t_render, t_write;
 
-    rad_load_options load = {cli_log, NULL};
-    status = s.scene_path ? rad_scene_load(s.scene_path, &load, &scene, &error)
-                          : rad_scene_cornell_box(&scene, &error);
+    status = cli_load_scene(s.scene_path, &scene, &error);
     if (status != RAD_OK)
         goto fail;
     t_load = cli_now();
@@ -210,15 +156,7 @@ int command_render(int argc, char **argv)
                  "be black",
                  scene->source);
 
-    rad_camera camera = scene->has_camera ? scene->camera : rad_scene_default_camera(scene);
-    if (s.has_eye)
-        camera.eye = s.camera.eye;
-    if (s.has_target)
-        camera.target = s.camera.target;
-    if (s.has_up)
-        camera.up = s.camera.up;
-    if (s.has_fov)
-        camera.fov_degrees = s.camera.fov_degrees;
+    rad_camera camera = cli_view_camera(&s.view, scene);
 
     double patch_size = s.shared.patch_size > 0 ? s.shared.patch_size
                                          : rad_mesh_default_patch_size(scene, DEFAULT_TARGET_PATCHES);
@@ -256,13 +194,13 @@ int command_render(int argc, char **argv)
                  solve_report.iterations, solve_report.criterion);
     t_solve = cli_now();
 
-    status = rad_image_create(s.width, s.height, &image, &error);
+    status = rad_image_create(s.view.width, s.view.height, &image, &error);
     if (status == RAD_OK)
         status = rad_render(mesh, B, &camera, &s.render, image, &error);
     if (status != RAD_OK)
         goto fail;
     t_render = cli_now();
-    status = rad_image_write(image, s.output, &s.write, &error);
+    status = rad_image_write(image, s.output, &s.view.write, &error);
     if (status != RAD_OK)
         goto fail;
     t_write = cli_now();
@@ -318,8 +256,8 @@ int command_render(int argc, char **argv)
         stats_number(&stats, "largest_form_factor", check.largest_factor);
         stats_integer(&stats, "patches_seeing_nothing", check.empty_rows);
         stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
-        stats_integer(&stats, "width", s.width);
-        stats_integer(&stats, "height", s.height);
+        stats_integer(&stats, "width", s.view.width);
+        stats_integer(&stats, "height", s.view.height);
         if (!stats_write(&stats, s.stats_path))
             exit_code = EXIT_ERROR;
     }

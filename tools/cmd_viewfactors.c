@@ -27,9 +27,9 @@ static const char usage[] =
     "  --stats FILE.json    write counts, times and residuals\n"
     "  -h, --help           this text\n";
 
-enum { OPT_COUNT = OPT_SHARED_COUNT };
+enum { OPT_COUNT = OPT_OWN };
 
-static const cli_option options[OPT_COUNT] = {CLI_SHARED_OPTIONS};
+static const cli_option options[OPT_COUNT] = {CLI_BASE_OPTIONS, CLI_FORMFACTOR_OPTIONS};
 
 #define DEFAULT_TARGET_PATCHES 1500u
 #define DEFAULT_QUADRATURE 3u
@@ -67,8 +67,7 @@ int command_viewfactors(int argc, char **argv)
     double *matrix = NULL, *areas = NULL;
     rad_formfactor_report report = {0};
     double t0 = cli_now();
-    rad_load_options load = {cli_log, NULL};
-    rad_status status = rad_scene_load(args.positional[0], &load, &scene, &error);
+    rad_status status = cli_load_scene(args.positional[0], &scene, &error);
     if (status != RAD_OK)
         goto fail;
     if (patch_size <= 0)

@@ -9,6 +9,7 @@
  */
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include "core/error.h"
 #include "core/vec3.h"
@@ -60,8 +61,11 @@ rad_status rad_scene_cornell_box(rad_scene **out, rad_error *error)
         return status;
     uint32_t material[MATERIAL_COUNT];
     for (int m = 0; m < MATERIAL_COUNT; m++) {
-        material[m] = scene_builder_material(builder, materials[m].name, materials[m].albedo,
-                                             materials[m].emission);
+        rad_material description = {0};
+        snprintf(description.name, sizeof(description.name), "%s", materials[m].name);
+        description.albedo = materials[m].albedo;
+        description.emission = materials[m].emission;
+        material[m] = scene_builder_material(builder, &description);
         if (material[m] == UINT32_MAX)
             goto nomem;
     }

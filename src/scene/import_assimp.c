@@ -119,10 +119,18 @@ static rad_status map_material(import_state *state, unsigned index, uint32_t *ou
         struct aiString name;
         if (aiGetMaterialString(m, AI_MATKEY_NAME, &name) != aiReturn_SUCCESS)
             snprintf(name.data, sizeof(name.data), "material%u", index);
-        rad_rgb albedo = material_color(m, AI_MATKEY_COLOR_DIFFUSE, (rad_rgb){0.5, 0.5, 0.5});
-        rad_rgb emission = material_color(m, AI_MATKEY_COLOR_EMISSIVE, (rad_rgb){0, 0, 0});
-        state->material_map[index] =
-            scene_builder_material(state->builder, name.data, albedo, emission);
+        rad_material material = {0};
+        snprintf(material.name, sizeof(material.name), "%.*s", (int)sizeof(material.name) - 1,
+                 name.data);
+        material.albedo = material_color(m, AI_MATKEY_COLOR_DIFFUSE, (rad_rgb){0.5, 0.5, 0.5});
+        material.emission = material_color(m, AI_MATKEY_COLOR_EMISSIVE, (rad_rgb){0, 0, 0});
+        material.specular = material_color(m, AI_MATKEY_COLOR_SPECULAR, (rad_rgb){0, 0, 0});
+        /* the array form: aiGetMaterialFloat is C99 inline and fails to link at -O0 */
+        ai_real shininess = 0;
+        unsigned one = 1;
+        if (aiGetMaterialFloatArray(m, AI_MATKEY_SHININESS, &shininess, &one) == aiReturn_SUCCESS)
+            material.shininess = shininess;
+        state->material_map[index] = scene_builder_material(state->builder, &material);
         if (state->material_map[index] == UINT32_MAX)
             return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", state->path);
     }

@@ -63,18 +63,14 @@ void scene_builder_destroy(scene_builder *b)
     free(b);
 }
 
-uint32_t scene_builder_material(scene_builder *b, const char *name, rad_rgb albedo,
-                                rad_rgb emission)
+uint32_t scene_builder_material(scene_builder *b, const rad_material *material)
 {
     if (b->material_count >= UINT32_MAX - 1 ||
         !rad_grow_array((void **)&b->materials, &b->material_capacity, b->material_count + 1,
                         sizeof(*b->materials)))
         return UINT32_MAX;
-    rad_material *m = &b->materials[b->material_count];
-    memset(m, 0, sizeof(*m));
-    snprintf(m->name, sizeof(m->name), "%s", name);
-    m->albedo = albedo;
-    m->emission = emission;
+    b->materials[b->material_count] = *material;
+    b->materials[b->material_count].name[sizeof(material->name) - 1] = 0;
     return (uint32_t)b->material_count++;
 }
 
@@ -168,27 +164,38 @@ static int compare_surface(const void *a, const void *b)
     return (x->order > y->order) - (x->order < y->order);
 }
 
+/* Clamps *value into [0,1]; true when it had to. */
+static bool clamp_unit(double *value)
+{
+    if (*value >= 0 && *value <= 1)
+        return false;
+    *value = *value > 1 ? 1 : 0; /* NaN becomes 0 */
+    return true;
+}
+
 static void check_material(scene_builder *b, rad_material *m)
 {
     double *albedo[3] = {&m->albedo.r, &m->albedo.g, &m->albedo.b};
+    double *specular[3] = {&m->specular.r, &m->specular.g, &m->specular.b};
     double *emission[3] = {&m->emission.r, &m->emission.g, &m->emission.b};
-    bool clamped = false, negative = false;
+    bool clamped = false, negative = false, clamped_specular = false;
     for (int c = 0; c < 3; c++) {
-        if (!(*albedo[c] >= 0)) {
-            *albedo[c] = 0;
-            clamped = true;
-        } else if (*albedo[c] > 1) {
-            *albedo[c] = 1;
-            clamped = true;
-        }
+        clamped |= clamp_unit(albedo[c]);
+        clamped_specular |= clamp_unit(specular[c]);
         if (!(*emission[c] >= 0)) {
             *emission[c] = 0;
             negative = true;
         }
     }
+    if (!(m->shininess >= 0) || !isfinite(m->shininess))
+        m->shininess = 0;
     if (clamped)
         rad_warn(b->options.log, b->options.log_user,
                  "%s: material '%s': albedo outside [0,1] clamped", b->source, m->name);
+    if (clamped_specular)
+        rad_warn(b->options.log, b->options.log_user,
+                 "%s: material '%s': specular reflectance outside [0,1] clamped", b->source,
+                 m->name);
     if (negative)
         rad_warn(b->options.log, b->options.log_user,
                  "%s: material '%s': negative or invalid emission set to 0", b->source,

@@ -16,10 +16,9 @@ typedef struct scene_builder scene_builder;
 rad_status scene_builder_create(const char *source, const rad_load_options *options,
                                 scene_builder **out, rad_error *error);
 
-/* Index of the material (name, albedo, emitted radiance), or UINT32_MAX when out of
- * memory. Materials are kept even when no triangle uses them. */
-uint32_t scene_builder_material(scene_builder *builder, const char *name, rad_rgb albedo,
-                                rad_rgb emission);
+/* Index of a copy of the material, or UINT32_MAX when out of memory. Materials are kept
+ * even when no triangle uses them; finish() clamps values out of their domains. */
+uint32_t scene_builder_material(scene_builder *builder, const rad_material *material);
 
 /* Index of the surface with this name, created on first use; UINT32_MAX when out of
  * memory. Triangles added under the same name from several places join one surface. */
