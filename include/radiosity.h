@@ -437,6 +437,93 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                       rad_error *error);
 
 /* ------------------------------------------------------------------------------------ */
+/* Ray tracing (Whitted, Phong model) and path tracing                                   */
+
+/* A point light of the classic Phong model: no distance falloff (METHOD.md section 1). */
+typedef struct rad_point_light {
+    rad_vec3 position;
+    rad_rgb intensity; /* I_L */
+} rad_point_light;
+
+typedef struct rad_raytrace_options {
+    const rad_point_light *lights; /* point lights, may be NULL when light_count is 0 */
+    uint32_t light_count;
+    rad_rgb ambient;            /* I_A; the ambient reflectance K_A is the albedo Kd */
+    uint32_t light_samples;     /* points per emissive-surface light per shading point;
+                                   0 = 16 */
+    uint32_t max_depth;         /* reflected rays followed; 0 = 5 */
+    uint32_t samples_per_pixel; /* stratified, box filter; 0 = 4 */
+    uint64_t seed;
+    int threads;
+    rad_progress_fn progress;
+    void *progress_user;
+} rad_raytrace_options;
+
+/* Whitted ray tracing with the Phong model of METHOD.md section 1:
+ *   I = I_E + K_A I_A + sum over lights (K_D <N,L> + K_S <V,R>^n) I_L S_L + K_S I_R
+ * with I_E the emitted radiance, S_L the shadow-ray visibility and I_R the radiance along
+ * the mirror direction. Emissive surfaces act as area lights, sampled for soft shadows.
+ * Back faces show black (one-sided surfaces). Fills `image` (its size sets the
+ * resolution). */
+rad_status rad_raytrace(const rad_scene *scene, const rad_camera *camera,
+                        const rad_raytrace_options *options, rad_image *image,
+                        rad_error *error);
+
+typedef struct rad_pathtrace_options {
+    uint32_t samples_per_pixel; /* 0 = 64 */
+    uint32_t max_depth;         /* most bounces; 0 = no limit (Russian roulette ends paths) */
+    uint64_t seed;
+    int threads;
+    rad_progress_fn progress;
+    void *progress_user;
+} rad_pathtrace_options;
+
+typedef struct rad_pathtrace_report {
+    uint64_t rays;  /* closest-hit and shadow rays */
+    double seconds;
+} rad_pathtrace_report;
+
+/* An unbiased path tracer for the same Lambertian scenes radiosity solves (albedo Kd,
+ * emitted radiance Ke, one-sided): cosine-weighted importance sampling, next-event
+ * estimation on emitters combined with BSDF sampling by multiple importance sampling,
+ * Russian roulette. Deterministic per seed for any thread count; parallel over tiles. The
+ * reference for checking radiosity images. `standard_error` (NULL, or an image of the
+ * same size) receives each pixel's standard error of the mean, per channel. */
+rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
+                         const rad_pathtrace_options *options, rad_image *image,
+                         rad_image *standard_error, rad_pathtrace_report *report,
+                         rad_error *error);
+
+/* ------------------------------------------------------------------------------------ */
+/* Comparing images                                                                      */
+
+typedef struct rad_compare_options {
+    uint32_t block_size;    /* side of the square blocks compared; 0 = 8 */
+    double block_tolerance; /* relative difference a block may have; 0 = 0.10 */
+} rad_compare_options;
+
+typedef struct rad_image_difference {
+    double rmse;                 /* sqrt of the mean over pixels and channels of (a - b)^2 */
+    double mean_relative_error;  /* mean over pixels of |a - b|_1 / |b|_1, over the pixels
+                                    where b is not black */
+    rad_rgb mean_a, mean_b;      /* mean radiance per channel */
+    double worst_block_error;    /* largest relative difference of two blocks' means,
+                                    |mean_a - mean_b|_1 / |mean_b|_1 */
+    uint32_t worst_block_x, worst_block_y; /* its top-left pixel */
+    uint32_t block_count;        /* whole blocks compared */
+    double blocks_within_tolerance; /* fraction of them within block_tolerance */
+} rad_image_difference;
+
+/* Compares a against b (the reference). The images must have the same size
+ * (RAD_ERR_INVALID otherwise). `false_colour` (NULL, or an image of the same size)
+ * receives a picture of where they differ: per pixel, the relative difference mapped
+ * from blue (none) through green and yellow to red (100 % or more). */
+rad_status rad_image_compare(const rad_image *a, const rad_image *b,
+                             const rad_compare_options *options,
+                             rad_image_difference *difference, rad_image *false_colour,
+                             rad_error *error);
+
+/* ------------------------------------------------------------------------------------ */
 /* Output files                                                                          */
 
 /* Writes the view-factor matrix as CSV: header "surface,NAME1,...", then one row per
