@@ -129,7 +129,12 @@ bool stats_write(cli_stats *stats, const char *path);
 /* Prints an error and returns false when path is a folder or its folder is not writable. */
 bool cli_output_writable(const char *path);
 
+/* The subcommands, one file each (cmd_NAME.c); argv holds the arguments after the
+ * subcommand's name. Each returns the process exit code. */
 int command_render(int argc, char **argv);
 int command_viewfactors(int argc, char **argv);
+int command_raytrace(int argc, char **argv);
+int command_pathtrace(int argc, char **argv);
+int command_compare(int argc, char **argv);
 
 #endif

@@ -14,9 +14,31 @@ static const char usage[] =
     "  render [SCENE] -o OUT     solve and render an image (.png, .hdr, .pfm); no SCENE\n"
     "                            renders the built-in Cornell box\n"
     "  viewfactors SCENE         the surface-to-surface view-factor matrix as CSV\n"
+    "  raytrace SCENE -o OUT     Whitted ray tracing with the Phong model\n"
+    "  pathtrace SCENE -o OUT    a Monte-Carlo path tracer: the reference for radiosity\n"
+    "  compare A B [-o DIFF]     differences between two HDR images (.pfm, .hdr)\n"
     "  help [COMMAND]            this text, or a command's\n"
     "\n"
     "'radiosity COMMAND --help' tells a command's options.\n";
+
+typedef struct command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+} command;
+
+static const command commands[] = {
+    {"render", command_render},     {"viewfactors", command_viewfactors},
+    {"raytrace", command_raytrace}, {"pathtrace", command_pathtrace},
+    {"compare", command_compare},
+};
+
+static const command *find_command(const char *name)
+{
+    for (size_t k = 0; k < sizeof(commands) / sizeof(commands[0]); k++)
+        if (strcmp(commands[k].name, name) == 0)
+            return &commands[k];
+    return NULL;
+}
 
 int main(int argc, char **argv)
 {
@@ -24,24 +46,20 @@ int main(int argc, char **argv)
         fputs(usage, stderr);
         return EXIT_USAGE;
     }
-    const char *command = argv[1];
-    if (strcmp(command, "render") == 0)
-        return command_render(argc - 2, argv + 2);
-    if (strcmp(command, "viewfactors") == 0)
-        return command_viewfactors(argc - 2, argv + 2);
-    if (strcmp(command, "help") == 0 || strcmp(command, "--help") == 0 ||
-        strcmp(command, "-h") == 0) {
-        if (argc > 2 && strcmp(command, "help") == 0) {
+    const char *name = argv[1];
+    const command *found = find_command(name);
+    if (found)
+        return found->run(argc - 2, argv + 2);
+    if (strcmp(name, "help") == 0 || strcmp(name, "--help") == 0 || strcmp(name, "-h") == 0) {
+        found = argc > 2 && strcmp(name, "help") == 0 ? find_command(argv[2]) : NULL;
+        if (found) {
             char help[] = "--help";
             char *help_argv[] = {help};
-            if (strcmp(argv[2], "render") == 0)
-                return command_render(1, help_argv);
-            if (strcmp(argv[2], "viewfactors") == 0)
-                return command_viewfactors(1, help_argv);
+            return found->run(1, help_argv);
         }
         fputs(usage, stdout);
         return EXIT_OK;
     }
-    cli_error("unknown command '%s' (see 'radiosity --help')", command);
+    cli_error("unknown command '%s' (see 'radiosity --help')", name);
     return EXIT_USAGE;
 }
