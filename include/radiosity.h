@@ -418,6 +418,12 @@ rad_status rad_image_read(const char *path, rad_image **out, rad_error *error);
 typedef struct rad_render_options {
     uint32_t width, height;     /* 0 = 512 */
     uint32_t samples_per_pixel; /* rounded to a square, stratified, box filter; 0 = 4 */
+    /* The two-pass method: with `materials` (the scene's) given, a surface whose specular
+     * reflectance Ks > 0 adds Ks times the radiance seen along the mirror direction, traced
+     * through the radiosity-lit scene, up to max_depth reflections (0 = 5). NULL = the
+     * radiosity solution alone. */
+    const rad_material *materials;
+    uint32_t max_depth;
     uint64_t seed;
     int threads;
     rad_progress_fn progress;
@@ -431,7 +437,8 @@ void rad_reconstruct_vertices(const rad_mesh *mesh, const rad_rgb *B,
 
 /* Renders the mesh lit by the solution B (per patch exitance) through the camera: primary
  * rays hit the patches, radiance is interpolated from vertex values; back faces and misses
- * are black. Fills `image` (its size decides the resolution). */
+ * are black; mirror reflections are added when options->materials is given (above).
+ * Fills `image` (its size decides the resolution). */
 rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
                       const rad_render_options *options, rad_image *image,
                       rad_error *error);

@@ -130,6 +130,54 @@ static void check_folded_wall(void)
     rad_image_destroy(image[1]);
 }
 
+/* The two-pass method on the shared Cornell OBJ with the tall block made a mirror: its
+ * face towards the red wall shows the red wall (red far above green), where the diffuse
+ * block showed white with a red tint. */
+static void check_mirror_block(void)
+{
+    char *obj = read_file(RAD_SHARED_DIR "/scenes/cornell-box.obj");
+    if (!obj) {
+        printf("skipped the mirror-block check: no shared/ folder\n");
+        return;
+    }
+    char *block = strstr(obj, "o tall_block\nusemtl white\n");
+    CHECK(block != NULL);
+    if (!block)
+        return;
+    memcpy(block, "o tall_block\nusemtl glass\n", strlen("o tall_block\nusemtl glass\n"));
+    test_write_file("mirror-block.obj", obj);
+    char *mtl = read_file(RAD_SHARED_DIR "/scenes/cornell-box.mtl");
+    char materials[4096];
+    snprintf(materials, sizeof(materials), "%s\nnewmtl glass\nKd 0.05 0.05 0.05\nKs 0.9 0.9 0.9\n",
+             mtl ? mtl : "");
+    test_write_file("cornell-box.mtl", materials);
+    const char *camera = "--eye 278,273,-800 --target 278,273,0 --up 0,1,0 --fov 39.3077 "
+                         "--size 96x96 --patch-size 40";
+    char command[512];
+    rad_image *image[2] = {NULL, NULL};
+    const char *flags[2] = {"", "--specular"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(command, sizeof(command), "render mirror-block.obj -o mirror-%d.pfm %s %s", k,
+                 camera, flags[k]);
+        CHECK(test_run_tool(command) == 0);
+        char path[64];
+        snprintf(path, sizeof(path), "mirror-%d.pfm", k);
+        rad_error error;
+        CHECK(rad_image_read(test_path(path), &image[k], &error) == RAD_OK);
+    }
+    if (image[0] && image[1]) {
+        /* the middle of the block's face between (423, 247) and (472, 406) */
+        rgb3 dull = probe(image[0], 447.5, 165, 326.5, 1);
+        rgb3 shiny = probe(image[1], 447.5, 165, 326.5, 1);
+        printf("mirror block face: diffuse only %.4f %.4f %.4f, two-pass %.4f %.4f %.4f\n",
+               dull.r, dull.g, dull.b, shiny.r, shiny.g, shiny.b);
+        CHECK(shiny.r > 4 * shiny.g);
+        CHECK(shiny.r > 3 * dull.r);
+    }
+    rad_image_destroy(image[0]);
+    rad_image_destroy(image[1]);
+}
+
 int main(void)
 {
     rad_image *image = render("cornell.pfm", "--threads 2");
@@ -181,5 +229,6 @@ int main(void)
     rad_image_destroy(one);
     rad_image_destroy(image);
     check_folded_wall();
+    check_mirror_block();
     return test_finish("test_cornell");
 }

@@ -20,6 +20,9 @@ static const char usage[] =
     "  --eye X,Y,Z  --target X,Y,Z  --up X,Y,Z  --fov DEG (vertical)   --size WxH (512x512)\n"
     "  --spp N              samples per pixel, stratified, box filter (default 4)\n"
     "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"
+    "  --specular           the two-pass method: surfaces with Ks > 0 (MTL) also show\n"
+    "                       mirror reflections of the radiosity-lit scene\n"
+    "  --max-depth N        mirror reflections followed with --specular (default 5)\n"
     "Solution:\n"
     "  --solver NAME        gather (Jacobi, default), gauss-seidel, shoot, or direct (LU,\n"
     "                       small scenes only)\n"
@@ -34,7 +37,10 @@ static const char usage[] =
     "  --stats FILE.json    write counts, times, residuals and peak memory\n"
     "  -h, --help           this text\n";
 
-enum { OPT_SOLVER = OPT_OWN, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_COUNT };
+enum {
+    OPT_SOLVER = OPT_OWN, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_SPECULAR, OPT_MAX_DEPTH,
+    OPT_COUNT
+};
 
 static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS,
@@ -43,6 +49,8 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_SOLVER] = {"solver", 0, true},
     [OPT_TOLERANCE] = {"tolerance", 0, true},
     [OPT_MAX_ITERATIONS] = {"max-iterations", 0, true},
+    [OPT_SPECULAR] = {"specular", 0, false},
+    [OPT_MAX_DEPTH] = {"max-depth", 0, true},
 };
 
 /* Patches the default patch size aims at. */
@@ -54,6 +62,7 @@ typedef struct render_settings {
     cli_view view;
     rad_render_options render;
     rad_solve_options solve;
+    bool specular; /* the two-pass method */
 } render_settings;
 
 static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_code)
@@ -83,9 +92,19 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
     if (!cli_image_output_ok(s->output))
         return false;
     s->stats_path = s->shared.stats_path;
+    s->render.samples_per_pixel = s->view.samples_per_pixel;
+    s->specular = args.value[OPT_SPECULAR] != NULL;
     unsigned long value;
     double number;
-    s->render.samples_per_pixel = s->view.samples_per_pixel;
+    if (args.value[OPT_MAX_DEPTH]) {
+        if (!cli_parse_uint("max-depth", args.value[OPT_MAX_DEPTH], 64, &value))
+            return false;
+        if (value == 0) {
+            cli_error("--max-depth: must be at least 1");
+            return false;
+        }
+        s->render.max_depth = (uint32_t)value;
+    }
     const char *solver = args.value[OPT_SOLVER] ? args.value[OPT_SOLVER] : "gather";
     if (strcmp(solver, "gather") == 0 || strcmp(solver, "jacobi") == 0)
         s->solve.solver = RAD_SOLVER_JACOBI;
@@ -194,6 +213,8 @@ int command_render(int argc, char **argv)
                  solve_report.iterations, solve_report.criterion);
     t_solve = cli_now();
 
+    if (s.specular)
+        s.render.materials = scene->materials;
     status = rad_image_create(s.view.width, s.view.height, &image, &error);
     if (status == RAD_OK)
         status = rad_render(mesh, B, &camera, &s.render, image, &error);

@@ -1,10 +1,13 @@
 /*
- * render.c - images of a radiosity solution.
+ * render.c - images of a radiosity solution, and the two-pass method.
  *
  * The patches are split into triangles (quads along their first diagonal) and handed to a
  * tracer; each pixel averages k x k jittered stratified primary rays (box filter). A hit
  * on a front face takes the radiance interpolated from the vertex values with the hit's
- * barycentrics; a back face or a miss is black. Random numbers come from (seed, pixel).
+ * barycentrics; a back face or a miss is black. With the scene's materials given, a hit
+ * on a surface with Ks > 0 also sends a mirror ray, weighted by Ks, whose hit is shaded
+ * the same way (the radiosity solution replaces Whitted's ambient term), up to a depth.
+ * Random numbers come from (seed, pixel).
  */
 #include <math.h>
 #include <omp.h>
@@ -19,6 +22,77 @@
 #include "render/camera.h"
 
 #define MAX_STRATA 16u
+#define DEFAULT_MAX_DEPTH 5u
+
+/* One thread's rays of one image row, compacted bounce by bounce. */
+typedef struct row_work {
+    rad_ray *rays;
+    rad_hit *hits;
+    rad_rgb *weight;  /* product of the Ks met so far */
+    uint32_t *sample; /* the sample (pixel x, stratum) a ray belongs to */
+    rad_rgb *sum;     /* radiance gathered per sample */
+} row_work;
+
+typedef struct shading {
+    const rad_mesh *mesh;
+    const uint32_t (*triangles)[3]; /* render triangles, into mesh vertices */
+    const uint32_t *patch_of;       /* render triangle -> patch */
+    const rad_rgb *radiance;        /* per mesh vertex */
+    const rad_material *materials;  /* NULL: no mirror rays */
+    float t_near;
+} shading;
+
+static void set_ray(rad_ray *ray, rad_vec3 origin, rad_vec3 direction, float t_near)
+{
+    ray->origin[0] = (float)origin.x;
+    ray->origin[1] = (float)origin.y;
+    ray->origin[2] = (float)origin.z;
+    ray->direction[0] = (float)direction.x;
+    ray->direction[1] = (float)direction.y;
+    ray->direction[2] = (float)direction.z;
+    ray->t_near = t_near;
+    ray->t_far = INFINITY;
+}
+
+/* Adds each hit's interpolated radiance (times the ray's weight) to its sample and, when
+ * mirrors are allowed, writes the mirror rays of specular hits to the front of the arrays.
+ * Returns how many rays are left for the next bounce. */
+static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool mirrors)
+{
+    uint32_t next = 0;
+    for (uint32_t r = 0; r < count; r++) {
+        const rad_hit *hit = &w->hits[r];
+        if (hit->triangle == RAD_NO_HIT || !hit->front)
+            continue;
+        const uint32_t *v = sh->triangles[hit->triangle];
+        double w0 = 1.0 - hit->u - hit->v, w1 = hit->u, w2 = hit->v;
+        const rad_rgb *L = sh->radiance;
+        rad_rgb weight = w->weight[r];
+        rad_rgb *sum = &w->sum[w->sample[r]];
+        sum->r += weight.r * (w0 * L[v[0]].r + w1 * L[v[1]].r + w2 * L[v[2]].r);
+        sum->g += weight.g * (w0 * L[v[0]].g + w1 * L[v[1]].g + w2 * L[v[2]].g);
+        sum->b += weight.b * (w0 * L[v[0]].b + w1 * L[v[1]].b + w2 * L[v[2]].b);
+        if (!mirrors || !sh->materials)
+            continue;
+        const rad_patch *patch = &sh->mesh->patches[sh->patch_of[hit->triangle]];
+        rad_rgb ks = sh->materials[patch->material].specular;
+        if (!(ks.r > 0 || ks.g > 0 || ks.b > 0))
+            continue;
+        const rad_ray *ray = &w->rays[r];
+        rad_vec3 d = v3(ray->direction[0], ray->direction[1], ray->direction[2]);
+        rad_vec3 p = v3(ray->origin[0] + hit->t * d.x, ray->origin[1] + hit->t * d.y,
+                        ray->origin[2] + hit->t * d.z);
+        rad_vec3 n = patch->normal;
+        rad_vec3 mirror = v3_normalize(v3_sub(d, v3_scale(n, 2 * v3_dot(d, n))));
+        /* leave the surface on its front side: nudged along the normal, past t_near */
+        rad_vec3 origin = v3_add(p, v3_scale(n, 4.0 * sh->t_near));
+        w->weight[next] = (rad_rgb){weight.r * ks.r, weight.g * ks.g, weight.b * ks.b};
+        w->sample[next] = w->sample[r];
+        set_ray(&w->rays[next], origin, mirror, sh->t_near);
+        next++;
+    }
+    return next;
+}
 
 rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
                       const rad_render_options *options, rad_image *image, rad_error *error)
@@ -44,8 +118,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     uint32_t *patch_of = rad_alloc_array(triangle_count, sizeof(*patch_of));
     rad_rgb *radiance = rad_alloc_array(mesh->vertex_count, sizeof(*radiance));
     rad_tracer *tracer = NULL;
-    rad_ray *rays = NULL;
-    rad_hit *hits = NULL;
+    row_work *work = NULL;
     if (!triangles || !patch_of || !radiance || triangle_count > UINT32_MAX)
         goto nomem;
     size_t t = 0;
@@ -75,46 +148,54 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     float t_near = (float)(RAD_CAMERA_NEAR * diagonal);
 
     size_t per_row = (size_t)W * k * k;
-    rays = rad_alloc_array((size_t)threads * per_row, sizeof(*rays));
-    hits = rad_alloc_array((size_t)threads * per_row, sizeof(*hits));
-    if (!rays || !hits)
+    unsigned max_depth = options->max_depth ? options->max_depth : DEFAULT_MAX_DEPTH;
+    work = rad_alloc_array((size_t)threads, sizeof(*work));
+    if (!work)
         goto nomem;
+    for (int th = 0; th < threads; th++) {
+        row_work *w = &work[th];
+        w->rays = rad_alloc_array(per_row, sizeof(*w->rays));
+        w->hits = rad_alloc_array(per_row, sizeof(*w->hits));
+        w->weight = rad_alloc_array(per_row, sizeof(*w->weight));
+        w->sample = rad_alloc_array(per_row, sizeof(*w->sample));
+        w->sum = rad_alloc_array(per_row, sizeof(*w->sum));
+        if (!w->rays || !w->hits || !w->weight || !w->sample || !w->sum)
+            goto nomem;
+    }
+    shading shade = {mesh, (const uint32_t(*)[3])triangles, patch_of, radiance, options->materials,
+                     t_near};
 
     uint32_t rows_done = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (uint32_t y = 0; y < H; y++) {
         int thread = omp_get_thread_num();
-        rad_ray *row_rays = rays + (size_t)thread * per_row;
-        rad_hit *row_hits = hits + (size_t)thread * per_row;
+        row_work *w = &work[thread];
         for (uint32_t x = 0; x < W; x++) {
             rad_rng rng = rad_rng_seed(options->seed, y, x);
             for (unsigned s = 0; s < k * k; s++) {
                 double px = x + ((s % k) + rad_rng_uniform(&rng)) / k;
                 double py = y + ((s / k) + rad_rng_uniform(&rng)) / k;
                 rad_vec3 d = v3_normalize(camera_direction(&frame, px, py, W, H));
-                rad_ray *ray = &row_rays[(size_t)x * k * k + s];
-                ray->origin[0] = (float)frame.eye.x;
-                ray->origin[1] = (float)frame.eye.y;
-                ray->origin[2] = (float)frame.eye.z;
-                ray->direction[0] = (float)d.x;
-                ray->direction[1] = (float)d.y;
-                ray->direction[2] = (float)d.z;
-                ray->t_near = t_near;
-                ray->t_far = INFINITY;
+                size_t index = (size_t)x * k * k + s;
+                set_ray(&w->rays[index], frame.eye, d, t_near);
+                w->weight[index] = (rad_rgb){1, 1, 1};
+                w->sample[index] = (uint32_t)index;
+                w->sum[index] = (rad_rgb){0, 0, 0};
             }
         }
-        rad_tracer_intersect(tracer, row_rays, (uint32_t)per_row, row_hits);
+        /* each bounce shades the active rays and keeps the mirror rays for the next */
+        uint32_t active = (uint32_t)per_row;
+        for (unsigned depth = 0; active > 0; depth++) {
+            rad_tracer_intersect(tracer, w->rays, active, w->hits);
+            active = shade_hits(&shade, w, active, depth < max_depth);
+        }
         for (uint32_t x = 0; x < W; x++) {
             double sum[3] = {0, 0, 0};
             for (unsigned s = 0; s < k * k; s++) {
-                const rad_hit *hit = &row_hits[(size_t)x * k * k + s];
-                if (hit->triangle == RAD_NO_HIT || !hit->front)
-                    continue;
-                const uint32_t *v = triangles[hit->triangle];
-                double w0 = 1.0 - hit->u - hit->v, w1 = hit->u, w2 = hit->v;
-                sum[0] += w0 * radiance[v[0]].r + w1 * radiance[v[1]].r + w2 * radiance[v[2]].r;
-                sum[1] += w0 * radiance[v[0]].g + w1 * radiance[v[1]].g + w2 * radiance[v[2]].g;
-                sum[2] += w0 * radiance[v[0]].b + w1 * radiance[v[1]].b + w2 * radiance[v[2]].b;
+                const rad_rgb *L = &w->sum[(size_t)x * k * k + s];
+                sum[0] += L->r;
+                sum[1] += L->g;
+                sum[2] += L->b;
             }
             float *pixel = &image->rgb[((size_t)y * W + x) * 3];
             for (int c = 0; c < 3; c++)
@@ -132,11 +213,18 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
 nomem:
     status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for rendering");
 done:
+    if (work)
+        for (int th = 0; th < threads; th++) {
+            free(work[th].rays);
+            free(work[th].hits);
+            free(work[th].weight);
+            free(work[th].sample);
+            free(work[th].sum);
+        }
+    free(work);
     rad_tracer_destroy(tracer);
     free(triangles);
     free(patch_of);
     free(radiance);
-    free(rays);
-    free(hits);
     return status;
 }
