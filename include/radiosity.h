@@ -518,11 +518,15 @@ typedef struct rad_image_difference {
                                     |mean_a - mean_b|_1 / |mean_b|_1 */
     uint32_t worst_block_x, worst_block_y; /* its top-left pixel */
     uint32_t block_count;        /* whole blocks compared */
-    double blocks_within_tolerance; /* fraction of them within block_tolerance */
+    uint32_t blocks_within;      /* how many of them are within block_tolerance */
+    double blocks_within_tolerance; /* that fraction (0 when there is no whole block) */
 } rad_image_difference;
 
 /* Compares a against b (the reference). The images must have the same size
- * (RAD_ERR_INVALID otherwise). `false_colour` (NULL, or an image of the same size)
+ * (RAD_ERR_INVALID otherwise), and finite (RAD_ERR_INVALID naming the first bad pixel;
+ * false_colour is left untouched on failure). Blocks tile the image from the top-left
+ * corner; partial blocks at the right and bottom edges are left out. A block whose
+ * reference mean is black scores 0 when a's is black too, else HUGE_VAL. `false_colour` (NULL, or an image of the same size)
  * receives a picture of where they differ: per pixel, the relative difference mapped
  * from blue (none) through green and yellow to red (100 % or more). */
 rad_status rad_image_compare(const rad_image *a, const rad_image *b,

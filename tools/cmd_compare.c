@@ -46,6 +46,10 @@ static const cli_option options[OPT_COUNT] = {
 /* The largest --block: far beyond any useful block, small enough that block^2 fits. */
 #define MAX_BLOCK 65535ul
 
+/* The library's defaults for zero options (radiosity.h), printed in the report. */
+#define DEFAULT_BLOCK 8u
+#define DEFAULT_BLOCK_TOLERANCE 0.10
+
 /* The false colours are exact at exposure 0 (2^0 = 1): the ramp's corners are 0 and 1. */
 static const rad_image_write_options false_colour_write = {.fixed_exposure = true,
                                                            .exposure = 0};
@@ -134,9 +138,9 @@ int command_compare(int argc, char **argv)
         goto done;
     }
 
-    uint32_t block = compare.block_size ? compare.block_size : 8;
+    uint32_t block = compare.block_size ? compare.block_size : DEFAULT_BLOCK;
     unsigned long within =
-        (unsigned long)lround(difference.blocks_within_tolerance * difference.block_count);
+        (unsigned long)difference.blocks_within;
     print_report(a, &difference, block, within);
     if (fflush(stdout) != 0) {
         cli_error("standard output: write failed");
@@ -172,7 +176,8 @@ int command_compare(int argc, char **argv)
         stats_integer(&stats, "blocks_within", within);
         stats_number(&stats, "blocks_within_tolerance", difference.blocks_within_tolerance);
         stats_number(&stats, "block_tolerance",
-                     compare.block_tolerance > 0 ? compare.block_tolerance : 0.10);
+                     compare.block_tolerance > 0 ? compare.block_tolerance
+                                                    : DEFAULT_BLOCK_TOLERANCE);
         if (!stats_write(&stats, stats_path))
             exit_code = EXIT_ERROR;
     }

@@ -198,6 +198,7 @@ rad_status rad_image_compare(const rad_image *a, const rad_image *b,
     difference->worst_block_x = worst_x;
     difference->worst_block_y = worst_y;
     difference->block_count = block_count;
+    difference->blocks_within = within;
     difference->blocks_within_tolerance = block_count ? (double)within / block_count : 0.0;
     return RAD_OK;
 }
