@@ -456,8 +456,8 @@ typedef struct rad_raytrace_options {
     const rad_point_light *lights; /* point lights, may be NULL when light_count is 0 */
     uint32_t light_count;
     rad_rgb ambient;            /* I_A; the ambient reflectance K_A is the albedo Kd */
-    uint32_t light_samples;     /* points per emissive-surface light per shading point;
-                                   0 = 16 */
+    uint32_t light_samples;     /* points sampled on the emitters (all together, chosen by
+                                   power) per shading point; 0 = 16 */
     uint32_t max_depth;         /* reflected rays followed; 0 = 5 */
     uint32_t samples_per_pixel; /* stratified, box filter; 0 = 4 */
     uint64_t seed;
@@ -469,9 +469,12 @@ typedef struct rad_raytrace_options {
 /* Whitted ray tracing with the Phong model of METHOD.md section 1:
  *   I = I_E + K_A I_A + sum over lights (K_D <N,L> + K_S <V,R>^n) I_L S_L + K_S I_R
  * with I_E the emitted radiance, S_L the shadow-ray visibility and I_R the radiance along
- * the mirror direction. Emissive surfaces act as area lights, sampled for soft shadows.
- * Back faces show black (one-sided surfaces). Fills `image` (its size sets the
- * resolution). */
+ * the mirror direction. Point lights follow the classic model (no distance falloff).
+ * Emissive surfaces act as area lights, sampled for soft shadows: each sample adds
+ * (K_D + K_S <V,R>^n) / pi * L_e cos(surface) cos(light) / r^2 / pdf, the Phong model read as
+ * a reflectance function, so their diffuse part is exactly radiosity's direct light. Back
+ * faces show black (one-sided surfaces). One sample per pixel goes through the pixel's
+ * centre. Fills `image` (its size sets the resolution). */
 rad_status rad_raytrace(const rad_scene *scene, const rad_camera *camera,
                         const rad_raytrace_options *options, rad_image *image,
                         rad_error *error);
