@@ -480,8 +480,11 @@ rad_status rad_raytrace(const rad_scene *scene, const rad_camera *camera,
                         rad_error *error);
 
 typedef struct rad_pathtrace_options {
-    uint32_t samples_per_pixel; /* 0 = 64 */
-    uint32_t max_depth;         /* most bounces; 0 = no limit (Russian roulette ends paths) */
+    uint32_t samples_per_pixel; /* 0 = 64; the largest k^2 <= spp are stratified over the
+                                   pixel, the rest uniform */
+    uint32_t max_depth;         /* light reaches the eye after at most this many reflections
+                                   (1 = direct light only); 0 = no limit (Russian roulette
+                                   ends paths) */
     uint64_t seed;
     int threads;
     rad_progress_fn progress;
@@ -498,7 +501,8 @@ typedef struct rad_pathtrace_report {
  * estimation on emitters combined with BSDF sampling by multiple importance sampling,
  * Russian roulette. Deterministic per seed for any thread count; parallel over tiles. The
  * reference for checking radiosity images. `standard_error` (NULL, or an image of the
- * same size) receives each pixel's standard error of the mean, per channel. */
+ * same size) receives each pixel's standard error of the mean, per channel, estimated
+ * from that pixel's own samples (+INFINITY with one sample per pixel). */
 rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
                          const rad_pathtrace_options *options, rad_image *image,
                          rad_image *standard_error, rad_pathtrace_report *report,
