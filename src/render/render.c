@@ -4,7 +4,8 @@
  * The patches are split into triangles (quads along their first diagonal) and handed to a
  * tracer; each pixel averages k x k jittered stratified primary rays (box filter). A hit
  * on a front face takes the radiance interpolated from the vertex values with the hit's
- * barycentrics; a back face or a miss is black. With the scene's materials given, a hit
+ * barycentrics; a back face or a miss is black. Pixels whose first samples disagree
+ * (silhouettes, the light's rim) get edge_samples more. With the scene's materials given, a hit
  * on a surface with Ks > 0 also sends a mirror ray, weighted by Ks, whose hit is shaded
  * the same way (the radiosity solution replaces Whitted's ambient term), up to a depth.
  * Random numbers come from (seed, pixel).
@@ -23,6 +24,9 @@
 
 #define MAX_STRATA 16u
 #define DEFAULT_MAX_DEPTH 5u
+#define DEFAULT_EDGE_SAMPLES 64u /* extra samples for an edge pixel */
+#define EDGE_CONTRAST 0.1        /* relative luminance spread that makes an edge */
+#define EDGE_STREAM 0x5EED0EDCEull /* keeps edge samples' random numbers apart */
 
 /* One thread's rays of one image row, compacted bounce by bounce. */
 typedef struct row_work {
@@ -30,7 +34,8 @@ typedef struct row_work {
     rad_hit *hits;
     rad_rgb *weight;  /* product of the Ks met so far */
     uint32_t *sample; /* the sample (pixel x, stratum) a ray belongs to */
-    rad_rgb *sum;     /* radiance gathered per sample */
+    rad_rgb *sum;     /* radiance gathered per sample: first samples, then edge samples */
+    uint8_t *edge;    /* per pixel of the row: gets edge samples */
 } row_work;
 
 typedef struct shading {
@@ -41,6 +46,25 @@ typedef struct shading {
     const rad_material *materials;  /* NULL: no mirror rays */
     float t_near;
 } shading;
+
+/* Traces `count` rays set up at the front of w's arrays, bounce by bounce: each bounce
+ * shades the hits and keeps the mirror rays for the next. */
+static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work *w,
+                          uint32_t count, unsigned max_depth);
+
+/* A pixel is an edge when the luminance of its first samples spreads by more than
+ * EDGE_CONTRAST of their mean. */
+static bool is_edge(const rad_rgb *samples, unsigned count)
+{
+    double lo = INFINITY, hi = 0, mean = 0;
+    for (unsigned s = 0; s < count; s++) {
+        double y = 0.2126 * samples[s].r + 0.7152 * samples[s].g + 0.0722 * samples[s].b;
+        lo = fmin(lo, y);
+        hi = fmax(hi, y);
+        mean += y / count;
+    }
+    return hi - lo > EDGE_CONTRAST * mean;
+}
 
 static void set_ray(rad_ray *ray, rad_vec3 origin, rad_vec3 direction, float t_near)
 {
@@ -94,6 +118,15 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
     return next;
 }
 
+static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work *w,
+                          uint32_t count, unsigned max_depth)
+{
+    for (unsigned depth = 0; count > 0; depth++) {
+        rad_tracer_intersect(tracer, w->rays, count, w->hits);
+        count = shade_hits(sh, w, count, depth < max_depth);
+    }
+}
+
 rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
                       const rad_render_options *options, rad_image *image, rad_error *error)
 {
@@ -105,7 +138,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     rad_status status = camera_frame_make(camera, W, H, &frame, error);
     if (status != RAD_OK)
         return status;
-    unsigned spp = options->samples_per_pixel ? options->samples_per_pixel : 4;
+    unsigned spp = options->samples_per_pixel ? options->samples_per_pixel : 16;
     unsigned k = (unsigned)lround(sqrt((double)spp));
     k = k < 1 ? 1 : k > MAX_STRATA ? MAX_STRATA : k;
     int threads = options->threads > 0 ? options->threads : omp_get_max_threads();
@@ -148,18 +181,24 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     float t_near = (float)(RAD_CAMERA_NEAR * diagonal);
 
     size_t per_row = (size_t)W * k * k;
+    unsigned edge_k = (unsigned)lround(sqrt((double)(options->edge_samples ? options->edge_samples
+                                                                          : DEFAULT_EDGE_SAMPLES)));
+    edge_k = edge_k < 1 ? 1 : edge_k > MAX_STRATA ? MAX_STRATA : edge_k;
+    size_t per_row_edges = (size_t)W * edge_k * edge_k;
+    size_t ray_capacity = per_row > per_row_edges ? per_row : per_row_edges;
     unsigned max_depth = options->max_depth ? options->max_depth : DEFAULT_MAX_DEPTH;
     work = rad_alloc_array((size_t)threads, sizeof(*work));
     if (!work)
         goto nomem;
     for (int th = 0; th < threads; th++) {
         row_work *w = &work[th];
-        w->rays = rad_alloc_array(per_row, sizeof(*w->rays));
-        w->hits = rad_alloc_array(per_row, sizeof(*w->hits));
-        w->weight = rad_alloc_array(per_row, sizeof(*w->weight));
-        w->sample = rad_alloc_array(per_row, sizeof(*w->sample));
-        w->sum = rad_alloc_array(per_row, sizeof(*w->sum));
-        if (!w->rays || !w->hits || !w->weight || !w->sample || !w->sum)
+        w->rays = rad_alloc_array(ray_capacity, sizeof(*w->rays));
+        w->hits = rad_alloc_array(ray_capacity, sizeof(*w->hits));
+        w->weight = rad_alloc_array(ray_capacity, sizeof(*w->weight));
+        w->sample = rad_alloc_array(ray_capacity, sizeof(*w->sample));
+        w->sum = rad_alloc_array(per_row + per_row_edges, sizeof(*w->sum));
+        w->edge = rad_alloc_array(W, sizeof(*w->edge));
+        if (!w->rays || !w->hits || !w->weight || !w->sample || !w->sum || !w->edge)
             goto nomem;
     }
     shading shade = {mesh, (const uint32_t(*)[3])triangles, patch_of, radiance, options->materials,
@@ -183,23 +222,52 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                 w->sum[index] = (rad_rgb){0, 0, 0};
             }
         }
-        /* each bounce shades the active rays and keeps the mirror rays for the next */
-        uint32_t active = (uint32_t)per_row;
-        for (unsigned depth = 0; active > 0; depth++) {
-            rad_tracer_intersect(tracer, w->rays, active, w->hits);
-            active = shade_hits(&shade, w, active, depth < max_depth);
+        trace_samples(&shade, tracer, w, (uint32_t)per_row, max_depth);
+
+        /* edges: pixels whose first samples disagree (a silhouette, the light's rim) get
+         * edge_k x edge_k more, so that high-contrast edges are antialiased */
+        uint32_t extra = 0;
+        for (uint32_t x = 0; x < W; x++) {
+            w->edge[x] = is_edge(&w->sum[(size_t)x * k * k], k * k);
+            if (!w->edge[x])
+                continue;
+            rad_rng rng = rad_rng_seed(options->seed ^ EDGE_STREAM, y, x);
+            for (unsigned s = 0; s < edge_k * edge_k; s++) {
+                double px = x + ((s % edge_k) + rad_rng_uniform(&rng)) / edge_k;
+                double py = y + ((s / edge_k) + rad_rng_uniform(&rng)) / edge_k;
+                rad_vec3 d = v3_normalize(camera_direction(&frame, px, py, W, H));
+                size_t index = per_row + extra++;
+                set_ray(&w->rays[index - per_row], frame.eye, d, t_near);
+                w->weight[index - per_row] = (rad_rgb){1, 1, 1};
+                w->sample[index - per_row] = (uint32_t)index;
+                w->sum[index] = (rad_rgb){0, 0, 0};
+            }
         }
+        if (extra)
+            trace_samples(&shade, tracer, w, extra, max_depth);
+
+        uint32_t next_extra = 0;
         for (uint32_t x = 0; x < W; x++) {
             double sum[3] = {0, 0, 0};
+            unsigned count = k * k;
             for (unsigned s = 0; s < k * k; s++) {
                 const rad_rgb *L = &w->sum[(size_t)x * k * k + s];
                 sum[0] += L->r;
                 sum[1] += L->g;
                 sum[2] += L->b;
             }
+            if (w->edge[x]) {
+                for (unsigned s = 0; s < edge_k * edge_k; s++) {
+                    const rad_rgb *L = &w->sum[per_row + next_extra++];
+                    sum[0] += L->r;
+                    sum[1] += L->g;
+                    sum[2] += L->b;
+                }
+                count += edge_k * edge_k;
+            }
             float *pixel = &image->rgb[((size_t)y * W + x) * 3];
             for (int c = 0; c < 3; c++)
-                pixel[c] = (float)(sum[c] / (k * k));
+                pixel[c] = (float)(sum[c] / count);
         }
         uint32_t done;
 #pragma omp atomic capture
@@ -220,6 +288,7 @@ done:
             free(work[th].weight);
             free(work[th].sample);
             free(work[th].sum);
+            free(work[th].edge);
         }
     free(work);
     rad_tracer_destroy(tracer);
