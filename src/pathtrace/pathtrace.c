@@ -30,9 +30,11 @@
 #include "core/error.h"
 #include "core/random.h"
 #include "core/tolerance.h"
+#include "core/rgb.h"
 #include "core/vec3.h"
 #include "render/camera.h"
 #include "scene/emitters.h"
+#include "trace/ray.h"
 
 /* Tiles are TILE x TILE pixels: the unit of parallel work (dynamic schedule). */
 #define TILE 16u
@@ -106,29 +108,9 @@ static double larger(double a, double b) { return a > b ? a : b; }
 
 static double max3(rad_rgb c) { return larger(c.r, larger(c.g, c.b)); }
 
-static rad_rgb rgb_mul(rad_rgb a, rad_rgb b) { return (rad_rgb){a.r * b.r, a.g * b.g, a.b * b.b}; }
 
-static rad_rgb rgb_scale(rad_rgb a, double s) { return (rad_rgb){a.r * s, a.g * s, a.b * s}; }
 
-static void rgb_add_to(rad_rgb *sum, rad_rgb a)
-{
-    sum->r += a.r;
-    sum->g += a.g;
-    sum->b += a.b;
-}
 
-static void set_ray(rad_ray *ray, rad_vec3 origin, rad_vec3 direction, float t_near,
-                    float t_far)
-{
-    ray->origin[0] = (float)origin.x;
-    ray->origin[1] = (float)origin.y;
-    ray->origin[2] = (float)origin.z;
-    ray->direction[0] = (float)direction.x;
-    ray->direction[1] = (float)direction.y;
-    ray->direction[2] = (float)direction.z;
-    ray->t_near = t_near;
-    ray->t_far = t_far;
-}
 
 /* Power heuristic (beta = 2) weight of a strategy with density `a` against one with `b`. */
 static double power_heuristic(double a, double b)
@@ -218,7 +200,7 @@ static int queue_light_sample(const pt_context *c, pt_workspace *w, uint32_t slo
     double t_far = length - c->offset;
     if (!(t_far > 0))
         t_far = 0; /* the light is within the offset: nothing can be in between */
-    set_ray(&w->shadow_rays[slot], o, v3_scale(segment, 1.0 / length), 0.0f, (float)t_far);
+    ray_set(&w->shadow_rays[slot], o, v3_scale(segment, 1.0 / length), 0.0f, (float)t_far);
     w->shadow_path[slot] = p;
     w->shadow_value[slot] = value;
     return 1;
@@ -284,7 +266,7 @@ static uint32_t extend_paths(const pt_context *c, pt_workspace *w, uint32_t live
             path->throughput = rgb_scale(path->throughput, 1.0 / survive);
         }
         path->bsdf_pdf = cos_theta / RAD_PI;
-        set_ray(&w->rays[next], o, wo, 0.0f, INFINITY);
+        ray_set(&w->rays[next], o, wo, 0.0f, INFINITY);
         w->active[next++] = p;
     }
     rad_tracer_occluded(c->tracer, w->shadow_rays, shadows, w->occluded);
@@ -313,7 +295,7 @@ static void trace_wave(const pt_context *c, pt_workspace *w, uint32_t x0, uint32
         double px, py;
         film_point(c, &path->rng, x, y, sample, &px, &py);
         rad_vec3 d = v3_normalize(camera_direction(&c->frame, px, py, c->width, c->height));
-        set_ray(&w->rays[j], c->frame.eye, d, c->camera_near, INFINITY);
+        ray_set(&w->rays[j], c->frame.eye, d, c->camera_near, INFINITY);
         w->active[j] = j;
     }
     for (uint32_t live = paths; live > 0;)

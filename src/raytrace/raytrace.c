@@ -50,9 +50,11 @@
 #include "core/error.h"
 #include "core/random.h"
 #include "core/tolerance.h"
+#include "core/rgb.h"
 #include "core/vec3.h"
 #include "render/camera.h"
 #include "scene/emitters.h"
+#include "trace/ray.h"
 
 /* Secondary rays leave a surface from a point nudged this far along its normal and ignore
  * hits closer than it (t_near): this fraction of the scene's bounding-box diagonal (scene
@@ -124,27 +126,7 @@ typedef struct rt_workspace {
     rad_rgb *pixel_sum;       /* width: the row's pixel sums */
 } rt_workspace;
 
-static rad_rgb rgb_mul(rad_rgb a, rad_rgb b) { return (rad_rgb){a.r * b.r, a.g * b.g, a.b * b.b}; }
-static rad_rgb rgb_scale(rad_rgb a, double s) { return (rad_rgb){a.r * s, a.g * s, a.b * s}; }
-static rad_rgb rgb_add(rad_rgb a, rad_rgb b) { return (rad_rgb){a.r + b.r, a.g + b.g, a.b + b.b}; }
-static bool rgb_is_zero(rad_rgb a) { return !(a.r != 0 || a.g != 0 || a.b != 0); }
-static bool rgb_valid(rad_rgb a)
-{
-    return isfinite(a.r) && isfinite(a.g) && isfinite(a.b) && a.r >= 0 && a.g >= 0 && a.b >= 0;
-}
 
-static void set_ray(rad_ray *ray, rad_vec3 origin, rad_vec3 direction, double t_near,
-                    double t_far)
-{
-    ray->origin[0] = (float)origin.x;
-    ray->origin[1] = (float)origin.y;
-    ray->origin[2] = (float)origin.z;
-    ray->direction[0] = (float)direction.x;
-    ray->direction[1] = (float)direction.y;
-    ray->direction[2] = (float)direction.z;
-    ray->t_near = (float)t_near;
-    ray->t_far = (float)t_far;
-}
 
 /* Traces the queued shadow rays and adds what the unblocked ones bring. */
 static void flush_shadows(const rt_context *ctx, rt_workspace *ws)
@@ -172,7 +154,7 @@ static void queue_shadow(const rt_context *ctx, rt_workspace *ws, rad_vec3 from,
      * (t_near > t_far: nothing can be hit) */
     double t_near = length > 0 ? ctx->offset / length : 1;
     double t_far = length > 0 ? 1 - end_gap / length : 0;
-    set_ray(&ws->shadow_rays[k], from, d, t_near, t_far);
+    ray_set(&ws->shadow_rays[k], from, d, t_near, t_far);
     ws->shadow_sample[k] = sample;
     ws->shadow_add[k] = add;
 }
@@ -272,7 +254,7 @@ static void trace_packet(const rt_context *ctx, rt_workspace *ws, uint32_t count
     for (uint32_t depth = 0; count > 0; depth++) {
         for (uint32_t i = 0; i < count; i++) {
             double t_near = depth == 0 ? ctx->camera_near : ctx->offset;
-            set_ray(&ws->rays[i], ws->paths[i].origin, ws->paths[i].direction, t_near, INFINITY);
+            ray_set(&ws->rays[i], ws->paths[i].origin, ws->paths[i].direction, t_near, INFINITY);
         }
         rad_tracer_intersect(ctx->tracer, ws->rays, count, ws->hits);
         uint32_t alive = 0;

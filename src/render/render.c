@@ -21,6 +21,7 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "render/camera.h"
+#include "trace/ray.h"
 
 #define MAX_STRATA 16u
 #define DEFAULT_MAX_DEPTH 5u
@@ -66,17 +67,6 @@ static bool is_edge(const rad_rgb *samples, unsigned count)
     return hi - lo > EDGE_CONTRAST * mean;
 }
 
-static void set_ray(rad_ray *ray, rad_vec3 origin, rad_vec3 direction, float t_near)
-{
-    ray->origin[0] = (float)origin.x;
-    ray->origin[1] = (float)origin.y;
-    ray->origin[2] = (float)origin.z;
-    ray->direction[0] = (float)direction.x;
-    ray->direction[1] = (float)direction.y;
-    ray->direction[2] = (float)direction.z;
-    ray->t_near = t_near;
-    ray->t_far = INFINITY;
-}
 
 /* Adds each hit's interpolated radiance (times the ray's weight) to its sample and, when
  * mirrors are allowed, writes the mirror rays of specular hits to the front of the arrays.
@@ -112,7 +102,7 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
         rad_vec3 origin = v3_add(p, v3_scale(n, 4.0 * sh->t_near));
         w->weight[next] = (rad_rgb){weight.r * ks.r, weight.g * ks.g, weight.b * ks.b};
         w->sample[next] = w->sample[r];
-        set_ray(&w->rays[next], origin, mirror, sh->t_near);
+        ray_set(&w->rays[next], origin, mirror, sh->t_near, INFINITY);
         next++;
     }
     return next;
@@ -216,7 +206,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                 double py = y + ((s / k) + rad_rng_uniform(&rng)) / k;
                 rad_vec3 d = v3_normalize(camera_direction(&frame, px, py, W, H));
                 size_t index = (size_t)x * k * k + s;
-                set_ray(&w->rays[index], frame.eye, d, t_near);
+                ray_set(&w->rays[index], frame.eye, d, t_near, INFINITY);
                 w->weight[index] = (rad_rgb){1, 1, 1};
                 w->sample[index] = (uint32_t)index;
                 w->sum[index] = (rad_rgb){0, 0, 0};
@@ -237,7 +227,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                 double py = y + ((s / edge_k) + rad_rng_uniform(&rng)) / edge_k;
                 rad_vec3 d = v3_normalize(camera_direction(&frame, px, py, W, H));
                 size_t index = per_row + extra++;
-                set_ray(&w->rays[index - per_row], frame.eye, d, t_near);
+                ray_set(&w->rays[index - per_row], frame.eye, d, t_near, INFINITY);
                 w->weight[index - per_row] = (rad_rgb){1, 1, 1};
                 w->sample[index - per_row] = (uint32_t)index;
                 w->sum[index] = (rad_rgb){0, 0, 0};

@@ -16,6 +16,7 @@
 #endif
 
 #include "core/error.h"
+#include "core/rgb.h"
 #include "solve/solve_internal.h"
 
 /* Defaults for the zero values of rad_solve_options (see radiosity.h). */
@@ -37,7 +38,6 @@ static double wall_seconds(void)
 #endif
 }
 
-static bool rgb_finite(rad_rgb c) { return isfinite(c.r) && isfinite(c.g) && isfinite(c.b); }
 
 static rad_status check_system(const rad_system *system, rad_error *error)
 {
