@@ -276,6 +276,35 @@ bool cli_image_output_ok(const char *path)
     return false;
 }
 
+bool cli_parse_image_command(const char *command, const char *usage, int argc, char **argv,
+                             const cli_option *options, int option_count, cli_args *args,
+                             cli_shared *shared, cli_view *view, const char **scene_path,
+                             int *exit_code)
+{
+    *exit_code = EXIT_USAGE;
+    if (!cli_parse(command, argc, argv, options, option_count, args))
+        return false;
+    if (args->value[OPT_HELP]) {
+        fputs(usage, stdout);
+        *exit_code = EXIT_OK;
+        return false;
+    }
+    if (!cli_parse_shared(args, shared) || !cli_parse_view(args, view))
+        return false;
+    if (args->positional_count > 1) {
+        cli_error("%s: one scene at most (see 'radiosity %s --help')", command, command);
+        return false;
+    }
+    *scene_path = args->positional_count ? args->positional[0] : NULL;
+    if (!shared->output) {
+        cli_error("%s: no output file: give -o OUT.png, .hdr or .pfm", command);
+        return false;
+    }
+    if (!cli_image_output_ok(shared->output))
+        return false;
+    return true;
+}
+
 rad_status cli_load_scene(const char *path, rad_scene **scene, rad_error *error)
 {
     rad_load_options load = {cli_log, NULL};

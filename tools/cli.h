@@ -90,6 +90,15 @@ rad_camera cli_view_camera(const cli_view *view, const rad_scene *scene);
 /* True for .png, .hdr and .pfm; prints the usage error otherwise. */
 bool cli_image_output_ok(const char *path);
 
+/* The opening every image command shares: parses argv against its option table, prints
+ * `usage` for --help, reads the BASE and VIEW groups, the optional SCENE and the required
+ * -o OUT image. Returns false with *exit_code set (0 after --help, 2 on a usage error)
+ * when the command should stop. */
+bool cli_parse_image_command(const char *command, const char *usage, int argc, char **argv,
+                             const cli_option *options, int option_count, cli_args *args,
+                             cli_shared *shared, cli_view *view, const char **scene_path,
+                             int *exit_code);
+
 /* Loads SCENE, or the built-in Cornell box when path is NULL; warnings go to stderr. */
 rad_status cli_load_scene(const char *path, rad_scene **scene, rad_error *error);
 

@@ -56,29 +56,11 @@ typedef struct pathtrace_settings {
 static bool parse_settings(int argc, char **argv, pathtrace_settings *s, int *exit_code)
 {
     cli_args args;
-    *exit_code = EXIT_USAGE;
-    if (!cli_parse("pathtrace", argc, argv, options, OPT_COUNT, &args))
-        return false;
-    if (args.value[OPT_HELP]) {
-        fputs(usage, stdout);
-        *exit_code = EXIT_OK;
-        return false;
-    }
     memset(s, 0, sizeof(*s));
-    if (!cli_parse_shared(&args, &s->shared) || !cli_parse_view(&args, &s->view))
+    if (!cli_parse_image_command("pathtrace", usage, argc, argv, options, OPT_COUNT, &args,
+                                 &s->shared, &s->view, &s->scene_path, exit_code))
         return false;
-    if (args.positional_count > 1) {
-        cli_error("pathtrace: one scene at most (see 'radiosity pathtrace --help')");
-        return false;
-    }
-    s->scene_path = args.positional_count ? args.positional[0] : NULL;
     s->output = s->shared.output;
-    if (!s->output) {
-        cli_error("pathtrace: no output file: give -o OUT.png, .hdr or .pfm");
-        return false;
-    }
-    if (!cli_image_output_ok(s->output))
-        return false;
     s->error_path = args.value[OPT_STANDARD_ERROR];
     if (s->error_path) {
         const char *dot = strrchr(s->error_path, '.');

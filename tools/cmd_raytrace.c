@@ -162,28 +162,11 @@ static bool collect_lights(int argc, char **argv, raytrace_settings *s)
 static bool parse_settings(int argc, char **argv, raytrace_settings *s, int *exit_code)
 {
     cli_args args;
-    *exit_code = EXIT_USAGE;
-    if (!cli_parse("raytrace", argc, argv, options, OPT_COUNT, &args))
+    memset(s, 0, sizeof(*s));
+    if (!cli_parse_image_command("raytrace", usage, argc, argv, options, OPT_COUNT, &args,
+                                 &s->shared, &s->view, &s->scene_path, exit_code))
         return false;
-    if (args.value[OPT_HELP]) {
-        fputs(usage, stdout);
-        *exit_code = EXIT_OK;
-        return false;
-    }
-    if (!cli_parse_shared(&args, &s->shared) || !cli_parse_view(&args, &s->view))
-        return false;
-    if (args.positional_count > 1) {
-        cli_error("raytrace: one scene at most (see 'radiosity raytrace --help')");
-        return false;
-    }
-    s->scene_path = args.positional_count ? args.positional[0] : NULL;
     s->output = s->shared.output;
-    if (!s->output) {
-        cli_error("raytrace: no output file: give -o OUT.png, .hdr or .pfm");
-        return false;
-    }
-    if (!cli_image_output_ok(s->output))
-        return false;
     s->stats_path = s->shared.stats_path;
     if (!collect_lights(argc, argv, s))
         return false;

@@ -69,29 +69,11 @@ typedef struct render_settings {
 static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_code)
 {
     cli_args args;
-    *exit_code = EXIT_USAGE;
-    if (!cli_parse("render", argc, argv, options, OPT_COUNT, &args))
-        return false;
-    if (args.value[OPT_HELP]) {
-        fputs(usage, stdout);
-        *exit_code = EXIT_OK;
-        return false;
-    }
     memset(s, 0, sizeof(*s));
-    if (!cli_parse_shared(&args, &s->shared) || !cli_parse_view(&args, &s->view))
+    if (!cli_parse_image_command("render", usage, argc, argv, options, OPT_COUNT, &args,
+                                 &s->shared, &s->view, &s->scene_path, exit_code))
         return false;
-    if (args.positional_count > 1) {
-        cli_error("render: one scene at most (see 'radiosity render --help')");
-        return false;
-    }
-    s->scene_path = args.positional_count ? args.positional[0] : NULL;
     s->output = s->shared.output;
-    if (!s->output) {
-        cli_error("render: no output file: give -o OUT.png, .hdr or .pfm");
-        return false;
-    }
-    if (!cli_image_output_ok(s->output))
-        return false;
     s->stats_path = s->shared.stats_path;
     s->render.samples_per_pixel = s->view.samples_per_pixel;
     s->specular = args.value[OPT_SPECULAR] != NULL;
