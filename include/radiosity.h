@@ -394,22 +394,27 @@ rad_status rad_image_create(uint32_t width, uint32_t height, rad_image **out,
                             rad_error *error);
 void rad_image_destroy(rad_image *image);
 
-/* Zero-initialised (or NULL) means automatic exposure. */
+/* Zero-initialised (or NULL) means automatic exposure and half-float EXR. */
 typedef struct rad_image_write_options {
     bool fixed_exposure; /* PNG only: false = automatic (the 95th percentile of the lit
                             pixels' luminance is scaled to 0.9), true = use `exposure` */
     double exposure;     /* PNG only: radiance is multiplied by 2^exposure */
+    bool exr_float;      /* .exr: 32-bit float channels instead of half (half keeps 11
+                            significant bits and turns values above 65504 into infinity) */
 } rad_image_write_options;
 
 /* Writes by the extension of path: .png (exposure, tone map, sRGB, 8-bit), .hdr (Radiance
- * RGBE; negative and NaN values are written as 0), .pfm (portable float map). Writes to a
+ * RGBE; negative and NaN values are written as 0), .pfm (portable float map), .exr (OpenEXR
+ * scanline, ZIP, R G B half, or float with exr_float). Writes to a
  * temporary name in the same folder and renames it, so a failed write leaves no file. */
 rad_status rad_image_write(const rad_image *image, const char *path,
                            const rad_image_write_options *options, rad_error *error);
 
 /* Reads a .pfm (colour or grey, either byte order) or a Radiance .hdr (flat or
- * run-length encoded RGBE; EXPOSURE lines undone; XYZE is RAD_ERR_UNSUPPORTED), whatever
- * its name; row 0 of the result is the top. */
+ * run-length encoded RGBE; EXPOSURE lines undone; XYZE is RAD_ERR_UNSUPPORTED) or a
+ * single-part scanline OpenEXR (R G B, or Y as grey; half or float; tiled, deep, multi-part
+ * and other channel sets are RAD_ERR_UNSUPPORTED), whatever its name; row 0 of the result
+ * is the top. */
 rad_status rad_image_read(const char *path, rad_image **out, rad_error *error);
 
 /* ------------------------------------------------------------------------------------ */

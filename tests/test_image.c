@@ -1,11 +1,13 @@
 /*
- * test_image.c - the image module: PFM/HDR round trips and orientation, hand-made RLE and
- * big-endian files, the sRGB curve and exposure, PNG pixels decoded with libpng, and the
- * error paths (missing folder, failed rename, unknown extension, truncated files).
+ * test_image.c - the image module: PFM/HDR/EXR round trips and orientation, hand-made RLE
+ * and big-endian files, EXR layouts written by OpenEXR itself (grey, RGBA, data windows,
+ * other compressions, tiled), the sRGB curve and exposure, PNG pixels decoded with libpng,
+ * and the error paths (missing folder, failed rename, unknown extension, truncated files).
  *
  * Not tested here: rendering into images (test_render) or the CLI's use of them.
  */
 #include <math.h>
+#include <openexr.h>
 #include <png.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -18,6 +20,9 @@
 /* RGBE keeps 8 bits for the largest channel; the decoder returns the centre of the
  * truncation step, so every channel is within 1/256 of the pixel's largest channel. */
 #define RGBE_RELATIVE_PRECISION (1.0 / 256)
+/* Half floats keep 11 significant bits; rounding to nearest is within half a step:
+ * relative 2^-11 for normal halves (6.1e-5 to 65504). */
+#define HALF_RELATIVE_PRECISION 0x1p-11
 
 static rad_image *new_image(uint32_t width, uint32_t height)
 {
@@ -439,8 +444,8 @@ static void test_write_errors(void)
     int before = scratch_entries();
 
     /* A folder that does not exist: I/O error naming the path, nothing left behind. */
-    const char *formats[] = {"out.pfm", "out.hdr", "out.png"};
-    for (int i = 0; i < 3; i++) {
+    const char *formats[] = {"out.pfm", "out.hdr", "out.png", "out.exr"};
+    for (int i = 0; i < 4; i++) {
         char path[4200];
         snprintf(path, sizeof(path), "%s/no-such-folder/%s", test_tmpdir(), formats[i]);
         CHECK(rad_image_write(image, path, NULL, &error) == RAD_ERR_IO);
@@ -457,12 +462,18 @@ static void test_write_errors(void)
     CHECK(rad_image_write(image, folder, NULL, &error) == RAD_ERR_IO);
     CHECK(strstr(error.message, folder) != NULL);
     CHECK(test_count_files("taken.pfm") == 1);
+    folder = test_path("taken.exr");
+    CHECK(mkdir(folder, 0755) == 0);
+    CHECK(rad_image_write(image, folder, NULL, &error) == RAD_ERR_IO);
+    CHECK(strstr(error.message, folder) == error.message);
+    CHECK(test_count_files("taken.exr") == 1);
 
     /* Unknown or missing extension. */
     before = scratch_entries();
     const char *jpg = test_path("out.jpg");
     CHECK(rad_image_write(image, jpg, NULL, &error) == RAD_ERR_INVALID);
-    CHECK(strstr(error.message, "unknown image format '.jpg' (use .png, .hdr or .pfm)"));
+    CHECK(strstr(error.message,
+                 "unknown image format '.jpg' (use .png, .hdr, .pfm or .exr)"));
     CHECK(strstr(error.message, jpg) == error.message);
     CHECK(rad_image_write(image, test_path("no-extension"), NULL, &error) ==
           RAD_ERR_INVALID);
@@ -532,6 +543,377 @@ static void test_read_errors(void)
     CHECK(strstr(error.message, missing) == error.message);
 }
 
+/* ----------------------------------------------------------------------------------- */
+/* OpenEXR                                                                             */
+
+/* How OpenEXR itself sees a file: part 0's storage, compression and channel types. */
+typedef struct exr_layout {
+    int parts;
+    exr_storage_t storage;
+    exr_compression_t compression;
+    int channels;
+    char names[8][8];
+    exr_pixel_type_t types[8];
+} exr_layout;
+
+static void silent(exr_const_context_t context, exr_result_t code, const char *message)
+{
+    (void)context;
+    (void)code;
+    (void)message;
+}
+
+static int exr_layout_of(const char *path, exr_layout *layout)
+{
+    memset(layout, 0, sizeof(*layout));
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = silent;
+    exr_context_t context = NULL;
+    const exr_attr_chlist_t *list = NULL;
+    int ok = exr_start_read(&context, path, &init) == EXR_ERR_SUCCESS &&
+             exr_get_count(context, &layout->parts) == EXR_ERR_SUCCESS &&
+             exr_get_storage(context, 0, &layout->storage) == EXR_ERR_SUCCESS &&
+             exr_get_compression(context, 0, &layout->compression) == EXR_ERR_SUCCESS &&
+             exr_get_channels(context, 0, &list) == EXR_ERR_SUCCESS &&
+             list->num_channels <= 8;
+    for (int i = 0; ok && i < list->num_channels; i++) {
+        snprintf(layout->names[i], sizeof(layout->names[i]), "%s",
+                 list->entries[i].name.str);
+        layout->types[i] = list->entries[i].pixel_type;
+        layout->channels++;
+    }
+    exr_finish(&context);
+    return ok;
+}
+
+/* A file written by OpenEXR directly (not by our writer), for the layouts we only read. */
+typedef struct exr_spec {
+    const char *names[4];          /* channels, any order */
+    int channels;
+    exr_pixel_type_t type;         /* of every channel */
+    exr_compression_t compression;
+    exr_lineorder_t order;
+    int32_t x0, y0;                /* the data window's top-left corner */
+    bool tiled;                    /* SPEC_TILE x SPEC_TILE tiles instead of scanlines */
+} exr_spec;
+
+enum { SPEC_WIDTH = 7, SPEC_HEIGHT = 5, SPEC_TILE = 4 };
+
+/* Channel c of pixel (x, y), counted from the data window's corner: multiples of 1/4
+ * below 100, so exact in half as in float. */
+static float spec_value(int c, int x, int y)
+{
+    return (float)(c + 1) + 0.25f * (float)x + 8.0f * (float)y;
+}
+
+static const char *write_spec(const char *name, const exr_spec *spec)
+{
+    const char *path = test_path(name);
+    static float planes[4][SPEC_HEIGHT][SPEC_WIDTH];
+    for (int c = 0; c < spec->channels; c++)
+        for (int y = 0; y < SPEC_HEIGHT; y++)
+            for (int x = 0; x < SPEC_WIDTH; x++)
+                planes[c][y][x] = spec_value(c, x, y);
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = silent;
+    exr_context_t context = NULL;
+    int part = 0;
+    exr_attr_box2i_t window;
+    window.min.x = spec->x0;
+    window.min.y = spec->y0;
+    window.max.x = spec->x0 + SPEC_WIDTH - 1;
+    window.max.y = spec->y0 + SPEC_HEIGHT - 1;
+    exr_attr_v2f_t centre;
+    centre.x = centre.y = 0;
+    exr_result_t rv = exr_start_write(&context, path, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_add_part(context, NULL,
+                          spec->tiled ? EXR_STORAGE_TILED : EXR_STORAGE_SCANLINE, &part);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_initialize_required_attr(context, part, &window, &window, 1, &centre, 1,
+                                          spec->order, spec->compression);
+    if (rv == EXR_ERR_SUCCESS && spec->tiled)
+        rv = exr_set_tile_descriptor(context, part, SPEC_TILE, SPEC_TILE,
+                                     EXR_TILE_ONE_LEVEL, EXR_TILE_ROUND_DOWN);
+    for (int c = 0; c < spec->channels && rv == EXR_ERR_SUCCESS; c++)
+        rv = exr_add_channel(context, part, spec->names[c], spec->type,
+                             EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_write_header(context);
+    int32_t lines = 1;
+    if (rv == EXR_ERR_SUCCESS && !spec->tiled)
+        rv = exr_get_scanlines_per_chunk(context, part, &lines);
+    /* Chunks: scanline blocks of `lines` rows, or SPEC_TILE x SPEC_TILE tiles. */
+    int columns = spec->tiled ? (SPEC_WIDTH + SPEC_TILE - 1) / SPEC_TILE : 1;
+    int rows = spec->tiled ? (SPEC_HEIGHT + SPEC_TILE - 1) / SPEC_TILE
+                           : (SPEC_HEIGHT + lines - 1) / lines;
+    exr_encode_pipeline_t encoder = EXR_ENCODE_PIPELINE_INITIALIZER;
+    bool started = false;
+    for (int i = 0; i < rows * columns && rv == EXR_ERR_SUCCESS; i++) {
+        int column = i % columns, row = i / columns;
+        int x = spec->tiled ? column * SPEC_TILE : 0;
+        int y = spec->tiled ? row * SPEC_TILE : row * lines;
+        exr_chunk_info_t chunk;
+        if (spec->tiled)
+            rv = exr_write_tile_chunk_info(context, part, column, row, 0, 0, &chunk);
+        else
+            rv = exr_write_scanline_chunk_info(context, part, spec->y0 + y, &chunk);
+        if (rv == EXR_ERR_SUCCESS)
+            rv = started ? exr_encoding_update(context, part, &chunk, &encoder)
+                         : exr_encoding_initialize(context, part, &chunk, &encoder);
+        started = started || rv == EXR_ERR_SUCCESS;
+        for (int16_t k = 0; rv == EXR_ERR_SUCCESS && k < encoder.channel_count; k++) {
+            int c = 0;
+            while (strcmp(spec->names[c], encoder.channels[k].channel_name) != 0)
+                c++;
+            encoder.channels[k].encode_from_ptr = (const uint8_t *)&planes[c][y][x];
+            encoder.channels[k].user_pixel_stride = (int32_t)sizeof(float);
+            encoder.channels[k].user_line_stride = (int32_t)sizeof(float) * SPEC_WIDTH;
+            encoder.channels[k].user_bytes_per_element = (int16_t)sizeof(float);
+            encoder.channels[k].user_data_type = EXR_PIXEL_FLOAT;
+        }
+        if (rv == EXR_ERR_SUCCESS)
+            rv = exr_encoding_choose_default_routines(context, part, &encoder);
+        if (rv == EXR_ERR_SUCCESS)
+            rv = exr_encoding_run(context, part, &encoder);
+    }
+    if (started)
+        exr_encoding_destroy(context, &encoder);
+    exr_result_t finished = exr_finish(&context);
+    if (rv != EXR_ERR_SUCCESS || finished != EXR_ERR_SUCCESS) {
+        fprintf(stderr, "cannot write %s with OpenEXR: %s\n", path,
+                exr_get_default_error_message(rv != EXR_ERR_SUCCESS ? rv : finished));
+        exit(1);
+    }
+    return path;
+}
+
+/* Reads a spec file and checks every pixel: channels R, G, B (or Y for all three) of
+ * spec_value, for the channel's position in spec->names. */
+static void check_spec(const char *path, const exr_spec *spec)
+{
+    int source[3] = {-1, -1, -1};
+    for (int c = 0; c < spec->channels; c++) {
+        const char *n = spec->names[c];
+        for (int k = 0; k < 3; k++)
+            if (strcmp(n, (const char *[]){"R", "G", "B"}[k]) == 0 || strcmp(n, "Y") == 0)
+                source[k] = c;
+    }
+    rad_image *image = NULL;
+    rad_error error;
+    rad_status status = rad_image_read(path, &image, &error);
+    if (status != RAD_OK)
+        test_fail(__FILE__, __LINE__, "%s", error.message);
+    test_checks++;
+    if (!image)
+        return;
+    CHECK(image->width == SPEC_WIDTH && image->height == SPEC_HEIGHT);
+    int wrong = 0;
+    for (int y = 0; y < SPEC_HEIGHT && image->height == SPEC_HEIGHT; y++)
+        for (int x = 0; x < SPEC_WIDTH && image->width == SPEC_WIDTH; x++)
+            for (int k = 0; k < 3; k++)
+                wrong += pixel(image, (uint32_t)x, (uint32_t)y)[k] !=
+                         spec_value(source[k], x, y);
+    if (wrong)
+        test_fail(__FILE__, __LINE__, "%s: %d samples differ from the values written", path,
+                  wrong);
+    test_checks++;
+    rad_image_destroy(image);
+}
+
+static void test_exr_round_trip(void)
+{
+    /* 37 x 23: ZIP stores 16 scanlines per chunk, so the second chunk is partial. */
+    const uint32_t w = 37, h = 23;
+    rad_image *image = gradient(w, h);
+    set_pixel(image, 3, 4, -2.5, 1e-3, 65504.0); /* negative, small, largest half */
+    set_pixel(image, 5, 0, 1.0 / 3.0, 0.1, 1234.567);
+    set_pixel(image, 6, 0, 0, 0, 0);
+    const char *half_path = test_path("gradient.exr");
+    const char *float_path = test_path("GRADIENT-FLOAT.EXR");
+    rad_error error;
+    rad_image_write_options float_options = {.exr_float = true};
+    CHECK(rad_image_write(image, half_path, NULL, &error) == RAD_OK);
+    CHECK(rad_image_write(image, float_path, &float_options, &error) == RAD_OK);
+    CHECK(test_count_files("gradient.exr") == 1); /* no temporary file left */
+
+    /* OpenEXR's view: one scanline part, ZIP, channels B G R (sorted), half or float. */
+    const char *paths[2] = {half_path, float_path};
+    const exr_pixel_type_t types[2] = {EXR_PIXEL_HALF, EXR_PIXEL_FLOAT};
+    for (int i = 0; i < 2; i++) {
+        exr_layout layout;
+        CHECK(exr_layout_of(paths[i], &layout));
+        CHECK(layout.parts == 1 && layout.storage == EXR_STORAGE_SCANLINE);
+        CHECK(layout.compression == EXR_COMPRESSION_ZIP);
+        CHECK(layout.channels == 3);
+        CHECK(strcmp(layout.names[0], "B") == 0 && strcmp(layout.names[1], "G") == 0 &&
+              strcmp(layout.names[2], "R") == 0);
+        for (int c = 0; c < layout.channels; c++)
+            CHECK(layout.types[c] == types[i]);
+    }
+    uint8_t magic[4];
+    CHECK(read_bytes(half_path, magic, 4) == 4 && magic[0] == 0x76 && magic[1] == 0x2f &&
+          magic[2] == 0x31 && magic[3] == 0x01);
+
+    /* Half: within half a step of 11 significant bits; float: bit for bit. */
+    rad_image *half = NULL, *exact = NULL;
+    CHECK(rad_image_read(half_path, &half, &error) == RAD_OK);
+    CHECK(rad_image_read(float_path, &exact, &error) == RAD_OK);
+    CHECK(half && half->width == w && half->height == h);
+    CHECK(exact && exact->width == w && exact->height == h);
+    if (half && half->width == w && half->height == h) {
+        double worst = 0;
+        for (size_t i = 0; i < (size_t)w * h * 3; i++) {
+            double a = image->rgb[i], b = half->rgb[i];
+            worst = fmax(worst, a != 0 ? fabs(b - a) / fabs(a) : fabs(b));
+        }
+        printf("test_image: EXR half round trip: largest relative error %.3g "
+               "(2^-11 = %.3g)\n", worst, HALF_RELATIVE_PRECISION);
+        CHECK(worst <= HALF_RELATIVE_PRECISION);
+        CHECK(pixel(half, 3, 4)[0] == -2.5f && pixel(half, 3, 4)[2] == 65504.0f);
+        CHECK(pixel(half, 6, 0)[0] == 0 && pixel(half, 6, 0)[2] == 0);
+        /* Orientation: green 0 on the top row, 1 on the bottom; red 1 on the right. */
+        CHECK(pixel(half, 0, 0)[1] == 0);
+        CHECK(pixel(half, 9, h - 1)[1] == 1);
+        CHECK(pixel(half, w - 1, 7)[0] == 1);
+        CHECK_NEAR(pixel(half, 18, 17)[0], 18.0 / 36, HALF_RELATIVE_PRECISION);
+        CHECK_NEAR(pixel(half, 18, 17)[1], 17.0 / 22, HALF_RELATIVE_PRECISION);
+    }
+    if (exact && exact->width == w && exact->height == h) {
+        size_t differ = 0;
+        for (size_t i = 0; i < (size_t)w * h * 3; i++)
+            differ += memcmp(&exact->rgb[i], &image->rgb[i], sizeof(float)) != 0;
+        printf("test_image: EXR float round trip: %zu of %zu values differ\n", differ,
+               (size_t)w * h * 3);
+        CHECK(differ == 0);
+    }
+    rad_image_destroy(exact);
+
+    /* Half range: above 65504 is infinity; below it precision fades gradually. */
+    set_pixel(image, 0, 0, 1e6, 3e-5, -1e6);
+    CHECK(rad_image_write(image, half_path, NULL, &error) == RAD_OK);
+    rad_image_destroy(half);
+    half = NULL;
+    CHECK(rad_image_read(half_path, &half, &error) == RAD_OK);
+    if (half) {
+        CHECK(isinf(pixel(half, 0, 0)[0]) && pixel(half, 0, 0)[0] > 0);
+        CHECK(isinf(pixel(half, 0, 0)[2]) && pixel(half, 0, 0)[2] < 0);
+        CHECK_NEAR(pixel(half, 0, 0)[1], 3e-5, 0x1p-10); /* a subnormal half: 10 bits */
+    }
+    rad_image_destroy(half);
+    rad_image_destroy(image);
+}
+
+static void test_exr_layouts(void)
+{
+    /* Grey: a lone Y channel, uncompressed half. */
+    exr_spec grey = {{"Y"}, 1, EXR_PIXEL_HALF, EXR_COMPRESSION_NONE,
+                     EXR_LINEORDER_INCREASING_Y, 0, 0, false};
+    check_spec(write_spec("grey.exr", &grey), &grey);
+
+    /* RGBA in float, bottom-up line order, a data window that does not start at 0,0: A is
+     * ignored, the data window's top-left pixel is pixel 0, rows run top-down. */
+    exr_spec rgba = {{"R", "G", "B", "A"}, 4, EXR_PIXEL_FLOAT, EXR_COMPRESSION_NONE,
+                     EXR_LINEORDER_DECREASING_Y, 5, -3, false};
+    check_spec(write_spec("rgba.exr", &rgba), &rgba);
+
+    /* Other compressions OpenEXR decodes for us. */
+    exr_spec piz = {{"B", "G", "R"}, 3, EXR_PIXEL_HALF, EXR_COMPRESSION_PIZ,
+                    EXR_LINEORDER_INCREASING_Y, 0, 0, false};
+    check_spec(write_spec("piz.exr", &piz), &piz);
+    exr_spec rle = {{"R", "G", "B"}, 3, EXR_PIXEL_FLOAT, EXR_COMPRESSION_RLE,
+                    EXR_LINEORDER_INCREASING_Y, 0, 0, false};
+    check_spec(write_spec("rle.exr", &rle), &rle);
+
+    /* Layouts we do not read: unsupported, one line naming the file. */
+    const exr_compression_t none = EXR_COMPRESSION_NONE;
+    const exr_lineorder_t down = EXR_LINEORDER_INCREASING_Y;
+    const exr_spec unsupported[] = {
+        {{"R", "G"}, 2, EXR_PIXEL_HALF, none, down, 0, 0, false},
+        {{"Z"}, 1, EXR_PIXEL_FLOAT, none, down, 0, 0, false},
+        {{"Y", "RY", "BY"}, 3, EXR_PIXEL_HALF, none, down, 0, 0, false}, /* chroma */
+        {{"R", "G", "B"}, 3, EXR_PIXEL_UINT, none, down, 0, 0, false},
+        {{"R", "G", "B"}, 3, EXR_PIXEL_HALF, none, down, 0, 0, true},
+    };
+    const char *expected[] = {"not R, G, B", "not R, G, B", "not R, G, B", "integers",
+                              "tiled"};
+    for (size_t i = 0; i < sizeof(unsupported) / sizeof(unsupported[0]); i++) {
+        const char *path = write_spec("unsupported.exr", &unsupported[i]);
+        rad_image *image = NULL;
+        rad_error error = {0};
+        rad_status status = rad_image_read(path, &image, &error);
+        if (status != RAD_ERR_UNSUPPORTED || !strstr(error.message, expected[i]))
+            test_fail(__FILE__, __LINE__, "layout %zu: status %s, message '%s'", i,
+                      rad_status_name(status), error.message);
+        test_checks++;
+        CHECK(image == NULL);
+        CHECK(strstr(error.message, path) == error.message);
+        CHECK(strchr(error.message, '\n') == NULL);
+    }
+}
+
+static void test_exr_damaged(void)
+{
+    rad_image *image = gradient(40, 20); /* two ZIP chunks */
+    const char *path = test_path("whole.exr");
+    rad_error error;
+    CHECK(rad_image_write(image, path, NULL, &error) == RAD_OK);
+    rad_image_destroy(image);
+    static uint8_t bytes[65536];
+    size_t size = read_bytes(path, bytes, sizeof(bytes));
+    CHECK(size > 100 && size < sizeof(bytes));
+
+    /* Every prefix of the file: a parse error naming the file, never a crash or a read
+     * past the bytes present (the sanitizer build checks that). */
+    size_t wrong = 0, first_wrong = 0;
+    char sample[RAD_ERROR_MESSAGE_MAX] = "";
+    for (size_t cut = 0; cut < size; cut++) {
+        const char *cut_path = write_bytes("cut.exr", bytes, cut);
+        rad_image *back = NULL;
+        rad_error cut_error = {0};
+        rad_status status = rad_image_read(cut_path, &back, &cut_error);
+        int ok = status == RAD_ERR_PARSE && back == NULL &&
+                 strstr(cut_error.message, cut_path) == cut_error.message &&
+                 strchr(cut_error.message, '\n') == NULL;
+        if (!ok && wrong++ == 0)
+            first_wrong = cut;
+        if (cut == size / 2)
+            snprintf(sample, sizeof(sample), "%s", cut_error.message);
+        rad_image_destroy(back);
+    }
+    if (wrong)
+        test_fail(__FILE__, __LINE__, "%zu of %zu truncated EXR files not a one-line parse "
+                  "error naming the file (first: %zu bytes)", wrong, size, first_wrong);
+    test_checks++;
+    printf("test_image: truncated EXR: %s\n", sample);
+
+    /* Damaged compressed data: an error or some pixels, but no crash. */
+    for (size_t at = size - 60; at < size; at += 7) {
+        bytes[at] ^= 0x5a;
+        rad_image *back = NULL;
+        const char *bent = write_bytes("bent.exr", bytes, size);
+        rad_status status = rad_image_read(bent, &back, &error);
+        CHECK(status == RAD_OK || status == RAD_ERR_PARSE);
+        CHECK((status == RAD_OK) == (back != NULL));
+        rad_image_destroy(back);
+        bytes[at] ^= 0x5a;
+    }
+}
+
+/* The command-line tool reads what we wrote: an image compared with itself. */
+static void test_exr_cli(void)
+{
+    rad_image *image = gradient(24, 16);
+    rad_error error;
+    CHECK(rad_image_write(image, test_path("a.exr"), NULL, &error) == RAD_OK);
+    rad_image_destroy(image);
+    CHECK(test_run_tool("compare a.exr a.exr -o diff.exr") == 0);
+    const char *out = test_read_text(test_path("stdout.txt"));
+    CHECK(strstr(out, "rmse: 0\n") != NULL);
+    CHECK(strstr(out, "size: 24x16\n") != NULL);
+    CHECK(test_file_exists(test_path("diff.exr")));
+}
+
 int main(void)
 {
     test_create();
@@ -544,5 +926,9 @@ int main(void)
     test_png();
     test_write_errors();
     test_read_errors();
+    test_exr_round_trip();
+    test_exr_layouts();
+    test_exr_damaged();
+    test_exr_cli();
     return test_finish("test_image");
 }

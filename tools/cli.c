@@ -270,9 +270,9 @@ bool cli_image_output_ok(const char *path)
 {
     const char *dot = strrchr(path, '.');
     if (dot && (strcasecmp(dot, ".png") == 0 || strcasecmp(dot, ".hdr") == 0 ||
-                strcasecmp(dot, ".pfm") == 0))
+                strcasecmp(dot, ".pfm") == 0 || strcasecmp(dot, ".exr") == 0))
         return true;
-    cli_error("%s: unknown image format (use .png, .hdr or .pfm)", path);
+    cli_error("%s: unknown image format (use .png, .hdr, .pfm or .exr)", path);
     return false;
 }
 
@@ -297,7 +297,7 @@ bool cli_parse_image_command(const char *command, const char *usage, int argc, c
     }
     *scene_path = args->positional_count ? args->positional[0] : NULL;
     if (!shared->output) {
-        cli_error("%s: no output file: give -o OUT.png, .hdr or .pfm", command);
+        cli_error("%s: no output file: give -o OUT.png, .hdr, .pfm or .exr", command);
         return false;
     }
     if (!cli_image_output_ok(shared->output))

@@ -19,8 +19,8 @@ static const char usage[] =
     "estimation on the emitters with multiple importance sampling, Russian roulette. The\n"
     "image is the reference a radiosity image is checked against; the same seed gives the\n"
     "same image for any thread count. OUT's extension picks the format: .png (exposure,\n"
-    "tone map, sRGB 8-bit), .hdr (Radiance RGBE) or .pfm (portable float map); .hdr and\n"
-    ".pfm hold linear radiance.\n"
+    "tone map, sRGB 8-bit), .hdr (Radiance RGBE), .pfm (portable float map) or .exr\n"
+    "(OpenEXR, half float); .hdr, .pfm and .exr hold linear radiance.\n"
     "\n"
     "Camera (default: the scene's camera, or a view of the whole scene from -z):\n"
     "  --eye X,Y,Z  --target X,Y,Z  --up X,Y,Z  --fov DEG (vertical)   --size WxH (512x512)\n"
@@ -31,7 +31,7 @@ static const char usage[] =
     "  --max-depth N        most bounces per path (default 0: no limit, Russian roulette\n"
     "                       ends paths without bias)\n"
     "  --standard-error FILE  also write each pixel's standard error of the mean, per\n"
-    "                       channel (.hdr or .pfm)\n"
+    "                       channel (.hdr, .pfm or .exr)\n"
     "  --threads N          worker threads (default: all cores)\n"
     "  --seed N             seed of every random choice (default 1)\n"
     "  --stats FILE.json    write rays, times, mean radiance and peak memory\n"
@@ -67,8 +67,8 @@ static bool parse_settings(int argc, char **argv, pathtrace_settings *s, int *ex
         if (!cli_image_output_ok(s->error_path))
             return false;
         if (dot && strcasecmp(dot, ".png") == 0) {
-            cli_error("--standard-error: %s: use .hdr or .pfm (a standard error is not a "
-                      "picture)",
+            cli_error("--standard-error: %s: use .hdr, .pfm or .exr (a standard error is "
+                      "not a picture)",
                       s->error_path);
             return false;
         }

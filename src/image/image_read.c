@@ -1,13 +1,15 @@
 /*
- * image_read.c - rad_image_read: Radiance RGBE (.hdr) and portable float maps (.pfm).
+ * image_read.c - rad_image_read: Radiance RGBE (.hdr), portable float maps (.pfm) and
+ * OpenEXR (.exr, decoded by OpenEXR in exr.c).
  *
- * The whole file is read into memory and the format is recognised by its magic ("#?" or
- * "PF"/"Pf"), not by the name. The image returned has row 0 at the top, whatever order the
- * file stores its rows in. Every length is checked against the bytes actually present
- * before anything is allocated or copied, so a truncated or hostile file is RAD_ERR_PARSE,
- * never a crash. Not supported: XYZE pictures (RAD_ERR_UNSUPPORTED), the PFM scale
- * magnitude (only its sign, the byte order, is used) and the Radiance header's colour
- * correction; EXPOSURE lines are undone so pixels come back as radiance.
+ * The whole file is read into memory and the format is recognised by its magic ("#?",
+ * "PF"/"Pf" or the bytes 76 2f 31 01), not by the name. The image returned has row 0 at
+ * the top, whatever order the file stores its rows in. Every length is checked against the
+ * bytes actually present before anything is allocated or copied (for EXR, by OpenEXR and
+ * exr.c), so a truncated or hostile file is RAD_ERR_PARSE, never a crash. Not supported:
+ * XYZE pictures (RAD_ERR_UNSUPPORTED), the PFM scale magnitude (only its sign, the byte
+ * order, is used) and the Radiance header's colour correction; EXPOSURE lines are undone
+ * so pixels come back as radiance. EXR limits: see exr.h.
  */
 #include <errno.h>
 #include <inttypes.h>
@@ -19,6 +21,7 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "image/exr.h"
 
 _Static_assert(sizeof(float) == 4, "PFM needs 32-bit floats");
 
@@ -34,6 +37,8 @@ _Static_assert(sizeof(float) == 4, "PFM needs 32-bit floats");
 /* Scanline widths that may be new-style run-length encoded. */
 #define RGBE_RLE_MIN_WIDTH 8
 #define RGBE_RLE_MAX_WIDTH 0x7fff
+/* The first four bytes of every OpenEXR file (20000630 little-endian). */
+static const uint8_t EXR_MAGIC[4] = {0x76, 0x2f, 0x31, 0x01};
 
 typedef struct reader {
     const char *path;  /* for messages */
@@ -436,9 +441,13 @@ rad_status rad_image_read(const char *path, rad_image **out, rad_error *error)
         status = read_hdr(&in, out);
     else if (in.size >= 2 && data[0] == 'P' && (data[1] == 'F' || data[1] == 'f'))
         status = read_pfm(&in, out);
+    else if (in.size >= sizeof(EXR_MAGIC) &&
+             memcmp(data, EXR_MAGIC, sizeof(EXR_MAGIC)) == 0)
+        status = rad_exr_read(data, in.size, path, out, error);
     else
         status = rad_fail(error, RAD_ERR_PARSE,
-                          "%s: not a PFM or Radiance HDR image (unknown magic)", path);
+                          "%s: not a PFM, Radiance HDR or OpenEXR image (unknown magic)",
+                          path);
     free(data);
     return status;
 }

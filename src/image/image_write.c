@@ -2,14 +2,16 @@
  * image_write.c - rad_image_write: picks the format by the file extension and writes
  * through an atomic file (temporary name + rename), so a failed write leaves nothing.
  *
- * The encoders themselves are in png_writer.c, rgbe_writer.c and pfm_writer.c; this file
- * only validates, dispatches, and commits or aborts.
+ * The encoders themselves are in png_writer.c, rgbe_writer.c, pfm_writer.c and exr.c
+ * (through OpenEXR, which writes into our temporary file through a custom-stream hook);
+ * this file only validates, dispatches, and commits or aborts.
  */
 #include <ctype.h>
 #include <string.h>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "image/exr.h"
 #include "image/tonemap.h"
 #include "image/writers.h"
 
@@ -17,7 +19,8 @@ typedef enum image_format {
     FORMAT_UNKNOWN,
     FORMAT_PNG,
     FORMAT_HDR,
-    FORMAT_PFM
+    FORMAT_PFM,
+    FORMAT_EXR
 } image_format;
 
 /* Case-insensitive equality of two NUL-terminated ASCII strings. */
@@ -47,6 +50,8 @@ static image_format format_of(const char *extension)
         return FORMAT_HDR;
     if (same_ignoring_case(extension, ".pfm"))
         return FORMAT_PFM;
+    if (same_ignoring_case(extension, ".exr"))
+        return FORMAT_EXR;
     return FORMAT_UNKNOWN;
 }
 
@@ -61,8 +66,8 @@ rad_status rad_image_write(const rad_image *image, const char *path,
     image_format format = format_of(extension);
     if (format == FORMAT_UNKNOWN)
         return rad_fail(error, RAD_ERR_INVALID,
-                        "%s: unknown image format '%s' (use .png, .hdr or .pfm)", path,
-                        extension ? extension : "");
+                        "%s: unknown image format '%s' (use .png, .hdr, .pfm or .exr)",
+                        path, extension ? extension : "");
 
     /* Settle everything that can fail without touching the disk first. */
     double scale = 1;
@@ -83,6 +88,10 @@ rad_status rad_image_write(const rad_image *image, const char *path,
     case FORMAT_PNG: status = rad_png_write(image, scale, file.stream, path, error); break;
     case FORMAT_HDR: status = rad_rgbe_write(image, file.stream, path, error); break;
     case FORMAT_PFM: status = rad_pfm_write(image, file.stream, path, error); break;
+    case FORMAT_EXR:
+        status = rad_exr_write(image, options && options->exr_float, file.stream, path,
+                               error);
+        break;
     case FORMAT_UNKNOWN: status = rad_fail(error, RAD_ERR_INTERNAL, "%s: no writer", path);
     }
     if (status != RAD_OK) {

@@ -4,7 +4,8 @@
  * Each writer encodes a valid image (non-NULL, non-empty) into an open stream, normally
  * the temporary file of an atomic write; it neither opens, closes nor removes files, and
  * reports failures as one line naming `path`. rad_image_write picks the writer by the
- * extension and commits or aborts the file.
+ * extension and commits or aborts the file. The .exr writer, rad_exr_write, is declared
+ * in exr.h beside its reader.
  */
 #ifndef RAD_IMAGE_WRITERS_H
 #define RAD_IMAGE_WRITERS_H
