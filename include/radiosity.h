@@ -400,7 +400,8 @@ typedef struct rad_image_write_options {
                             pixels' luminance is scaled to 0.9), true = use `exposure` */
     double exposure;     /* PNG only: radiance is multiplied by 2^exposure */
     bool exr_float;      /* .exr: 32-bit float channels instead of half (half keeps 11
-                            significant bits and turns values above 65504 into infinity) */
+                            significant bits; an image with a value above 65504, half's
+                            largest, is written as float whatever this says) */
 } rad_image_write_options;
 
 /* Writes by the extension of path: .png (exposure, tone map, sRGB, 8-bit), .hdr (Radiance

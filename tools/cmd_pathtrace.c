@@ -62,6 +62,10 @@ static bool parse_settings(int argc, char **argv, pathtrace_settings *s, int *ex
         return false;
     s->output = s->shared.output;
     s->error_path = args.value[OPT_STANDARD_ERROR];
+    if (s->error_path && s->view.samples_per_pixel == 1) {
+        cli_error("--standard-error: needs at least 2 samples per pixel (--spp)");
+        return false;
+    }
     if (s->error_path) {
         const char *dot = strrchr(s->error_path, '.');
         if (!cli_image_output_ok(s->error_path))

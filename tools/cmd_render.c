@@ -19,7 +19,8 @@ static const char usage[] =
     "\n"
     "Camera (default: the scene's camera, or a view of the whole scene from -z):\n"
     "  --eye X,Y,Z  --target X,Y,Z  --up X,Y,Z  --fov DEG (vertical)   --size WxH (512x512)\n"
-    "  --spp N              samples per pixel, stratified, box filter (default 16;\n"
+    "  --spp N              samples per pixel, stratified, box filter (default 16, at\n"
+    "                       most 256;\n"
     "                       pixels on an edge get 64 more)\n"
     "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"
     "  --specular           the two-pass method: surfaces with Ks > 0 (MTL) also show\n"
@@ -57,6 +58,7 @@ static const cli_option options[OPT_COUNT] = {
 
 /* Patches the default patch size aims at. */
 #define DEFAULT_TARGET_PATCHES 3000u
+#define RENDER_MAX_SPP 256u
 
 typedef struct render_settings {
     const char *scene_path, *output, *stats_path;
@@ -77,6 +79,12 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
     s->output = s->shared.output;
     s->stats_path = s->shared.stats_path;
     s->render.samples_per_pixel = s->view.samples_per_pixel;
+    if (s->view.samples_per_pixel > RENDER_MAX_SPP) {
+        cli_error("--spp: at most %u for render (16 x 16 strata; the radiosity image has no "
+                  "noise to average away)",
+                  RENDER_MAX_SPP);
+        return false;
+    }
     s->specular = args.value[OPT_SPECULAR] != NULL;
     unsigned long value;
     double number;

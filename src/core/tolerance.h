@@ -31,6 +31,12 @@
  * bounding-box diagonal (scene units; guards coplanar and touching patches). */
 #define RAD_PLANE_EPSILON 1e-7
 
+/* Secondary rays (mirror rays of the two-pass method) leave a surface this far along its
+ * normal: a fraction of the scene diagonal plus a fraction of the largest coordinate, since
+ * a float hit point's error grows with its distance from the origin. */
+#define RAD_SURFACE_LEAVE_DIAGONAL 1e-5
+#define RAD_SURFACE_LEAVE_COORDINATE 1e-6
+
 /* Camera rays start this far from the eye, as a fraction of the scene diagonal. */
 #define RAD_CAMERA_NEAR 1e-6
 

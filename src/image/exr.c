@@ -16,6 +16,7 @@
 #include <inttypes.h>
 #include <limits.h>
 #include <openexr.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/types.h>
@@ -144,6 +145,9 @@ static exr_result_t write_chunks(exr_context_t context, const rad_image *image)
     return rv;
 }
 
+/* The largest finite half-precision value. */
+#define HALF_LARGEST 65504.0f
+
 rad_status rad_exr_write(const rad_image *image, bool float_channels, FILE *stream,
                          const char *path, rad_error *error)
 {
@@ -165,6 +169,10 @@ rad_status rad_exr_write(const rad_image *image, bool float_channels, FILE *stre
                         message_of(&sink, rv));
     }
     int part = 0;
+    /* half holds at most 65504: brighter images go to float rather than to infinity */
+    size_t values = (size_t)image->width * image->height * 3;
+    for (size_t k = 0; k < values && !float_channels; k++)
+        float_channels = fabsf(image->rgb[k]) > HALF_LARGEST && isfinite(image->rgb[k]);
     exr_pixel_type_t type = float_channels ? EXR_PIXEL_FLOAT : EXR_PIXEL_HALF;
     rv = exr_add_part(context, NULL, EXR_STORAGE_SCANLINE, &part);
     if (rv == EXR_ERR_SUCCESS)

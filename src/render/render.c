@@ -46,6 +46,7 @@ typedef struct shading {
     const rad_rgb *radiance;        /* per mesh vertex */
     const rad_material *materials;  /* NULL: no mirror rays */
     float t_near;
+    double leave;                   /* how far mirror rays start off a surface (scene units) */
 } shading;
 
 /* Traces `count` rays set up at the front of w's arrays, bounce by bounce: each bounce
@@ -98,8 +99,9 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
                         ray->origin[2] + hit->t * d.z);
         rad_vec3 n = patch->normal;
         rad_vec3 mirror = v3_normalize(v3_sub(d, v3_scale(n, 2 * v3_dot(d, n))));
-        /* leave the surface on its front side: nudged along the normal, past t_near */
-        rad_vec3 origin = v3_add(p, v3_scale(n, 4.0 * sh->t_near));
+        /* leave the surface on its front side: nudged along the normal, past the float
+         * rounding of the hit point */
+        rad_vec3 origin = v3_add(p, v3_scale(n, sh->leave));
         w->weight[next] = (rad_rgb){weight.r * ks.r, weight.g * ks.g, weight.b * ks.b};
         w->sample[next] = w->sample[r];
         ray_set(&w->rays[next], origin, mirror, sh->t_near, INFINITY);
@@ -131,6 +133,9 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     unsigned spp = options->samples_per_pixel ? options->samples_per_pixel : 16;
     unsigned k = (unsigned)lround(sqrt((double)spp));
     k = k < 1 ? 1 : k > MAX_STRATA ? MAX_STRATA : k;
+    if (options->threads < 0)
+        return rad_fail(error, RAD_ERR_INVALID, "render: thread count %d is negative",
+                        options->threads);
     int threads = options->threads > 0 ? options->threads : omp_get_max_threads();
 
     /* triangles of the patches, and the radiance at each vertex */
@@ -169,6 +174,10 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     }
     double diagonal = mesh->vertex_count ? v3_length(v3_sub(hi, lo)) : 1;
     float t_near = (float)(RAD_CAMERA_NEAR * diagonal);
+    double largest = fmax(fmax(fmax(fabs(lo.x), fabs(hi.x)), fmax(fabs(lo.y), fabs(hi.y))),
+                          fmax(fabs(lo.z), fabs(hi.z)));
+    /* hit points are float: their error grows with the distance from the origin */
+    double leave = RAD_SURFACE_LEAVE_DIAGONAL * diagonal + RAD_SURFACE_LEAVE_COORDINATE * largest;
 
     size_t per_row = (size_t)W * k * k;
     unsigned edge_k = (unsigned)lround(sqrt((double)(options->edge_samples ? options->edge_samples
@@ -192,7 +201,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
             goto nomem;
     }
     shading shade = {mesh, (const uint32_t(*)[3])triangles, patch_of, radiance, options->materials,
-                     t_near};
+                     t_near, leave};
 
     uint32_t rows_done = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
