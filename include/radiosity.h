@@ -425,8 +425,9 @@ typedef struct rad_render_options {
     uint32_t width, height;     /* 0 = 512 */
     uint32_t samples_per_pixel; /* rounded to a square, stratified, box filter; 0 = 16 */
     uint32_t edge_samples;      /* more samples (rounded to a square) for a pixel whose first
-                                   ones disagree by over 10 % in luminance: silhouettes and
-                                   the light's rim; 0 = 64 */
+                                   ones disagree by over 10 % in luminance, or that differs
+                                   so from a row neighbour: silhouettes and the light's rim;
+                                   0 = 64 */
     /* The two-pass method: with `materials` (the scene's) given, a surface whose specular
      * reflectance Ks > 0 adds Ks times the radiance seen along the mirror direction, traced
      * through the radiosity-lit scene, up to max_depth reflections (0 = 5). NULL = the

@@ -69,5 +69,30 @@ int main(void)
         CHECK_NEAR(shallow->rgb[(8 * 16 + 8) * 3], expected[0], 1e-5);
     rad_image_destroy(shallow);
     CHECK(test_run_tool("render mirror.obj -o x.pfm --specular --max-depth 0") == 2);
+
+    /* the same scene 30000 units from the origin: float hit points are coarser there, and
+     * mirror rays must still leave the mirror without hitting it again */
+    test_write_file("far.obj",
+                    "mtllib mirror.mtl\n"
+                    "o mirror\nusemtl glass\n"
+                    "v 29999 29999 30000\nv 29999 30001 30000\nv 30001 30001 30000\n"
+                    "v 30001 29999 30000\nf 1 2 3 4\n"
+                    "o lamp\nusemtl lamp\n"
+                    "v 29997 29997 29998\nv 30003 29997 29998\nv 30003 30003 29998\n"
+                    "v 29997 30003 29998\nf 5 6 7 8\n");
+    CHECK(test_run_tool("render far.obj -o far.pfm --eye 30000,30000,29999 "
+                        "--target 30000,30000,30000 --up 0,1,0 --fov 60 --size 32x32 "
+                        "--patch-size 0.5 --specular") == 0);
+    rad_image *far = NULL;
+    rad_error error;
+    CHECK(rad_image_read(test_path("far.pfm"), &far, &error) == RAD_OK);
+    if (far) {
+        int wrong = 0;
+        for (size_t p = 0; p < 32 * 32; p++)
+            wrong += fabs(far->rgb[p * 3] - expected[0]) > 1e-3 * expected[0];
+        printf("far from the origin: %d of 1024 pixels wrong\n", wrong);
+        CHECK(wrong == 0);
+    }
+    rad_image_destroy(far);
     return test_finish("test_specular");
 }

@@ -37,6 +37,7 @@ typedef struct row_work {
     uint32_t *sample; /* the sample (pixel x, stratum) a ray belongs to */
     rad_rgb *sum;     /* radiance gathered per sample: first samples, then edge samples */
     uint8_t *edge;    /* per pixel of the row: gets edge samples */
+    double *level;    /* per pixel of the row: mean luminance of its first samples */
 } row_work;
 
 typedef struct shading {
@@ -53,6 +54,17 @@ typedef struct shading {
  * shades the hits and keeps the mirror rays for the next. */
 static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work *w,
                           uint32_t count, unsigned max_depth);
+
+static double mean_luminance(const rad_rgb *samples, unsigned count)
+{
+    double mean = 0;
+    for (unsigned s = 0; s < count; s++)
+        mean += (0.2126 * samples[s].r + 0.7152 * samples[s].g + 0.0722 * samples[s].b) / count;
+    return mean;
+}
+
+/* Two neighbouring pixels' luminances differ by more than EDGE_CONTRAST of the larger. */
+static bool is_step(double a, double b) { return fabs(a - b) > EDGE_CONTRAST * fmax(a, b); }
 
 /* A pixel is an edge when the luminance of its first samples spreads by more than
  * EDGE_CONTRAST of their mean. */
@@ -197,7 +209,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         w->sample = rad_alloc_array(ray_capacity, sizeof(*w->sample));
         w->sum = rad_alloc_array(per_row + per_row_edges, sizeof(*w->sum));
         w->edge = rad_alloc_array(W, sizeof(*w->edge));
-        if (!w->rays || !w->hits || !w->weight || !w->sample || !w->sum || !w->edge)
+        w->level = rad_alloc_array(W, sizeof(*w->level));
+        if (!w->rays || !w->hits || !w->weight || !w->sample || !w->sum || !w->edge || !w->level)
             goto nomem;
     }
     shading shade = {mesh, (const uint32_t(*)[3])triangles, patch_of, radiance, options->materials,
@@ -226,8 +239,14 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         /* edges: pixels whose first samples disagree (a silhouette, the light's rim) get
          * edge_k x edge_k more, so that high-contrast edges are antialiased */
         uint32_t extra = 0;
+        for (uint32_t x = 0; x < W; x++)
+            w->level[x] = mean_luminance(&w->sum[(size_t)x * k * k], k * k);
         for (uint32_t x = 0; x < W; x++) {
-            w->edge[x] = is_edge(&w->sum[(size_t)x * k * k], k * k);
+            /* an edge shows inside the pixel's samples, or as a step to a row neighbour
+             * (samples that all fell on one side of an edge crossing the pixel) */
+            w->edge[x] = is_edge(&w->sum[(size_t)x * k * k], k * k) ||
+                         (x > 0 && is_step(w->level[x], w->level[x - 1])) ||
+                         (x + 1 < W && is_step(w->level[x], w->level[x + 1]));
             if (!w->edge[x])
                 continue;
             rad_rng rng = rad_rng_seed(options->seed ^ EDGE_STREAM, y, x);
@@ -288,6 +307,7 @@ done:
             free(work[th].sample);
             free(work[th].sum);
             free(work[th].edge);
+            free(work[th].level);
         }
     free(work);
     rad_tracer_destroy(tracer);
