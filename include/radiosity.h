@@ -207,8 +207,12 @@ void rad_mesh_destroy(rad_mesh *mesh);
 /* Tracer: ray queries against a triangle set                                            */
 
 typedef enum rad_tracer_backend {
-    RAD_TRACER_EMBREE = 0, /* Embree 3 BVH: the default */
-    RAD_TRACER_BRUTE_FORCE /* tests every triangle: a test oracle, slow */
+    RAD_TRACER_EMBREE = 0,  /* Embree 3 BVH, watertight (robust mode): the default */
+    RAD_TRACER_BRUTE_FORCE, /* tests every triangle: a test oracle, slow */
+    RAD_TRACER_EMBREE_FAST  /* Embree 3 BVH, not watertight, about 1.6x faster: a ray may
+                               rarely slip along an edge two triangles share. For the
+                               occlusion segments of form factors, where that is one
+                               segment of many; never for camera rays */
 } rad_tracer_backend;
 
 /* A ray or segment: points origin + t * direction for t in [t_near, t_far]. direction

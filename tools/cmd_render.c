@@ -176,7 +176,7 @@ int command_render(int argc, char **argv)
         goto fail;
     t_mesh = cli_now();
 
-    status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &occluders, &error);
+    status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, &error);
     if (status != RAD_OK)
         goto fail;
     status = rad_formfactors_compute(mesh, occluders, &s.shared.formfactor, &ff, &ff_report, &error);

@@ -74,7 +74,7 @@ int command_viewfactors(int argc, char **argv)
         patch_size = rad_mesh_default_patch_size(scene, DEFAULT_TARGET_PATCHES);
     status = rad_mesh_build(scene, patch_size, &mesh, &error);
     if (status == RAD_OK)
-        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &occluders, &error);
+        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, &error);
     if (status != RAD_OK)
         goto fail;
     size_t S = scene->surface_count;

@@ -25,7 +25,8 @@ static rad_status validate(rad_tracer_backend backend, const rad_vec3 *positions
                            uint32_t position_count, const uint32_t (*triangles)[3],
                            uint32_t triangle_count, rad_error *error)
 {
-    if (backend != RAD_TRACER_EMBREE && backend != RAD_TRACER_BRUTE_FORCE)
+    if (backend != RAD_TRACER_EMBREE && backend != RAD_TRACER_EMBREE_FAST &&
+        backend != RAD_TRACER_BRUTE_FORCE)
         return rad_fail(error, RAD_ERR_INVALID, "tracer: unknown backend %d", (int)backend);
     if (position_count > 0 && !positions)
         return rad_fail(error, RAD_ERR_INVALID, "tracer: %u positions but no array",
@@ -88,7 +89,7 @@ rad_status rad_tracer_create(rad_tracer_backend backend, const rad_vec3 *positio
             tracer->indices[3 * (size_t)t + (size_t)k] = triangles[t][k];
     }
 
-    if (backend == RAD_TRACER_EMBREE) {
+    if (backend == RAD_TRACER_EMBREE || backend == RAD_TRACER_EMBREE_FAST) {
         status = rad_tracer_embree_build(tracer, error);
         if (status != RAD_OK)
             goto fail;
@@ -117,6 +118,7 @@ void rad_tracer_occluded(const rad_tracer *tracer, const rad_ray *rays, uint32_t
 {
     switch (tracer->backend) {
     case RAD_TRACER_EMBREE:
+    case RAD_TRACER_EMBREE_FAST:
         rad_tracer_embree_occluded(tracer, rays, count, occluded);
         break;
     case RAD_TRACER_BRUTE_FORCE:
@@ -130,6 +132,7 @@ void rad_tracer_intersect(const rad_tracer *tracer, const rad_ray *rays, uint32_
 {
     switch (tracer->backend) {
     case RAD_TRACER_EMBREE:
+    case RAD_TRACER_EMBREE_FAST:
         rad_tracer_embree_intersect(tracer, rays, count, hits);
         break;
     case RAD_TRACER_BRUTE_FORCE:

@@ -137,8 +137,9 @@ rad_status rad_tracer_embree_build(rad_tracer *tracer, rad_error *error)
     /* Form factors cast many rays per triangle: a slower, better BVH pays for itself. */
     rtcSetSceneBuildQuality(e->scene, RTC_BUILD_QUALITY_HIGH);
     /* watertight: no ray slips between two triangles sharing an edge, even far from the
-     * origin where float coordinates are coarse */
-    rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_ROBUST);
+     * origin where float coordinates are coarse (RAD_TRACER_EMBREE_FAST opts out) */
+    if (tracer->backend == RAD_TRACER_EMBREE)
+        rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_ROBUST);
     if (tracer->triangle_count > 0) {
         status = attach_triangles(tracer, e, error);
         if (status != RAD_OK)

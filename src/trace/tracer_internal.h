@@ -39,7 +39,7 @@ struct rad_tracer {
                                 a 16-byte load */
     uint32_t *indices;       /* 3 vertex indices per triangle, all < vertex_count,
                                 counter-clockwise seen from the front */
-    struct rad_tracer_embree *embree; /* RAD_TRACER_EMBREE only, else NULL */
+    struct rad_tracer_embree *embree; /* the Embree backends only, else NULL */
 };
 
 /* The miss record of the query contract. */
