@@ -11,13 +11,14 @@
 #include <stdlib.h>
 
 #include "core/alloc.h"
+#include "core/rgb.h"
 
 /* Below this linear value the sRGB curve is the straight line 12.92 x (IEC 61966-2-1). */
 #define SRGB_LINEAR_KNEE 0.0031308
 
 double rad_tonemap_luminance(double r, double g, double b)
 {
-    return 0.2126 * r + 0.7152 * g + 0.0722 * b;
+    return rgb_luminance((rad_rgb){r, g, b});
 }
 
 double rad_tonemap_srgb_encode(double linear)

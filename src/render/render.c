@@ -18,6 +18,7 @@
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/random.h"
+#include "core/rgb.h"
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "render/camera.h"
@@ -50,17 +51,12 @@ typedef struct shading {
     double leave;                   /* how far mirror rays start off a surface (scene units) */
 } shading;
 
-/* Traces `count` rays set up at the front of w's arrays, bounce by bounce: each bounce
- * shades the hits and keeps the mirror rays for the next. */
-static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work *w,
-                          uint32_t count, unsigned max_depth);
-
 static double mean_luminance(const rad_rgb *samples, unsigned count)
 {
     double mean = 0;
     for (unsigned s = 0; s < count; s++)
-        mean += (0.2126 * samples[s].r + 0.7152 * samples[s].g + 0.0722 * samples[s].b) / count;
-    return mean;
+        mean += rgb_luminance(samples[s]);
+    return mean / count;
 }
 
 /* Two neighbouring pixels' luminances differ by more than EDGE_CONTRAST of the larger. */
@@ -68,18 +64,16 @@ static bool is_step(double a, double b) { return fabs(a - b) > EDGE_CONTRAST * f
 
 /* A pixel is an edge when the luminance of its first samples spreads by more than
  * EDGE_CONTRAST of their mean. */
-static bool is_edge(const rad_rgb *samples, unsigned count)
+static bool is_edge(const rad_rgb *samples, unsigned count, double mean)
 {
-    double lo = INFINITY, hi = 0, mean = 0;
+    double lo = INFINITY, hi = 0;
     for (unsigned s = 0; s < count; s++) {
-        double y = 0.2126 * samples[s].r + 0.7152 * samples[s].g + 0.0722 * samples[s].b;
+        double y = rgb_luminance(samples[s]);
         lo = fmin(lo, y);
         hi = fmax(hi, y);
-        mean += y / count;
     }
     return hi - lo > EDGE_CONTRAST * mean;
 }
-
 
 /* Adds each hit's interpolated radiance (times the ray's weight) to its sample and, when
  * mirrors are allowed, writes the mirror rays of specular hits to the front of the arrays.
@@ -92,13 +86,11 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
         if (hit->triangle == RAD_NO_HIT || !hit->front)
             continue;
         const uint32_t *v = sh->triangles[hit->triangle];
-        double w0 = 1.0 - hit->u - hit->v, w1 = hit->u, w2 = hit->v;
         const rad_rgb *L = sh->radiance;
         rad_rgb weight = w->weight[r];
-        rad_rgb *sum = &w->sum[w->sample[r]];
-        sum->r += weight.r * (w0 * L[v[0]].r + w1 * L[v[1]].r + w2 * L[v[2]].r);
-        sum->g += weight.g * (w0 * L[v[0]].g + w1 * L[v[1]].g + w2 * L[v[2]].g);
-        sum->b += weight.b * (w0 * L[v[0]].b + w1 * L[v[1]].b + w2 * L[v[2]].b);
+        rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit->u - hit->v),
+                                       rgb_add(rgb_scale(L[v[1]], hit->u), rgb_scale(L[v[2]], hit->v)));
+        rgb_add_to(&w->sum[w->sample[r]], rgb_mul(weight, interpolated));
         if (!mirrors || !sh->materials)
             continue;
         const rad_patch *patch = &sh->mesh->patches[sh->patch_of[hit->triangle]];
@@ -114,7 +106,7 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
         /* leave the surface on its front side: nudged along the normal, past the float
          * rounding of the hit point */
         rad_vec3 origin = v3_add(p, v3_scale(n, sh->leave));
-        w->weight[next] = (rad_rgb){weight.r * ks.r, weight.g * ks.g, weight.b * ks.b};
+        w->weight[next] = rgb_mul(weight, ks);
         w->sample[next] = w->sample[r];
         ray_set(&w->rays[next], origin, mirror, sh->t_near, INFINITY);
         next++;
@@ -244,7 +236,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         for (uint32_t x = 0; x < W; x++) {
             /* an edge shows inside the pixel's samples, or as a step to a row neighbour
              * (samples that all fell on one side of an edge crossing the pixel) */
-            w->edge[x] = is_edge(&w->sum[(size_t)x * k * k], k * k) ||
+            w->edge[x] = is_edge(&w->sum[(size_t)x * k * k], k * k, w->level[x]) ||
                          (x > 0 && is_step(w->level[x], w->level[x - 1])) ||
                          (x + 1 < W && is_step(w->level[x], w->level[x + 1]));
             if (!w->edge[x])
@@ -266,26 +258,19 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
 
         uint32_t next_extra = 0;
         for (uint32_t x = 0; x < W; x++) {
-            double sum[3] = {0, 0, 0};
+            rad_rgb sum = {0, 0, 0};
             unsigned count = k * k;
-            for (unsigned s = 0; s < k * k; s++) {
-                const rad_rgb *L = &w->sum[(size_t)x * k * k + s];
-                sum[0] += L->r;
-                sum[1] += L->g;
-                sum[2] += L->b;
-            }
+            for (unsigned s = 0; s < k * k; s++)
+                rgb_add_to(&sum, w->sum[(size_t)x * k * k + s]);
             if (w->edge[x]) {
-                for (unsigned s = 0; s < edge_k * edge_k; s++) {
-                    const rad_rgb *L = &w->sum[per_row + next_extra++];
-                    sum[0] += L->r;
-                    sum[1] += L->g;
-                    sum[2] += L->b;
-                }
+                for (unsigned s = 0; s < edge_k * edge_k; s++)
+                    rgb_add_to(&sum, w->sum[per_row + next_extra++]);
                 count += edge_k * edge_k;
             }
             float *pixel = &image->rgb[((size_t)y * W + x) * 3];
-            for (int c = 0; c < 3; c++)
-                pixel[c] = (float)(sum[c] / count);
+            pixel[0] = (float)(sum.r / count);
+            pixel[1] = (float)(sum.g / count);
+            pixel[2] = (float)(sum.b / count);
         }
         uint32_t done;
 #pragma omp atomic capture

@@ -9,9 +9,8 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/rgb.h"
 #include "core/vec3.h"
-
-static double luminance(rad_rgb c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
 static double triangle_area(const rad_scene *scene, uint32_t t)
 {
@@ -25,7 +24,7 @@ rad_status emitters_build(const rad_scene *scene, emitter_set *set, rad_error *e
     memset(set, 0, sizeof(*set));
     uint32_t count = 0;
     for (uint32_t t = 0; t < scene->triangle_count; t++)
-        count += luminance(scene->materials[scene->triangles[t].material].emission) > 0;
+        count += rgb_luminance(scene->materials[scene->triangles[t].material].emission) > 0;
     set->triangle = rad_alloc_array(count, sizeof(*set->triangle));
     set->cdf = rad_alloc_array(count, sizeof(*set->cdf));
     set->pdf_area_of = rad_alloc_array(scene->triangle_count, sizeof(*set->pdf_area_of));
@@ -35,7 +34,7 @@ rad_status emitters_build(const rad_scene *scene, emitter_set *set, rad_error *e
     }
     double total = 0;
     for (uint32_t t = 0; t < scene->triangle_count; t++) {
-        double power = luminance(scene->materials[scene->triangles[t].material].emission) *
+        double power = rgb_luminance(scene->materials[scene->triangles[t].material].emission) *
                        triangle_area(scene, t);
         if (!(power > 0))
             continue;
