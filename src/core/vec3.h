@@ -29,6 +29,21 @@ static inline rad_vec3 v3_lerp(rad_vec3 a, rad_vec3 b, double t)
 {
     return v3(a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t, a.z + (b.z - a.z) * t);
 }
+/* The axis-aligned box of `count` points; both corners 0 when there are none. */
+static inline void v3_bounds(const rad_vec3 *points, size_t count, rad_vec3 *lo, rad_vec3 *hi)
+{
+    rad_vec3 a = v3(INFINITY, INFINITY, INFINITY), b = v3(-INFINITY, -INFINITY, -INFINITY);
+    for (size_t i = 0; i < count; i++) {
+        rad_vec3 p = points[i];
+        a = v3(fmin(a.x, p.x), fmin(a.y, p.y), fmin(a.z, p.z));
+        b = v3(fmax(b.x, p.x), fmax(b.y, p.y), fmax(b.z, p.z));
+    }
+    if (count == 0)
+        a = b = v3(0, 0, 0);
+    *lo = a;
+    *hi = b;
+}
+
 static inline int v3_is_finite(rad_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 
 #endif

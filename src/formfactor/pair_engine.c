@@ -403,13 +403,9 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
     e.seed = options->seed;
     e.sink = sink;
     e.sink_data = sink_data;
-    rad_vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
-    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
-        rad_vec3 p = mesh->vertices[v];
-        lo = v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
-        hi = v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
-    }
-    e.plane_epsilon = mesh->vertex_count ? RAD_PLANE_EPSILON * v3_length(v3_sub(hi, lo)) : 0;
+    rad_vec3 lo, hi;
+    v3_bounds(mesh->vertices, mesh->vertex_count, &lo, &hi);
+    e.plane_epsilon = RAD_PLANE_EPSILON * v3_length(v3_sub(hi, lo));
 
     int threads = pair_engine_threads(options);
     rad_status status = RAD_OK;

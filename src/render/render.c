@@ -170,12 +170,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     if (status != RAD_OK)
         goto done;
 
-    rad_vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
-    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
-        rad_vec3 q = mesh->vertices[v];
-        lo = v3(fmin(lo.x, q.x), fmin(lo.y, q.y), fmin(lo.z, q.z));
-        hi = v3(fmax(hi.x, q.x), fmax(hi.y, q.y), fmax(hi.z, q.z));
-    }
+    rad_vec3 lo, hi;
+    v3_bounds(mesh->vertices, mesh->vertex_count, &lo, &hi);
     double diagonal = mesh->vertex_count ? v3_length(v3_sub(hi, lo)) : 1;
     float t_near = (float)(RAD_CAMERA_NEAR * diagonal);
     double largest = fmax(fmax(fmax(fabs(lo.x), fabs(hi.x)), fmax(fabs(lo.y), fabs(hi.y))),

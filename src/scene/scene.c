@@ -32,16 +32,7 @@ double rad_scene_area(const rad_scene *scene)
 
 void rad_scene_bounds(const rad_scene *scene, rad_vec3 *lo, rad_vec3 *hi)
 {
-    rad_vec3 a = v3(INFINITY, INFINITY, INFINITY), b = v3(-INFINITY, -INFINITY, -INFINITY);
-    for (uint32_t i = 0; i < scene->position_count; i++) {
-        rad_vec3 p = scene->positions[i];
-        a = v3(fmin(a.x, p.x), fmin(a.y, p.y), fmin(a.z, p.z));
-        b = v3(fmax(b.x, p.x), fmax(b.y, p.y), fmax(b.z, p.z));
-    }
-    if (scene->position_count == 0)
-        a = b = v3(0, 0, 0);
-    *lo = a;
-    *hi = b;
+    v3_bounds(scene->positions, scene->position_count, lo, hi);
 }
 
 bool rad_scene_has_emitter(const rad_scene *scene)
