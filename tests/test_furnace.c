@@ -10,18 +10,6 @@
 
 #include "testlib.h"
 
-static const char *cube_obj =
-    "mtllib furnace.mtl\n"
-    "usemtl glow\n"
-    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
-    "o zlo\nf 1 2 3 4\n"
-    "o zhi\nf 5 8 7 6\n"
-    "o xlo\nf 1 4 8 5\n"
-    "o xhi\nf 2 6 7 3\n"
-    "o ylo\nf 1 5 6 2\n"
-    "o yhi\nf 4 3 7 8\n";
-
-static const char *cube_mtl = "newmtl glow\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
 
 static void check_solver(const char *solver)
 {
@@ -62,8 +50,7 @@ static void check_solver(const char *solver)
 
 int main(void)
 {
-    test_write_file("furnace.obj", cube_obj);
-    test_write_file("furnace.mtl", cube_mtl);
+    test_write_furnace("furnace.obj");
     check_solver("gather");
     check_solver("gauss-seidel");
     check_solver("shoot");

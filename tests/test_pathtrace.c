@@ -79,18 +79,6 @@ static void block_mean(const rad_image *image, const rad_image *se, uint32_t x0,
 /* ---------------------------------------------------------------------------------- */
 /* furnace                                                                             */
 
-static const char *cube_obj =
-    "mtllib furnace.mtl\n"
-    "usemtl glow\n"
-    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
-    "o zlo\nf 1 2 3 4\n"
-    "o zhi\nf 5 8 7 6\n"
-    "o xlo\nf 1 4 8 5\n"
-    "o xhi\nf 2 6 7 3\n"
-    "o ylo\nf 1 5 6 2\n"
-    "o yhi\nf 4 3 7 8\n";
-
-static const char *cube_mtl = "newmtl glow\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
 
 /* From inside, looking at a corner region so that edges and corners are in view. */
 static const rad_camera furnace_camera = {{0.5, 0.5, 0.05}, {0.7, 0.4, 1}, {0, 1, 0}, 100};
@@ -421,8 +409,7 @@ static void check_cli(void)
 
 int main(void)
 {
-    test_write_file("furnace.obj", cube_obj);
-    test_write_file("furnace.mtl", cube_mtl);
+    test_write_furnace("furnace.obj");
     rad_scene *furnace = load("furnace.obj");
     if (furnace) {
         check_furnace(furnace, 256, 0, 11, true);

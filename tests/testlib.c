@@ -112,3 +112,17 @@ int test_count_files(const char *prefix)
     closedir(dir);
     return count;
 }
+
+void test_write_furnace(const char *name)
+{
+    test_write_file(name, "mtllib furnace.mtl\n"
+                          "usemtl glow\n"
+                          "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                          "o zlo\nf 1 2 3 4\n"
+                          "o zhi\nf 5 8 7 6\n"
+                          "o xlo\nf 1 4 8 5\n"
+                          "o xhi\nf 2 6 7 3\n"
+                          "o ylo\nf 1 5 6 2\n"
+                          "o yhi\nf 4 3 7 8\n");
+    test_write_file("furnace.mtl", "newmtl glow\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
+}

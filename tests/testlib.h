@@ -69,6 +69,11 @@ const char *test_read_text(const char *path);
 
 bool test_file_exists(const char *path);
 
+/* Writes the furnace scene (VALIDATION.md section 3): a closed, inward-facing unit cube
+ * whose six faces (objects zlo, zhi, xlo, xhi, ylo, yhi) all have Kd 0.5 and Ke 1, as
+ * `name` with its material library furnace.mtl, in the scratch folder. */
+void test_write_furnace(const char *name);
+
 /* Counts the files in the scratch folder whose name starts with prefix. */
 int test_count_files(const char *prefix);
 
