@@ -21,52 +21,29 @@
 /* The CLI prints 6 significant digits. */
 #define PRINTED_PRECISION 1e-5
 
-static rad_image *new_image(uint32_t width, uint32_t height)
-{
-    rad_image *image = NULL;
-    rad_error error;
-    if (rad_image_create(width, height, &image, &error) != RAD_OK) {
-        fprintf(stderr, "rad_image_create: %s\n", error.message);
-        exit(1);
-    }
-    return image;
-}
-
-static float *pixel(const rad_image *image, uint32_t x, uint32_t y)
-{
-    return image->rgb + ((size_t)y * image->width + x) * 3;
-}
-
-static void set_pixel(rad_image *image, uint32_t x, uint32_t y, double r, double g, double b)
-{
-    float *p = pixel(image, x, y);
-    p[0] = (float)r;
-    p[1] = (float)g;
-    p[2] = (float)b;
-}
 
 static rad_image *constant(uint32_t width, uint32_t height, double value)
 {
-    rad_image *image = new_image(width, height);
+    rad_image *image = test_new_image(width, height);
     for (uint32_t y = 0; y < height; y++)
         for (uint32_t x = 0; x < width; x++)
-            set_pixel(image, x, y, value, value, value);
+            test_set_pixel(image, x, y, value, value, value);
     return image;
 }
 
 /* Nowhere black: every channel in [0.1, 1.2]. */
 static rad_image *gradient(uint32_t width, uint32_t height)
 {
-    rad_image *image = new_image(width, height);
+    rad_image *image = test_new_image(width, height);
     for (uint32_t y = 0; y < height; y++)
         for (uint32_t x = 0; x < width; x++)
-            set_pixel(image, x, y, 0.1 + (double)x / width, 0.2 + (double)y / height, 0.5);
+            test_set_pixel(image, x, y, 0.1 + (double)x / width, 0.2 + (double)y / height, 0.5);
     return image;
 }
 
 static rad_image *copy(const rad_image *image)
 {
-    rad_image *out = new_image(image->width, image->height);
+    rad_image *out = test_new_image(image->width, image->height);
     memcpy(out->rgb, image->rgb, (size_t)image->width * image->height * 3 * sizeof(float));
     return out;
 }
@@ -114,7 +91,7 @@ static rad_image *one_bright_block(void)
     rad_image *a = constant(BLOCK_W, BLOCK_H, 1.0);
     for (uint32_t y = BRIGHT_Y; y < BRIGHT_Y + 8; y++)
         for (uint32_t x = BRIGHT_X; x < BRIGHT_X + 8; x++)
-            set_pixel(a, x, y, 1.5, 1.5, 1.5);
+            test_set_pixel(a, x, y, 1.5, 1.5, 1.5);
     return a;
 }
 
@@ -194,9 +171,9 @@ static void test_partial_blocks(void)
     /* 20 x 13 with blocks of 8: 2 x 1 whole blocks cover x < 16, y < 8. */
     rad_image *b = constant(20, 13, 1.0);
     rad_image *a = copy(b);
-    set_pixel(a, 17, 3, 100, 100, 100); /* right partial column */
-    set_pixel(a, 4, 10, 100, 100, 100); /* bottom partial row */
-    set_pixel(a, 19, 12, 100, 100, 100); /* bottom-right corner */
+    test_set_pixel(a, 17, 3, 100, 100, 100); /* right partial column */
+    test_set_pixel(a, 4, 10, 100, 100, 100); /* bottom partial row */
+    test_set_pixel(a, 19, 12, 100, 100, 100); /* bottom-right corner */
     rad_image_difference d;
     rad_error error;
     CHECK(rad_image_compare(a, b, NULL, &d, NULL, &error) == RAD_OK);
@@ -230,7 +207,7 @@ static void test_black_reference(void)
     /* 16 x 8: block (0, 0) black in both, block (8, 0) black in b only. */
     rad_image *b = constant(16, 8, 0.0);
     rad_image *a = copy(b);
-    set_pixel(a, 9, 1, 0, 0.5, 0);
+    test_set_pixel(a, 9, 1, 0, 0.5, 0);
     rad_image_difference d;
     rad_error error;
     CHECK(rad_image_compare(a, b, NULL, &d, NULL, &error) == RAD_OK);
@@ -242,8 +219,8 @@ static void test_black_reference(void)
 
     /* Only lit reference pixels count for the mean relative error: one lit pixel at 2 in
      * b, 3 in a (relative 0.5); the black ones are left out. */
-    set_pixel(b, 0, 0, 2, 2, 2);
-    set_pixel(a, 0, 0, 3, 3, 3);
+    test_set_pixel(b, 0, 0, 2, 2, 2);
+    test_set_pixel(a, 0, 0, 3, 3, 3);
     CHECK(rad_image_compare(a, b, NULL, &d, NULL, &error) == RAD_OK);
     CHECK_NEAR(d.mean_relative_error, 0.5, FLOAT_PRECISION);
     rad_image_destroy(a);
@@ -261,21 +238,21 @@ static void test_refusals(void)
 
     b = constant(4, 4, 1.0);
     rad_image *picture = constant(4, 4, 7.0);
-    set_pixel(a, 3, 2, 1, NAN, 1);
-    set_pixel(a, 1, 3, INFINITY, 1, 1);
+    test_set_pixel(a, 3, 2, 1, NAN, 1);
+    test_set_pixel(a, 1, 3, INFINITY, 1, 1);
     CHECK(rad_image_compare(a, b, NULL, &d, picture, &error) == RAD_ERR_INVALID);
     CHECK(strstr(error.message, "pixel (3, 2) of image a") != NULL);
     CHECK(strchr(error.message, '\n') == NULL);
-    CHECK(pixel(picture, 0, 0)[0] == 7); /* untouched on failure */
+    CHECK(test_pixel(picture, 0, 0)[0] == 7); /* untouched on failure */
 
-    set_pixel(a, 3, 2, 1, 1, 1);
+    test_set_pixel(a, 3, 2, 1, 1, 1);
     CHECK(rad_image_compare(a, b, NULL, &d, NULL, &error) == RAD_ERR_INVALID);
     CHECK(strstr(error.message, "pixel (1, 3) of image a") != NULL);
-    set_pixel(a, 1, 3, 1, 1, 1);
-    set_pixel(b, 0, 1, 1, 1, -INFINITY);
+    test_set_pixel(a, 1, 3, 1, 1, 1);
+    test_set_pixel(b, 0, 1, 1, 1, -INFINITY);
     CHECK(rad_image_compare(a, b, NULL, &d, NULL, &error) == RAD_ERR_INVALID);
     CHECK(strstr(error.message, "pixel (0, 1) of image b") != NULL);
-    set_pixel(b, 0, 1, 1, 1, 1);
+    test_set_pixel(b, 0, 1, 1, 1, 1);
     CHECK(rad_image_compare(a, b, NULL, &d, NULL, &error) == RAD_OK);
 
     /* Bad options, a wrong-size picture, missing arguments. */
@@ -297,7 +274,7 @@ static void test_refusals(void)
 static bool colour_is(const rad_image *image, uint32_t x, uint32_t y, double r, double g,
                       double b)
 {
-    const float *p = pixel(image, x, y);
+    const float *p = test_pixel(image, x, y);
     return fabs(p[0] - r) <= FLOAT_PRECISION && fabs(p[1] - g) <= FLOAT_PRECISION &&
            fabs(p[2] - b) <= FLOAT_PRECISION;
 }
@@ -313,22 +290,22 @@ static void test_false_colour(void)
     rad_image *b = constant(7, 2, 2.0), *a = constant(7, 2, 2.0);
     for (uint32_t x = 0; x < 7; x++) {
         double v = 2 * (1 + relative[x]);
-        set_pixel(a, x, 0, v, v, v);
+        test_set_pixel(a, x, 0, v, v, v);
     }
-    set_pixel(b, 0, 1, 0, 0, 0);
-    set_pixel(a, 0, 1, 0, 0, 0);
-    set_pixel(b, 1, 1, 0, 0, 0);
-    set_pixel(a, 1, 1, 0.001, 0, 0);
-    set_pixel(a, 2, 1, 1.0, 3.0, 2.0); /* |(-1, 1, 0)|_1 / 6 = 1/3: between cyan and green */
-    rad_image *picture = new_image(7, 2);
+    test_set_pixel(b, 0, 1, 0, 0, 0);
+    test_set_pixel(a, 0, 1, 0, 0, 0);
+    test_set_pixel(b, 1, 1, 0, 0, 0);
+    test_set_pixel(a, 1, 1, 0.001, 0, 0);
+    test_set_pixel(a, 2, 1, 1.0, 3.0, 2.0); /* |(-1, 1, 0)|_1 / 6 = 1/3: between cyan and green */
+    rad_image *picture = test_new_image(7, 2);
     rad_image_difference d;
     rad_error error;
     CHECK(rad_image_compare(a, b, NULL, &d, picture, &error) == RAD_OK);
     for (uint32_t x = 0; x < 7; x++)
         if (!colour_is(picture, x, 0, expected[x][0], expected[x][1], expected[x][2]))
             test_fail(__FILE__, __LINE__, "false colour at relative %g: %g %g %g",
-                      relative[x], pixel(picture, x, 0)[0], pixel(picture, x, 0)[1],
-                      pixel(picture, x, 0)[2]);
+                      relative[x], test_pixel(picture, x, 0)[0], test_pixel(picture, x, 0)[1],
+                      test_pixel(picture, x, 0)[2]);
     test_checks++;
     CHECK(colour_is(picture, 0, 1, 0, 0, 1)); /* both black: equal */
     CHECK(colour_is(picture, 1, 1, 1, 0, 0)); /* black reference, lit a: red */
@@ -443,7 +420,7 @@ static void test_cli(void)
     CHECK(strstr(err, "a.pfm") != NULL && strstr(err, "other.hdr") != NULL);
     CHECK(line_count(err) == 1);
     CHECK(!test_file_exists(test_path("wrong.png")));
-    set_pixel(b, 2, 1, NAN, 0, 0);
+    test_set_pixel(b, 2, 1, NAN, 0, 0);
     write_image(b, "nan.pfm");
     CHECK(test_run_tool("compare a.pfm nan.pfm") == 1);
     err = test_read_text(test_path("stderr.txt"));

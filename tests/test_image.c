@@ -24,37 +24,14 @@
  * relative 2^-11 for normal halves (6.1e-5 to 65504). */
 #define HALF_RELATIVE_PRECISION 0x1p-11
 
-static rad_image *new_image(uint32_t width, uint32_t height)
-{
-    rad_image *image = NULL;
-    rad_error error;
-    if (rad_image_create(width, height, &image, &error) != RAD_OK) {
-        fprintf(stderr, "rad_image_create: %s\n", error.message);
-        exit(1);
-    }
-    return image;
-}
-
-static float *pixel(const rad_image *image, uint32_t x, uint32_t y)
-{
-    return image->rgb + ((size_t)y * image->width + x) * 3;
-}
-
-static void set_pixel(rad_image *image, uint32_t x, uint32_t y, double r, double g, double b)
-{
-    float *p = pixel(image, x, y);
-    p[0] = (float)r;
-    p[1] = (float)g;
-    p[2] = (float)b;
-}
 
 /* A smooth gradient: red grows left to right, green top to bottom, blue is constant. */
 static rad_image *gradient(uint32_t width, uint32_t height)
 {
-    rad_image *image = new_image(width, height);
+    rad_image *image = test_new_image(width, height);
     for (uint32_t y = 0; y < height; y++)
         for (uint32_t x = 0; x < width; x++)
-            set_pixel(image, x, y, (double)x / (width - 1), (double)y / (height - 1), 0.25);
+            test_set_pixel(image, x, y, (double)x / (width - 1), (double)y / (height - 1), 0.25);
     return image;
 }
 
@@ -144,9 +121,9 @@ static void test_exposure(void)
 {
     /* 100 lit grey pixels of luminance 1..100 and 10 black ones. The 95th percentile of
      * the lit ones sits at position 0.95 * 99 = 94.05 between 95 and 96. */
-    rad_image *image = new_image(11, 10);
+    rad_image *image = test_new_image(11, 10);
     for (uint32_t i = 0; i < 100; i++)
-        set_pixel(image, i % 10, i / 10, i + 1.0, i + 1.0, i + 1.0);
+        test_set_pixel(image, i % 10, i / 10, i + 1.0, i + 1.0, i + 1.0);
     double scale = 0;
     CHECK(rad_tonemap_scale(image, NULL, &scale) == RAD_OK);
     CHECK_NEAR(scale, 0.9 / 95.05, 1e-9);
@@ -178,7 +155,7 @@ static void test_exposure(void)
     png_image_free(&png);
     rad_image_destroy(image);
 
-    rad_image *black = new_image(4, 4);
+    rad_image *black = test_new_image(4, 4);
     CHECK(rad_tonemap_scale(black, NULL, &scale) == RAD_OK);
     CHECK(scale == 1);
     rad_image_destroy(black);
@@ -188,8 +165,8 @@ static void test_pfm_round_trip(void)
 {
     const uint32_t w = 16, h = 9;
     rad_image *image = gradient(w, h);
-    set_pixel(image, 3, 4, -2.5, 1e-30, 65504.0); /* negative, tiny, large: all exact */
-    set_pixel(image, 5, 0, 1.0 / 3.0, 0.1, 123456.789);
+    test_set_pixel(image, 3, 4, -2.5, 1e-30, 65504.0); /* negative, tiny, large: all exact */
+    test_set_pixel(image, 5, 0, 1.0 / 3.0, 0.1, 123456.789);
     const char *path = test_path("gradient.pfm");
     rad_error error;
     CHECK(rad_image_write(image, path, NULL, &error) == RAD_OK);
@@ -213,13 +190,13 @@ static void test_pfm_round_trip(void)
     if (back && back->width == w && back->height == h) {
         CHECK(memcmp(back->rgb, image->rgb, (size_t)w * h * 3 * sizeof(float)) == 0);
         /* The gradient, row 0 at the top: green is 0 on the top row, 1 on the bottom. */
-        CHECK(pixel(back, 0, 0)[1] == 0);
-        CHECK(pixel(back, 0, h - 1)[1] == 1);
-        CHECK(pixel(back, w - 1, 2)[0] == 1);
-        CHECK(pixel(back, 0, 2)[0] == 0);
-        CHECK_NEAR(pixel(back, 6, 2)[0], 6.0 / 15, 1e-7);
-        CHECK_NEAR(pixel(back, 6, 2)[1], 2.0 / 8, 1e-7);
-        CHECK(pixel(back, 3, 4)[0] == -2.5f && pixel(back, 3, 4)[2] == 65504.0f);
+        CHECK(test_pixel(back, 0, 0)[1] == 0);
+        CHECK(test_pixel(back, 0, h - 1)[1] == 1);
+        CHECK(test_pixel(back, w - 1, 2)[0] == 1);
+        CHECK(test_pixel(back, 0, 2)[0] == 0);
+        CHECK_NEAR(test_pixel(back, 6, 2)[0], 6.0 / 15, 1e-7);
+        CHECK_NEAR(test_pixel(back, 6, 2)[1], 2.0 / 8, 1e-7);
+        CHECK(test_pixel(back, 3, 4)[0] == -2.5f && test_pixel(back, 3, 4)[2] == 65504.0f);
     }
     rad_image_destroy(back);
     rad_image_destroy(image);
@@ -240,8 +217,8 @@ static void test_pfm_variants(void)
     CHECK(rad_image_read(write_bytes("be.pfm", colour, n + 24), &image, &error) == RAD_OK);
     if (image) {
         CHECK(image->width == 1 && image->height == 2);
-        CHECK(pixel(image, 0, 1)[0] == 1 && pixel(image, 0, 1)[2] == 3);
-        CHECK(pixel(image, 0, 0)[0] == 4 && pixel(image, 0, 0)[2] == 6);
+        CHECK(test_pixel(image, 0, 1)[0] == 1 && test_pixel(image, 0, 1)[2] == 3);
+        CHECK(test_pixel(image, 0, 0)[0] == 4 && test_pixel(image, 0, 0)[2] == 6);
     }
     rad_image_destroy(image);
 
@@ -266,10 +243,10 @@ static void test_hdr_round_trip(void)
 {
     const uint32_t w = 16, h = 9;
     rad_image *image = gradient(w, h);
-    set_pixel(image, 1, 1, 1000.0, 1e-3, 12345.0);
-    set_pixel(image, 2, 1, 1.0, 1.0, 1.0);
-    set_pixel(image, 3, 1, 0, 0, 0);
-    set_pixel(image, 4, 1, 1e-20, 3e-21, 0);
+    test_set_pixel(image, 1, 1, 1000.0, 1e-3, 12345.0);
+    test_set_pixel(image, 2, 1, 1.0, 1.0, 1.0);
+    test_set_pixel(image, 3, 1, 0, 0, 0);
+    test_set_pixel(image, 4, 1, 1e-20, 3e-21, 0);
     const char *path = test_path("gradient.hdr");
     rad_error error;
     CHECK(rad_image_write(image, path, NULL, &error) == RAD_OK);
@@ -288,7 +265,7 @@ static void test_hdr_round_trip(void)
         double worst = 0; /* error / largest channel, over all pixels and channels */
         for (uint32_t y = 0; y < h; y++)
             for (uint32_t x = 0; x < w; x++) {
-                const float *a = pixel(image, x, y), *b = pixel(back, x, y);
+                const float *a = test_pixel(image, x, y), *b = test_pixel(back, x, y);
                 double max = fmax(a[0], fmax(a[1], a[2]));
                 for (int c = 0; c < 3; c++) {
                     double e = max > 0 ? fabs(b[c] - a[c]) / max : fabs(b[c]);
@@ -296,15 +273,15 @@ static void test_hdr_round_trip(void)
                 }
             }
         CHECK(worst <= RGBE_RELATIVE_PRECISION);
-        CHECK(pixel(back, 3, 1)[0] == 0 && pixel(back, 3, 1)[1] == 0);
-        CHECK_NEAR(pixel(back, 1, 1)[2], 12345.0, RGBE_RELATIVE_PRECISION);
+        CHECK(test_pixel(back, 3, 1)[0] == 0 && test_pixel(back, 3, 1)[1] == 0);
+        CHECK_NEAR(test_pixel(back, 1, 1)[2], 12345.0, RGBE_RELATIVE_PRECISION);
         /* The other channels share the exponent of the largest one. */
-        CHECK_ABS(pixel(back, 1, 1)[0], 1000.0, 12345.0 * RGBE_RELATIVE_PRECISION);
-        CHECK(pixel(back, 1, 1)[1] < 12345.0 * RGBE_RELATIVE_PRECISION);
-        CHECK_NEAR(pixel(back, 2, 1)[1], 1.0, RGBE_RELATIVE_PRECISION);
+        CHECK_ABS(test_pixel(back, 1, 1)[0], 1000.0, 12345.0 * RGBE_RELATIVE_PRECISION);
+        CHECK(test_pixel(back, 1, 1)[1] < 12345.0 * RGBE_RELATIVE_PRECISION);
+        CHECK_NEAR(test_pixel(back, 2, 1)[1], 1.0, RGBE_RELATIVE_PRECISION);
         /* Orientation: top row green 0, bottom row green 1. */
-        CHECK(pixel(back, 8, 0)[1] < 0.01);
-        CHECK_NEAR(pixel(back, 8, h - 1)[1], 1.0, RGBE_RELATIVE_PRECISION);
+        CHECK(test_pixel(back, 8, 0)[1] < 0.01);
+        CHECK_NEAR(test_pixel(back, 8, h - 1)[1], 1.0, RGBE_RELATIVE_PRECISION);
     }
     rad_image_destroy(back);
     rad_image_destroy(image);
@@ -334,12 +311,12 @@ static void check_hand_made(const rad_image *image, uint32_t rle_row, double exp
     if (image->width != 10 || image->height != 2)
         return;
     for (uint32_t x = 0; x < 10; x++) {
-        const float *p = pixel(image, x, rle_row);
+        const float *p = test_pixel(image, x, rle_row);
         double unit = 1.0 / 128 / exposure; /* 2^(129 - 136) */
         CHECK_NEAR(p[0], 128.5 * unit, 1e-7);
         CHECK_NEAR(p[1], (10.0 * x + 0.5) * unit, 1e-7);
         CHECK_NEAR(p[2], (x < 5 ? 200.5 : x - 4 + 0.5) * unit, 1e-7);
-        const float *q = pixel(image, x, 1 - rle_row);
+        const float *q = test_pixel(image, x, 1 - rle_row);
         unit = 1.0 / 256 / exposure; /* 2^(128 - 136) */
         CHECK_NEAR(q[0], 128.5 * unit, 1e-7);
         CHECK_NEAR(q[1], 64.5 * unit, 1e-7);
@@ -385,11 +362,11 @@ static void test_hdr_rle(void)
 
 static void test_png(void)
 {
-    rad_image *image = new_image(2, 2);
-    set_pixel(image, 0, 0, 0, 1, 0.5);
-    set_pixel(image, 1, 0, 0.2, 0.001, 2.0);
-    set_pixel(image, 0, 1, -1, NAN, 0.0031308);
-    set_pixel(image, 1, 1, 0.25, 0.25, 0.25);
+    rad_image *image = test_new_image(2, 2);
+    test_set_pixel(image, 0, 0, 0, 1, 0.5);
+    test_set_pixel(image, 1, 0, 0.2, 0.001, 2.0);
+    test_set_pixel(image, 0, 1, -1, NAN, 0.0031308);
+    test_set_pixel(image, 1, 1, 0.25, 0.25, 0.25);
     const char *path = test_path("pixels.png");
     rad_error error;
     rad_image_write_options options = {.fixed_exposure = true, .exposure = 0};
@@ -712,7 +689,7 @@ static void check_spec(const char *path, const exr_spec *spec)
     for (int y = 0; y < SPEC_HEIGHT && image->height == SPEC_HEIGHT; y++)
         for (int x = 0; x < SPEC_WIDTH && image->width == SPEC_WIDTH; x++)
             for (int k = 0; k < 3; k++)
-                wrong += pixel(image, (uint32_t)x, (uint32_t)y)[k] !=
+                wrong += test_pixel(image, (uint32_t)x, (uint32_t)y)[k] !=
                          spec_value(source[k], x, y);
     if (wrong)
         test_fail(__FILE__, __LINE__, "%s: %d samples differ from the values written", path,
@@ -726,9 +703,9 @@ static void test_exr_round_trip(void)
     /* 37 x 23: ZIP stores 16 scanlines per chunk, so the second chunk is partial. */
     const uint32_t w = 37, h = 23;
     rad_image *image = gradient(w, h);
-    set_pixel(image, 3, 4, -2.5, 1e-3, 65504.0); /* negative, small, largest half */
-    set_pixel(image, 5, 0, 1.0 / 3.0, 0.1, 1234.567);
-    set_pixel(image, 6, 0, 0, 0, 0);
+    test_set_pixel(image, 3, 4, -2.5, 1e-3, 65504.0); /* negative, small, largest half */
+    test_set_pixel(image, 5, 0, 1.0 / 3.0, 0.1, 1234.567);
+    test_set_pixel(image, 6, 0, 0, 0, 0);
     const char *half_path = test_path("gradient.exr");
     const char *float_path = test_path("GRADIENT-FLOAT.EXR");
     rad_error error;
@@ -770,14 +747,14 @@ static void test_exr_round_trip(void)
         printf("test_image: EXR half round trip: largest relative error %.3g "
                "(2^-11 = %.3g)\n", worst, HALF_RELATIVE_PRECISION);
         CHECK(worst <= HALF_RELATIVE_PRECISION);
-        CHECK(pixel(half, 3, 4)[0] == -2.5f && pixel(half, 3, 4)[2] == 65504.0f);
-        CHECK(pixel(half, 6, 0)[0] == 0 && pixel(half, 6, 0)[2] == 0);
+        CHECK(test_pixel(half, 3, 4)[0] == -2.5f && test_pixel(half, 3, 4)[2] == 65504.0f);
+        CHECK(test_pixel(half, 6, 0)[0] == 0 && test_pixel(half, 6, 0)[2] == 0);
         /* Orientation: green 0 on the top row, 1 on the bottom; red 1 on the right. */
-        CHECK(pixel(half, 0, 0)[1] == 0);
-        CHECK(pixel(half, 9, h - 1)[1] == 1);
-        CHECK(pixel(half, w - 1, 7)[0] == 1);
-        CHECK_NEAR(pixel(half, 18, 17)[0], 18.0 / 36, HALF_RELATIVE_PRECISION);
-        CHECK_NEAR(pixel(half, 18, 17)[1], 17.0 / 22, HALF_RELATIVE_PRECISION);
+        CHECK(test_pixel(half, 0, 0)[1] == 0);
+        CHECK(test_pixel(half, 9, h - 1)[1] == 1);
+        CHECK(test_pixel(half, w - 1, 7)[0] == 1);
+        CHECK_NEAR(test_pixel(half, 18, 17)[0], 18.0 / 36, HALF_RELATIVE_PRECISION);
+        CHECK_NEAR(test_pixel(half, 18, 17)[1], 17.0 / 22, HALF_RELATIVE_PRECISION);
     }
     if (exact && exact->width == w && exact->height == h) {
         size_t differ = 0;
@@ -791,24 +768,24 @@ static void test_exr_round_trip(void)
 
     /* Half range: an image with a value above 65504 (half's largest) is written as float so
      * nothing becomes infinity; tiny values in a half image fade gradually. */
-    set_pixel(image, 0, 0, 1e6, 3e-5, -1e6);
+    test_set_pixel(image, 0, 0, 1e6, 3e-5, -1e6);
     CHECK(rad_image_write(image, half_path, NULL, &error) == RAD_OK);
     rad_image_destroy(half);
     half = NULL;
     CHECK(rad_image_read(half_path, &half, &error) == RAD_OK);
     if (half) {
-        CHECK(pixel(half, 0, 0)[0] == 1e6f);
-        CHECK(pixel(half, 0, 0)[2] == -1e6f);
-        CHECK(pixel(half, 0, 0)[1] == 3e-5f);
+        CHECK(test_pixel(half, 0, 0)[0] == 1e6f);
+        CHECK(test_pixel(half, 0, 0)[2] == -1e6f);
+        CHECK(test_pixel(half, 0, 0)[1] == 3e-5f);
     }
     rad_image_destroy(half);
     half = NULL;
-    set_pixel(image, 0, 0, 60000, 3e-5, -1);
+    test_set_pixel(image, 0, 0, 60000, 3e-5, -1);
     CHECK(rad_image_write(image, half_path, NULL, &error) == RAD_OK);
     CHECK(rad_image_read(half_path, &half, &error) == RAD_OK);
     if (half) {
-        CHECK_NEAR(pixel(half, 0, 0)[0], 60000, 0x1p-11);
-        CHECK_NEAR(pixel(half, 0, 0)[1], 3e-5, 0x1p-10); /* a subnormal half: 10 bits */
+        CHECK_NEAR(test_pixel(half, 0, 0)[0], 60000, 0x1p-11);
+        CHECK_NEAR(test_pixel(half, 0, 0)[1], 3e-5, 0x1p-10); /* a subnormal half: 10 bits */
     }
     rad_image_destroy(half);
     rad_image_destroy(image);

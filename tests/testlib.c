@@ -126,3 +126,27 @@ void test_write_furnace(const char *name)
                           "o yhi\nf 4 3 7 8\n");
     test_write_file("furnace.mtl", "newmtl glow\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
 }
+
+rad_image *test_new_image(uint32_t width, uint32_t height)
+{
+    rad_image *image = NULL;
+    rad_error error;
+    if (rad_image_create(width, height, &image, &error) != RAD_OK) {
+        fprintf(stderr, "rad_image_create: %s\n", error.message);
+        exit(1);
+    }
+    return image;
+}
+
+float *test_pixel(const rad_image *image, uint32_t x, uint32_t y)
+{
+    return image->rgb + ((size_t)y * image->width + x) * 3;
+}
+
+void test_set_pixel(rad_image *image, uint32_t x, uint32_t y, double r, double g, double b)
+{
+    float *p = test_pixel(image, x, y);
+    p[0] = (float)r;
+    p[1] = (float)g;
+    p[2] = (float)b;
+}

@@ -69,6 +69,11 @@ const char *test_read_text(const char *path);
 
 bool test_file_exists(const char *path);
 
+/* A new black image (exits the test on failure), and pixel access. */
+rad_image *test_new_image(uint32_t width, uint32_t height);
+float *test_pixel(const rad_image *image, uint32_t x, uint32_t y);
+void test_set_pixel(rad_image *image, uint32_t x, uint32_t y, double r, double g, double b);
+
 /* Writes the furnace scene (VALIDATION.md section 3): a closed, inward-facing unit cube
  * whose six faces (objects zlo, zhi, xlo, xhi, ylo, yhi) all have Kd 0.5 and Ke 1, as
  * `name` with its material library furnace.mtl, in the scratch folder. */
