@@ -110,7 +110,17 @@ typedef struct rad_surface {
     char name[128];
     uint32_t first_triangle;
     uint32_t triangle_count;
+    uint32_t flags;    /* RAD_SURFACE_* below; 0 for a plain one-sided surface */
+    double emissivity; /* hemispherical emissivity in (0,1] for grey-body exchange
+                          (View3D's `emit` field); 0.9 unless the input says otherwise */
 } rad_surface;
+
+enum {
+    RAD_SURFACE_OBSTRUCTION = 1u << 0, /* blocks rays but has no row or column of view
+                                          factors (View3D `O`, `--obstruction FILE`) */
+    RAD_SURFACE_TWO_SIDED = 1u << 1    /* both sides radiate: one row whose area is twice
+                                          the triangles' (`--two-sided NAME`) */
+};
 
 typedef struct rad_triangle {
     uint32_t vertex[3]; /* indices into rad_scene.positions, counter-clockwise = front */
@@ -327,6 +337,62 @@ rad_status rad_viewfactors_compute(const rad_scene *scene, const rad_mesh *mesh,
                                    const rad_formfactor_options *options, double *matrix,
                                    double *areas, rad_formfactor_report *report,
                                    rad_error *error);
+
+/* ------------------------------------------------------------------------------------ */
+/* View factors for engineers: surface to surface, sparse, with error bounds             */
+
+/* A surface-to-surface view-factor matrix in compressed sparse rows. Rows and columns are
+ * the scene's surfaces (n = scene->surface_count); obstruction surfaces have empty rows
+ * and columns. Only non-zero factors are stored, columns ascending within a row. */
+typedef struct rad_viewfactor_matrix {
+    uint32_t n;
+    double *area;          /* n: A_I (twice the triangles' area for a two-sided surface) */
+    uint64_t *row_start;   /* n + 1: row I is entries [row_start[I], row_start[I + 1]) */
+    uint32_t *column;      /* row_start[n] column indices J */
+    double *value;         /* F_IJ */
+    double *error_bound;   /* estimated absolute error of each F_IJ (about two standard
+                              errors of its sampled obstruction; the quadrature's
+                              tolerance where unobstructed) */
+} rad_viewfactor_matrix;
+
+typedef struct rad_viewfactor_options {
+    double accuracy;     /* relative error target of each factor; 0 = 1e-4. Unobstructed
+                            pairs meet it by adaptive quadrature; obstructed pairs sample
+                            visibility until their error bound meets it or max_rays */
+    uint32_t max_rays;   /* visibility rays per obstructed polygon pair at most; 0 = 16384 */
+    uint64_t seed;
+    int threads;         /* 0 = all cores */
+    rad_progress_fn progress;
+    void *progress_user;
+} rad_viewfactor_options;
+
+typedef struct rad_viewfactor_report {
+    uint64_t surface_pairs;      /* surface pairs considered */
+    uint64_t polygon_pairs;      /* triangle pairs that face each other */
+    uint64_t obstructed_pairs;   /* of those, pairs with something in between */
+    uint64_t capped_pairs;       /* obstructed pairs that reached max_rays first */
+    uint64_t rays;               /* visibility rays cast */
+    uint64_t nonzeros;           /* stored factors */
+    double largest_error_bound;  /* largest error_bound / F_IJ over the stored factors */
+    double seconds;
+    int threads;
+} rad_viewfactor_report;
+
+/* Computes the view factors between the scene's surfaces, each surface taken as a whole
+ * (its triangles need not be coplanar: a curved surface given as a mesh is one surface and
+ * may see itself). Every triangle of the scene, obstruction surfaces included, blocks.
+ * Reciprocity A_I F_IJ = A_J F_JI holds by construction, 0 <= F_IJ <= 1, and an obstructed
+ * factor never exceeds its unobstructed value. Memory grows with the non-zero count. */
+rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
+                                         const rad_viewfactor_options *options,
+                                         rad_viewfactor_matrix **out,
+                                         rad_viewfactor_report *report, rad_error *error);
+
+void rad_viewfactor_matrix_destroy(rad_viewfactor_matrix *matrix);
+
+/* F_IJ, or 0 when it is not stored. */
+double rad_viewfactor_matrix_get(const rad_viewfactor_matrix *matrix, uint32_t row,
+                                 uint32_t column);
 
 /* ------------------------------------------------------------------------------------ */
 /* Solvers for (I - diag(rho) F) B = E                                                   */
