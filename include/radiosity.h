@@ -329,15 +329,6 @@ typedef struct rad_formfactor_check {
 void rad_formfactors_check(const rad_formfactors *formfactors, const rad_mesh *mesh,
                            rad_formfactor_check *check);
 
-/* The surface-to-surface view-factor matrix: F_IJ = sum over patches i of I, j of J of
- * A_i F_ij / A_I, computed pair by pair without storing the patch matrix. `matrix` receives
- * surface_count^2 values, row-major; `areas` (optional) the surface areas. */
-rad_status rad_viewfactors_compute(const rad_scene *scene, const rad_mesh *mesh,
-                                   const rad_tracer *occluders,
-                                   const rad_formfactor_options *options, double *matrix,
-                                   double *areas, rad_formfactor_report *report,
-                                   rad_error *error);
-
 /* ------------------------------------------------------------------------------------ */
 /* View factors for engineers: surface to surface, sparse, with error bounds             */
 
@@ -359,7 +350,7 @@ typedef struct rad_viewfactor_options {
     double accuracy;     /* relative error target of each factor; 0 = 1e-4. Unobstructed
                             pairs meet it by adaptive quadrature; obstructed pairs sample
                             visibility until their error bound meets it or max_rays */
-    uint32_t max_rays;   /* visibility rays per obstructed polygon pair at most; 0 = 16384 */
+    uint32_t max_rays;   /* visibility rays per obstructed polygon pair at most; 0 = 4096 */
     uint64_t seed;
     int threads;         /* 0 = all cores */
     rad_progress_fn progress;
@@ -393,6 +384,20 @@ void rad_viewfactor_matrix_destroy(rad_viewfactor_matrix *matrix);
 /* F_IJ, or 0 when it is not stored. */
 double rad_viewfactor_matrix_get(const rad_viewfactor_matrix *matrix, uint32_t row,
                                  uint32_t column);
+
+/* The physical invariants of a view-factor matrix, measured (checked on every CLI run). */
+typedef struct rad_viewfactor_check {
+    double smallest, largest;   /* smallest and largest stored F_IJ: within [0, 1] */
+    double reciprocity;         /* largest |A_I F_IJ - A_J F_JI| / max(A_I F_IJ, A_J F_JI) */
+    double largest_planar_self; /* largest F_II of a planar surface: 0 */
+    double largest_row_sum;     /* max_I sum_J F_IJ: above 1 means a row creates energy */
+    double row_sum_deviation;   /* max_I |sum_J F_IJ - 1| over radiating surfaces */
+    bool closed;                /* the radiating surfaces form a closed enclosure: every
+                                   edge of their triangles is shared by exactly two of them */
+} rad_viewfactor_check;
+
+void rad_viewfactor_matrix_check(const rad_viewfactor_matrix *matrix, const rad_scene *scene,
+                                 rad_viewfactor_check *check);
 
 /* ------------------------------------------------------------------------------------ */
 /* Solvers for (I - diag(rho) F) B = E                                                   */

@@ -14,25 +14,27 @@ static const char usage[] =
     "Computes the view factor F_ij between every pair of surfaces of SCENE (an OBJ object\n"
     "or group is a surface): the fraction of the energy leaving surface i that reaches\n"
     "surface j, with obstructions. Surfaces are one-sided: the front is the side from\n"
-    "which the vertices run counter-clockwise. Output: CSV, first row\n"
+    "which the vertices run counter-clockwise; a surface need not be flat (a cylinder\n"
+    "given as a mesh is one surface and may see itself). Unobstructed polygon pairs are\n"
+    "integrated analytically to --accuracy; pairs with something in between sample\n"
+    "visibility until their error bound meets it (or --max-rays). Output: CSV, first row\n"
     "'surface,NAME1,...,NAMEn', then one row per surface; to stdout without -o.\n"
-    "A summary (reciprocity and row sums) goes to stderr.\n"
+    "A summary (the invariants: range, reciprocity, row sums; error bounds) goes to stderr.\n"
     "\n"
     "  -o, --output FILE    write the CSV here (atomically)\n"
-    "  --patch-size L       longest patch edge in scene units (default: about 1500 patches)\n"
-    "  --visibility-rays N  occlusion rays per patch pair (default 16)\n"
-    "  --quadrature M       M x M points per patch for the analytic part (default 3)\n"
+    "  --accuracy E         relative error target of each factor (default 1e-4)\n"
+    "  --max-rays N         visibility rays per obstructed polygon pair at most\n"
+    "                       (default 4096)\n"
     "  --threads N          worker threads (default: all cores)\n"
     "  --seed N             seed of the sample points (default 1)\n"
-    "  --stats FILE.json    write counts, times and residuals\n"
+    "  --stats FILE.json    write counts, times, invariants and error bounds\n"
     "  -h, --help           this text\n";
 
-enum { OPT_COUNT = OPT_OWN };
+enum { OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_COUNT };
 
-static const cli_option options[OPT_COUNT] = {CLI_BASE_OPTIONS, CLI_FORMFACTOR_OPTIONS};
-
-#define DEFAULT_TARGET_PATCHES 1500u
-#define DEFAULT_QUADRATURE 3u
+static const cli_option options[OPT_COUNT] = {
+    CLI_BASE_OPTIONS, [OPT_ACCURACY] = {"accuracy", 0, true},
+    [OPT_MAX_RAYS] = {"max-rays", 0, true}};
 
 int command_viewfactors(int argc, char **argv)
 {
@@ -50,10 +52,26 @@ int command_viewfactors(int argc, char **argv)
     cli_shared shared;
     if (!cli_parse_shared(&args, &shared))
         return EXIT_USAGE;
-    rad_formfactor_options ff = shared.formfactor;
-    if (!args.value[OPT_QUADRATURE])
-        ff.quadrature = DEFAULT_QUADRATURE;
-    double patch_size = shared.patch_size;
+    rad_viewfactor_options vf = {.seed = shared.seed, .threads = shared.threads,
+                                 .progress = cli_progress};
+    if (args.value[OPT_ACCURACY]) {
+        if (!cli_parse_double("accuracy", args.value[OPT_ACCURACY], &vf.accuracy))
+            return EXIT_USAGE;
+        if (!(vf.accuracy >= 1e-9 && vf.accuracy <= 0.5)) {
+            cli_error("--accuracy: must be between 1e-9 and 0.5");
+            return EXIT_USAGE;
+        }
+    }
+    if (args.value[OPT_MAX_RAYS]) {
+        unsigned long value;
+        if (!cli_parse_uint("max-rays", args.value[OPT_MAX_RAYS], 1u << 24, &value))
+            return EXIT_USAGE;
+        if (value < 64) {
+            cli_error("--max-rays: must be at least 64");
+            return EXIT_USAGE;
+        }
+        vf.max_rays = (uint32_t)value;
+    }
     const char *output = shared.output, *stats_path = shared.stats_path;
     if ((output && !cli_output_writable(output)) ||
         (stats_path && !cli_output_writable(stats_path)))
@@ -62,59 +80,57 @@ int command_viewfactors(int argc, char **argv)
     int exit_code = EXIT_OK;
     rad_error error = {0};
     rad_scene *scene = NULL;
-    rad_mesh *mesh = NULL;
-    rad_tracer *occluders = NULL;
-    double *matrix = NULL, *areas = NULL;
-    rad_formfactor_report report = {0};
+    rad_viewfactor_matrix *matrix = NULL;
+    double *dense = NULL;
+    rad_viewfactor_report report = {0};
     double t0 = cli_now();
     rad_status status = cli_load_scene(args.positional[0], &scene, &error);
-    if (status != RAD_OK)
-        goto fail;
-    if (patch_size <= 0)
-        patch_size = rad_mesh_default_patch_size(scene, DEFAULT_TARGET_PATCHES);
-    status = rad_mesh_build(scene, patch_size, &mesh, &error);
     if (status == RAD_OK)
-        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, &error);
-    if (status != RAD_OK)
-        goto fail;
-    size_t S = scene->surface_count;
-    matrix = calloc(S * S, sizeof(*matrix));
-    areas = calloc(S, sizeof(*areas));
-    if (!matrix || !areas) {
-        snprintf(error.message, sizeof(error.message), "out of memory for %zu surfaces", S);
-        goto fail;
-    }
-    status = rad_viewfactors_compute(scene, mesh, occluders, &ff, matrix, areas, &report, &error);
+        status = rad_viewfactor_matrix_compute(scene, &vf, &matrix, &report, &error);
     if (status != RAD_OK)
         goto fail;
     cli_progress_end();
 
-    /* the invariants, reported on every run */
-    double reciprocity = 0, row_deviation = 0, largest = 0;
-    for (size_t i = 0; i < S; i++) {
-        double row = 0;
-        for (size_t j = 0; j < S; j++) {
-            row += matrix[i * S + j];
-            largest = fmax(largest, matrix[i * S + j]);
-            double a = areas[i] * matrix[i * S + j], b = areas[j] * matrix[j * S + i];
-            if (fmax(a, b) > 0)
-                reciprocity = fmax(reciprocity, fabs(a - b) / fmax(a, b));
-        }
-        row_deviation = fmax(row_deviation, fabs(row - 1));
-    }
+    rad_viewfactor_check check;
+    rad_viewfactor_matrix_check(matrix, scene, &check);
+    size_t S = scene->surface_count;
     fprintf(stderr,
-            "radiosity: %zu surfaces, %u patches, %llu rays, %.2f s; largest F %.6g, "
-            "reciprocity residual %.2e, largest |row sum - 1| %.4g (0 only for closed "
-            "enclosures)\n",
-            S, mesh->patch_count, (unsigned long long)report.rays, cli_now() - t0, largest,
-            reciprocity, row_deviation);
+            "radiosity: %zu surfaces, %llu polygon pairs (%llu obstructed), %llu rays, "
+            "%llu non-zero factors, %.2f s\n"
+            "radiosity: F in [%.6g, %.6g]; reciprocity residual %.2e; planar F_ii %.2g; "
+            "largest row sum %.6f",
+            S, (unsigned long long)report.polygon_pairs,
+            (unsigned long long)report.obstructed_pairs, (unsigned long long)report.rays,
+            (unsigned long long)report.nonzeros, cli_now() - t0, check.smallest, check.largest,
+            check.reciprocity, check.largest_planar_self, check.largest_row_sum);
+    if (check.closed)
+        fprintf(stderr, "; closed enclosure: largest |row sum - 1| %.3g", check.row_sum_deviation);
+    fprintf(stderr, "\nradiosity: largest error bound %.3g of its factor", report.largest_error_bound);
+    if (report.capped_pairs)
+        fprintf(stderr, " (%llu obstructed pairs reached --max-rays first)",
+                (unsigned long long)report.capped_pairs);
+    fputc('\n', stderr);
+    if (check.largest > 1 || check.smallest < 0 || check.largest_planar_self > 0) {
+        snprintf(error.message, sizeof(error.message),
+                 "%s: internal error: a view factor outside [0, 1] or a planar F_ii > 0",
+                 scene->source);
+        goto fail;
+    }
 
+    dense = calloc(S ? S * S : 1, sizeof(*dense));
+    if (!dense) {
+        snprintf(error.message, sizeof(error.message), "out of memory for %zu surfaces", S);
+        goto fail;
+    }
+    for (size_t I = 0; I < S; I++)
+        for (uint64_t k = matrix->row_start[I]; k < matrix->row_start[I + 1]; k++)
+            dense[I * S + matrix->column[k]] = matrix->value[k];
     if (output) {
-        status = rad_viewfactors_write_csv(scene, matrix, output, &error);
+        status = rad_viewfactors_write_csv(scene, dense, output, &error);
         if (status != RAD_OK)
             goto fail;
     } else {
-        status = rad_viewfactors_print_csv(scene, matrix, stdout, &error);
+        status = rad_viewfactors_print_csv(scene, dense, stdout, &error);
         if (status != RAD_OK)
             goto fail;
     }
@@ -123,12 +139,20 @@ int command_viewfactors(int argc, char **argv)
         stats_begin(&stats);
         stats_string(&stats, "scene", scene->source);
         stats_integer(&stats, "surfaces", S);
-        stats_integer(&stats, "patches", mesh->patch_count);
+        stats_integer(&stats, "surface_pairs", report.surface_pairs);
+        stats_integer(&stats, "polygon_pairs", report.polygon_pairs);
+        stats_integer(&stats, "obstructed_pairs", report.obstructed_pairs);
+        stats_integer(&stats, "capped_pairs", report.capped_pairs);
         stats_integer(&stats, "rays_cast", report.rays);
-        stats_number(&stats, "seconds_form_factors", report.seconds);
+        stats_integer(&stats, "nonzeros", report.nonzeros);
+        stats_integer(&stats, "threads", (uint64_t)report.threads);
+        stats_number(&stats, "seconds_view_factors", report.seconds);
         stats_number(&stats, "seconds_total", cli_now() - t0);
-        stats_number(&stats, "reciprocity_residual", reciprocity);
-        stats_number(&stats, "row_sum_deviation", row_deviation);
+        stats_number(&stats, "largest_error_bound", report.largest_error_bound);
+        stats_number(&stats, "reciprocity_residual", check.reciprocity);
+        stats_number(&stats, "largest_row_sum", check.largest_row_sum);
+        stats_number(&stats, "row_sum_deviation", check.row_sum_deviation);
+        stats_integer(&stats, "closed_enclosure", check.closed);
         stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
         if (!stats_write(&stats, stats_path))
             exit_code = EXIT_ERROR;
@@ -138,10 +162,8 @@ fail:
     cli_error("%s", error.message);
     exit_code = EXIT_ERROR;
 done:
-    free(matrix);
-    free(areas);
-    rad_tracer_destroy(occluders);
-    rad_mesh_destroy(mesh);
+    free(dense);
+    rad_viewfactor_matrix_destroy(matrix);
     rad_scene_destroy(scene);
     return exit_code;
 }

@@ -1,0 +1,26 @@
+/*
+ * occluder_tree.h - "could anything block the view between these two polygons?"
+ *
+ * A bounding-volume tree over every scene triangle (obstructions included), queried with
+ * the convex hull of two polygons: every segment between them lies inside that hull, so a
+ * triangle that is separated from the hull cannot block any of them. The answer is
+ * conservative: `false` means provably unobstructed (the analytic value is exact), `true`
+ * means some triangle may block and visibility must be sampled.
+ */
+#ifndef RAD_VIEWFACTOR_OCCLUDER_TREE_H
+#define RAD_VIEWFACTOR_OCCLUDER_TREE_H
+
+#include "radiosity.h"
+#include "viewfactor/vf_geometry.h"
+
+typedef struct occluder_tree occluder_tree;
+
+rad_status occluder_tree_build(const rad_scene *scene, occluder_tree **out, rad_error *error);
+void occluder_tree_destroy(occluder_tree *tree);
+
+/* True when a triangle other than the polygons' own may cut the hull of p and q. Touching
+ * the hull's boundary (within epsilon, scene units) does not count. */
+bool occluder_tree_may_block(const occluder_tree *tree, const vf_polygon *p,
+                             const vf_polygon *q, double epsilon);
+
+#endif

@@ -1,0 +1,62 @@
+/*
+ * vf_geometry.h - the scene as the view-factor engine sees it: convex planar polygons
+ * grouped by surface.
+ *
+ * Every triangle of a radiating surface becomes a polygon; two triangles of one surface that
+ * share an edge and together form a flat convex quadrilateral become one quad (a wall given
+ * as two triangles is one polygon again, which quarters the pair count). A two-sided surface
+ * gets every polygon twice, the second copy reversed. Obstruction surfaces get no polygons:
+ * they only block, through the occluder tree and the tracer.
+ */
+#ifndef RAD_VIEWFACTOR_VF_GEOMETRY_H
+#define RAD_VIEWFACTOR_VF_GEOMETRY_H
+
+#include "radiosity.h"
+
+typedef struct vf_polygon {
+    rad_vec3 vertex[4];  /* counter-clockwise seen from the front */
+    unsigned count;      /* 3 or 4 */
+    rad_vec3 normal;     /* unit front normal */
+    double area;
+    rad_vec3 centroid;
+    double radius;       /* largest distance from the centroid to a corner */
+    uint32_t surface;
+    uint32_t triangle[2]; /* the scene triangles it covers; triangle[1] = UINT32_MAX for one */
+} vf_polygon;
+
+typedef struct vf_surface {
+    uint32_t first_polygon, polygon_count;
+    double area;        /* sum of its polygons' areas (both copies when two-sided) */
+    rad_vec3 center;    /* bounding sphere of its corners */
+    double radius;
+    bool planar;        /* every polygon in one plane with one front normal: cannot see
+                           itself */
+    rad_vec3 normal;    /* the plane, when planar: normal . x = offset */
+    double offset;
+} vf_surface;
+
+typedef struct vf_geometry {
+    vf_polygon *polygons;
+    uint32_t polygon_count;
+    vf_surface *surfaces; /* one per scene surface; obstructions have no polygons */
+    uint32_t surface_count;
+    double plane_epsilon; /* in front of a plane means beyond this distance (scene units) */
+} vf_geometry;
+
+rad_status vf_geometry_build(const rad_scene *scene, vf_geometry *geometry, rad_error *error);
+void vf_geometry_free(vf_geometry *geometry);
+
+/* True when some corner of `polygon` lies in front of the plane (n, offset) by more than
+ * epsilon. */
+static inline bool vf_polygon_in_front(const vf_polygon *polygon, rad_vec3 n, double offset,
+                                       double epsilon)
+{
+    for (unsigned k = 0; k < polygon->count; k++) {
+        const rad_vec3 *v = &polygon->vertex[k];
+        if (n.x * v->x + n.y * v->y + n.z * v->z - offset > epsilon)
+            return true;
+    }
+    return false;
+}
+
+#endif
