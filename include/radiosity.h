@@ -638,6 +638,78 @@ rad_status rad_viewfactors_write_csv(const rad_scene *scene, const double *matri
 rad_status rad_viewfactors_print_csv(const rad_scene *scene, const double *matrix, FILE *stream,
                                      rad_error *error);
 
+/* The lit mesh: the solution as geometry other tools read, view-independent. Each mesh
+ * vertex carries its linear radiance (rad_reconstruct_vertices: what the renderer
+ * interpolates) and a display colour: radiance times an exposure, clamped to [0,1]. The
+ * automatic exposure is the PNG one applied to vertices: the 95th percentile of the
+ * luminance of the lit vertices (luminance > 0) is scaled to 0.9. Vertices are per smooth
+ * region (rad_mesh), so creases and emitters stay sharp; quads are written as the two
+ * triangles the renderer uses (0,1,2 and 0,2,3). Coordinates are the scene's own (the
+ * built-in Cornell box is in millimetres); radiance is in the unit of the emitters' Ke,
+ * the same numbers as a .pfm render. */
+typedef struct rad_lit_mesh_options {
+    bool fixed_exposure; /* false = automatic (above), true = use `exposure` */
+    double exposure;     /* the display colour is radiance * 2^exposure */
+} rad_lit_mesh_options;
+
+/* Writes the mesh lit by B (per-patch exitance) by the extension of path:
+ *   .ply  binary little-endian PLY. Vertex: float x y z, float nx ny nz, uchar red green
+ *         blue (the display colour, sRGB-encoded), float radiance_r radiance_g radiance_b
+ *         (linear); face: list uchar int vertex_indices. Comments give the exposure.
+ *   .glb  binary glTF 2.0, one mesh of triangles with POSITION, NORMAL, COLOR_0 (the
+ *         display colour as float RGB, linear as glTF requires: viewers apply the sRGB
+ *         curve themselves), _RADIANCE (float RGB linear radiance, an application
+ *         attribute) and an unlit material (KHR_materials_unlit), so viewers show the
+ *         colours as they are, not shaded again.
+ *   .obj  `v x y z r g b` (the display colour, sRGB-encoded, in [0,1]: the vertex-colour
+ *         extension MeshLab and Blender read), `vn`, triangles `f a//a b//b c//c`; the
+ *         linear radiance is a comment line `#radiance R G B` per vertex, in vertex order,
+ *         after the `v` lines, so the file stays one plain OBJ for every reader.
+ * options NULL = automatic exposure. Atomic like rad_image_write. RAD_ERR_INVALID for an
+ * unknown extension or a non-finite exposure. */
+rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char *path,
+                              const rad_lit_mesh_options *options, rad_error *error);
+
+/* A solution file: the per-patch radiosity B of one scene and meshing, so a scene is
+ * solved once and rendered from many views (radiosity is view-independent). Binary,
+ * little-endian: magic "\x89RADSOL\n", format version (uint32, RAD_SOLUTION_VERSION),
+ * patch count (uint32), fingerprint (uint64), patch size (double), then B as patch_count x
+ * 3 doubles (r, g, b), then an FNV-1a 64 checksum of every byte before it. */
+enum { RAD_SOLUTION_VERSION = 1 };
+
+typedef struct rad_solution {
+    uint32_t patch_count;
+    double patch_size;    /* the mesh was built with rad_mesh_build(scene, patch_size) */
+    uint64_t fingerprint; /* rad_solution_fingerprint of that scene and mesh */
+    rad_rgb *B;           /* patch_count exitances */
+    char source[512];     /* the file it was read from */
+} rad_solution;
+
+/* A hash of what the solution depends on: the scene's positions and triangles (vertices,
+ * materials, surfaces), each patch's albedo and exitance as the solve sees them
+ * (rad_system_from_mesh), the patch size, and the mesh's vertex count, patch count and
+ * patch vertices. Floating-point values are hashed bit for bit. */
+rad_status rad_solution_fingerprint(const rad_scene *scene, const rad_mesh *mesh,
+                                    uint64_t *fingerprint, rad_error *error);
+
+/* Writes B (mesh->patch_count values) for this scene and mesh. Atomic like
+ * rad_image_write. */
+rad_status rad_solution_write(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
+                              const char *path, rad_error *error);
+
+/* Reads a solution file and checks it whole: RAD_ERR_PARSE, with a message naming the
+ * file, when it is not a solution file, has another format version, is truncated or too
+ * long, fails its checksum, or holds a negative or non-finite value. It is not yet tied to
+ * a scene: build the mesh with its patch_size, then call rad_solution_match. */
+rad_status rad_solution_read(const char *path, rad_solution **out, rad_error *error);
+
+/* RAD_OK when the solution belongs to this scene and mesh (same fingerprint), else
+ * RAD_ERR_INVALID with a message naming the file. */
+rad_status rad_solution_match(const rad_solution *solution, const rad_scene *scene,
+                              const rad_mesh *mesh, rad_error *error);
+
+void rad_solution_destroy(rad_solution *solution);
+
 /* Writes `size` bytes to path atomically (temporary name, then rename). */
 rad_status rad_write_file_atomic(const char *path, const void *data, size_t size,
                                  rad_error *error);

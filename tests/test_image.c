@@ -4,7 +4,7 @@
  * other compressions, tiled), the sRGB curve and exposure, PNG pixels decoded with libpng,
  * and the error paths (missing folder, failed rename, unknown extension, truncated files).
  *
- * Not tested here: rendering into images (test_render) or the CLI's use of them.
+ * The CLI's use of them: `compare` reads .exr, `render --exr-float` writes float channels.
  */
 #include <math.h>
 #include <openexr.h>
@@ -901,6 +901,41 @@ static void test_exr_cli(void)
     CHECK(test_file_exists(test_path("diff.exr")));
 }
 
+/* `--exr-float` on the command line: the .exr holds exactly the floats of a .pfm of the
+ * same render; without it, halves (close, not equal). */
+static void test_exr_float_cli(void)
+{
+    const char *render = "render --patch-size 150 --size 24x18 --spp 1";
+    char command[256];
+    snprintf(command, sizeof(command), "%s -o same.pfm", render);
+    CHECK(test_run_tool(command) == 0);
+    snprintf(command, sizeof(command), "%s -o float.exr --exr-float", render);
+    CHECK(test_run_tool(command) == 0);
+    snprintf(command, sizeof(command), "%s -o half.exr", render);
+    CHECK(test_run_tool(command) == 0);
+    rad_image *pfm = NULL, *full = NULL, *half = NULL;
+    rad_error error;
+    CHECK(rad_image_read(test_path("same.pfm"), &pfm, &error) == RAD_OK);
+    CHECK(rad_image_read(test_path("float.exr"), &full, &error) == RAD_OK);
+    CHECK(rad_image_read(test_path("half.exr"), &half, &error) == RAD_OK);
+    if (pfm && full && half) {
+        size_t n = (size_t)pfm->width * pfm->height * 3;
+        size_t differ_float = 0, differ_half = 0, beyond_half = 0;
+        for (size_t k = 0; k < n; k++) {
+            differ_float += full->rgb[k] != pfm->rgb[k];
+            differ_half += half->rgb[k] != pfm->rgb[k];
+            beyond_half += fabs(half->rgb[k] - pfm->rgb[k]) >
+                           HALF_RELATIVE_PRECISION * fabs(pfm->rgb[k]) + 1e-7;
+        }
+        CHECK(differ_float == 0);
+        CHECK(differ_half > 0);
+        CHECK(beyond_half == 0);
+    }
+    rad_image_destroy(pfm);
+    rad_image_destroy(full);
+    rad_image_destroy(half);
+}
+
 int main(void)
 {
     test_create();
@@ -917,5 +952,6 @@ int main(void)
     test_exr_layouts();
     test_exr_damaged();
     test_exr_cli();
+    test_exr_float_cli();
     return test_finish("test_image");
 }

@@ -249,6 +249,7 @@ bool cli_parse_view(const cli_args *args, cli_view *view)
             return false;
         view->write.fixed_exposure = true;
     }
+    view->write.exr_float = args->value[OPT_EXR_FLOAT] != NULL;
     return true;
 }
 

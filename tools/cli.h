@@ -34,13 +34,16 @@ bool cli_parse(const char *command, int argc, char **argv, const cli_option *opt
                int option_count, cli_args *args);
 
 /* Option groups shared by several commands, at fixed indices in every command's table:
- * BASE (every command), FORMFACTOR (render, viewfactors), VIEW (commands that make an
- * image). A command's own options start at OPT_OWN. Entries of a group a command does not
- * include stay empty (NULL name) and are never matched. */
+ * BASE (every command), FORMFACTOR (render, solve, viewfactors), VIEW (commands that make
+ * an image), SOLVE (render, solve). A command's own options start at OPT_OWN. Entries of a
+ * group a command does not include stay empty (NULL name) and are never matched. */
 enum {
     OPT_OUTPUT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_HELP,            /* BASE */
     OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS, OPT_QUADRATURE,                /* FORMFACTOR */
     OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE, /* VIEW */
+    OPT_EXR_FLOAT,
+    OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_SOLUTION,        /* SOLVE */
+    OPT_SAVE_SOLUTION,
     OPT_OWN
 };
 
@@ -58,7 +61,12 @@ enum {
     [OPT_EYE] = {"eye", 0, true}, [OPT_TARGET] = {"target", 0, true},                      \
     [OPT_UP] = {"up", 0, true}, [OPT_FOV] = {"fov", 0, true},                              \
     [OPT_SIZE] = {"size", 0, true}, [OPT_SPP] = {"spp", 0, true},                          \
-    [OPT_EXPOSURE] = {"exposure", 0, true}
+    [OPT_EXPOSURE] = {"exposure", 0, true}, [OPT_EXR_FLOAT] = {"exr-float", 0, false}
+
+#define CLI_SOLVE_OPTIONS                                                                  \
+    [OPT_SOLVER] = {"solver", 0, true}, [OPT_TOLERANCE] = {"tolerance", 0, true},          \
+    [OPT_MAX_ITERATIONS] = {"max-iterations", 0, true},                                    \
+    [OPT_SOLUTION] = {"solution", 0, true}, [OPT_SAVE_SOLUTION] = {"save-solution", 0, true}
 
 /* What the BASE and FORMFACTOR options say; patch_size 0 = the command's default. */
 typedef struct cli_shared {
@@ -79,7 +87,7 @@ typedef struct cli_view {
     bool has_eye, has_target, has_up, has_fov;
     uint32_t width, height;            /* 512 x 512 by default */
     uint32_t samples_per_pixel;        /* 0 = the command's default */
-    rad_image_write_options write;     /* exposure */
+    rad_image_write_options write;     /* exposure, --exr-float */
 } cli_view;
 
 bool cli_parse_view(const cli_args *args, cli_view *view);
@@ -135,12 +143,55 @@ void stats_bool(cli_stats *stats, const char *key, bool value);
 /* Closes the object and writes it atomically; false (after printing) on failure. */
 bool stats_write(cli_stats *stats, const char *path);
 
+/* What the SOLVE options say (cli_solve.c). */
+typedef struct cli_solve {
+    rad_solve_options options;      /* solver, tolerance, iterations, threads, progress */
+    const char *solution_path;      /* --solution: read B from this file instead of solving */
+    const char *save_solution_path; /* --save-solution: write B to this file */
+} cli_solve;
+
+/* Parses the SOLVE options (after cli_parse_shared, whose threads it takes); false (after
+ * printing) on a bad value. */
+bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *solve);
+
+/* A scene, its mesh and its solution, and what getting them cost. */
+typedef struct cli_solved {
+    rad_scene *scene;
+    rad_mesh *mesh;
+    rad_rgb *B;     /* mesh->patch_count exitances */
+    bool from_file; /* B came from --solution: no form factors, no solve */
+    rad_formfactor_report formfactors;
+    rad_solve_report report;
+    rad_formfactor_check check;
+    double seconds_load, seconds_mesh, seconds_form_factors, seconds_check, seconds_solve,
+        seconds_save;
+} cli_solved;
+
+/* The part `render` and `solve` share: loads SCENE (NULL = the built-in Cornell box),
+ * meshes it (--patch-size, else the solution file's, else about target_patches patches),
+ * then reads B from --solution (refused unless it belongs to this scene and mesh) or
+ * computes the form factors and solves, warning when the solver stops at its limit;
+ * writes --save-solution. On failure, fills error and frees what it made. */
+rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
+                           const cli_solve *solve, uint32_t target_patches, cli_solved *out,
+                           rad_error *error);
+void cli_solved_free(cli_solved *solved);
+
+/* The --stats fields of the solution: scene, patches, rays, phase times, solver,
+ * iterations, residuals and form-factor checks (or the solution file it came from). */
+void cli_solved_stats(const cli_solved *solved, const cli_solve *solve, cli_stats *stats);
+
+/* One line for a person watching a terminal: "N patches, M rays, K sweeps (residual R)". */
+void cli_solved_summary(const cli_solved *solved, const cli_solve *solve, char *text,
+                        size_t size);
+
 /* Prints an error and returns false when path is a folder or its folder is not writable. */
 bool cli_output_writable(const char *path);
 
 /* The subcommands, one file each (cmd_NAME.c); argv holds the arguments after the
  * subcommand's name. Each returns the process exit code. */
 int command_render(int argc, char **argv);
+int command_solve(int argc, char **argv);
 int command_viewfactors(int argc, char **argv);
 int command_raytrace(int argc, char **argv);
 int command_pathtrace(int argc, char **argv);

@@ -25,6 +25,7 @@ static const char usage[] =
     "Camera (default: the scene's camera, or a view of the whole scene from -z):\n"
     "  --eye X,Y,Z  --target X,Y,Z  --up X,Y,Z  --fov DEG (vertical)   --size WxH (512x512)\n"
     "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"
+    "  --exr-float          .exr: 32-bit float channels instead of half\n"
     "Sampling:\n"
     "  --spp N              paths per pixel, stratified over the pixel, box filter\n"
     "                       (default 64); the noise falls as 1/sqrt(N)\n"
@@ -151,7 +152,9 @@ int command_pathtrace(int argc, char **argv)
     t_trace = cli_now();
     status = rad_image_write(image, s.output, &s.view.write, &error);
     if (status == RAD_OK && s.error_path)
-        status = rad_image_write(standard_error, s.error_path, NULL, &error);
+        status = rad_image_write(standard_error, s.error_path,
+                                 &(rad_image_write_options){.exr_float = s.view.write.exr_float},
+                                 &error);
     if (status != RAD_OK)
         goto fail;
     t_write = cli_now();

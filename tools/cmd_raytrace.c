@@ -39,6 +39,7 @@ static const char usage[] =
     "  --spp N              samples per pixel, rounded to a square, stratified, box filter\n"
     "                       (default 4; 1 = through the pixel centre)\n"
     "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"
+    "  --exr-float          .exr: 32-bit float channels instead of half\n"
     "Run:\n"
     "  --threads N          worker threads (default: all cores)\n"
     "  --seed N             seed of every random choice (default 1)\n"

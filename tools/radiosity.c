@@ -13,6 +13,8 @@ static const char usage[] =
     "commands:\n"
     "  render [SCENE] -o OUT     solve and render an image (.png, .hdr, .pfm, .exr); no\n"
     "                            SCENE renders the built-in Cornell box\n"
+    "  solve [SCENE] -o OUT      solve and write the lit mesh (.ply, .glb, .obj: vertex\n"
+    "                            radiance and colour) or a solution file for render\n"
     "  viewfactors SCENE         the surface-to-surface view-factor matrix as CSV\n"
     "  raytrace SCENE -o OUT     Whitted ray tracing with the Phong model\n"
     "  pathtrace SCENE -o OUT    a Monte-Carlo path tracer: the reference for radiosity\n"
@@ -27,7 +29,8 @@ typedef struct command {
 } command;
 
 static const command commands[] = {
-    {"render", command_render},     {"viewfactors", command_viewfactors},
+    {"render", command_render},     {"solve", command_solve},
+    {"viewfactors", command_viewfactors},
     {"raytrace", command_raytrace}, {"pathtrace", command_pathtrace},
     {"compare", command_compare},
 };

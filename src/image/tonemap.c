@@ -43,32 +43,37 @@ static int compare_doubles(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The automatic multiplier; see rad_tonemap_scale. */
+double rad_tonemap_auto_scale(double *luminance, size_t count)
+{
+    size_t lit = 0; /* the finite values > 0, moved to the front */
+    for (size_t i = 0; i < count; i++)
+        if (luminance[i] > 0 && isfinite(luminance[i]))
+            luminance[lit++] = luminance[i];
+    if (lit == 0)
+        return 1;
+    qsort(luminance, lit, sizeof(*luminance), compare_doubles);
+    double position = RAD_TONEMAP_AUTO_PERCENTILE * (double)(lit - 1);
+    size_t below = (size_t)position;
+    double fraction = position - (double)below;
+    double quantile = luminance[below];
+    if (below + 1 < lit)
+        quantile += fraction * (luminance[below + 1] - luminance[below]);
+    return RAD_TONEMAP_AUTO_TARGET / quantile;
+}
+
+/* The automatic multiplier of an image's pixels; see rad_tonemap_scale. */
 static rad_status auto_scale(const rad_image *image, double *scale)
 {
     size_t pixels = (size_t)image->width * image->height; /* fits: the image exists */
-    double *lit = rad_alloc_array(pixels, sizeof(*lit));
-    if (!lit)
+    double *luminance = rad_alloc_array(pixels, sizeof(*luminance));
+    if (!luminance)
         return RAD_ERR_NOMEM;
-    size_t count = 0;
     for (size_t i = 0; i < pixels; i++) {
         const float *p = image->rgb + 3 * i;
-        double y = rad_tonemap_luminance(p[0], p[1], p[2]);
-        if (y > 0 && isfinite(y))
-            lit[count++] = y;
+        luminance[i] = rad_tonemap_luminance(p[0], p[1], p[2]);
     }
-    *scale = 1;
-    if (count > 0) {
-        qsort(lit, count, sizeof(*lit), compare_doubles);
-        double position = RAD_TONEMAP_AUTO_PERCENTILE * (double)(count - 1);
-        size_t below = (size_t)position;
-        double fraction = position - (double)below;
-        double quantile = lit[below];
-        if (below + 1 < count)
-            quantile += fraction * (lit[below + 1] - lit[below]);
-        *scale = RAD_TONEMAP_AUTO_TARGET / quantile;
-    }
-    free(lit);
+    *scale = rad_tonemap_auto_scale(luminance, pixels);
+    free(luminance);
     return RAD_OK;
 }
 

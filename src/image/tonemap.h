@@ -1,5 +1,6 @@
 /*
- * tonemap.h - from linear radiance to 8-bit sRGB for PNG output (internal).
+ * tonemap.h - from linear radiance to 8-bit sRGB: PNG output and lit-mesh vertex colours
+ * (internal).
  *
  * The PNG pipeline per channel is: radiance * scale, clamp to [0,1], the sRGB transfer
  * curve, round to 8 bits. The scale is 2^exposure, or chosen automatically so that the
@@ -9,6 +10,7 @@
 #ifndef RAD_IMAGE_TONEMAP_H
 #define RAD_IMAGE_TONEMAP_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "radiosity.h"
@@ -27,6 +29,12 @@ double rad_tonemap_srgb_encode(double linear);
 
 /* Clamp, sRGB encode, round to the nearest of 0..255. */
 uint8_t rad_tonemap_srgb8(double linear);
+
+/* The automatic multiplier for a set of luminances, whatever they come from (the pixels
+ * of an image, the vertices of a lit mesh): RAD_TONEMAP_AUTO_TARGET / (the
+ * RAD_TONEMAP_AUTO_PERCENTILE quantile of the finite values > 0, linearly interpolated
+ * between order statistics); 1 when there is none. Reorders `luminance`. */
+double rad_tonemap_auto_scale(double *luminance, size_t count);
 
 /* The multiplier 2^exposure, or, with options NULL or not fixed_exposure, the automatic
  * one: RAD_TONEMAP_AUTO_TARGET / (the RAD_TONEMAP_AUTO_PERCENTILE quantile of the finite

@@ -1,0 +1,498 @@
+/*
+ * test_lit_mesh.c - `radiosity solve -o OUT`: the lit mesh in .glb, .ply and .obj.
+ *
+ * References, each independent of the writers under test:
+ *   - the vertex radiances the library computes in this process (scene, mesh, form
+ *     factors, solve, rad_reconstruct_vertices, with the tool's default settings): every
+ *     file must carry them, and the geometry must be the mesh's, read back through this
+ *     test's own .glb parser (cJSON and the binary chunk), its own PLY and OBJ readers, and
+ *     Assimp (rad_scene_load);
+ *   - the display colour recomputed here from the PNG rule (95th percentile of the lit
+ *     vertices' luminance to 0.9, clamp, the sRGB curve written out below);
+ *   - the glTF rules a validator checks: 4-byte alignment, chunk and buffer lengths,
+ *     POSITION min/max equal to the data, unit normals, colours in [0,1];
+ *   - physics: in the furnace (every face Kd 0.5, Ke 1) every vertex radiance is
+ *     Le / (1 - rho) = 2 within 0.5 %;
+ *   - creases: vertices at one position on two walls keep different radiances.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
+#include "testlib.h"
+
+#define CORNELL_PATCH_SIZE 100.0
+#define FLOAT_RELATIVE 1e-6 /* a double stored as float, or printed with 9 digits */
+
+/* What the library computes for a scene: the tool's defaults, in this process. */
+typedef struct reference {
+    rad_scene *scene;
+    rad_mesh *mesh;
+    rad_rgb *radiance; /* per mesh vertex */
+    uint32_t (*triangles)[3];
+    uint32_t triangle_count;
+    double scale; /* the automatic exposure, recomputed here */
+} reference;
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double luminance(rad_rgb c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+
+/* IEC 61966-2-1, on [0,1]. */
+static double srgb(double linear)
+{
+    linear = fmin(fmax(linear, 0), 1);
+    return linear <= 0.0031308 ? 12.92 * linear : 1.055 * pow(linear, 1 / 2.4) - 0.055;
+}
+
+static double display(double radiance, double scale) { return fmin(fmax(radiance * scale, 0), 1); }
+
+static void compute_reference(const char *scene_path, double patch_size, reference *ref)
+{
+    rad_error error;
+    memset(ref, 0, sizeof(*ref));
+    rad_status status = scene_path ? rad_scene_load(scene_path, NULL, &ref->scene, &error)
+                                   : rad_scene_cornell_box(&ref->scene, &error);
+    rad_tracer *tracer = NULL;
+    rad_formfactors *ff = NULL;
+    rad_system system = {0};
+    if (status == RAD_OK)
+        status = rad_mesh_build(ref->scene, patch_size, &ref->mesh, &error);
+    if (status == RAD_OK)
+        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, ref->scene, &tracer, &error);
+    rad_formfactor_options ff_options = {.seed = 1};
+    if (status == RAD_OK)
+        status = rad_formfactors_compute(ref->mesh, tracer, &ff_options, &ff, NULL, &error);
+    if (status == RAD_OK)
+        status = rad_system_from_mesh(ref->scene, ref->mesh, ff, &system, &error);
+    rad_rgb *B = calloc(ref->mesh ? ref->mesh->patch_count : 1, sizeof(*B));
+    rad_solve_options solve = {.solver = RAD_SOLVER_JACOBI, .ambient = true};
+    if (status == RAD_OK)
+        status = rad_solve(&system, &solve, B, NULL, &error);
+    if (status != RAD_OK) {
+        fprintf(stderr, "reference: %s\n", error.message);
+        exit(1);
+    }
+    uint32_t n = ref->mesh->vertex_count;
+    ref->radiance = calloc(n, sizeof(*ref->radiance));
+    rad_reconstruct_vertices(ref->mesh, B, ref->radiance);
+    ref->triangles = calloc(2 * (size_t)ref->mesh->patch_count, sizeof(*ref->triangles));
+    for (uint32_t p = 0; p < ref->mesh->patch_count; p++) {
+        const rad_patch *patch = &ref->mesh->patches[p];
+        uint32_t *t = ref->triangles[ref->triangle_count++];
+        t[0] = patch->vertex[0], t[1] = patch->vertex[1], t[2] = patch->vertex[2];
+        if (patch->vertex_count == 4) {
+            t = ref->triangles[ref->triangle_count++];
+            t[0] = patch->vertex[0], t[1] = patch->vertex[2], t[2] = patch->vertex[3];
+        }
+    }
+    double *lit = calloc(n, sizeof(*lit));
+    size_t count = 0;
+    for (uint32_t v = 0; v < n; v++)
+        if (luminance(ref->radiance[v]) > 0)
+            lit[count++] = luminance(ref->radiance[v]);
+    qsort(lit, count, sizeof(*lit), compare_doubles);
+    double position = 0.95 * (double)(count - 1);
+    size_t below = (size_t)position;
+    double quantile = lit[below];
+    if (below + 1 < count)
+        quantile += (position - (double)below) * (lit[below + 1] - lit[below]);
+    ref->scale = 0.9 / quantile;
+    free(lit);
+    free(B);
+    rad_system_free_arrays(&system);
+    rad_formfactors_destroy(ff);
+    rad_tracer_destroy(tracer);
+}
+
+static void free_reference(reference *ref)
+{
+    free(ref->radiance);
+    free(ref->triangles);
+    rad_mesh_destroy(ref->mesh);
+    rad_scene_destroy(ref->scene);
+}
+
+/* |a - b| within FLOAT_RELATIVE of the larger magnitude (or of 1e-30 near zero). */
+static bool same_float(double a, double b)
+{
+    return fabs(a - b) <= FLOAT_RELATIVE * fmax(fmax(fabs(a), fabs(b)), 1e-30);
+}
+
+static bool same_rgb(const float *f, rad_rgb c)
+{
+    return same_float(f[0], c.r) && same_float(f[1], c.g) && same_float(f[2], c.b);
+}
+
+static uint8_t *read_file(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long length = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    uint8_t *bytes = malloc(length > 0 ? (size_t)length : 1);
+    *size = fread(bytes, 1, (size_t)length, f);
+    fclose(f);
+    return bytes;
+}
+
+static uint32_t get_u32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static float get_f32(const uint8_t *p)
+{
+    uint32_t bits = get_u32(p);
+    float v;
+    memcpy(&v, &bits, sizeof(v));
+    return v;
+}
+
+static int json_int(const cJSON *object, const char *key)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(object, key);
+    return cJSON_IsNumber(item) ? item->valueint : -1;
+}
+
+/* The accessor `index` of a float VEC3 or uint SCALAR: its data in BIN, checked. */
+static const uint8_t *accessor_data(const cJSON *json, int index, const uint8_t *bin,
+                                    size_t bin_length, uint32_t *count, int component,
+                                    const char *type)
+{
+    const cJSON *accessor = cJSON_GetArrayItem(cJSON_GetObjectItem(json, "accessors"), index);
+    CHECK(accessor != NULL);
+    if (!accessor)
+        return NULL;
+    CHECK(json_int(accessor, "componentType") == component);
+    const cJSON *type_item = cJSON_GetObjectItem(accessor, "type");
+    CHECK(cJSON_IsString(type_item) && strcmp(type_item->valuestring, type) == 0);
+    *count = (uint32_t)json_int(accessor, "count");
+    const cJSON *view = cJSON_GetArrayItem(cJSON_GetObjectItem(json, "bufferViews"),
+                                           json_int(accessor, "bufferView"));
+    CHECK(view != NULL);
+    if (!view)
+        return NULL;
+    int offset = json_int(view, "byteOffset"), length = json_int(view, "byteLength");
+    int element = strcmp(type, "VEC3") == 0 ? 12 : 4;
+    CHECK(offset >= 0 && offset % 4 == 0);
+    CHECK(length == element * (int)*count);
+    CHECK((size_t)offset + (size_t)length <= bin_length);
+    if (offset < 0 || (size_t)offset + (size_t)length > bin_length)
+        return NULL;
+    return bin + offset;
+}
+
+/* Reads x.glb back by hand and checks it against the reference and the glTF rules. */
+static void check_glb(const char *name, const reference *ref)
+{
+    size_t size = 0;
+    uint8_t *bytes = read_file(test_path(name), &size);
+    CHECK(bytes != NULL && size >= 28);
+    if (!bytes || size < 28)
+        return;
+    CHECK(memcmp(bytes, "glTF", 4) == 0);
+    CHECK(get_u32(bytes + 4) == 2);
+    CHECK(get_u32(bytes + 8) == size);
+    uint32_t json_length = get_u32(bytes + 12);
+    CHECK(memcmp(bytes + 16, "JSON", 4) == 0);
+    CHECK(json_length % 4 == 0 && 20 + json_length + 8 <= size);
+    const uint8_t *bin_header = bytes + 20 + json_length;
+    uint32_t bin_length = get_u32(bin_header);
+    CHECK(memcmp(bin_header + 4, "BIN\0", 4) == 0);
+    CHECK(bin_length % 4 == 0 && 20 + json_length + 8 + bin_length == size);
+    const uint8_t *bin = bin_header + 8;
+    cJSON *json = cJSON_ParseWithLength((const char *)bytes + 20, json_length);
+    CHECK(json != NULL);
+    if (!json) {
+        free(bytes);
+        return;
+    }
+    const cJSON *asset = cJSON_GetObjectItem(json, "asset");
+    CHECK(cJSON_IsString(cJSON_GetObjectItem(asset, "version")) &&
+          strcmp(cJSON_GetObjectItem(asset, "version")->valuestring, "2.0") == 0);
+    const cJSON *buffer = cJSON_GetArrayItem(cJSON_GetObjectItem(json, "buffers"), 0);
+    CHECK(json_int(buffer, "byteLength") == (int)bin_length);
+    const cJSON *primitive = cJSON_GetArrayItem(
+        cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(json, "meshes"), 0),
+                            "primitives"),
+        0);
+    const cJSON *attributes = cJSON_GetObjectItem(primitive, "attributes");
+    CHECK(json_int(primitive, "mode") == 4 || cJSON_GetObjectItem(primitive, "mode") == NULL);
+    const cJSON *used = cJSON_GetObjectItem(json, "extensionsUsed");
+    CHECK(cJSON_IsArray(used) &&
+          strcmp(cJSON_GetArrayItem(used, 0)->valuestring, "KHR_materials_unlit") == 0);
+
+    uint32_t n = ref->mesh->vertex_count, count;
+    const uint8_t *position = accessor_data(json, json_int(attributes, "POSITION"), bin,
+                                            bin_length, &count, 5126, "VEC3");
+    CHECK(count == n);
+    const uint8_t *normal = accessor_data(json, json_int(attributes, "NORMAL"), bin, bin_length,
+                                          &count, 5126, "VEC3");
+    CHECK(count == n);
+    const uint8_t *colour = accessor_data(json, json_int(attributes, "COLOR_0"), bin,
+                                          bin_length, &count, 5126, "VEC3");
+    CHECK(count == n);
+    const uint8_t *radiance = accessor_data(json, json_int(attributes, "_RADIANCE"), bin,
+                                            bin_length, &count, 5126, "VEC3");
+    CHECK(count == n);
+    const uint8_t *indices = accessor_data(json, json_int(primitive, "indices"), bin,
+                                           bin_length, &count, 5125, "SCALAR");
+    CHECK(count == 3 * ref->triangle_count);
+    if (!position || !normal || !colour || !radiance || !indices || count != 3 * ref->triangle_count) {
+        cJSON_Delete(json);
+        free(bytes);
+        return;
+    }
+
+    /* POSITION: the mesh's vertices, and min/max exactly those of the data */
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    uint32_t bad_position = 0, bad_normal = 0, bad_colour = 0, bad_radiance = 0;
+    for (uint32_t v = 0; v < n; v++) {
+        float p[3], nn[3], c[3], L[3];
+        for (int k = 0; k < 3; k++) {
+            p[k] = get_f32(position + 12 * v + 4 * k);
+            nn[k] = get_f32(normal + 12 * v + 4 * k);
+            c[k] = get_f32(colour + 12 * v + 4 * k);
+            L[k] = get_f32(radiance + 12 * v + 4 * k);
+            lo[k] = fminf(lo[k], p[k]);
+            hi[k] = fmaxf(hi[k], p[k]);
+        }
+        rad_vec3 q = ref->mesh->vertices[v];
+        bad_position += !(p[0] == (float)q.x && p[1] == (float)q.y && p[2] == (float)q.z);
+        bad_normal += fabs(sqrt((double)nn[0] * nn[0] + (double)nn[1] * nn[1] +
+                                (double)nn[2] * nn[2]) - 1) > 1e-6;
+        rad_rgb Lr = ref->radiance[v];
+        bad_radiance += !same_rgb(L, Lr);
+        rad_rgb d = {display(Lr.r, ref->scale), display(Lr.g, ref->scale),
+                     display(Lr.b, ref->scale)};
+        bad_colour += !same_rgb(c, d) || c[0] < 0 || c[0] > 1 || c[1] < 0 || c[1] > 1 ||
+                      c[2] < 0 || c[2] > 1;
+    }
+    printf("%s: %u vertices, %u triangles; mismatches: position %u, normal %u, colour %u, "
+           "radiance %u\n",
+           name, n, ref->triangle_count, bad_position, bad_normal, bad_colour, bad_radiance);
+    CHECK(bad_position == 0);
+    CHECK(bad_normal == 0);
+    CHECK(bad_colour == 0);
+    CHECK(bad_radiance == 0);
+    const cJSON *accessor = cJSON_GetArrayItem(cJSON_GetObjectItem(json, "accessors"),
+                                               json_int(attributes, "POSITION"));
+    const cJSON *min = cJSON_GetObjectItem(accessor, "min"), *max = cJSON_GetObjectItem(accessor, "max");
+    CHECK(cJSON_GetArraySize(min) == 3 && cJSON_GetArraySize(max) == 3);
+    for (int k = 0; k < 3; k++) {
+        CHECK((float)cJSON_GetArrayItem(min, k)->valuedouble == lo[k]);
+        CHECK((float)cJSON_GetArrayItem(max, k)->valuedouble == hi[k]);
+    }
+    /* triangles: the renderer's, in patch order */
+    uint32_t bad_index = 0;
+    for (uint32_t t = 0; t < ref->triangle_count; t++)
+        for (int k = 0; k < 3; k++)
+            bad_index += get_u32(indices + 12 * t + 4 * k) != ref->triangles[t][k];
+    CHECK(bad_index == 0);
+
+    /* creases stay sharp: some vertices share a position with another vertex (two walls
+     * meet there) yet keep a clearly different radiance */
+    uint32_t sharp = 0;
+    for (uint32_t a = 0; a < n && sharp == 0; a++)
+        for (uint32_t b = a + 1; b < n; b++)
+            if (memcmp(position + 12 * a, position + 12 * b, 12) == 0) {
+                double la = luminance(ref->radiance[a]), lb = luminance(ref->radiance[b]);
+                if (fabs(la - lb) > 0.2 * fmax(la, lb))
+                    sharp++;
+            }
+    CHECK(sharp > 0);
+    cJSON_Delete(json);
+    free(bytes);
+}
+
+/* Assimp (rad_scene_load) reads the file: same triangles at the same places. */
+static void check_geometry_through_assimp(const char *name, const reference *ref)
+{
+    rad_scene *scene = NULL;
+    rad_error error;
+    CHECK(rad_scene_load(test_path(name), NULL, &scene, &error) == RAD_OK);
+    if (!scene) {
+        fprintf(stderr, "%s: %s\n", name, error.message);
+        return;
+    }
+    CHECK(scene->triangle_count == ref->triangle_count);
+    /* each loaded triangle is one of the reference's, corner for corner (the loader may
+     * order triangles by surface; here there is one surface, so the order is kept) */
+    uint32_t matched = 0;
+    for (uint32_t t = 0; t < scene->triangle_count && t < ref->triangle_count; t++) {
+        bool same = true;
+        for (int k = 0; k < 3; k++) {
+            rad_vec3 a = scene->positions[scene->triangles[t].vertex[k]];
+            rad_vec3 b = ref->mesh->vertices[ref->triangles[t][k]];
+            same = same && a.x == (float)b.x && a.y == (float)b.y && a.z == (float)b.z;
+        }
+        matched += same;
+    }
+    printf("%s through Assimp: %u of %u triangles match\n", name, matched, ref->triangle_count);
+    CHECK(matched == ref->triangle_count);
+    rad_scene_destroy(scene);
+}
+
+/* A PLY as this writer makes it: the header line by line, then the binary records. */
+static void check_ply(const char *name, const reference *ref, bool furnace)
+{
+    size_t size = 0;
+    uint8_t *bytes = read_file(test_path(name), &size);
+    CHECK(bytes != NULL);
+    if (!bytes)
+        return;
+    const char *end = strstr((const char *)bytes, "end_header\n");
+    CHECK(end != NULL);
+    if (!end) {
+        free(bytes);
+        return;
+    }
+    size_t header = (size_t)(end - (const char *)bytes) + strlen("end_header\n");
+    char expected_elements[512];
+    snprintf(expected_elements, sizeof(expected_elements),
+             "element vertex %u\n"
+             "property float x\nproperty float y\nproperty float z\n"
+             "property float nx\nproperty float ny\nproperty float nz\n"
+             "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+             "property float radiance_r\nproperty float radiance_g\nproperty float radiance_b\n"
+             "element face %u\nproperty list uchar int vertex_indices\n",
+             ref->mesh->vertex_count, ref->triangle_count);
+    CHECK(strncmp((const char *)bytes, "ply\nformat binary_little_endian 1.0\n", 36) == 0);
+    CHECK(strstr((const char *)bytes, expected_elements) != NULL);
+    uint32_t n = ref->mesh->vertex_count;
+    size_t vertex_bytes = 39, face_bytes = 13;
+    CHECK(size == header + n * vertex_bytes + ref->triangle_count * face_bytes);
+    if (size != header + n * vertex_bytes + ref->triangle_count * face_bytes) {
+        free(bytes);
+        return;
+    }
+    uint32_t bad_position = 0, bad_colour = 0, bad_radiance = 0, bad_face = 0, off_furnace = 0;
+    for (uint32_t v = 0; v < n; v++) {
+        const uint8_t *r = bytes + header + v * vertex_bytes;
+        rad_vec3 q = ref->mesh->vertices[v];
+        bad_position += !(get_f32(r) == (float)q.x && get_f32(r + 4) == (float)q.y &&
+                          get_f32(r + 8) == (float)q.z);
+        rad_rgb L = ref->radiance[v];
+        float stored[3] = {get_f32(r + 27), get_f32(r + 31), get_f32(r + 35)};
+        bad_radiance += !same_rgb(stored, L);
+        double channel[3] = {L.r, L.g, L.b};
+        for (int k = 0; k < 3; k++) {
+            int expected = (int)lround(255 * srgb(display(channel[k], ref->scale)));
+            bad_colour += abs((int)r[24 + k] - expected) > 0; /* the same rounding */
+            off_furnace += furnace && fabs(stored[k] - 2.0) > 0.005 * 2.0;
+        }
+    }
+    for (uint32_t t = 0; t < ref->triangle_count; t++) {
+        const uint8_t *f = bytes + header + n * vertex_bytes + t * face_bytes;
+        bad_face += f[0] != 3;
+        for (int k = 0; k < 3; k++)
+            bad_face += get_u32(f + 1 + 4 * k) != ref->triangles[t][k];
+    }
+    printf("%s: %u vertices; mismatches: position %u, colour %u, radiance %u, face %u%s\n",
+           name, n, bad_position, bad_colour, bad_radiance, bad_face,
+           furnace ? "" : " (not the furnace)");
+    CHECK(bad_position == 0);
+    CHECK(bad_colour == 0);
+    CHECK(bad_radiance == 0);
+    CHECK(bad_face == 0);
+    if (furnace) {
+        printf("%s: %u channels off Le / (1 - rho) = 2 by over 0.5 %%\n", name, off_furnace);
+        CHECK(off_furnace == 0);
+    }
+    free(bytes);
+}
+
+/* The OBJ: `v x y z r g b`, then `#radiance R G B` per vertex in the same order. */
+static void check_obj(const char *name, const reference *ref, double scale)
+{
+    FILE *f = fopen(test_path(name), "r");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    char line[512];
+    uint32_t v = 0, radiance_lines = 0, faces = 0, bad_colour = 0, bad_radiance = 0;
+    bool described = false;
+    while (fgets(line, sizeof(line), f)) {
+        double x, y, z, r, g, b;
+        if (strncmp(line, "# v x y z r g b:", 16) == 0)
+            described = true;
+        if (sscanf(line, "v %lf %lf %lf %lf %lf %lf", &x, &y, &z, &r, &g, &b) == 6) {
+            if (v < ref->mesh->vertex_count) {
+                rad_rgb L = ref->radiance[v];
+                bad_colour += fabs(r - srgb(display(L.r, scale))) > 1e-6 ||
+                              fabs(g - srgb(display(L.g, scale))) > 1e-6 ||
+                              fabs(b - srgb(display(L.b, scale))) > 1e-6;
+            }
+            v++;
+        } else if (sscanf(line, "#radiance %lf %lf %lf", &r, &g, &b) == 3) {
+            if (radiance_lines < ref->mesh->vertex_count) {
+                float stored[3] = {(float)r, (float)g, (float)b};
+                bad_radiance += !same_rgb(stored, ref->radiance[radiance_lines]);
+            }
+            radiance_lines++;
+        } else if (line[0] == 'f' && line[1] == ' ') {
+            faces++;
+        }
+    }
+    fclose(f);
+    printf("%s: %u v lines, %u #radiance lines, %u faces; mismatches: colour %u, radiance %u\n",
+           name, v, radiance_lines, faces, bad_colour, bad_radiance);
+    CHECK(described);
+    CHECK(v == ref->mesh->vertex_count);
+    CHECK(radiance_lines == ref->mesh->vertex_count);
+    CHECK(faces == ref->triangle_count);
+    CHECK(bad_colour == 0);
+    CHECK(bad_radiance == 0);
+}
+
+static void run_ok(const char *arguments)
+{
+    int code = test_run_tool(arguments);
+    CHECK(code == 0);
+    if (code != 0)
+        fprintf(stderr, "radiosity %s: exit %d: %s", arguments, code,
+                test_read_text(test_path("stderr.txt")));
+}
+
+int main(void)
+{
+    /* the Cornell box: three formats, one solution */
+    reference cornell;
+    compute_reference(NULL, CORNELL_PATCH_SIZE, &cornell);
+    run_ok("solve -o cornell.glb --patch-size 100");
+    run_ok("solve -o cornell.ply --patch-size 100");
+    run_ok("solve -o cornell.obj --patch-size 100");
+    check_glb("cornell.glb", &cornell);
+    check_geometry_through_assimp("cornell.glb", &cornell);
+    check_ply("cornell.ply", &cornell, false);
+    check_geometry_through_assimp("cornell.ply", &cornell);
+    check_obj("cornell.obj", &cornell, cornell.scale);
+    free_reference(&cornell);
+
+    /* the furnace: radiance 2 everywhere; a uniform mesh exposes to 0.9 exactly */
+    test_write_furnace("furnace.obj");
+    reference furnace;
+    compute_reference(test_path("furnace.obj"), 0.125, &furnace);
+    run_ok("solve furnace.obj -o furnace.ply --patch-size 0.125");
+    check_ply("furnace.ply", &furnace, true);
+    run_ok("solve furnace.obj -o furnace.obj.obj --patch-size 0.125 --exposure -3");
+    check_obj("furnace.obj.obj", &furnace, 0.125); /* 2^-3 */
+    free_reference(&furnace);
+
+    /* refusals: a usage error, no file left */
+    CHECK(test_run_tool("solve -o out.stl") == 2);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "out.stl: unknown mesh format"));
+    CHECK(test_run_tool("solve") == 2);
+    CHECK(test_run_tool("solve -o nowhere/out.glb") == 1);
+    CHECK(test_count_files("out") == 0);
+    return test_finish("test_lit_mesh");
+}

@@ -1,0 +1,210 @@
+/*
+ * test_solution.c - solution files: solve once, render many views.
+ *
+ *   - the library: write then read gives B bit for bit; the fingerprint changes with an
+ *     albedo, a position (one ulp), the patch size, and not with a rebuild;
+ *   - the tool: `render --solution` of a file from `solve --save-solution` gives the same
+ *     .pfm, byte for byte, as a render that solves (and `render --save-solution` writes
+ *     the same file as `solve --save-solution`);
+ *   - refusals, one each: another scene, another patch size, a flipped byte, a truncated
+ *     file, another format version, a file that is not a solution, a missing file. Each:
+ *     a one-line message naming the file, exit code 1, no output left behind.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testlib.h"
+
+#define VIEW "--size 48x36 --spp 4"
+
+static int count_lines(const char *text)
+{
+    int lines = 0;
+    for (; *text; text++)
+        lines += *text == '\n';
+    return lines;
+}
+
+static uint8_t *read_file(const char *path, size_t *size)
+{
+    *size = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long length = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    uint8_t *bytes = malloc(length > 0 ? (size_t)length : 1);
+    *size = fread(bytes, 1, (size_t)length, f);
+    fclose(f);
+    return bytes;
+}
+
+static void write_bytes(const char *name, const uint8_t *bytes, size_t size)
+{
+    FILE *f = fopen(test_path(name), "wb");
+    if (!f || fwrite(bytes, 1, size, f) != size || fclose(f) != 0) {
+        fprintf(stderr, "cannot write %s\n", name);
+        exit(1);
+    }
+}
+
+static bool same_files(const char *a, const char *b)
+{
+    size_t na, nb;
+    uint8_t *x = read_file(test_path(a), &na), *y = read_file(test_path(b), &nb);
+    bool same = x && y && na == nb && memcmp(x, y, na) == 0;
+    free(x);
+    free(y);
+    return same;
+}
+
+static void run_ok(const char *arguments)
+{
+    int code = test_run_tool(arguments);
+    CHECK(code == 0);
+    if (code != 0)
+        fprintf(stderr, "radiosity %s: exit %d: %s", arguments, code,
+                test_read_text(test_path("stderr.txt")));
+}
+
+/* A refusal: exit 1, one line naming the file and saying `what`, no out* file left. */
+static void expect_refusal(const char *arguments, const char *file, const char *what)
+{
+    int code = test_run_tool(arguments);
+    const char *err = test_read_text(test_path("stderr.txt"));
+    char named[256];
+    snprintf(named, sizeof(named), "radiosity: %s: ", file);
+    bool ok = code == 1 && count_lines(err) == 1 && strstr(err, named) == err &&
+              strstr(err, what) != NULL;
+    if (!ok)
+        fprintf(stderr, "radiosity %s: exit %d, stderr: %s", arguments, code, err);
+    CHECK(code == 1);
+    CHECK(count_lines(err) == 1);
+    CHECK(strstr(err, named) == err);
+    CHECK(strstr(err, what) != NULL);
+    CHECK(test_count_files("out") == 0);
+}
+
+static void check_library(void)
+{
+    rad_error error;
+    rad_scene *scene = NULL;
+    rad_mesh *mesh = NULL, *again = NULL, *finer = NULL;
+    CHECK(rad_scene_cornell_box(&scene, &error) == RAD_OK);
+    CHECK(rad_mesh_build(scene, 150, &mesh, &error) == RAD_OK);
+    CHECK(rad_mesh_build(scene, 150, &again, &error) == RAD_OK);
+    CHECK(rad_mesh_build(scene, 140, &finer, &error) == RAD_OK);
+    if (!mesh || !again || !finer)
+        return;
+    uint64_t base = 0, rebuilt = 1, other_size = 0, other_albedo = 0, other_position = 0;
+    CHECK(rad_solution_fingerprint(scene, mesh, &base, &error) == RAD_OK);
+    CHECK(rad_solution_fingerprint(scene, again, &rebuilt, &error) == RAD_OK);
+    CHECK(rad_solution_fingerprint(scene, finer, &other_size, &error) == RAD_OK);
+    CHECK(base == rebuilt);
+    CHECK(base != other_size);
+    double albedo = scene->materials[0].albedo.g;
+    scene->materials[0].albedo.g = nextafter(albedo, 0);
+    CHECK(rad_solution_fingerprint(scene, mesh, &other_albedo, &error) == RAD_OK);
+    scene->materials[0].albedo.g = albedo;
+    double x = scene->positions[0].x;
+    scene->positions[0].x = nextafter(x, INFINITY);
+    CHECK(rad_solution_fingerprint(scene, mesh, &other_position, &error) == RAD_OK);
+    scene->positions[0].x = x;
+    CHECK(other_albedo != base);
+    CHECK(other_position != base);
+
+    /* write, read back: every bit of B */
+    rad_rgb *B = calloc(mesh->patch_count, sizeof(*B));
+    for (uint32_t i = 0; i < mesh->patch_count; i++)
+        B[i] = (rad_rgb){1.0 / (i + 3), 3.14159265358979 * i, i * 1e-300};
+    CHECK(rad_solution_write(scene, mesh, B, test_path("library.sol"), &error) == RAD_OK);
+    rad_solution *solution = NULL;
+    CHECK(rad_solution_read(test_path("library.sol"), &solution, &error) == RAD_OK);
+    if (solution) {
+        CHECK(solution->patch_count == mesh->patch_count);
+        CHECK(solution->patch_size == 150);
+        CHECK(solution->fingerprint == base);
+        CHECK(memcmp(solution->B, B, mesh->patch_count * sizeof(*B)) == 0);
+        CHECK(rad_solution_match(solution, scene, again, &error) == RAD_OK);
+        CHECK(rad_solution_match(solution, scene, finer, &error) == RAD_ERR_INVALID);
+        CHECK(strstr(error.message, "library.sol") != NULL);
+    }
+    rad_solution_destroy(solution);
+    rad_solution_destroy(NULL);
+    free(B);
+    rad_mesh_destroy(mesh);
+    rad_mesh_destroy(again);
+    rad_mesh_destroy(finer);
+    rad_scene_destroy(scene);
+}
+
+int main(void)
+{
+    check_library();
+
+    /* solve once, render from the file: the same image as solving */
+    run_ok("render -o fresh.pfm --patch-size 100 " VIEW);
+    run_ok("solve --save-solution cornell.sol --patch-size 100");
+    run_ok("render --solution cornell.sol -o saved.pfm " VIEW);
+    CHECK(same_files("fresh.pfm", "saved.pfm"));
+    run_ok("render -o fresh2.pfm --patch-size 100 --save-solution cornell2.sol " VIEW);
+    CHECK(same_files("cornell.sol", "cornell2.sol"));
+    /* the images are not black: the comparison could fail */
+    rad_image *image = NULL;
+    rad_error error;
+    CHECK(rad_image_read(test_path("saved.pfm"), &image, &error) == RAD_OK);
+    double sum = 0;
+    for (size_t k = 0; image && k < (size_t)image->width * image->height * 3; k++)
+        sum += image->rgb[k];
+    CHECK(sum > 0);
+    rad_image_destroy(image);
+    /* another view of the same solution */
+    run_ok("render --solution cornell.sol -o other-view.pfm --eye 100,400,200 "
+           "--target 400,100,500 " VIEW);
+    CHECK(!same_files("saved.pfm", "other-view.pfm"));
+    /* the lit mesh from a saved solution is the lit mesh from a solve */
+    run_ok("solve -o solved.ply --patch-size 100");
+    run_ok("solve -o read.ply --solution cornell.sol");
+    CHECK(same_files("solved.ply", "read.ply"));
+
+    /* refusals */
+    test_write_furnace("furnace.obj");
+    expect_refusal("render furnace.obj --solution cornell.sol -o out.pfm " VIEW, "cornell.sol",
+                   "another scene");
+    expect_refusal("render --solution cornell.sol --patch-size 90 -o out.pfm " VIEW,
+                   "cornell.sol", "patch-size");
+    size_t size;
+    uint8_t *bytes = read_file(test_path("cornell.sol"), &size);
+    CHECK(bytes && size > 200);
+    if (bytes && size > 200) {
+        bytes[size / 2] ^= 0x10;
+        write_bytes("flipped.sol", bytes, size);
+        expect_refusal("render --solution flipped.sol -o out.pfm " VIEW, "flipped.sol",
+                       "corrupted");
+        expect_refusal("solve --solution flipped.sol -o out.glb", "flipped.sol", "corrupted");
+        bytes[size / 2] ^= 0x10;
+        bytes[20] ^= 0x01; /* the fingerprint */
+        write_bytes("flipped-header.sol", bytes, size);
+        expect_refusal("render --solution flipped-header.sol -o out.pfm " VIEW,
+                       "flipped-header.sol", "corrupted");
+        bytes[20] ^= 0x01;
+        write_bytes("truncated.sol", bytes, size - 10);
+        expect_refusal("render --solution truncated.sol -o out.pfm " VIEW, "truncated.sol",
+                       "truncated");
+        bytes[8] = 2; /* format version 2 */
+        write_bytes("version.sol", bytes, size);
+        expect_refusal("render --solution version.sol -o out.pfm " VIEW, "version.sol",
+                       "version 2");
+    }
+    free(bytes);
+    test_write_file("text.sol", "this is not a solution\n");
+    expect_refusal("render --solution text.sol -o out.pfm " VIEW, "text.sol",
+                   "not a radiosity solution file");
+    expect_refusal("render --solution missing.sol -o out.pfm " VIEW, "missing.sol",
+                   "cannot open");
+    CHECK(test_run_tool("render --solution cornell.sol --save-solution out.sol -o out.pfm") == 2);
+    CHECK(test_count_files("out") == 0);
+    return test_finish("test_solution");
+}

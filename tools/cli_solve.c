@@ -1,0 +1,237 @@
+/*
+ * cli_solve.c - what `render` and `solve` share: the SOLVE options, and scene -> mesh ->
+ * form factors -> solution (or a solution file read back), with its --stats fields.
+ * See cli.h.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *solve)
+{
+    memset(solve, 0, sizeof(*solve));
+    const char *solver = args->value[OPT_SOLVER] ? args->value[OPT_SOLVER] : "gather";
+    if (strcmp(solver, "gather") == 0 || strcmp(solver, "jacobi") == 0)
+        solve->options.solver = RAD_SOLVER_JACOBI;
+    else if (strcmp(solver, "gauss-seidel") == 0)
+        solve->options.solver = RAD_SOLVER_GAUSS_SEIDEL;
+    else if (strcmp(solver, "shoot") == 0)
+        solve->options.solver = RAD_SOLVER_SHOOT;
+    else if (strcmp(solver, "direct") == 0)
+        solve->options.solver = RAD_SOLVER_DIRECT;
+    else {
+        cli_error("--solver: '%s' is not gather, gauss-seidel, shoot or direct", solver);
+        return false;
+    }
+    solve->options.ambient = true;
+    if (args->value[OPT_TOLERANCE]) {
+        double number;
+        if (!cli_parse_double("tolerance", args->value[OPT_TOLERANCE], &number))
+            return false;
+        if (!(number > 0)) {
+            cli_error("--tolerance: must be positive");
+            return false;
+        }
+        solve->options.tolerance = number;
+    }
+    if (args->value[OPT_MAX_ITERATIONS]) {
+        unsigned long value;
+        if (!cli_parse_uint("max-iterations", args->value[OPT_MAX_ITERATIONS], UINT32_MAX,
+                            &value))
+            return false;
+        solve->options.max_iterations = (uint32_t)value;
+    }
+    solve->options.threads = shared->threads;
+    solve->options.progress = cli_progress;
+    solve->solution_path = args->value[OPT_SOLUTION];
+    solve->save_solution_path = args->value[OPT_SAVE_SOLUTION];
+    if (solve->solution_path && solve->save_solution_path) {
+        cli_error("--solution and --save-solution together: a solution read from a file "
+                  "is saved already");
+        return false;
+    }
+    return true;
+}
+
+static const char *solver_name(rad_solver solver)
+{
+    switch (solver) {
+    case RAD_SOLVER_JACOBI: return "gather";
+    case RAD_SOLVER_GAUSS_SEIDEL: return "gauss-seidel";
+    case RAD_SOLVER_SHOOT: return "shoot";
+    case RAD_SOLVER_DIRECT: return "direct";
+    }
+    return "unknown";
+}
+
+/* B from the form factors and the solver. */
+static rad_status solve_here(const cli_shared *shared, const cli_solve *solve, cli_solved *out,
+                             rad_error *error)
+{
+    rad_tracer *occluders = NULL;
+    rad_formfactors *ff = NULL;
+    rad_system system = {0};
+    double t0 = cli_now();
+    rad_status status =
+        rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, out->scene, &occluders, error);
+    if (status == RAD_OK)
+        status = rad_formfactors_compute(out->mesh, occluders, &shared->formfactor, &ff,
+                                         &out->formfactors, error);
+    if (status != RAD_OK)
+        goto done;
+    double t_ff = cli_now();
+    out->seconds_form_factors = t_ff - t0;
+    rad_formfactors_check(ff, out->mesh, &out->check);
+    double t_check = cli_now();
+    out->seconds_check = t_check - t_ff;
+    status = rad_system_from_mesh(out->scene, out->mesh, ff, &system, error);
+    if (status == RAD_OK)
+        status = rad_solve(&system, &solve->options, out->B, &out->report, error);
+    if (status != RAD_OK)
+        goto done;
+    cli_progress_end();
+    if (!out->report.converged)
+        cli_warn("the solver stopped at its iteration limit (%u) with residual %.3g, above the "
+                 "tolerance",
+                 out->report.iterations, out->report.criterion);
+    out->seconds_solve = cli_now() - t_check;
+done:
+    rad_system_free_arrays(&system);
+    rad_formfactors_destroy(ff);
+    rad_tracer_destroy(occluders);
+    return status;
+}
+
+rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
+                           const cli_solve *solve, uint32_t target_patches, cli_solved *out,
+                           rad_error *error)
+{
+    memset(out, 0, sizeof(*out));
+    rad_solution *solution = NULL;
+    double t0 = cli_now();
+    rad_status status = cli_load_scene(scene_path, &out->scene, error);
+    if (status != RAD_OK)
+        goto done;
+    if (!rad_scene_has_emitter(out->scene))
+        cli_warn("%s: no surface emits light (no material with non-zero Ke): the result will "
+                 "be black",
+                 out->scene->source);
+    double t_load = cli_now();
+    out->seconds_load = t_load - t0;
+
+    double patch_size = shared->patch_size;
+    if (solve->solution_path) {
+        status = rad_solution_read(solve->solution_path, &solution, error);
+        if (status != RAD_OK)
+            goto done;
+        if (patch_size > 0 && patch_size != solution->patch_size) {
+            status = error->status = RAD_ERR_INVALID;
+            snprintf(error->message, sizeof(error->message),
+                     "%s: solved with --patch-size %.17g, not %.17g (leave --patch-size out "
+                     "to use the file's)",
+                     solve->solution_path, solution->patch_size, patch_size);
+            goto done;
+        }
+        patch_size = solution->patch_size;
+    }
+    if (!(patch_size > 0))
+        patch_size = rad_mesh_default_patch_size(out->scene, target_patches);
+    status = rad_mesh_build(out->scene, patch_size, &out->mesh, error);
+    if (status != RAD_OK)
+        goto done;
+    out->seconds_mesh = cli_now() - t_load;
+
+    if (solution) {
+        status = rad_solution_match(solution, out->scene, out->mesh, error);
+        if (status != RAD_OK)
+            goto done;
+        out->B = solution->B; /* taken over */
+        solution->B = NULL;
+        out->from_file = true;
+        goto done;
+    }
+    out->B = calloc(out->mesh->patch_count ? out->mesh->patch_count : 1, sizeof(*out->B));
+    if (!out->B) {
+        status = error->status = RAD_ERR_NOMEM;
+        snprintf(error->message, sizeof(error->message), "out of memory");
+        goto done;
+    }
+    status = solve_here(shared, solve, out, error);
+    if (status != RAD_OK || !solve->save_solution_path)
+        goto done;
+    double t_save = cli_now();
+    status = rad_solution_write(out->scene, out->mesh, out->B, solve->save_solution_path, error);
+    out->seconds_save = cli_now() - t_save;
+done:
+    rad_solution_destroy(solution);
+    if (status != RAD_OK)
+        cli_solved_free(out);
+    return status;
+}
+
+void cli_solved_free(cli_solved *solved)
+{
+    free(solved->B);
+    rad_mesh_destroy(solved->mesh);
+    rad_scene_destroy(solved->scene);
+    solved->B = NULL;
+    solved->mesh = NULL;
+    solved->scene = NULL;
+}
+
+void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *stats)
+{
+    stats_string(stats, "scene", s->scene->source);
+    stats_integer(stats, "triangles", s->scene->triangle_count);
+    stats_integer(stats, "patches", s->mesh->patch_count);
+    stats_number(stats, "patch_size", s->mesh->patch_size);
+    stats_number(stats, "seconds_load", s->seconds_load);
+    stats_number(stats, "seconds_mesh", s->seconds_mesh);
+    if (s->from_file) {
+        stats_string(stats, "solution", solve->solution_path);
+        return;
+    }
+    const rad_formfactor_report *ff = &s->formfactors;
+    stats_integer(stats, "patch_pairs", ff->pairs);
+    stats_integer(stats, "patch_pairs_facing", ff->pairs_facing);
+    stats_integer(stats, "patch_pairs_refined", ff->pairs_refined);
+    stats_integer(stats, "rays_cast", ff->rays);
+    stats_number(stats, "rays_per_second", ff->seconds > 0 ? ff->rays / ff->seconds : 0);
+    /* the tracer's own rate: rays per second of tracing per thread, times threads */
+    stats_integer(stats, "threads", (unsigned long long)ff->threads);
+    stats_number(stats, "tracing_rays_per_second",
+                 ff->tracing_seconds > 0 ? ff->rays / (ff->tracing_seconds / ff->threads) : 0);
+    stats_number(stats, "seconds_form_factors", s->seconds_form_factors);
+    stats_number(stats, "seconds_solve", s->seconds_solve);
+    stats_string(stats, "solver", solver_name(solve->options.solver));
+    stats_integer(stats, "iterations", s->report.iterations);
+    stats_number(stats, "solver_criterion", s->report.criterion);
+    stats_number(stats, "final_residual", s->report.residual);
+    stats_bool(stats, "converged", s->report.converged);
+    stats_number(stats, "seconds_check", s->seconds_check);
+    stats_number(stats, "reciprocity_residual", s->check.reciprocity);
+    stats_number(stats, "largest_row_sum", s->check.largest_row_sum);
+    stats_number(stats, "closure_residual", s->check.closure);
+    stats_number(stats, "largest_form_factor", s->check.largest_factor);
+    stats_integer(stats, "patches_seeing_nothing", s->check.empty_rows);
+    if (solve->save_solution_path)
+        stats_number(stats, "seconds_save_solution", s->seconds_save);
+}
+
+void cli_solved_summary(const cli_solved *s, const cli_solve *solve, char *text, size_t size)
+{
+    if (s->from_file) {
+        snprintf(text, size, "%u patches, solution read from %s", s->mesh->patch_count,
+                 solve->solution_path);
+        return;
+    }
+    char solved[64];
+    if (solve->options.solver == RAD_SOLVER_DIRECT)
+        snprintf(solved, sizeof(solved), "direct solve");
+    else
+        snprintf(solved, sizeof(solved), "%u %s", s->report.iterations,
+                 solve->options.solver == RAD_SOLVER_SHOOT ? "shots" : "sweeps");
+    snprintf(text, size, "%u patches, %.1f M rays, %s (residual %.2g)", s->mesh->patch_count,
+             s->formfactors.rays / 1e6, solved, s->report.residual);
+}
