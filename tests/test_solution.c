@@ -2,7 +2,8 @@
  * test_solution.c - solution files: solve once, render many views.
  *
  *   - the library: write then read gives B bit for bit; the fingerprint changes with an
- *     albedo, a position (one ulp), the patch size, and not with a rebuild;
+ *     albedo, a position (one ulp), the patch size, and not with a rebuild; a bit flipped
+ *     in the header, the checksum or across B, and cuts at many lengths, are all refused;
  *   - the tool: `render --solution` of a file from `solve --save-solution` gives the same
  *     .pfm, byte for byte, as a render that solves (and `render --save-solution` writes
  *     the same file as `solve --save-solution`);
@@ -133,6 +134,35 @@ static void check_library(void)
     }
     rad_solution_destroy(solution);
     rad_solution_destroy(NULL);
+
+    /* a flipped bit anywhere (every byte of the header and checksum, every 13th byte of
+     * B; the bit turns with the byte) and a cut anywhere are refused */
+    size_t size;
+    uint8_t *bytes = read_file(test_path("library.sol"), &size);
+    uint32_t accepted_flips = 0, accepted_cuts = 0, flips = 0, cuts = 0;
+    for (size_t k = 0; bytes && k < size; k += (k < 32 || k + 8 >= size) ? 1 : 13) {
+        uint8_t bit = (uint8_t)(1u << (k % 8));
+        bytes[k] ^= bit;
+        write_bytes("damaged.sol", bytes, size);
+        bytes[k] ^= bit;
+        solution = NULL;
+        accepted_flips += rad_solution_read(test_path("damaged.sol"), &solution, &error) == RAD_OK;
+        rad_solution_destroy(solution);
+        flips++;
+    }
+    for (size_t length = 0; bytes && length < size; length += length + 29 < size ? 29 : 1) {
+        write_bytes("damaged.sol", bytes, length);
+        solution = NULL;
+        accepted_cuts += rad_solution_read(test_path("damaged.sol"), &solution, &error) == RAD_OK;
+        rad_solution_destroy(solution);
+        cuts++;
+    }
+    printf("library.sol: %zu bytes; accepted %u of %u bit flips, %u of %u truncations\n",
+           size, accepted_flips, flips, accepted_cuts, cuts);
+    CHECK(bytes != NULL);
+    CHECK(accepted_flips == 0);
+    CHECK(accepted_cuts == 0);
+    free(bytes);
     free(B);
     rad_mesh_destroy(mesh);
     rad_mesh_destroy(again);
