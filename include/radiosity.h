@@ -142,6 +142,10 @@ typedef struct rad_scene {
     uint32_t surface_count;
     bool has_camera;   /* the file (or the built-in scene) defines a camera */
     rad_camera camera; /* valid when has_camera */
+    rad_vec3 up;        /* the file's up direction, unit length: (0,1,0) unless the file says
+                           otherwise (FBX UpAxis metadata); the default camera keeps it up */
+    double unit_metres; /* metres per scene unit when the file says (glTF: 1; FBX:
+                           UnitScaleFactor / 100), else 0. Coordinates are never rescaled */
     char source[512];  /* file the scene came from, or "(built-in Cornell box)" */
 } rad_scene;
 
@@ -150,9 +154,19 @@ typedef struct rad_load_options {
     void *log_user;
 } rad_load_options;
 
-/* Reads a scene file through Assimp (OBJ + MTL and the other formats Assimp reads).
- * Degenerate triangles are skipped with a warning; non-finite coordinates, a missing
- * material library, unreadable or empty files are errors. */
+/* The albedo (grey) of surfaces whose file gives no material: STL, PLY without a material
+ * element, OBJ faces before any usemtl, glTF primitives without a material. */
+#define RAD_DEFAULT_ALBEDO 0.5
+
+/* Reads a scene file through Assimp: OBJ + MTL, glTF 2.0 (.gltf, .glb), PLY, STL, FBX,
+ * Collada, 3DS and the other formats Assimp reads. Materials map onto METHOD.md's units:
+ * MTL Kd and glTF baseColorFactor are the albedo; MTL Ke, and glTF emissiveFactor times
+ * KHR_materials_emissive_strength (read from the file's JSON: Assimp 5.2 drops it), the
+ * emitted radiance. A surface is a mesh's name (OBJ o/g, glTF mesh, STL solid), else its
+ * node's, else the file's name without extension. The first glTF camera becomes the
+ * scene's camera. Degenerate triangles are skipped with a warning; non-finite
+ * coordinates, a missing material library or glTF buffer, a truncated .glb, an index out
+ * of range, unreadable or empty files are errors. */
 rad_status rad_scene_load(const char *path, const rad_load_options *options,
                           rad_scene **out, rad_error *error);
 
@@ -170,8 +184,18 @@ void rad_scene_bounds(const rad_scene *scene, rad_vec3 *lo, rad_vec3 *hi);
 /* True when some material with triangles has non-zero emission. */
 bool rad_scene_has_emitter(const rad_scene *scene);
 
-/* A camera that frames the whole scene from the front (-z side, looking +z, y up). */
+/* A camera that frames the whole scene from the front: for a y-up scene from the -z side
+ * looking +z; for a z-up scene (scene->up) from the -y side looking +y; up = scene->up. */
 rad_camera rad_scene_default_camera(const rad_scene *scene);
+
+/* Sets the albedo and/or the emitted radiance (either may be NULL) of what `name` names:
+ * a surface by that name, else the one material by that name. A surface keeps its other
+ * material values; when its material is shared with triangles of other surfaces, it gets
+ * its own copy first, so nothing else changes. RAD_ERR_INVALID, naming `name`, when
+ * nothing or several materials have that name (and no surface does), or when a value is
+ * out of its domain (albedo in [0,1], emission >= 0, both finite). */
+rad_status rad_scene_set_material(rad_scene *scene, const char *name, const rad_rgb *albedo,
+                                  const rad_rgb *emission, rad_error *error);
 
 /* ------------------------------------------------------------------------------------ */
 /* Mesh: the scene split into patches                                                    */

@@ -106,6 +106,12 @@ bool cli_parse(const char *command, int argc, char **argv, const cli_option *opt
             inline_value = argv[++a];
         }
         args->value[k] = inline_value;
+        if (args->given_count == CLI_MAX_GIVEN) {
+            cli_error("%s: more than %d options", command, CLI_MAX_GIVEN);
+            return false;
+        }
+        args->given_value[args->given_count] = inline_value;
+        args->given_option[args->given_count++] = k;
     }
     return true;
 }
@@ -174,8 +180,52 @@ bad:
     return false;
 }
 
+/* The --emit / --albedo options, for cli_load_scene: one command runs per process. */
+typedef struct material_override {
+    char name[128];
+    rad_rgb value;
+    bool is_emission;
+} material_override;
+
+static material_override overrides[CLI_MAX_GIVEN];
+static int override_count;
+
+/* NAME=R,G,B; NAME may itself hold '=' (the last one splits). */
+static bool parse_override(const char *option, const char *text, material_override *out)
+{
+    const char *eq = strrchr(text, '=');
+    rad_vec3 v;
+    if (!eq || eq == text || (size_t)(eq - text) >= sizeof(out->name)) {
+        cli_error("--%s: '%s' is not NAME=R,G,B", option, text);
+        return false;
+    }
+    if (!cli_parse_vec3(option, eq + 1, &v))
+        return false;
+    snprintf(out->name, sizeof(out->name), "%.*s", (int)(eq - text), text);
+    out->value = (rad_rgb){v.x, v.y, v.z};
+    out->is_emission = strcmp(option, "emit") == 0;
+    bool in_range = v.x >= 0 && v.y >= 0 && v.z >= 0 &&
+                    (out->is_emission || (v.x <= 1 && v.y <= 1 && v.z <= 1));
+    if (!in_range) {
+        cli_error("--%s: '%s': %s", option, text,
+                  out->is_emission ? "radiance must be >= 0" : "albedo must be in [0,1]");
+        return false;
+    }
+    return true;
+}
+
 bool cli_parse_shared(const cli_args *args, cli_shared *shared)
 {
+    override_count = 0;
+    for (int k = 0; k < args->given_count; k++) {
+        int option = args->given_option[k];
+        if (option != OPT_EMIT && option != OPT_ALBEDO)
+            continue;
+        if (!parse_override(option == OPT_EMIT ? "emit" : "albedo", args->given_value[k],
+                            &overrides[override_count]))
+            return false;
+        override_count++;
+    }
     unsigned long value;
     memset(shared, 0, sizeof(*shared));
     shared->seed = 1;
@@ -308,8 +358,29 @@ bool cli_parse_image_command(const char *command, const char *usage, int argc, c
 
 rad_status cli_load_scene(const char *path, rad_scene **scene, rad_error *error)
 {
-    rad_load_options load = {cli_log, NULL};
-    return path ? rad_scene_load(path, &load, scene, error) : rad_scene_cornell_box(scene, error);
+    return cli_load_scene_logged(path, cli_log, NULL, scene, error);
+}
+
+rad_status cli_load_scene_logged(const char *path, rad_log_fn log, void *log_user,
+                                 rad_scene **scene, rad_error *error)
+{
+    rad_load_options load = {log, log_user};
+    rad_status status = path ? rad_scene_load(path, &load, scene, error)
+                             : rad_scene_cornell_box(scene, error);
+    for (int k = 0; k < override_count && status == RAD_OK; k++) {
+        const material_override *o = &overrides[k];
+        status = rad_scene_set_material(*scene, o->name, o->is_emission ? NULL : &o->value,
+                                        o->is_emission ? &o->value : NULL, error);
+        if (status != RAD_OK) {
+            char message[RAD_ERROR_MESSAGE_MAX];
+            snprintf(message, sizeof(message), "%s", error->message);
+            snprintf(error->message, sizeof(error->message), "--%s: %.900s",
+                     o->is_emission ? "emit" : "albedo", message);
+            rad_scene_destroy(*scene);
+            *scene = NULL;
+        }
+    }
+    return status;
 }
 
 double cli_now(void)

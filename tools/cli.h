@@ -21,11 +21,18 @@ typedef struct cli_option {
     bool takes_value;
 } cli_option;
 
-/* A parsed command line: the values by option index, and positional arguments. */
+enum { CLI_MAX_GIVEN = 128 };
+
+/* A parsed command line: the values by option index (the last one given), every option
+ * value in command-line order (for options that may repeat: --emit, --albedo), and
+ * positional arguments. */
 typedef struct cli_args {
     const char *value[64]; /* NULL = not given; "" for a flag given */
     const char *positional[8];
     int positional_count;
+    const char *given_value[CLI_MAX_GIVEN];
+    int given_option[CLI_MAX_GIVEN];
+    int given_count;
 } cli_args;
 
 /* Parses argv against options; on a usage error prints "radiosity: ..." plus a hint to
@@ -35,8 +42,9 @@ bool cli_parse(const char *command, int argc, char **argv, const cli_option *opt
 
 /* Option groups shared by several commands, at fixed indices in every command's table:
  * BASE (every command), FORMFACTOR (render, solve, viewfactors), VIEW (commands that make
- * an image), SOLVE (render, solve). A command's own options start at OPT_OWN. Entries of a
- * group a command does not include stay empty (NULL name) and are never matched. */
+ * an image), SOLVE (render, solve), SCENE (every command that loads a scene: --emit and
+ * --albedo, applied by cli_load_scene). A command's own options start at OPT_OWN. Entries
+ * of a group a command does not include stay empty (NULL name) and are never matched. */
 enum {
     OPT_OUTPUT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_HELP,            /* BASE */
     OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS, OPT_QUADRATURE,                /* FORMFACTOR */
@@ -44,6 +52,7 @@ enum {
     OPT_EXR_FLOAT,
     OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_SOLUTION,        /* SOLVE */
     OPT_SAVE_SOLUTION,
+    OPT_EMIT, OPT_ALBEDO,                                               /* SCENE */
     OPT_OWN
 };
 
@@ -68,6 +77,15 @@ enum {
     [OPT_MAX_ITERATIONS] = {"max-iterations", 0, true},                                    \
     [OPT_SOLUTION] = {"solution", 0, true}, [OPT_SAVE_SOLUTION] = {"save-solution", 0, true}
 
+#define CLI_SCENE_OPTIONS                                                                  \
+    [OPT_EMIT] = {"emit", 0, true}, [OPT_ALBEDO] = {"albedo", 0, true}
+
+/* The help lines of the SCENE group. */
+#define CLI_SCENE_HELP                                                                     \
+    "  --emit NAME=R,G,B    set the emitted radiance of surface NAME (or, when no surface\n" \
+    "                       has that name, of the one material named NAME); repeatable\n"  \
+    "  --albedo NAME=R,G,B  set its albedo (0 to 1) the same way; repeatable\n"
+
 /* What the BASE and FORMFACTOR options say; patch_size 0 = the command's default. */
 typedef struct cli_shared {
     const char *output, *stats_path;
@@ -77,8 +95,8 @@ typedef struct cli_shared {
     unsigned long seed;
 } cli_shared;
 
-/* Parses the BASE and FORMFACTOR options (after cli_parse); false (after printing) on a
- * bad value. */
+/* Parses the BASE, FORMFACTOR and SCENE options (after cli_parse); false (after printing)
+ * on a bad value. The SCENE options are kept for cli_load_scene. */
 bool cli_parse_shared(const cli_args *args, cli_shared *shared);
 
 /* What the VIEW options say. */
@@ -107,8 +125,14 @@ bool cli_parse_image_command(const char *command, const char *usage, int argc, c
                              cli_shared *shared, cli_view *view, const char **scene_path,
                              int *exit_code);
 
-/* Loads SCENE, or the built-in Cornell box when path is NULL; warnings go to stderr. */
+/* Loads SCENE, or the built-in Cornell box when path is NULL, and applies the --emit and
+ * --albedo options cli_parse_shared saw, in command-line order; warnings go to stderr, an
+ * unknown NAME is an error naming it. */
 rad_status cli_load_scene(const char *path, rad_scene **scene, rad_error *error);
+
+/* The same with the loader's warnings sent to `log` instead. */
+rad_status cli_load_scene_logged(const char *path, rad_log_fn log, void *log_user,
+                                 rad_scene **scene, rad_error *error);
 
 /* Value parsers: print "radiosity: --NAME: ..." and return false on a bad value. */
 bool cli_parse_double(const char *name, const char *text, double *out);
@@ -196,5 +220,6 @@ int command_viewfactors(int argc, char **argv);
 int command_raytrace(int argc, char **argv);
 int command_pathtrace(int argc, char **argv);
 int command_compare(int argc, char **argv);
+int command_info(int argc, char **argv);
 
 #endif

@@ -33,6 +33,7 @@ static const char usage[] =
     "                       ends paths without bias)\n"
     "  --standard-error FILE  also write each pixel's standard error of the mean, per\n"
     "                       channel (.hdr, .pfm or .exr)\n"
+    CLI_SCENE_HELP
     "  --threads N          worker threads (default: all cores)\n"
     "  --seed N             seed of every random choice (default 1)\n"
     "  --stats FILE.json    write rays, times, mean radiance and peak memory\n"
@@ -43,6 +44,7 @@ enum { OPT_MAX_DEPTH = OPT_OWN, OPT_STANDARD_ERROR, OPT_COUNT };
 static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS,
     CLI_VIEW_OPTIONS,
+    CLI_SCENE_OPTIONS,
     [OPT_MAX_DEPTH] = {"max-depth", 0, true},
     [OPT_STANDARD_ERROR] = {"standard-error", 0, true},
 };

@@ -41,6 +41,7 @@ static const char usage[] =
     "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"
     "  --exr-float          .exr: 32-bit float channels instead of half\n"
     "Run:\n"
+    CLI_SCENE_HELP
     "  --threads N          worker threads (default: all cores)\n"
     "  --seed N             seed of every random choice (default 1)\n"
     "  --stats FILE.json    write counts, times and peak memory\n"
@@ -51,6 +52,7 @@ enum { OPT_LIGHT = OPT_OWN, OPT_AMBIENT, OPT_LIGHT_SAMPLES, OPT_MAX_DEPTH, OPT_C
 static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS,
     CLI_VIEW_OPTIONS,
+    CLI_SCENE_OPTIONS,
     [OPT_LIGHT] = {"light", 0, true},
     [OPT_AMBIENT] = {"ambient", 0, true},
     [OPT_LIGHT_SAMPLES] = {"light-samples", 0, true},

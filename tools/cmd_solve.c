@@ -37,6 +37,7 @@ static const char usage[] =
     "  --visibility-rays N  most occlusion rays per patch pair (default 16; 4 first,\n"
     "                       all N only where those 4 disagree)\n"
     "  --quadrature M       M x M points per patch for the analytic form factor (default 1)\n"
+    CLI_SCENE_HELP
     "  --threads N          worker threads (default: all cores)\n"
     "  --seed N             seed of every random choice (default 1)\n"
     "  --stats FILE.json    write counts, times, residuals and peak memory\n"
@@ -46,6 +47,7 @@ static const cli_option options[OPT_OWN] = {
     CLI_BASE_OPTIONS,
     CLI_FORMFACTOR_OPTIONS,
     CLI_SOLVE_OPTIONS,
+    CLI_SCENE_OPTIONS,
     [OPT_EXPOSURE] = {"exposure", 0, true},
 };
 

@@ -25,6 +25,7 @@ static const char usage[] =
     "  --accuracy E         relative error target of each factor (default 1e-4)\n"
     "  --max-rays N         visibility rays per obstructed polygon pair at most\n"
     "                       (default 4096)\n"
+    CLI_SCENE_HELP
     "  --threads N          worker threads (default: all cores)\n"
     "  --seed N             seed of the sample points (default 1)\n"
     "  --stats FILE.json    write counts, times, invariants and error bounds\n"
@@ -33,7 +34,7 @@ static const char usage[] =
 enum { OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_COUNT };
 
 static const cli_option options[OPT_COUNT] = {
-    CLI_BASE_OPTIONS, [OPT_ACCURACY] = {"accuracy", 0, true},
+    CLI_BASE_OPTIONS, CLI_SCENE_OPTIONS, [OPT_ACCURACY] = {"accuracy", 0, true},
     [OPT_MAX_RAYS] = {"max-rays", 0, true}};
 
 int command_viewfactors(int argc, char **argv)

@@ -19,6 +19,7 @@ static const char usage[] =
     "  raytrace SCENE -o OUT     Whitted ray tracing with the Phong model\n"
     "  pathtrace SCENE -o OUT    a Monte-Carlo path tracer: the reference for radiosity\n"
     "  compare A B [-o DIFF]     differences between two HDR images (.pfm, .hdr, .exr)\n"
+    "  info [SCENE]              what was read: surfaces, materials, emitters, camera\n"
     "  help [COMMAND]            this text, or a command's\n"
     "\n"
     "'radiosity COMMAND --help' tells a command's options.\n";
@@ -32,7 +33,7 @@ static const command commands[] = {
     {"render", command_render},     {"solve", command_solve},
     {"viewfactors", command_viewfactors},
     {"raytrace", command_raytrace}, {"pathtrace", command_pathtrace},
-    {"compare", command_compare},
+    {"compare", command_compare},   {"info", command_info},
 };
 
 static const command *find_command(const char *name)

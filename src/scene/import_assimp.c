@@ -3,9 +3,15 @@
  *
  * Assimp does the parsing. This file only (1) checks, for OBJ files, what Assimp passes
  * over silently and what a user must hear about with a line number: a material library
- * that is not there, and non-finite vertex coordinates; (2) walks Assimp's node tree,
- * applying node transforms, and hands triangles, materials and surface names to the
- * scene builder. A surface is an Assimp mesh name (OBJ `o`/`g`), or its node's name.
+ * that is not there, and non-finite vertex coordinates; for glTF files, runs our own
+ * reading (gltf_json.c) first; (2) walks Assimp's node tree, applying node transforms, and
+ * hands triangles, materials and surface names to the scene builder. A surface is an
+ * Assimp mesh name (OBJ `o`/`g`, glTF mesh, STL solid), else its node's name, else the
+ * file's name without folder and extension; (3) maps materials onto METHOD.md's units:
+ * Kd / glTF baseColorFactor = albedo, Ke / glTF emissiveFactor x emissiveStrength =
+ * emitted radiance; a format's "no material" (STL, PLY without a material element, OBJ
+ * faces before any usemtl, glTF primitives without one) gets RAD_DEFAULT_ALBEDO; (4) takes
+ * the first glTF camera, and the up axis and unit from the file's metadata.
  */
 #include <assimp/cimport.h>
 #include <assimp/material.h>
@@ -23,6 +29,8 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/vec3.h"
+#include "scene/gltf_json.h"
 #include "scene/scene_builder.h"
 
 static bool has_extension(const char *path, const char *extension)
@@ -106,7 +114,92 @@ typedef struct import_state {
     scene_builder *builder;
     uint32_t *material_map; /* Assimp material index -> builder index, UINT32_MAX = not yet */
     const char *path;
+    const gltf_info *gltf;  /* our reading of a glTF file, else NULL */
+    bool ply_without_materials;
+    char stem[128];         /* the file's name without folder and extension */
+    const rad_load_options *options;
 } import_state;
+
+static bool near_value(double a, double b)
+{
+    return fabs(a - b) <= 1e-6 * fmax(1, fabs(b));
+}
+
+/* Assimp's values of material m agree with the glTF file's material g. */
+static bool same_gltf_material(const struct aiMaterial *m, const char *name,
+                               const gltf_material *g)
+{
+    rad_rgb base = material_color(m, AI_MATKEY_COLOR_DIFFUSE, (rad_rgb){1, 1, 1});
+    rad_rgb emissive = material_color(m, AI_MATKEY_COLOR_EMISSIVE, (rad_rgb){0, 0, 0});
+    return strcmp(name, g->name) == 0 && near_value(base.r, g->base_color[0]) &&
+           near_value(base.g, g->base_color[1]) && near_value(base.b, g->base_color[2]) &&
+           near_value(emissive.r, g->emissive_factor[0]) &&
+           near_value(emissive.g, g->emissive_factor[1]) &&
+           near_value(emissive.b, g->emissive_factor[2]);
+}
+
+/* The glTF material behind Assimp material `index`, or NULL for Assimp's own default.
+ * Assimp 5.2 numbers glTF materials by first reference in its walk of the scene (see
+ * gltf_json.h), which gltf_json.c replays; the values Assimp read must then agree with
+ * that JSON material (name, base colour, emissive factor). If they do not (an Assimp
+ * whose walk differs), the material is looked up by those values among all of the file's
+ * materials; if that leaves several with different emissive strengths, a warning says
+ * which strength was taken. */
+static const gltf_material *gltf_material_of(const import_state *state, unsigned index,
+                                             const struct aiMaterial *m, const char *name)
+{
+    const gltf_info *g = state->gltf;
+    const gltf_material *walked = index < g->assimp_count ? &g->materials[g->assimp_order[index]]
+                                                          : NULL;
+    if (walked && same_gltf_material(m, name, walked))
+        return walked;
+    const gltf_material *found = NULL;
+    bool ambiguous = false;
+    for (uint32_t k = 0; k < g->material_count; k++)
+        if (same_gltf_material(m, name, &g->materials[k])) {
+            ambiguous |= found && found->emissive_strength != g->materials[k].emissive_strength;
+            if (!found)
+                found = &g->materials[k];
+        }
+    if (!found && walked)
+        rad_warn(state->options ? state->options->log : NULL,
+                 state->options ? state->options->log_user : NULL,
+                 "%s: material '%s': not found in the glTF JSON; emissive strength 1 assumed",
+                 state->path, name);
+    if (ambiguous)
+        rad_warn(state->options ? state->options->log : NULL,
+                 state->options ? state->options->log_user : NULL,
+                 "%s: material '%s': several glTF materials match with different emissive "
+                 "strengths; %g taken",
+                 state->path, name, found->emissive_strength);
+    return found;
+}
+
+/* Albedo textures (MTL map_Kd, glTF baseColorTexture) are not applied yet: the albedo is the
+ * material's Kd / baseColorFactor. A user hears which, and when the file is missing. */
+static void check_texture(const import_state *state, const struct aiMaterial *m,
+                          const char *material)
+{
+    struct aiString texture;
+    if (aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &texture, NULL, NULL, NULL, NULL, NULL,
+                             NULL) != aiReturn_SUCCESS ||
+        texture.length == 0)
+        return;
+    rad_log_fn log = state->options ? state->options->log : NULL;
+    void *user = state->options ? state->options->log_user : NULL;
+    char folder[4096], file[8192];
+    folder_of(state->path, folder, sizeof(folder));
+    snprintf(file, sizeof(file), "%s%s", texture.data[0] == '/' ? "" : folder, texture.data);
+    struct stat st;
+    if (texture.data[0] != '*' && (stat(file, &st) != 0 || !S_ISREG(st.st_mode)))
+        rad_warn(log, user, "%s: material '%s': texture '%s' not found; its albedo is the "
+                 "material's colour",
+                 state->path, material, texture.data);
+    else
+        rad_warn(log, user, "%s: material '%s': texture '%s' is not applied (not supported "
+                 "yet); its albedo is the material's colour",
+                 state->path, material, texture.data);
+}
 
 static rad_status map_material(import_state *state, unsigned index, uint32_t *out,
                                rad_error *error)
@@ -118,18 +211,46 @@ static rad_status map_material(import_state *state, unsigned index, uint32_t *ou
         const struct aiMaterial *m = state->ai->mMaterials[index];
         struct aiString name;
         if (aiGetMaterialString(m, AI_MATKEY_NAME, &name) != aiReturn_SUCCESS)
-            snprintf(name.data, sizeof(name.data), "material%u", index);
+            name.data[0] = 0;
+        const gltf_material *gltf = state->gltf ? gltf_material_of(state, index, m, name.data)
+                                                : NULL;
+        /* Assimp's stand-in when the file has no material: "DefaultMaterial" (OBJ, STL,
+         * Collada; 3DS adds "_N"), an unnamed one after glTF's own, PLY's only one */
+        bool is_default = strncmp(name.data, AI_DEFAULT_MATERIAL_NAME,
+                                  strlen(AI_DEFAULT_MATERIAL_NAME)) == 0 ||
+                          (state->gltf && !gltf) || state->ply_without_materials;
         rad_material material = {0};
-        snprintf(material.name, sizeof(material.name), "%.*s", (int)sizeof(material.name) - 1,
-                 name.data);
-        material.albedo = material_color(m, AI_MATKEY_COLOR_DIFFUSE, (rad_rgb){0.5, 0.5, 0.5});
-        material.emission = material_color(m, AI_MATKEY_COLOR_EMISSIVE, (rad_rgb){0, 0, 0});
-        material.specular = material_color(m, AI_MATKEY_COLOR_SPECULAR, (rad_rgb){0, 0, 0});
-        /* the array form: aiGetMaterialFloat is C99 inline and fails to link at -O0 */
-        ai_real shininess = 0;
-        unsigned one = 1;
-        if (aiGetMaterialFloatArray(m, AI_MATKEY_SHININESS, &shininess, &one) == aiReturn_SUCCESS)
-            material.shininess = shininess;
+        if (is_default) {
+            snprintf(material.name, sizeof(material.name), "default");
+            material.albedo = (rad_rgb){RAD_DEFAULT_ALBEDO, RAD_DEFAULT_ALBEDO, RAD_DEFAULT_ALBEDO};
+        } else {
+            if (name.data[0])
+                snprintf(material.name, sizeof(material.name), "%.*s",
+                         (int)sizeof(material.name) - 1, name.data);
+            else
+                snprintf(material.name, sizeof(material.name), "material%u", index);
+            material.albedo = material_color(m, AI_MATKEY_COLOR_DIFFUSE,
+                                             (rad_rgb){RAD_DEFAULT_ALBEDO, RAD_DEFAULT_ALBEDO,
+                                                       RAD_DEFAULT_ALBEDO});
+            material.emission = material_color(m, AI_MATKEY_COLOR_EMISSIVE, (rad_rgb){0, 0, 0});
+            material.specular = material_color(m, AI_MATKEY_COLOR_SPECULAR, (rad_rgb){0, 0, 0});
+            if (gltf) {
+                /* glTF: emitted radiance = emissiveFactor x KHR_materials_emissive_strength;
+                 * Assimp's specular is its own guess from metallic-roughness: none */
+                material.emission.r *= gltf->emissive_strength;
+                material.emission.g *= gltf->emissive_strength;
+                material.emission.b *= gltf->emissive_strength;
+                material.specular = (rad_rgb){0, 0, 0};
+            } else {
+                /* the array form: aiGetMaterialFloat is C99 inline and fails to link at -O0 */
+                ai_real shininess = 0;
+                unsigned one = 1;
+                if (aiGetMaterialFloatArray(m, AI_MATKEY_SHININESS, &shininess, &one) ==
+                    aiReturn_SUCCESS)
+                    material.shininess = shininess;
+            }
+        }
+        check_texture(state, m, material.name);
         state->material_map[index] = scene_builder_material(state->builder, &material);
         if (state->material_map[index] == UINT32_MAX)
             return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", state->path);
@@ -165,7 +286,7 @@ static rad_status add_mesh(import_state *state, const struct aiMesh *mesh,
         return RAD_OK; /* points and lines carry no area */
     const char *name = mesh->mName.length ? mesh->mName.data
                        : node->mName.length ? node->mName.data
-                                            : "unnamed";
+                                            : state->stem;
     uint32_t surface = scene_builder_surface(state->builder, name);
     uint32_t material;
     if (surface == UINT32_MAX)
@@ -217,6 +338,105 @@ static rad_status add_node(import_state *state, const struct aiNode *node,
     return RAD_OK;
 }
 
+/* PLY: true when the header declares no material element (Assimp then invents one). */
+static bool ply_has_materials(FILE *file)
+{
+    char line[1024];
+    while (fgets(line, sizeof(line), file)) {
+        if (strncmp(line, "element material", 16) == 0 && isspace((unsigned char)line[16]))
+            return true;
+        if (strncmp(line, "end_header", 10) == 0)
+            break;
+    }
+    return false;
+}
+
+static bool find_node(const struct aiNode *node, const char *name, const struct aiMatrix4x4 *parent,
+                      unsigned depth, struct aiMatrix4x4 *to_world)
+{
+    struct aiMatrix4x4 here = multiply(parent, &node->mTransformation);
+    if (strcmp(node->mName.data, name) == 0) {
+        *to_world = here;
+        return true;
+    }
+    for (unsigned i = 0; depth < 256 && i < node->mNumChildren; i++)
+        if (find_node(node->mChildren[i], name, &here, depth + 1, to_world))
+            return true;
+    return false;
+}
+
+/* The first camera of a glTF file, placed by its node. Assimp 5.2's glTF importer copies
+ * the node's translation into mPosition as well, so the camera sits at its node's origin;
+ * it reports mHorizontalFOV = yfov x aspectRatio (yfov alone without an aspect ratio),
+ * from which the vertical field of view is recovered exactly. Other importers' cameras
+ * follow other conventions in Assimp 5.2 and are not used. */
+static void take_gltf_camera(const struct aiScene *ai, scene_builder *builder)
+{
+    if (ai->mNumCameras == 0 || !ai->mRootNode)
+        return;
+    const struct aiCamera *c = ai->mCameras[0];
+    struct aiMatrix4x4 identity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, to_world;
+    if (!find_node(ai->mRootNode, c->mName.data, &identity, 0, &to_world))
+        return;
+    struct aiVector3D origin = {0, 0, 0};
+    struct aiVector3D ahead = {c->mLookAt.x, c->mLookAt.y, c->mLookAt.z};
+    struct aiVector3D above = {c->mUp.x, c->mUp.y, c->mUp.z};
+    rad_camera camera;
+    camera.eye = transform(&to_world, origin);
+    camera.target = transform(&to_world, ahead);
+    camera.up = v3_sub(transform(&to_world, above), camera.eye);
+    double vertical = c->mAspect > 0 ? c->mHorizontalFOV / c->mAspect : c->mHorizontalFOV;
+    camera.fov_degrees = vertical * 180.0 / RAD_PI;
+    if (!(camera.fov_degrees > 0 && camera.fov_degrees < 180) || !v3_is_finite(camera.eye) ||
+        !v3_is_finite(camera.target) || !(v3_length(camera.up) > 0) ||
+        !(v3_length(v3_sub(camera.target, camera.eye)) > 0))
+        return;
+    scene_builder_set_camera(builder, &camera);
+}
+
+/* A numeric metadata value. */
+static bool metadata_number(const struct aiScene *ai, const char *key, double *out)
+{
+    const struct aiMetadata *meta = ai->mMetaData;
+    for (unsigned k = 0; meta && k < meta->mNumProperties; k++) {
+        if (strcmp(meta->mKeys[k].data, key) != 0 || !meta->mValues[k].mData)
+            continue;
+        const void *data = meta->mValues[k].mData;
+        switch (meta->mValues[k].mType) {
+        case AI_INT32: *out = *(const int32_t *)data; return true;
+        case AI_UINT64: *out = (double)*(const uint64_t *)data; return true;
+        case AI_FLOAT: *out = *(const float *)data; return true;
+        case AI_DOUBLE: *out = *(const double *)data; return true;
+        default: return false;
+        }
+    }
+    return false;
+}
+
+/* Up axis and unit: glTF is y-up metres by definition; FBX says UpAxis (0,1,2), UpAxisSign
+ * and UnitScaleFactor (centimetres per unit) in Assimp's metadata. */
+static void take_frame(const struct aiScene *ai, bool is_gltf, scene_builder *builder)
+{
+    rad_vec3 up = {0, 1, 0};
+    double unit = is_gltf ? 1 : 0, axis, sign = 1, centimetres;
+    if (metadata_number(ai, "UpAxis", &axis) && axis >= 0 && axis <= 2) {
+        metadata_number(ai, "UpAxisSign", &sign);
+        up = (rad_vec3){0, 0, 0};
+        (&up.x)[(int)axis] = sign < 0 ? -1 : 1;
+    }
+    if (metadata_number(ai, "UnitScaleFactor", &centimetres) && centimetres > 0)
+        unit = centimetres / 100;
+    scene_builder_set_frame(builder, up, unit);
+}
+
+/* Assimp's message on one line. */
+static void one_line(char *text)
+{
+    for (; *text; text++)
+        if (*text == '\n' || *text == '\r')
+            *text = ' ';
+}
+
 rad_status rad_scene_load(const char *path, const rad_load_options *options, rad_scene **out,
                           rad_error *error)
 {
@@ -230,20 +450,39 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
         return rad_fail(error, RAD_ERR_IO, "%s: cannot open: not a file", path);
     }
     rad_status status = RAD_OK;
+    import_state state = {NULL, NULL, NULL, path, NULL, false, "", options};
+    gltf_info gltf = {0};
+    bool is_gltf = has_extension(path, ".gltf") || has_extension(path, ".glb");
     if (has_extension(path, ".obj"))
         status = check_obj(path, file, error);
+    else if (has_extension(path, ".ply"))
+        state.ply_without_materials = !ply_has_materials(file);
     fclose(file);
+    if (status == RAD_OK && is_gltf) {
+        status = gltf_info_read(path, &gltf, error);
+        state.gltf = &gltf;
+    }
     if (status != RAD_OK)
         return status;
+    const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+    snprintf(state.stem, sizeof(state.stem), "%s", base);
+    char *dot = strrchr(state.stem, '.');
+    if (dot && dot != state.stem)
+        *dot = 0;
 
     const struct aiScene *ai =
         aiImportFile(path, aiProcess_Triangulate | aiProcess_SortByPType);
-    if (!ai)
-        return rad_fail(error, RAD_ERR_PARSE, "%s: cannot read the scene: %s", path,
-                        aiGetErrorString());
+    if (!ai) {
+        status = rad_fail(error, RAD_ERR_PARSE, "%s: cannot read the scene: %s", path,
+                          aiGetErrorString());
+        if (error)
+            one_line(error->message);
+        gltf_info_free(&gltf);
+        return status;
+    }
+    state.ai = ai;
 
     scene_builder *builder = NULL;
-    import_state state = {ai, NULL, NULL, path};
     status = scene_builder_create(path, options, &builder, error);
     if (status != RAD_OK)
         goto done;
@@ -261,11 +500,15 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
         if (status != RAD_OK)
             goto done;
     }
+    if (is_gltf)
+        take_gltf_camera(ai, builder);
+    take_frame(ai, is_gltf, builder);
     status = scene_builder_finish(builder, out, error);
     builder = NULL;
 done:
     scene_builder_destroy(builder);
     free(state.material_map);
+    gltf_info_free(&gltf);
     aiReleaseImport(ai);
     return status;
 }

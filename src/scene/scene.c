@@ -1,9 +1,13 @@
 /*
- * scene.c - queries on a loaded rad_scene: area, bounds, emitters, a framing camera.
+ * scene.c - queries on a loaded rad_scene: area, bounds, emitters, a framing camera;
+ * and changing a surface's or material's values after loading (command-line overrides).
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
+#include "core/error.h"
 #include "core/vec3.h"
 #include "radiosity.h"
 
@@ -45,22 +49,132 @@ bool rad_scene_has_emitter(const rad_scene *scene)
     return false;
 }
 
+/* The scene's up axis, snapped to the nearest coordinate axis with its sign; y when unset. */
+static int up_axis(const rad_scene *scene, double *sign)
+{
+    const double *u = &scene->up.x;
+    int axis = 1;
+    for (int a = 0; a < 3; a++)
+        if (fabs(u[a]) > fabs(u[axis]))
+            axis = a;
+    *sign = u[axis] < 0 ? -1 : 1;
+    return axis;
+}
+
 rad_camera rad_scene_default_camera(const rad_scene *scene)
 {
     rad_vec3 lo, hi;
     rad_scene_bounds(scene, &lo, &hi);
     rad_vec3 center = v3_scale(v3_add(lo, hi), 0.5);
-    rad_vec3 half = v3_scale(v3_sub(hi, lo), 0.5);
+    const rad_vec3 half = v3_scale(v3_sub(hi, lo), 0.5);
+    const double *h = &half.x;
+    /* y up: look along +z; z up: along +y (the front view of z-up modellers); x up: +z */
+    double sign;
+    int up = up_axis(scene, &sign);
+    int depth = up == 2 ? 1 : 2;
+    int side = 3 - up - depth;
     rad_camera camera;
     camera.fov_degrees = 40.0;
     double tan_half = tan(camera.fov_degrees * RAD_PI / 360.0);
     /* back off until the front face's larger half extent fits the narrower (vertical) fov */
-    double extent = fmax(half.x, half.y);
-    double distance = extent / tan_half + half.z;
+    double extent = fmax(h[side], h[up]);
+    double distance = extent / tan_half + h[depth];
     if (!(distance > 0))
         distance = 1;
-    camera.eye = v3(center.x, center.y, center.z - distance * 1.05);
+    camera.eye = center;
+    (&camera.eye.x)[depth] -= distance * 1.05;
     camera.target = center;
-    camera.up = v3(0, 1, 0);
+    camera.up = v3(0, 0, 0);
+    (&camera.up.x)[up] = sign;
     return camera;
+}
+
+/* Albedo in [0,1] and emission >= 0, finite. */
+static bool rgb_in(const rad_rgb *c, double hi)
+{
+    const double *v = &c->r;
+    for (int k = 0; k < 3; k++)
+        if (!(v[k] >= 0 && v[k] <= hi))
+            return false;
+    return true;
+}
+
+/* Appends a copy of material m; UINT32_MAX when out of memory. */
+static uint32_t copy_material(rad_scene *scene, uint32_t m)
+{
+    if (scene->material_count >= UINT32_MAX - 1)
+        return UINT32_MAX;
+    rad_material *grown = realloc(scene->materials,
+                                  (scene->material_count + 1) * sizeof(*scene->materials));
+    if (!grown)
+        return UINT32_MAX;
+    scene->materials = grown;
+    grown[scene->material_count] = grown[m];
+    return scene->material_count++;
+}
+
+static void apply(rad_material *m, const rad_rgb *albedo, const rad_rgb *emission)
+{
+    if (albedo)
+        m->albedo = *albedo;
+    if (emission)
+        m->emission = *emission;
+}
+
+rad_status rad_scene_set_material(rad_scene *scene, const char *name, const rad_rgb *albedo,
+                                  const rad_rgb *emission, rad_error *error)
+{
+    if ((albedo && !rgb_in(albedo, 1)) || (emission && !rgb_in(emission, INFINITY)))
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "'%s': albedo must be in [0,1] and emission finite and >= 0", name);
+    for (uint32_t s = 0; s < scene->surface_count; s++) {
+        const rad_surface *surface = &scene->surfaces[s];
+        if (strcmp(surface->name, name) != 0)
+            continue;
+        /* each material of this surface: changed in place when no other surface uses it,
+         * else replaced by a changed copy for this surface's triangles */
+        uint32_t count = scene->material_count;
+        uint8_t *use = calloc(count ? count : 1, 1); /* bit 1: used here, bit 2: elsewhere */
+        if (!use)
+            return rad_fail(error, RAD_ERR_NOMEM, "out of memory");
+        for (uint32_t t = 0; t < scene->triangle_count; t++)
+            use[scene->triangles[t].material] |= scene->triangles[t].surface == s ? 1 : 2;
+        uint32_t first = surface->first_triangle, end = first + surface->triangle_count;
+        for (uint32_t m = 0; m < count; m++) {
+            if (!(use[m] & 1))
+                continue;
+            uint32_t target = m;
+            if ((use[m] & 2) && (target = copy_material(scene, m)) == UINT32_MAX) {
+                free(use);
+                return rad_fail(error, RAD_ERR_NOMEM, "out of memory");
+            }
+            apply(&scene->materials[target], albedo, emission);
+            if (target != m) {
+                for (uint32_t t = first; t < end; t++)
+                    if (scene->triangles[t].material == m)
+                        scene->triangles[t].material = target;
+                char original[sizeof(scene->materials[m].name)];
+                memcpy(original, scene->materials[m].name, sizeof(original));
+                snprintf(scene->materials[target].name, sizeof(scene->materials[target].name),
+                         "%.60s@%.60s", original, name);
+            }
+        }
+        free(use);
+        return RAD_OK;
+    }
+    uint32_t found = UINT32_MAX, matches = 0;
+    for (uint32_t m = 0; m < scene->material_count; m++)
+        if (strcmp(scene->materials[m].name, name) == 0) {
+            found = m;
+            matches++;
+        }
+    if (matches == 0)
+        return rad_fail(error, RAD_ERR_INVALID, "%s: no surface or material named '%s'",
+                        scene->source, name);
+    if (matches > 1)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "%s: no surface is named '%s' and %u materials are: name a surface",
+                        scene->source, name, matches);
+    apply(&scene->materials[found], albedo, emission);
+    return RAD_OK;
 }

@@ -37,6 +37,8 @@ struct scene_builder {
     size_t surface_slot_count;
     bool has_camera;
     rad_camera camera;
+    rad_vec3 up;
+    double unit_metres;
 };
 
 rad_status scene_builder_create(const char *source, const rad_load_options *options,
@@ -48,6 +50,7 @@ rad_status scene_builder_create(const char *source, const rad_load_options *opti
     snprintf(b->source, sizeof(b->source), "%s", source);
     if (options)
         b->options = *options;
+    b->up = (rad_vec3){0, 1, 0};
     *out = b;
     return RAD_OK;
 }
@@ -144,6 +147,14 @@ void scene_builder_set_camera(scene_builder *b, const rad_camera *camera)
 {
     b->has_camera = true;
     b->camera = *camera;
+}
+
+void scene_builder_set_frame(scene_builder *b, rad_vec3 up, double unit_metres)
+{
+    double length = v3_length(up);
+    if (length > 0 && isfinite(length))
+        b->up = v3_scale(up, 1 / length);
+    b->unit_metres = unit_metres > 0 && isfinite(unit_metres) ? unit_metres : 0;
 }
 
 /* True when the triangle has no area relative to its size (collinear or repeated corners). */
@@ -312,6 +323,8 @@ rad_status scene_builder_finish(scene_builder *b, rad_scene **out, rad_error *er
     b->materials = NULL;
     scene->has_camera = b->has_camera;
     scene->camera = b->camera;
+    scene->up = b->up;
+    scene->unit_metres = b->unit_metres;
     snprintf(scene->source, sizeof(scene->source), "%s", b->source);
 
     *out = scene;

@@ -30,6 +30,9 @@ rad_status scene_builder_triangle(scene_builder *builder, uint32_t surface, uint
 
 void scene_builder_set_camera(scene_builder *builder, const rad_camera *camera);
 
+/* The file's up direction (unit; (0,1,0) unless set) and metres per unit (0 = unknown). */
+void scene_builder_set_frame(scene_builder *builder, rad_vec3 up, double unit_metres);
+
 /* Validates and hands over the scene; the builder is freed in every case. */
 rad_status scene_builder_finish(scene_builder *builder, rad_scene **out, rad_error *error);
 

@@ -1,0 +1,125 @@
+/*
+ * test_scene_errors.c - bad scene files, one test each: a truncated .glb, a glTF whose
+ * buffer file is missing, a missing texture (a warning; the albedo falls back to Kd), an
+ * accessor index out of range, an empty scene, files that are not scenes at all, and an
+ * --emit naming nothing. Each error: one line "radiosity: FILE: ...", exit 1, and no
+ * output file (nor temporary file) left behind.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testlib.h"
+
+static int count_lines(const char *text)
+{
+    int lines = 0;
+    for (; *text; text++)
+        lines += *text == '\n';
+    return lines;
+}
+
+static void expect_error(const char *case_name, const char *arguments, const char *names)
+{
+    int code = test_run_tool(arguments);
+    const char *err = test_read_text(test_path("stderr.txt"));
+    if (code != 1 || count_lines(err) != 1 || strstr(err, names) == NULL)
+        fprintf(stderr, "[%s] exit %d, stderr: %s", case_name, code, err);
+    CHECK(code == 1);
+    CHECK(count_lines(err) == 1);
+    CHECK(strncmp(err, "radiosity: ", 11) == 0);
+    CHECK(strstr(err, names) != NULL);
+    CHECK(test_count_files("out") == 0);
+}
+
+/* One triangle as glTF, its buffer as a data URI (3 float positions, 3 uint16 indices). */
+static const char *triangle_gltf(const char *buffers, const char *index_accessor)
+{
+    static char json[4096];
+    snprintf(json, sizeof(json),
+             "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[0]}],"
+             "\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":"
+             "{\"POSITION\":0},\"indices\":%s}]}],\"buffers\":%s,"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,"
+             "\"byteOffset\":36,\"byteLength\":6}],\"accessors\":[{\"bufferView\":0,"
+             "\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],"
+             "\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5123,\"count\":3,"
+             "\"type\":\"SCALAR\"}]}",
+             index_accessor, buffers);
+    return json;
+}
+
+int main(void)
+{
+    test_tmpdir();
+    /* 0,0,0 1,0,0 0,1,0 as floats, then 0 1 2 as uint16, base64 */
+    const char *data = "[{\"byteLength\":42,\"uri\":\"data:application/octet-stream;base64,"
+                       "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIA\"}]";
+
+    /* sanity: the good triangle loads */
+    test_write_file("good.gltf", triangle_gltf(data, "1"));
+    CHECK(test_run_tool("info good.gltf") == 0);
+    CHECK(strstr(test_read_text(test_path("stdout.txt")), "triangles: 1") != NULL);
+
+    /* a truncated .glb: the header's length is longer than the file */
+    FILE *file = fopen(test_path("cut.glb"), "wb");
+    if (file) {
+        const unsigned char header[20] = {'g', 'l', 'T', 'F', 2, 0, 0, 0, 0, 4, 0, 0,
+                                          0, 2, 0, 0, 'J', 'S', 'O', 'N'};
+        fwrite(header, 1, sizeof(header), file);
+        fputs("{\"asset\":{\"version\":\"2.0\"}", file);
+        fclose(file);
+    }
+    expect_error("truncated glb", "render cut.glb -o out.png", "cut.glb: truncated");
+
+    /* a glTF whose buffer file is not there */
+    test_write_file("nobin.gltf",
+                    triangle_gltf("[{\"byteLength\":42,\"uri\":\"gone%20away.bin\"}]", "1"));
+    expect_error("missing buffer", "render nobin.gltf -o out.png",
+                 "nobin.gltf: buffer 0: file 'gone%20away.bin' not found");
+
+    /* an accessor index out of range, and an index buffer reaching past its view */
+    test_write_file("badaccessor.gltf", triangle_gltf(data, "7"));
+    expect_error("accessor out of range", "render badaccessor.gltf -o out.png",
+                 "badaccessor.gltf: mesh 0, primitive 0: indices name an accessor out of range");
+    test_write_file("shortview.gltf",
+                    triangle_gltf("[{\"byteLength\":40,\"uri\":\"data:application/"
+                                  "octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAA==\"}]",
+                                  "1"));
+    expect_error("view past buffer", "render shortview.gltf -o out.png",
+                 "shortview.gltf: bufferView 1 reaches past the end of buffer 0");
+
+    /* an OBJ face naming a vertex beyond the file's */
+    test_write_file("beyond.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    expect_error("obj index", "render beyond.obj -o out.png", "beyond.obj:");
+
+    /* empty scenes: a glTF with no meshes, an empty OBJ */
+    test_write_file("empty.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[]}]}");
+    expect_error("empty gltf", "render empty.gltf -o out.png", "empty.gltf:");
+    test_write_file("empty.obj", "# nothing here\n");
+    expect_error("empty obj", "render empty.obj -o out.png", "empty.obj:");
+
+    /* not a scene at all: a PNG signature under a glb name, prose under a gltf name, an
+     * unknown extension */
+    test_write_file("photo.glb", "\x89PNG\r\n\x1a\nnot really a picture either");
+    expect_error("png as glb", "render photo.glb -o out.png", "photo.glb: not a binary glTF");
+    test_write_file("notes.gltf", "Dear diary, today I wrote no JSON.\n");
+    expect_error("prose as gltf", "render notes.gltf -o out.png", "notes.gltf: not glTF");
+    test_write_file("notes.txt", "Dear diary, today I wrote no scene.\n");
+    expect_error("prose", "render notes.txt -o out.png", "notes.txt:");
+
+    /* --emit naming nothing in the scene */
+    expect_error("unknown name", "render good.gltf -o out.png --emit lamp=1,1,1",
+                 "--emit: ");
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "'lamp'") != NULL);
+
+    /* a missing texture: a warning naming it, and the albedo is Kd */
+    test_write_file("tex.mtl", "newmtl painted\nKd 0.25 0.5 0.75\nKe 1 1 1\nmap_Kd nowhere.png\n");
+    test_write_file("tex.obj", "mtllib tex.mtl\nusemtl painted\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    CHECK(test_run_tool("info tex.obj") == 0);
+    const char *out = test_read_text(test_path("stdout.txt"));
+    CHECK(strstr(out, "albedo (0.25, 0.5, 0.75)") != NULL);
+    CHECK(strstr(out, "tex.obj: material 'painted': texture 'nowhere.png' not found") != NULL);
+
+    return test_finish("test_scene_errors");
+}

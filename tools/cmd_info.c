@@ -1,0 +1,263 @@
+/*
+ * cmd_info.c - `radiosity info [SCENE]`: what the loader read from a scene file (or the
+ * built-in Cornell box): surfaces, triangles, materials, emitters, bounding box, camera,
+ * units and up axis, and the warnings, as text on stdout or in -o FILE.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+static const char usage[] =
+    "usage: radiosity info [SCENE] [options]\n"
+    "\n"
+    "Tells what was read from SCENE (any file the other commands read; none = the built-in\n"
+    "Cornell box): each surface (name, triangles, area, material), each material (albedo,\n"
+    "emitted radiance), the emitters and their power, the bounding box, the camera the\n"
+    "image commands would use, the unit and up axis when the file says, and the warnings.\n"
+    "The --emit and --albedo options show their effect. Exit status 1 when the scene\n"
+    "cannot be read.\n"
+    "\n"
+    CLI_SCENE_HELP
+    "  -o FILE              write the report to FILE instead of stdout\n"
+    "  --stats FILE.json    load time, counts and peak memory\n"
+    "  -h, --help           this text\n";
+
+enum { OPT_COUNT = OPT_OWN };
+
+static const cli_option options[OPT_COUNT] = {CLI_BASE_OPTIONS, CLI_SCENE_OPTIONS};
+
+/* The report, built in memory and written at once. */
+typedef struct report {
+    char *text;
+    size_t length, capacity;
+    bool failed;
+} report;
+
+static void say(report *r, const char *format, ...) __attribute__((format(printf, 2, 3)));
+static void say(report *r, const char *format, ...)
+{
+    va_list args;
+    va_start(args, format);
+    int n = vsnprintf(NULL, 0, format, args);
+    va_end(args);
+    if (n < 0 || r->failed)
+        return;
+    if (r->length + (size_t)n + 1 > r->capacity) {
+        size_t capacity = (r->length + (size_t)n + 1) * 2;
+        char *grown = realloc(r->text, capacity);
+        if (!grown) {
+            r->failed = true;
+            return;
+        }
+        r->text = grown;
+        r->capacity = capacity;
+    }
+    va_start(args, format);
+    vsnprintf(r->text + r->length, r->capacity - r->length, format, args);
+    va_end(args);
+    r->length += (size_t)n;
+}
+
+/* Warnings the loader sent, kept for the report. */
+typedef struct warnings {
+    report lines;
+    unsigned count;
+} warnings;
+
+static void keep_warning(void *user, const char *message)
+{
+    warnings *w = user;
+    say(&w->lines, "  %s\n", message);
+    w->count++;
+}
+
+static double triangle_area(const rad_scene *scene, uint32_t t)
+{
+    const uint32_t *v = scene->triangles[t].vertex;
+    const rad_vec3 *p = scene->positions;
+    double a[3] = {p[v[1]].x - p[v[0]].x, p[v[1]].y - p[v[0]].y, p[v[1]].z - p[v[0]].z};
+    double b[3] = {p[v[2]].x - p[v[0]].x, p[v[2]].y - p[v[0]].y, p[v[2]].z - p[v[0]].z};
+    double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    return 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+}
+
+static bool emits(const rad_material *m)
+{
+    return m->emission.r > 0 || m->emission.g > 0 || m->emission.b > 0;
+}
+
+static const char *axis_name(rad_vec3 up)
+{
+    static const char *names[] = {"+x", "+y", "+z", "-x", "-y", "-z"};
+    const double *u = &up.x;
+    for (int a = 0; a < 3; a++)
+        if (fabs(u[a]) == 1)
+            return names[a + (u[a] < 0 ? 3 : 0)];
+    return "oblique";
+}
+
+static void describe(report *r, const rad_scene *scene)
+{
+    rad_vec3 lo, hi;
+    rad_scene_bounds(scene, &lo, &hi);
+    say(r, "scene: %s\n", scene->source);
+    say(r, "triangles: %u\nvertices: %u (shared positions after welding)\n",
+        scene->triangle_count, scene->position_count);
+    say(r, "area: %.6g\n", rad_scene_area(scene));
+    say(r, "bounding box: (%.6g, %.6g, %.6g) to (%.6g, %.6g, %.6g), size %.6g x %.6g x %.6g\n",
+        lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, hi.x - lo.x, hi.y - lo.y, hi.z - lo.z);
+    if (scene->unit_metres > 0)
+        say(r, "unit: %.6g m\n", scene->unit_metres);
+    else
+        say(r, "unit: not given by the file\n");
+    say(r, "up axis: %s\n", axis_name(scene->up));
+    rad_camera c = scene->has_camera ? scene->camera : rad_scene_default_camera(scene);
+    say(r, "camera: %s: eye (%.6g, %.6g, %.6g), target (%.6g, %.6g, %.6g), up (%.6g, %.6g, "
+           "%.6g), vertical fov %.6g degrees\n",
+        scene->has_camera ? "from the scene" : "none in the file; the default view", c.eye.x,
+        c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.up.x, c.up.y, c.up.z,
+        c.fov_degrees);
+
+    /* per material: triangles and area using it */
+    uint32_t nm = scene->material_count;
+    double *material_area = calloc(nm ? nm : 1, sizeof(double));
+    uint32_t *material_triangles = calloc(nm ? nm : 1, sizeof(uint32_t));
+    uint32_t *listed_for = calloc(nm ? nm : 1, sizeof(uint32_t)); /* surface + 1 */
+    if (!material_area || !material_triangles || !listed_for) {
+        r->failed = true;
+        free(material_area);
+        free(material_triangles);
+        free(listed_for);
+        return;
+    }
+    say(r, "surfaces: %u\n", scene->surface_count);
+    for (uint32_t s = 0; s < scene->surface_count; s++) {
+        const rad_surface *surface = &scene->surfaces[s];
+        double area = 0;
+        uint32_t end = surface->first_triangle + surface->triangle_count;
+        for (uint32_t t = surface->first_triangle; t < end; t++) {
+            double a = triangle_area(scene, t);
+            uint32_t m = scene->triangles[t].material;
+            area += a;
+            material_area[m] += a;
+            material_triangles[m]++;
+        }
+        /* the materials of this surface, in order of first use */
+        say(r, "  %-24s %8u triangles  area %-12.6g material", surface->name,
+            surface->triangle_count, area);
+        unsigned listed = 0;
+        for (uint32_t t = surface->first_triangle; t < end && listed <= 3; t++) {
+            uint32_t m = scene->triangles[t].material;
+            if (listed_for[m] == s + 1)
+                continue;
+            listed_for[m] = s + 1;
+            say(r, listed == 3 ? ", ..." : "%s %s", listed ? "," : "", scene->materials[m].name);
+            listed++;
+        }
+        say(r, "\n");
+    }
+    say(r, "materials: %u\n", nm);
+    for (uint32_t m = 0; m < nm; m++) {
+        const rad_material *material = &scene->materials[m];
+        say(r, "  %-24s albedo (%.4g, %.4g, %.4g)  emission (%.4g, %.4g, %.4g)  %u triangles%s\n",
+            material->name, material->albedo.r, material->albedo.g, material->albedo.b,
+            material->emission.r, material->emission.g, material->emission.b,
+            material_triangles[m], material_triangles[m] ? "" : " (unused)");
+    }
+    unsigned emitters = 0;
+    for (uint32_t m = 0; m < nm; m++)
+        emitters += emits(&scene->materials[m]) && material_triangles[m];
+    say(r, "emitters: %u\n", emitters);
+    for (uint32_t m = 0; m < nm; m++) {
+        const rad_material *material = &scene->materials[m];
+        if (!emits(material) || !material_triangles[m])
+            continue;
+        /* power of a Lambertian emitter: pi L_e A (per unit of the scene's length squared) */
+        double k = 3.14159265358979323846 * material_area[m];
+        say(r, "  %-24s radiance (%.4g, %.4g, %.4g)  area %.6g  power (%.6g, %.6g, %.6g)\n",
+            material->name, material->emission.r, material->emission.g, material->emission.b,
+            material_area[m], k * material->emission.r, k * material->emission.g,
+            k * material->emission.b);
+    }
+    say(r, "textures: 0\n");
+    free(listed_for);
+    free(material_area);
+    free(material_triangles);
+}
+
+int command_info(int argc, char **argv)
+{
+    cli_args args;
+    cli_shared shared;
+    if (!cli_parse("info", argc, argv, options, OPT_COUNT, &args))
+        return EXIT_USAGE;
+    if (args.value[OPT_HELP]) {
+        fputs(usage, stdout);
+        return EXIT_OK;
+    }
+    if (!cli_parse_shared(&args, &shared))
+        return EXIT_USAGE;
+    if (args.positional_count > 1) {
+        cli_error("info: one scene at most (see 'radiosity info --help')");
+        return EXIT_USAGE;
+    }
+    if ((shared.output && !cli_output_writable(shared.output)) ||
+        (shared.stats_path && !cli_output_writable(shared.stats_path)))
+        return EXIT_ERROR;
+    const char *path = args.positional_count ? args.positional[0] : NULL;
+
+    warnings w = {{0}, 0};
+    rad_scene *scene = NULL;
+    rad_error error = {0};
+    double t0 = cli_now();
+    rad_status status = cli_load_scene_logged(path, keep_warning, &w, &scene, &error);
+    double t_load = cli_now() - t0;
+    int exit_code = EXIT_OK;
+    report r = {0};
+    if (status != RAD_OK) {
+        /* the warnings that led up to the error still help */
+        if (w.lines.text)
+            fputs(w.lines.text, stderr);
+        cli_error("%s", error.message);
+        exit_code = EXIT_ERROR;
+        goto done;
+    }
+    describe(&r, scene);
+    say(&r, "warnings: %u\n%s", w.count, w.lines.text ? w.lines.text : "");
+    if (r.failed || w.lines.failed) {
+        cli_error("out of memory");
+        exit_code = EXIT_ERROR;
+        goto done;
+    }
+    if (shared.output) {
+        if (rad_write_file_atomic(shared.output, r.text, r.length, &error) != RAD_OK) {
+            cli_error("%s", error.message);
+            exit_code = EXIT_ERROR;
+            goto done;
+        }
+    } else {
+        fwrite(r.text, 1, r.length, stdout);
+    }
+    if (shared.stats_path) {
+        cli_stats stats;
+        stats_begin(&stats);
+        stats_string(&stats, "scene", scene->source);
+        stats_integer(&stats, "triangles", scene->triangle_count);
+        stats_integer(&stats, "vertices", scene->position_count);
+        stats_integer(&stats, "surfaces", scene->surface_count);
+        stats_integer(&stats, "materials", scene->material_count);
+        stats_integer(&stats, "warnings", w.count);
+        stats_number(&stats, "seconds_load", t_load);
+        stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
+        if (!stats_write(&stats, shared.stats_path))
+            exit_code = EXIT_ERROR;
+    }
+done:
+    free(r.text);
+    free(w.lines.text);
+    rad_scene_destroy(scene);
+    return exit_code;
+}
