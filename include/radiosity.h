@@ -371,9 +371,11 @@ typedef struct rad_viewfactor_matrix {
 } rad_viewfactor_matrix;
 
 typedef struct rad_viewfactor_options {
-    double accuracy;     /* relative error target of each factor; 0 = 1e-4. Unobstructed
-                            pairs meet it by adaptive quadrature; obstructed pairs sample
-                            visibility until their error bound meets it or max_rays */
+    double accuracy;     /* relative error target of each factor; 0 = 1e-4. Pairs meet it
+                            by adaptive quadrature of the exact point-to-polygon factor
+                            (shadows of up to 8 occluding triangles clipped exactly);
+                            pairs behind more occluders sample visibility until their
+                            error bound meets it or max_rays */
     uint32_t max_rays;   /* visibility rays per obstructed polygon pair at most; 0 = 4096 */
     uint64_t seed;
     int threads;         /* 0 = all cores */
@@ -385,7 +387,9 @@ typedef struct rad_viewfactor_report {
     uint64_t surface_pairs;      /* surface pairs considered */
     uint64_t polygon_pairs;      /* triangle pairs that face each other */
     uint64_t obstructed_pairs;   /* of those, pairs with something in between */
-    uint64_t capped_pairs;       /* obstructed pairs that reached max_rays first */
+    uint64_t sampled_pairs;      /* of those, pairs with too many occluders for exact
+                                    shadow clipping: visibility sampled */
+    uint64_t capped_pairs;       /* sampled pairs that reached max_rays first */
     uint64_t rays;               /* visibility rays cast */
     uint64_t nonzeros;           /* stored factors */
     double largest_error_bound;  /* largest error_bound / F_IJ over the stored factors */

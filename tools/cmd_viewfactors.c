@@ -96,12 +96,13 @@ int command_viewfactors(int argc, char **argv)
     rad_viewfactor_matrix_check(matrix, scene, &check);
     size_t S = scene->surface_count;
     fprintf(stderr,
-            "radiosity: %zu surfaces, %llu polygon pairs (%llu obstructed), %llu rays, "
-            "%llu non-zero factors, %.2f s\n"
+            "radiosity: %zu surfaces, %llu polygon pairs (%llu obstructed, %llu of them "
+            "sampled), %llu rays, %llu non-zero factors, %.2f s\n"
             "radiosity: F in [%.6g, %.6g]; reciprocity residual %.2e; planar F_ii %.2g; "
             "largest row sum %.6f",
             S, (unsigned long long)report.polygon_pairs,
-            (unsigned long long)report.obstructed_pairs, (unsigned long long)report.rays,
+            (unsigned long long)report.obstructed_pairs,
+            (unsigned long long)report.sampled_pairs, (unsigned long long)report.rays,
             (unsigned long long)report.nonzeros, cli_now() - t0, check.smallest, check.largest,
             check.reciprocity, check.largest_planar_self, check.largest_row_sum);
     if (check.closed)
@@ -143,6 +144,7 @@ int command_viewfactors(int argc, char **argv)
         stats_integer(&stats, "surface_pairs", report.surface_pairs);
         stats_integer(&stats, "polygon_pairs", report.polygon_pairs);
         stats_integer(&stats, "obstructed_pairs", report.obstructed_pairs);
+        stats_integer(&stats, "sampled_pairs", report.sampled_pairs);
         stats_integer(&stats, "capped_pairs", report.capped_pairs);
         stats_integer(&stats, "rays_cast", report.rays);
         stats_integer(&stats, "nonzeros", report.nonzeros);

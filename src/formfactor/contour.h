@@ -14,7 +14,7 @@
 #include "radiosity.h"
 
 /* Most vertices a polygon may have (clipping adds one). */
-#define CONTOUR_MAX_VERTICES 8
+#define CONTOUR_MAX_VERTICES 16
 
 /* polygon: count vertices (count <= CONTOUR_MAX_VERTICES - 1), counter-clockwise seen
  * from its front, with unit front normal polygon_normal. plane_epsilon (scene units): p

@@ -232,11 +232,13 @@ static bool triangle_cuts(const hull *h, const tree_triangle *t, double epsilon)
     return !(below || above);
 }
 
-bool occluder_tree_may_block(const occluder_tree *tree, const vf_polygon *p,
-                             const vf_polygon *q, double epsilon)
+uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
+                               const vf_polygon *q, double epsilon, shadow_occluder *out,
+                               uint32_t max)
 {
     if (tree->node_count == 0)
-        return false;
+        return 0;
+    uint32_t found = 0;
     hull h;
     make_hull(&h, p, q, epsilon);
     h.exclude[0] = p->triangle[0];
@@ -251,13 +253,17 @@ bool occluder_tree_may_block(const occluder_tree *tree, const vf_polygon *p,
         if (box_outside(&h, node, epsilon))
             continue;
         if (node->count) {
-            for (uint32_t t = node->first; t < node->first + node->count; t++)
-                if (triangle_cuts(&h, &tree->triangles[t], epsilon))
-                    return true;
+            for (uint32_t t = node->first; t < node->first + node->count; t++) {
+                if (!triangle_cuts(&h, &tree->triangles[t], epsilon))
+                    continue;
+                if (found == max)
+                    return max + 1;
+                memcpy(out[found++].corner, tree->triangles[t].corner, sizeof(out->corner));
+            }
         } else {
             stack[top++] = node->first;
             stack[top++] = node->first + 1;
         }
     }
-    return false;
+    return found;
 }

@@ -11,6 +11,7 @@
 #define RAD_VIEWFACTOR_OCCLUDER_TREE_H
 
 #include "radiosity.h"
+#include "viewfactor/shadow_clip.h"
 #include "viewfactor/vf_geometry.h"
 
 typedef struct occluder_tree occluder_tree;
@@ -18,9 +19,11 @@ typedef struct occluder_tree occluder_tree;
 rad_status occluder_tree_build(const rad_scene *scene, occluder_tree **out, rad_error *error);
 void occluder_tree_destroy(occluder_tree *tree);
 
-/* True when a triangle other than the polygons' own may cut the hull of p and q. Touching
- * the hull's boundary (within epsilon, scene units) does not count. */
-bool occluder_tree_may_block(const occluder_tree *tree, const vf_polygon *p,
-                             const vf_polygon *q, double epsilon);
+/* The triangles other than the polygons' own that may cut the hull of p and q (touching
+ * the hull's boundary within epsilon, scene units, does not count): their corners go to
+ * `out` (room for `max`); returns how many, or max + 1 when there are more. */
+uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
+                               const vf_polygon *q, double epsilon, shadow_occluder *out,
+                               uint32_t max);
 
 #endif

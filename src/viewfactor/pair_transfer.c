@@ -15,6 +15,15 @@
 /* Deepest subdivision of the outer triangle: 4^12 cells would be far past any need. */
 #define MAX_DEPTH 12
 
+/* The same behind occluders, where the integrand has kinks along penumbra edges and each
+ * point costs more: what is left at this depth is reported in the error bound. */
+#define OBSTRUCTED_MAX_DEPTH 8
+
+/* Exact shadow clipping may spend this many (point, occluder) clippings on one pair, about
+ * a millisecond; a pair that needs more is sampled instead, so the run time stays
+ * predictable. */
+#define EXACT_WORK_BUDGET 8192u
+
 /* Largest k of a round's k x k stratified segments per replicate. */
 #define MAX_STRATA 32u
 
@@ -28,12 +37,30 @@ typedef struct outer_context {
     rad_vec3 normal;         /* of the outer polygon */
     const vf_polygon *inner;
     double plane_epsilon;
+    const shadow_occluder *occluders; /* what may stand in between (none: unobstructed) */
+    uint32_t occluder_count;
+    int max_depth;
+    uint64_t work_left;      /* occluder clippings this pair may still spend */
+    bool failed;             /* too many pieces somewhere, or the work budget ran out */
 } outer_context;
 
-static inline double point_factor(const outer_context *c, rad_vec3 x)
+static inline double point_factor(outer_context *c, rad_vec3 x)
 {
-    return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
-                                    c->inner->normal, c->plane_epsilon);
+    if (c->occluder_count == 0)
+        return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
+                                        c->inner->normal, c->plane_epsilon);
+    if (c->failed || c->work_left < c->occluder_count) {
+        c->failed = true;
+        return 0;
+    }
+    c->work_left -= c->occluder_count;
+    double factor = shadow_visible_factor(x, c->normal, c->inner, c->occluders,
+                                          c->occluder_count, c->plane_epsilon);
+    if (factor < 0) {
+        c->failed = true;
+        return 0;
+    }
+    return factor;
 }
 
 static inline rad_vec3 barycentric(rad_vec3 a, rad_vec3 b, rad_vec3 c, double u, double v,
@@ -44,7 +71,7 @@ static inline rad_vec3 barycentric(rad_vec3 a, rad_vec3 b, rad_vec3 c, double u,
 }
 
 /* The 7-point rule times the area; *centre receives the 1-point (centroid) rule. */
-static double rule7(const outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d, double area,
+static double rule7(outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d, double area,
                     double *centre)
 {
     double f0 = point_factor(c, barycentric(a, b, d, 1.0 / 3, 1.0 / 3, 1.0 / 3));
@@ -60,7 +87,7 @@ static double rule7(const outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d, 
 
 /* Integral over triangle (a, b, d) whose rule7 value is `whole`; *error accumulates the
  * estimated error of what is returned. */
-static double adapt(const outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d, double area,
+static double adapt(outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d, double area,
                     double whole, double tolerance, int depth, double *error)
 {
     rad_vec3 ab = v3_scale(v3_add(a, b), 0.5), bd = v3_scale(v3_add(b, d), 0.5),
@@ -70,7 +97,7 @@ static double adapt(const outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d, 
                       rule7(c, da, bd, d, quarter, &unused), rule7(c, ab, bd, da, quarter, &unused)};
     double sum = part[0] + part[1] + part[2] + part[3];
     double difference = fabs(sum - whole);
-    if (difference <= tolerance || depth >= MAX_DEPTH) {
+    if (difference <= tolerance || depth >= c->max_depth || c->failed) {
         *error += difference;
         return sum;
     }
@@ -81,7 +108,7 @@ static double adapt(const outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d, 
            adapt(c, ab, bd, da, quarter, part[3], t, depth + 1, error);
 }
 
-static double integrate_triangle(const outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d,
+static double integrate_triangle(outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d,
                                  double accuracy, double *error)
 {
     double area = 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(d, a)));
@@ -97,20 +124,37 @@ static double integrate_triangle(const outer_context *c, rad_vec3 a, rad_vec3 b,
     return adapt(c, a, b, d, area, whole, tolerance, 1, error);
 }
 
-double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accuracy,
-                         double plane_epsilon, double *bound)
+/* G = int over the smaller polygon of F(x -> the other, as far as it is visible). */
+static double integrate_outer(outer_context *c, const vf_polygon *outer, double accuracy,
+                              double *bound)
 {
-    /* integrate over the smaller polygon: G = int_outer F(x -> inner) dA_x */
-    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
-    outer_context c = {outer->normal, inner, plane_epsilon};
     double error = 0, sum = 0;
     /* the tolerance is shared by the outer polygon's triangles */
     double part_accuracy = outer->count == 4 ? 0.5 * accuracy : accuracy;
     for (unsigned k = 1; k + 1 < outer->count; k++)
-        sum += integrate_triangle(&c, outer->vertex[0], outer->vertex[k], outer->vertex[k + 1],
+        sum += integrate_triangle(c, outer->vertex[0], outer->vertex[k], outer->vertex[k + 1],
                                   part_accuracy, &error);
     *bound = error;
     return sum;
+}
+
+double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accuracy,
+                         double plane_epsilon, double *bound)
+{
+    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
+    outer_context c = {outer->normal, inner, plane_epsilon, NULL, 0, MAX_DEPTH, 0, false};
+    return integrate_outer(&c, outer, accuracy, bound);
+}
+
+bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
+                           const shadow_occluder *occluders, uint32_t occluder_count,
+                           double accuracy, double plane_epsilon, double *value, double *bound)
+{
+    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
+    outer_context c = {outer->normal,       inner, plane_epsilon, occluders, occluder_count,
+                       OBSTRUCTED_MAX_DEPTH, EXACT_WORK_BUDGET, false};
+    *value = integrate_outer(&c, outer, accuracy, bound);
+    return !c.failed;
 }
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)

@@ -4,7 +4,10 @@
  * Unobstructed: the outer integral of Lambert's contour formula (exact point-to-polygon
  * factor) over the smaller polygon by adaptive quadrature: a 7-point degree-5 rule on each
  * triangle, compared with its 4 children, split further where they disagree, to a
- * relative tolerance. Obstructed: that value times the visible fraction, estimated from
+ * relative tolerance. Obstructed by a few triangles: the same integral of the exact factor
+ * to the part left visible by their shadows (shadow_clip.h). Obstructed by many, or when
+ * the visible part breaks into too many pieces: the unobstructed value times the visible
+ * fraction, estimated from
  * replicated stratified segments between the polygons, weighted by the kernel
  * cos cos / r^2; rounds of 4x more segments until the estimate's error bound meets the
  * target or the ray budget is spent. The result never exceeds the unobstructed value.
@@ -13,6 +16,7 @@
 #define RAD_VIEWFACTOR_PAIR_TRANSFER_H
 
 #include "radiosity.h"
+#include "viewfactor/shadow_clip.h"
 #include "viewfactor/vf_geometry.h"
 
 /* Replicates of the visibility estimate; its spread gives the error bound. */
@@ -26,8 +30,20 @@
 double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accuracy,
                          double plane_epsilon, double *bound);
 
+/* The obstructed transfer by exact shadow clipping at every quadrature point
+ * (shadow_clip.h), to relative tolerance `accuracy`; false when the visible part broke into
+ * too many pieces (sample instead). */
+bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
+                           const shadow_occluder *occluders, uint32_t occluder_count,
+                           double accuracy, double plane_epsilon, double *value, double *bound);
+
 /* Scratch space for the sampled visibility of one thread. */
+/* Pairs with at most this many triangles in between get exact shadow clipping; pairs with
+ * more are sampled. */
+#define PAIR_EXACT_MAX_OCCLUDERS 8u
+
 typedef struct pair_workspace {
+    shadow_occluder occluders[PAIR_EXACT_MAX_OCCLUDERS];
     rad_ray *rays;
     uint8_t *occluded;
     double *weight;

@@ -13,8 +13,9 @@
 #include "core/vec3.h"
 
 /* Two triangles form one flat quad when the fourth corner lies within this fraction of the
- * quad's diagonal from the first triangle's plane (dimensionless). */
-#define QUAD_FLATNESS 1e-9
+ * quad's diagonal from the first triangle's plane (dimensionless): input read as floats
+ * (Assimp) rounds a flat quad's corners by about 1e-7. */
+#define QUAD_FLATNESS 1e-6
 
 typedef struct edge_use {
     uint32_t low, high; /* vertex indices, low < high */
