@@ -95,6 +95,14 @@ typedef struct rad_camera {
 /* ------------------------------------------------------------------------------------ */
 /* Scene: triangles with materials, grouped into named surfaces                          */
 
+/* An albedo texture: linear RGB texels (decoded from 8-bit sRGB PNG or JPEG), row 0 at
+ * the top. */
+typedef struct rad_texture {
+    char source[512]; /* the image file, or "FILE#N" for an image a glb embeds */
+    uint32_t width, height;
+    float *rgb;       /* width * height * 3 */
+} rad_texture;
+
 typedef struct rad_material {
     char name[128];
     rad_rgb albedo;   /* diffuse reflectance rho, linear RGB in [0,1] (MTL Kd) */
@@ -102,6 +110,9 @@ typedef struct rad_material {
     rad_rgb specular; /* Phong specular and mirror reflectance K_S, [0,1] (MTL Ks); radiosity
                          ignores it, the ray tracer and `render --specular` use it */
     double shininess; /* Phong exponent n (MTL Ns), >= 0 */
+    uint32_t albedo_texture; /* 1 + index into rad_scene.textures (MTL map_Kd, glTF
+                                baseColorTexture): the albedo is then `albedo` times the
+                                texel; 0 = none */
 } rad_material;
 
 /* A surface is what the user named: an OBJ object (o) or group (g). Its triangles are the
@@ -140,6 +151,10 @@ typedef struct rad_scene {
     uint32_t material_count;
     rad_surface *surfaces;
     uint32_t surface_count;
+    rad_texture *textures;
+    uint32_t texture_count;
+    float (*uv)[3][2]; /* per triangle, per corner texture coordinates (u, v), v = 0 at an
+                          image's bottom; NULL when no textured triangle has any */
     bool has_camera;   /* the file (or the built-in scene) defines a camera */
     rad_camera camera; /* valid when has_camera */
     rad_vec3 up;        /* the file's up direction, unit length: (0,1,0) unless the file says
@@ -236,6 +251,12 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
                           rad_error *error);
 
 void rad_mesh_destroy(rad_mesh *mesh);
+
+/* Each patch's albedo: its material's, or for a textured material the average of albedo
+ * times texel over the patch (8 x 8 points). `albedo` receives mesh->patch_count values.
+ * rad_system_from_mesh uses it. */
+rad_status rad_patch_albedo(const rad_scene *scene, const rad_mesh *mesh, rad_rgb *albedo,
+                            rad_error *error);
 
 /* ------------------------------------------------------------------------------------ */
 /* Tracer: ray queries against a triangle set                                            */
@@ -541,6 +562,11 @@ typedef struct rad_render_options {
     int threads;
     rad_progress_fn progress;
     void *progress_user;
+    /* The scene the mesh was built from, for its albedo textures: a hit on a textured
+     * surface shows its emission plus the texel's albedo times the irradiance
+     * reconstructed from (B - E) / (the patch's average albedo), so texture detail finer
+     * than the patches survives. NULL (or no textures): the solution alone. */
+    const rad_scene *scene;
 } rad_render_options;
 
 /* Radiance at every mesh vertex: the area-weighted average of B/pi over the patches that

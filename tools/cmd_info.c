@@ -162,10 +162,11 @@ static void describe(report *r, const rad_scene *scene)
     say(r, "materials: %u\n", nm);
     for (uint32_t m = 0; m < nm; m++) {
         const rad_material *material = &scene->materials[m];
-        say(r, "  %-24s albedo (%.4g, %.4g, %.4g)  emission (%.4g, %.4g, %.4g)  %u triangles%s\n",
+        say(r, "  %-24s albedo (%.4g, %.4g, %.4g)%s  emission (%.4g, %.4g, %.4g)  %u triangles%s\n",
             material->name, material->albedo.r, material->albedo.g, material->albedo.b,
-            material->emission.r, material->emission.g, material->emission.b,
-            material_triangles[m], material_triangles[m] ? "" : " (unused)");
+            material->albedo_texture ? " x texture" : "", material->emission.r,
+            material->emission.g, material->emission.b, material_triangles[m],
+            material_triangles[m] ? "" : " (unused)");
     }
     unsigned emitters = 0;
     for (uint32_t m = 0; m < nm; m++)
@@ -182,7 +183,15 @@ static void describe(report *r, const rad_scene *scene)
             material_area[m], k * material->emission.r, k * material->emission.g,
             k * material->emission.b);
     }
-    say(r, "textures: 0\n");
+    say(r, "textures: %u\n", scene->texture_count);
+    for (uint32_t t = 0; t < scene->texture_count; t++) {
+        const rad_texture *texture = &scene->textures[t];
+        say(r, "  %s  %u x %u  used by", texture->source, texture->width, texture->height);
+        for (uint32_t m = 0; m < nm; m++)
+            if (scene->materials[m].albedo_texture == t + 1)
+                say(r, " %s", scene->materials[m].name);
+        say(r, "\n");
+    }
     free(listed_for);
     free(material_area);
     free(material_triangles);

@@ -134,6 +134,7 @@ int command_render(int argc, char **argv)
     rad_camera camera = cli_view_camera(&s.view, solved.scene);
     if (s.specular)
         s.render.materials = solved.scene->materials;
+    s.render.scene = solved.scene;
     status = rad_image_create(s.view.width, s.view.height, &image, &error);
     if (status == RAD_OK)
         status = rad_render(solved.mesh, solved.B, &camera, &s.render, image, &error);

@@ -8,7 +8,9 @@
  * (silhouettes, the light's rim) get edge_samples more. With the scene's materials given, a hit
  * on a surface with Ks > 0 also sends a mirror ray, weighted by Ks, whose hit is shaded
  * the same way (the radiosity solution replaces Whitted's ambient term), up to a depth.
- * Random numbers come from (seed, pixel).
+ * Random numbers come from (seed, pixel). With the scene's albedo textures, a textured
+ * patch's vertices hold the irradiance (B - E) / (pi rho_avg) instead, and a hit shows
+ * L_e + texel albedo x that, so texture detail finer than the patches survives.
  */
 #include <math.h>
 #include <omp.h>
@@ -22,6 +24,7 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "render/camera.h"
+#include "scene/texture.h"
 #include "trace/ray.h"
 
 #define MAX_STRATA 16u
@@ -49,6 +52,9 @@ typedef struct shading {
     const rad_material *materials;  /* NULL: no mirror rays */
     float t_near;
     double leave;                   /* how far mirror rays start off a surface (scene units) */
+    const albedo_lookup *textures;  /* NULL: no textured surface */
+    const rad_material *scene_materials; /* for textured hits: L_e */
+    const rad_rgb *patch_albedo;    /* per patch: the average the solve used */
 } shading;
 
 static double mean_luminance(const rad_rgb *samples, unsigned count)
@@ -75,6 +81,19 @@ static bool is_edge(const rad_rgb *samples, unsigned count, double mean)
     return hi - lo > EDGE_CONTRAST * mean;
 }
 
+/* A textured patch's radiance at a hit: L_e + texel albedo x interpolated irradiance. */
+static rad_rgb textured_radiance(const shading *sh, const rad_ray *ray, const rad_hit *hit,
+                                 uint32_t patch_index, rad_rgb irradiance)
+{
+    const rad_patch *patch = &sh->mesh->patches[patch_index];
+    rad_vec3 point = v3(ray->origin[0] + (double)hit->t * ray->direction[0],
+                        ray->origin[1] + (double)hit->t * ray->direction[1],
+                        ray->origin[2] + (double)hit->t * ray->direction[2]);
+    rad_rgb albedo = sh->patch_albedo[patch_index];
+    albedo_lookup_at(sh->textures, point, patch->normal, 2 * patch->bulge, &albedo);
+    return rgb_add(sh->scene_materials[patch->material].emission, rgb_mul(albedo, irradiance));
+}
+
 /* Adds each hit's interpolated radiance (times the ray's weight) to its sample and, when
  * mirrors are allowed, writes the mirror rays of specular hits to the front of the arrays.
  * Returns how many rays are left for the next bounce. */
@@ -90,6 +109,10 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
         rad_rgb weight = w->weight[r];
         rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit->u - hit->v),
                                        rgb_add(rgb_scale(L[v[1]], hit->u), rgb_scale(L[v[2]], hit->v)));
+        uint32_t patch_index = sh->patch_of[hit->triangle];
+        if (sh->textures &&
+            albedo_lookup_textured(sh->textures, sh->mesh->patches[patch_index].material))
+            interpolated = textured_radiance(sh, &w->rays[r], hit, patch_index, interpolated);
         rgb_add_to(&w->sum[w->sample[r]], rgb_mul(weight, interpolated));
         if (!mirrors || !sh->materials)
             continue;
@@ -123,6 +146,42 @@ static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work 
     }
 }
 
+/* With textures: the lookup, each patch's average albedo, and the per-patch values to
+ * reconstruct: (B - E) / rho_avg on textured patches (0 where rho_avg is 0), B elsewhere.
+ * All NULL when the scene has no textured triangle. */
+static rad_status textures_begin(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
+                                 albedo_lookup **lookup, rad_rgb **patch_albedo,
+                                 rad_rgb **shaded, rad_error *error)
+{
+    *lookup = NULL;
+    *patch_albedo = *shaded = NULL;
+    if (!scene || scene->texture_count == 0)
+        return RAD_OK;
+    rad_status status = albedo_lookup_create(scene, lookup, error);
+    if (status != RAD_OK || !*lookup)
+        return status;
+    *patch_albedo = rad_alloc_array(mesh->patch_count, sizeof(**patch_albedo));
+    *shaded = rad_alloc_array(mesh->patch_count, sizeof(**shaded));
+    if (!*patch_albedo || !*shaded)
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for textures");
+    status = rad_patch_albedo(scene, mesh, *patch_albedo, error);
+    if (status != RAD_OK)
+        return status;
+    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        uint32_t m = mesh->patches[p].material;
+        if (!albedo_lookup_textured(*lookup, m)) {
+            (*shaded)[p] = B[p];
+            continue;
+        }
+        const double *b = &B[p].r, *e = &scene->materials[m].emission.r;
+        const double *rho = &(*patch_albedo)[p].r;
+        double *out = &(*shaded)[p].r;
+        for (int c = 0; c < 3; c++)
+            out[c] = rho[c] > 0 ? (b[c] - RAD_PI * e[c]) / rho[c] : 0;
+    }
+    return RAD_OK;
+}
+
 rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
                       const rad_render_options *options, rad_image *image, rad_error *error)
 {
@@ -151,6 +210,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     rad_rgb *radiance = rad_alloc_array(mesh->vertex_count, sizeof(*radiance));
     rad_tracer *tracer = NULL;
     row_work *work = NULL;
+    albedo_lookup *lookup = NULL;
+    rad_rgb *patch_albedo = NULL, *shaded = NULL;
     if (!triangles || !patch_of || !radiance || triangle_count > UINT32_MAX)
         goto nomem;
     size_t t = 0;
@@ -163,7 +224,10 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
             patch_of[t++] = p;
         }
     }
-    rad_reconstruct_vertices(mesh, B, radiance);
+    status = textures_begin(options->scene, mesh, B, &lookup, &patch_albedo, &shaded, error);
+    if (status != RAD_OK)
+        goto done;
+    rad_reconstruct_vertices(mesh, shaded ? shaded : B, radiance);
     status = rad_tracer_create(RAD_TRACER_EMBREE, mesh->vertices, mesh->vertex_count,
                                (const uint32_t(*)[3])triangles, (uint32_t)triangle_count,
                                &tracer, error);
@@ -202,7 +266,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
             goto nomem;
     }
     shading shade = {mesh, (const uint32_t(*)[3])triangles, patch_of, radiance, options->materials,
-                     t_near, leave};
+                     t_near, leave, lookup, options->scene ? options->scene->materials : NULL,
+                     patch_albedo};
 
     uint32_t rows_done = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
@@ -295,5 +360,8 @@ done:
     free(triangles);
     free(patch_of);
     free(radiance);
+    albedo_lookup_destroy(lookup);
+    free(patch_albedo);
+    free(shaded);
     return status;
 }

@@ -10,8 +10,10 @@
  * file's name without folder and extension; (3) maps materials onto METHOD.md's units:
  * Kd / glTF baseColorFactor = albedo, Ke / glTF emissiveFactor x emissiveStrength =
  * emitted radiance; a format's "no material" (STL, PLY without a material element, OBJ
- * faces before any usemtl, glTF primitives without one) gets RAD_DEFAULT_ALBEDO; (4) takes
- * the first glTF camera, and the up axis and unit from the file's metadata.
+ * faces before any usemtl, glTF primitives without one) gets RAD_DEFAULT_ALBEDO; albedo
+ * textures are decoded once each and triangles of textured materials keep their texture
+ * coordinates; (4) takes the first glTF camera, and the up axis and unit from the file's
+ * metadata.
  */
 #include <assimp/cimport.h>
 #include <assimp/material.h>
@@ -32,6 +34,14 @@
 #include "core/vec3.h"
 #include "scene/gltf_json.h"
 #include "scene/scene_builder.h"
+#include "scene/texture.h"
+
+enum { TEXTURE_CACHE = 256 };
+
+typedef struct texture_key {
+    char key[1600];         /* the texture's file, or "*N" for an embedded one */
+    uint32_t index;         /* rad_material.albedo_texture */
+} texture_key;
 
 static bool has_extension(const char *path, const char *extension)
 {
@@ -118,6 +128,9 @@ typedef struct import_state {
     bool ply_without_materials;
     char stem[128];         /* the file's name without folder and extension */
     const rad_load_options *options;
+    uint8_t *textured;      /* Assimp material index -> its albedo has a texture */
+    texture_key *cache;     /* textures already read (TEXTURE_CACHE at most) */
+    unsigned cache_count;
 } import_state;
 
 static bool near_value(double a, double b)
@@ -175,10 +188,10 @@ static const gltf_material *gltf_material_of(const import_state *state, unsigned
     return found;
 }
 
-/* Albedo textures (MTL map_Kd, glTF baseColorTexture) are not applied yet: the albedo is the
- * material's Kd / baseColorFactor. A user hears which, and when the file is missing. */
-static void check_texture(const import_state *state, const struct aiMaterial *m,
-                          const char *material)
+/* The albedo texture (MTL map_Kd, glTF baseColorTexture: Assimp's diffuse texture 0) of
+ * material m: a file beside the scene, or an image a glb embeds ("*N"). A texture that is
+ * missing or cannot be decoded is a warning: the albedo is then the material's colour. */
+static void take_texture(import_state *state, const struct aiMaterial *m, rad_material *material)
 {
     struct aiString texture;
     if (aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &texture, NULL, NULL, NULL, NULL, NULL,
@@ -187,18 +200,60 @@ static void check_texture(const import_state *state, const struct aiMaterial *m,
         return;
     rad_log_fn log = state->options ? state->options->log : NULL;
     void *user = state->options ? state->options->log_user : NULL;
-    char folder[4096], file[8192];
-    folder_of(state->path, folder, sizeof(folder));
-    snprintf(file, sizeof(file), "%s%s", texture.data[0] == '/' ? "" : folder, texture.data);
-    struct stat st;
-    if (texture.data[0] != '*' && (stat(file, &st) != 0 || !S_ISREG(st.st_mode)))
-        rad_warn(log, user, "%s: material '%s': texture '%s' not found; its albedo is the "
-                 "material's colour",
-                 state->path, material, texture.data);
-    else
-        rad_warn(log, user, "%s: material '%s': texture '%s' is not applied (not supported "
-                 "yet); its albedo is the material's colour",
-                 state->path, material, texture.data);
+    char key[sizeof(state->cache[0].key)];
+    if (texture.data[0] == '*' || texture.data[0] == '/')
+        snprintf(key, sizeof(key), "%s", texture.data);
+    else {
+        char folder[512];
+        folder_of(state->path, folder, sizeof(folder));
+        snprintf(key, sizeof(key), "%s%s", folder, texture.data);
+    }
+    for (unsigned k = 0; k < state->cache_count; k++)
+        if (strcmp(state->cache[k].key, key) == 0) {
+            material->albedo_texture = state->cache[k].index;
+            return;
+        }
+    rad_texture decoded;
+    rad_error why = {0};
+    rad_status status = RAD_ERR_IO;
+    if (texture.data[0] == '*') {
+        char name[600];
+        unsigned long n = strtoul(texture.data + 1, NULL, 10);
+        const struct aiTexture *embedded = n < state->ai->mNumTextures ? state->ai->mTextures[n]
+                                                                       : NULL;
+        snprintf(name, sizeof(name), "%.500s#%lu", state->path, n);
+        if (!embedded)
+            snprintf(why.message, sizeof(why.message), "embedded texture %lu is not in the file",
+                     n);
+        else if (embedded->mHeight != 0)
+            snprintf(why.message, sizeof(why.message),
+                     "embedded texture %lu is raw texels (not supported)", n);
+        else
+            status = texture_decode(name, (const unsigned char *)embedded->pcData,
+                                    embedded->mWidth, &decoded, &why);
+    } else {
+        struct stat st;
+        if (stat(key, &st) != 0 || !S_ISREG(st.st_mode)) {
+            rad_warn(log, user, "%s: material '%s': texture '%s' not found; its albedo is the "
+                     "material's colour",
+                     state->path, material->name, texture.data);
+            return;
+        }
+        status = texture_load_file(key, &decoded, &why);
+    }
+    if (status != RAD_OK) {
+        rad_warn(log, user, "%s: material '%s': texture '%s': %s; its albedo is the material's "
+                 "colour",
+                 state->path, material->name, texture.data, why.message);
+        return;
+    }
+    material->albedo_texture = scene_builder_texture(state->builder, &decoded);
+    if (!state->cache)
+        state->cache = rad_alloc_array(TEXTURE_CACHE, sizeof(*state->cache));
+    if (material->albedo_texture && state->cache && state->cache_count < TEXTURE_CACHE) {
+        snprintf(state->cache[state->cache_count].key, sizeof(state->cache[0].key), "%s", key);
+        state->cache[state->cache_count++].index = material->albedo_texture;
+    }
 }
 
 static rad_status map_material(import_state *state, unsigned index, uint32_t *out,
@@ -250,7 +305,9 @@ static rad_status map_material(import_state *state, unsigned index, uint32_t *ou
                     material.shininess = shininess;
             }
         }
-        check_texture(state, m, material.name);
+        if (!is_default)
+            take_texture(state, m, &material);
+        state->textured[index] = material.albedo_texture != 0;
         state->material_map[index] = scene_builder_material(state->builder, &material);
         if (state->material_map[index] == UINT32_MAX)
             return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", state->path);
@@ -294,11 +351,14 @@ static rad_status add_mesh(import_state *state, const struct aiMesh *mesh,
     rad_status status = map_material(state, mesh->mMaterialIndex, &material, error);
     if (status != RAD_OK)
         return status;
+    const struct aiVector3D *uvs =
+        state->textured[mesh->mMaterialIndex] ? mesh->mTextureCoords[0] : NULL;
     for (unsigned f = 0; f < mesh->mNumFaces; f++) {
         const struct aiFace *face = &mesh->mFaces[f];
         if (face->mNumIndices != 3)
             continue;
         rad_vec3 corner[3];
+        float uv[3][2];
         for (int k = 0; k < 3; k++) {
             unsigned index = face->mIndices[k];
             if (index >= mesh->mNumVertices)
@@ -306,9 +366,15 @@ static rad_status add_mesh(import_state *state, const struct aiMesh *mesh,
                                 "%s: surface '%s': face %u uses vertex %u of %u", state->path,
                                 name, f, index, mesh->mNumVertices);
             corner[k] = transform(to_world, mesh->mVertices[index]);
+            if (uvs) {
+                uv[k][0] = uvs[index].x;
+                uv[k][1] = uvs[index].y;
+            }
         }
-        status = scene_builder_triangle(state->builder, surface, material, corner[0], corner[1],
-                                        corner[2], error);
+        status = uvs ? scene_builder_triangle_uv(state->builder, surface, material, corner,
+                                                 (const float(*)[2])uv, error)
+                     : scene_builder_triangle(state->builder, surface, material, corner[0],
+                                              corner[1], corner[2], error);
         if (status != RAD_OK)
             return status;
     }
@@ -450,7 +516,7 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
         return rad_fail(error, RAD_ERR_IO, "%s: cannot open: not a file", path);
     }
     rad_status status = RAD_OK;
-    import_state state = {NULL, NULL, NULL, path, NULL, false, "", options};
+    import_state state = {NULL, NULL, NULL, path, NULL, false, "", options, NULL, NULL, 0};
     gltf_info gltf = {0};
     bool is_gltf = has_extension(path, ".gltf") || has_extension(path, ".glb");
     if (has_extension(path, ".obj"))
@@ -488,7 +554,8 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
         goto done;
     state.builder = builder;
     state.material_map = rad_alloc_array(ai->mNumMaterials, sizeof(*state.material_map));
-    if (!state.material_map) {
+    state.textured = rad_alloc_array(ai->mNumMaterials, sizeof(*state.textured));
+    if (!state.material_map || !state.textured) {
         status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", path);
         goto done;
     }
@@ -508,6 +575,8 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
 done:
     scene_builder_destroy(builder);
     free(state.material_map);
+    free(state.textured);
+    free(state.cache);
     gltf_info_free(&gltf);
     aiReleaseImport(ai);
     return status;

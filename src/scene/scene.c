@@ -19,6 +19,10 @@ void rad_scene_destroy(rad_scene *scene)
     free(scene->triangles);
     free(scene->materials);
     free(scene->surfaces);
+    for (uint32_t t = 0; t < scene->texture_count; t++)
+        free(scene->textures[t].rgb);
+    free(scene->textures);
+    free(scene->uv);
     free(scene);
 }
 

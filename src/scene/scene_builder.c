@@ -20,6 +20,8 @@
 
 typedef struct raw_triangle {
     rad_vec3 corner[3];
+    float uv[3][2];
+    bool has_uv;
     uint32_t material, surface;
     uint32_t order; /* position in the input: keeps the sort by surface stable */
 } raw_triangle;
@@ -35,6 +37,9 @@ struct scene_builder {
     size_t surface_count, surface_capacity;
     uint32_t *surface_slots; /* name hash table: surface index + 1, 0 = empty */
     size_t surface_slot_count;
+    rad_texture *textures;
+    size_t texture_count, texture_capacity;
+    bool any_uv;
     bool has_camera;
     rad_camera camera;
     rad_vec3 up;
@@ -63,6 +68,9 @@ void scene_builder_destroy(scene_builder *b)
     free(b->materials);
     free(b->surfaces);
     free(b->surface_slots);
+    for (size_t t = 0; t < b->texture_count; t++)
+        free(b->textures[t].rgb);
+    free(b->textures);
     free(b);
 }
 
@@ -140,7 +148,38 @@ rad_status scene_builder_triangle(scene_builder *b, uint32_t surface, uint32_t m
     t->material = material;
     t->surface = surface;
     t->order = (uint32_t)(b->triangle_count - 1);
+    t->has_uv = false;
+    memset(t->uv, 0, sizeof(t->uv));
     return RAD_OK;
+}
+
+rad_status scene_builder_triangle_uv(scene_builder *b, uint32_t surface, uint32_t material,
+                                     const rad_vec3 corner[3], const float uv[3][2],
+                                     rad_error *error)
+{
+    rad_status status =
+        scene_builder_triangle(b, surface, material, corner[0], corner[1], corner[2], error);
+    if (status == RAD_OK) {
+        raw_triangle *t = &b->triangles[b->triangle_count - 1];
+        memcpy(t->uv, uv, sizeof(t->uv));
+        t->has_uv = true;
+        b->any_uv = true;
+    }
+    return status;
+}
+
+uint32_t scene_builder_texture(scene_builder *b, rad_texture *texture)
+{
+    if (b->texture_count >= UINT32_MAX - 1 ||
+        !rad_grow_array((void **)&b->textures, &b->texture_capacity, b->texture_count + 1,
+                        sizeof(*b->textures))) {
+        free(texture->rgb);
+        texture->rgb = NULL;
+        return 0;
+    }
+    b->textures[b->texture_count++] = *texture;
+    texture->rgb = NULL;
+    return (uint32_t)b->texture_count;
 }
 
 void scene_builder_set_camera(scene_builder *b, const rad_camera *camera)
@@ -284,6 +323,17 @@ rad_status scene_builder_finish(scene_builder *b, rad_scene **out, rad_error *er
     scene->surfaces = rad_alloc_array(b->surface_count, sizeof(*scene->surfaces));
     if (!scene->triangles || !scene->surfaces)
         goto nomem;
+    if (b->any_uv) {
+        scene->uv = rad_alloc_array(kept, sizeof(*scene->uv));
+        if (!scene->uv)
+            goto nomem;
+        for (size_t t = 0; t < kept; t++)
+            memcpy(scene->uv[t], b->triangles[t].uv, sizeof(scene->uv[t]));
+    }
+    /* a texture index out of range (a bug of a source) becomes no texture */
+    for (size_t m = 0; m < b->material_count; m++)
+        if (b->materials[m].albedo_texture > b->texture_count)
+            b->materials[m].albedo_texture = 0;
 
     /* surfaces that kept triangles, renumbered in order of first appearance */
     uint32_t *surface_map = skipped; /* reuse after warning */
@@ -321,6 +371,10 @@ rad_status scene_builder_finish(scene_builder *b, rad_scene **out, rad_error *er
     scene->materials = b->materials;
     scene->material_count = (uint32_t)b->material_count;
     b->materials = NULL;
+    scene->textures = b->textures;
+    scene->texture_count = (uint32_t)b->texture_count;
+    b->textures = NULL;
+    b->texture_count = 0;
     scene->has_camera = b->has_camera;
     scene->camera = b->camera;
     scene->up = b->up;

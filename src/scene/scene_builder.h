@@ -28,6 +28,15 @@ uint32_t scene_builder_surface(scene_builder *builder, const char *name);
 rad_status scene_builder_triangle(scene_builder *builder, uint32_t surface, uint32_t material,
                                   rad_vec3 a, rad_vec3 b, rad_vec3 c, rad_error *error);
 
+/* The same with texture coordinates (u, v) for each corner. */
+rad_status scene_builder_triangle_uv(scene_builder *builder, uint32_t surface,
+                                     uint32_t material, const rad_vec3 corner[3],
+                                     const float uv[3][2], rad_error *error);
+
+/* Takes the texture (its texels now belong to the scene); returns 1 + its index, for
+ * rad_material.albedo_texture, or 0 when out of memory (the texture is then freed). */
+uint32_t scene_builder_texture(scene_builder *builder, rad_texture *texture);
+
 void scene_builder_set_camera(scene_builder *builder, const rad_camera *camera);
 
 /* The file's up direction (unit; (0,1,0) unless set) and metres per unit (0 = unknown). */

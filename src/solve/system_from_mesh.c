@@ -1,7 +1,8 @@
 /*
  * system_from_mesh.c - the per-patch arrays of the radiosity system from a mesh.
  *
- * Exitance E_i = pi * L_e (the material's emitted radiance, METHOD.md section 3).
+ * Exitance E_i = pi * L_e (the material's emitted radiance, METHOD.md section 3); albedo
+ * rho_i the material's, or its average over the patch for a textured one.
  */
 #include <stdint.h>
 #include <stdlib.h>
@@ -33,6 +34,15 @@ rad_status rad_system_from_mesh(const rad_scene *scene, const rad_mesh *mesh,
         albedo[i] = m->albedo;
         exitance[i] = (rad_rgb){RAD_PI * m->emission.r, RAD_PI * m->emission.g,
                                 RAD_PI * m->emission.b};
+    }
+    if (scene->texture_count > 0) {
+        rad_status status = rad_patch_albedo(scene, mesh, albedo, error);
+        if (status != RAD_OK) {
+            free(area);
+            free(albedo);
+            free(exitance);
+            return status;
+        }
     }
     system->n = n;
     system->F = formfactors ? formfactors->F : NULL;
