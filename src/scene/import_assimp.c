@@ -270,10 +270,13 @@ static rad_status map_material(import_state *state, unsigned index, uint32_t *ou
         const gltf_material *gltf = state->gltf ? gltf_material_of(state, index, m, name.data)
                                                 : NULL;
         /* Assimp's stand-in when the file has no material: "DefaultMaterial" (OBJ, STL,
-         * Collada; 3DS adds "_N"), an unnamed one after glTF's own, PLY's only one */
+         * Collada; 3DS adds "_N"), the unnamed one it appends after glTF's own, PLY's only
+         * one */
+        bool gltf_default = state->gltf && !gltf && name.data[0] == 0 &&
+                            index + 1 == state->ai->mNumMaterials;
         bool is_default = strncmp(name.data, AI_DEFAULT_MATERIAL_NAME,
                                   strlen(AI_DEFAULT_MATERIAL_NAME)) == 0 ||
-                          (state->gltf && !gltf) || state->ply_without_materials;
+                          gltf_default || state->ply_without_materials;
         rad_material material = {0};
         if (is_default) {
             snprintf(material.name, sizeof(material.name), "default");
