@@ -392,12 +392,14 @@ typedef struct rad_viewfactor_matrix {
 } rad_viewfactor_matrix;
 
 typedef struct rad_viewfactor_options {
-    double accuracy;     /* relative error target of each factor; 0 = 1e-4. Pairs meet it
-                            by adaptive quadrature of the exact point-to-polygon factor
-                            (shadows of up to 8 occluding triangles clipped exactly);
-                            pairs behind more occluders sample visibility until their
-                            error bound meets it or max_rays */
-    uint32_t max_rays;   /* visibility rays per obstructed polygon pair at most; 0 = 4096 */
+    double accuracy;     /* 0 = 1e-4. Relative error target of each factor computed by
+                            adaptive quadrature of the exact point-to-polygon factor
+                            (unobstructed, or behind up to 4 triangles whose shadows are
+                            clipped exactly). Pairs behind more occluders sample
+                            visibility until the absolute error bound of their F is at
+                            most accuracy x sqrt(F unobstructed), so a row's sum stays
+                            within accuracy, or until max_rays */
+    uint32_t max_rays;   /* visibility rays per sampled polygon pair at most; 0 = 1024 */
     uint64_t seed;
     int threads;         /* 0 = all cores */
     rad_progress_fn progress;
@@ -413,7 +415,7 @@ typedef struct rad_viewfactor_report {
     uint64_t capped_pairs;       /* sampled pairs that reached max_rays first */
     uint64_t rays;               /* visibility rays cast */
     uint64_t nonzeros;           /* stored factors */
-    double largest_error_bound;  /* largest error_bound / F_IJ over the stored factors */
+    double largest_error_bound;  /* largest error_bound (absolute, in units of F) */
     double seconds;
     int threads;
 } rad_viewfactor_report;

@@ -23,8 +23,8 @@ static const char usage[] =
     "\n"
     "  -o, --output FILE    write the CSV here (atomically)\n"
     "  --accuracy E         relative error target of each factor (default 1e-4)\n"
-    "  --max-rays N         visibility rays per obstructed polygon pair at most\n"
-    "                       (default 4096)\n"
+    "  --max-rays N         visibility rays per sampled polygon pair at most\n"
+    "                       (default 1024)\n"
     CLI_SCENE_HELP
     "  --threads N          worker threads (default: all cores)\n"
     "  --seed N             seed of the sample points (default 1)\n"
@@ -107,9 +107,9 @@ int command_viewfactors(int argc, char **argv)
             check.reciprocity, check.largest_planar_self, check.largest_row_sum);
     if (check.closed)
         fprintf(stderr, "; closed enclosure: largest |row sum - 1| %.3g", check.row_sum_deviation);
-    fprintf(stderr, "\nradiosity: largest error bound %.3g of its factor", report.largest_error_bound);
+    fprintf(stderr, "\nradiosity: largest error bound of a factor %.3g (absolute)", report.largest_error_bound);
     if (report.capped_pairs)
-        fprintf(stderr, " (%llu obstructed pairs reached --max-rays first)",
+        fprintf(stderr, " (%llu sampled pairs reached --max-rays first)",
                 (unsigned long long)report.capped_pairs);
     fputc('\n', stderr);
     if (check.largest > 1 || check.smallest < 0 || check.largest_planar_self > 0) {

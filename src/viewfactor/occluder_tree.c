@@ -17,8 +17,8 @@
 #include "core/vec3.h"
 
 #define LEAF_SIZE 4u
-#define MAX_CORNERS 8u
-#define MAX_PLANES 56u /* 8 choose 3 */
+#define MAX_CORNERS (2u * VF_MAX_VERTICES)
+#define MAX_PLANES (2u + 2u * VF_MAX_VERTICES * VF_MAX_VERTICES)
 #define MAX_DEPTH 64u
 
 typedef struct tree_node {
@@ -29,7 +29,8 @@ typedef struct tree_node {
 typedef struct tree_triangle {
     rad_vec3 corner[3];
     rad_vec3 normal; /* unit */
-    uint32_t index;  /* scene triangle */
+    uint32_t source; /* the radiating polygon it belongs to (vf_polygon.source), or
+                        UINT32_MAX */
 } tree_triangle;
 
 struct occluder_tree {
@@ -46,7 +47,7 @@ typedef struct hull {
     double offset[MAX_PLANES];
     unsigned plane_count;
     double lo[3], hi[3];
-    uint32_t exclude[4];
+    uint32_t exclude[2]; /* the sources of the two polygons */
 } hull;
 
 static double axis(rad_vec3 v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
@@ -104,7 +105,8 @@ static int build_node(occluder_tree *tree, uint32_t node, uint32_t first, uint32
            build_node(tree, children + 1, first + left, count - left, centres, depth + 1);
 }
 
-rad_status occluder_tree_build(const rad_scene *scene, occluder_tree **out, rad_error *error)
+rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_source,
+                               occluder_tree **out, rad_error *error)
 {
     *out = NULL;
     occluder_tree *tree = calloc(1, sizeof(*tree));
@@ -125,7 +127,7 @@ rad_status occluder_tree_build(const rad_scene *scene, occluder_tree **out, rad_
             tt->corner[c] = scene->positions[scene->triangles[t].vertex[c]];
         tt->normal = v3_normalize(v3_cross(v3_sub(tt->corner[1], tt->corner[0]),
                                            v3_sub(tt->corner[2], tt->corner[0])));
-        tt->index = t;
+        tt->source = triangle_source[t];
         centres[t] = v3_scale(v3_add(v3_add(tt->corner[0], tt->corner[1]), tt->corner[2]),
                               1.0 / 3);
     }
@@ -164,18 +166,25 @@ static void make_hull(hull *h, const vf_polygon *p, const vf_polygon *q, double 
             h->hi[a] = fmax(h->hi[a], axis(h->corner[k], a));
         }
     }
+    /* the hull's faces: the two polygons' planes, and planes through an edge of one and a
+     * corner of the other that have every corner on one side */
     h->plane_count = 0;
     unsigned n = h->corner_count;
-    for (unsigned i = 0; i < n; i++)
-        for (unsigned j = i + 1; j < n; j++)
-            for (unsigned k = j + 1; k < n; k++) {
-                rad_vec3 normal = v3_cross(v3_sub(h->corner[j], h->corner[i]),
-                                           v3_sub(h->corner[k], h->corner[i]));
+    h->normal[h->plane_count] = v3_scale(p->normal, -1);
+    h->offset[h->plane_count++] = -v3_dot(p->normal, p->vertex[0]);
+    h->normal[h->plane_count] = v3_scale(q->normal, -1);
+    h->offset[h->plane_count++] = -v3_dot(q->normal, q->vertex[0]);
+    for (int side = 0; side < 2; side++) {
+        const vf_polygon *a = side ? q : p, *b = side ? p : q;
+        for (unsigned e = 0; e < a->count; e++) {
+            rad_vec3 e0 = a->vertex[e], e1 = a->vertex[(e + 1) % a->count];
+            for (unsigned c = 0; c < b->count; c++) {
+                rad_vec3 normal = v3_cross(v3_sub(e1, e0), v3_sub(b->vertex[c], e0));
                 double length = v3_length(normal);
                 if (!(length > 0))
                     continue;
                 normal = v3_scale(normal, 1 / length);
-                double offset = v3_dot(normal, h->corner[i]);
+                double offset = v3_dot(normal, e0);
                 bool below = true, above = true;
                 for (unsigned m = 0; m < n && (below || above); m++) {
                     double d = v3_dot(normal, h->corner[m]) - offset;
@@ -191,6 +200,8 @@ static void make_hull(hull *h, const vf_polygon *p, const vf_polygon *q, double 
                 h->normal[h->plane_count] = normal;
                 h->offset[h->plane_count++] = offset;
             }
+        }
+    }
 }
 
 static bool box_outside(const hull *h, const tree_node *node, double epsilon)
@@ -212,9 +223,8 @@ static bool box_outside(const hull *h, const tree_node *node, double epsilon)
 
 static bool triangle_cuts(const hull *h, const tree_triangle *t, double epsilon)
 {
-    for (unsigned e = 0; e < 4; e++)
-        if (t->index == h->exclude[e])
-            return false;
+    if (t->source == h->exclude[0] || t->source == h->exclude[1])
+        return false;
     for (unsigned k = 0; k < h->plane_count; k++) {
         rad_vec3 n = h->normal[k];
         double o = h->offset[k];
@@ -241,10 +251,8 @@ uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
     uint32_t found = 0;
     hull h;
     make_hull(&h, p, q, epsilon);
-    h.exclude[0] = p->triangle[0];
-    h.exclude[1] = p->triangle[1];
-    h.exclude[2] = q->triangle[0];
-    h.exclude[3] = q->triangle[1];
+    h.exclude[0] = p->source;
+    h.exclude[1] = q->source;
     uint32_t stack[2 * MAX_DEPTH + 2];
     unsigned top = 0;
     stack[top++] = 0;

@@ -16,7 +16,10 @@
 
 typedef struct occluder_tree occluder_tree;
 
-rad_status occluder_tree_build(const rad_scene *scene, occluder_tree **out, rad_error *error);
+/* triangle_source: per scene triangle, the radiating polygon covering it (its own
+ * triangles never block a polygon's view), or UINT32_MAX (vf_geometry.triangle_source). */
+rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_source,
+                               occluder_tree **out, rad_error *error);
 void occluder_tree_destroy(occluder_tree *tree);
 
 /* The triangles other than the polygons' own that may cut the hull of p and q (touching

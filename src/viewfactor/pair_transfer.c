@@ -22,7 +22,7 @@
 /* Exact shadow clipping may spend this many (point, occluder) clippings on one pair, about
  * a millisecond; a pair that needs more is sampled instead, so the run time stays
  * predictable. */
-#define EXACT_WORK_BUDGET 8192u
+#define EXACT_WORK_BUDGET 4096u
 
 /* Largest k of a round's k x k stratified segments per replicate. */
 #define MAX_STRATA 32u
@@ -129,11 +129,10 @@ static double integrate_outer(outer_context *c, const vf_polygon *outer, double 
                               double *bound)
 {
     double error = 0, sum = 0;
-    /* the tolerance is shared by the outer polygon's triangles */
-    double part_accuracy = outer->count == 4 ? 0.5 * accuracy : accuracy;
+    /* each fan triangle to the relative accuracy: so is their sum */
     for (unsigned k = 1; k + 1 < outer->count; k++)
         sum += integrate_triangle(c, outer->vertex[0], outer->vertex[k], outer->vertex[k + 1],
-                                  part_accuracy, &error);
+                                  accuracy, &error);
     *bound = error;
     return sum;
 }
@@ -177,20 +176,15 @@ void pair_workspace_free(pair_workspace *workspace)
  * one of its two triangles by area with s. */
 static rad_vec3 polygon_point(const vf_polygon *polygon, double s, double t)
 {
-    rad_vec3 a = polygon->vertex[0], b = polygon->vertex[1], c = polygon->vertex[2];
-    if (polygon->count == 4) {
-        double first = 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(c, a)));
-        double split = first / polygon->area;
-        if (s < split) {
-            s = s / split;
-        } else {
-            s = (s - split) / (1 - split);
-            b = c;
-            c = polygon->vertex[3];
-        }
-    }
-    double r = sqrt(s);
-    return barycentric(a, b, c, 1 - r, r * (1 - t), r * t);
+    /* the fan triangle (0, k, k + 1) by area with s, then s rescaled within it */
+    unsigned k = 0;
+    while (k + 3 < polygon->count && s >= polygon->fan[k])
+        k++;
+    double low = k ? polygon->fan[k - 1] : 0, high = polygon->fan[k];
+    s = high > low ? (s - low) / (high - low) : 0;
+    double r = sqrt(fmin(fmax(s, 0), 1));
+    return barycentric(polygon->vertex[0], polygon->vertex[k + 1], polygon->vertex[k + 2], 1 - r,
+                       r * (1 - t), r * t);
 }
 
 /* One round: PAIR_REPLICATES independent stratified sets of k x k segments. */

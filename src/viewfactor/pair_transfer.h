@@ -40,7 +40,7 @@ bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
 /* Scratch space for the sampled visibility of one thread. */
 /* Pairs with at most this many triangles in between get exact shadow clipping; pairs with
  * more are sampled. */
-#define PAIR_EXACT_MAX_OCCLUDERS 8u
+#define PAIR_EXACT_MAX_OCCLUDERS 4u
 
 typedef struct pair_workspace {
     shadow_occluder occluders[PAIR_EXACT_MAX_OCCLUDERS];

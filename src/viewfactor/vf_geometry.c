@@ -12,14 +12,17 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 
-/* Two triangles form one flat quad when the fourth corner lies within this fraction of the
- * quad's diagonal from the first triangle's plane (dimensionless): input read as floats
- * (Assimp) rounds a flat quad's corners by about 1e-7. */
-#define QUAD_FLATNESS 1e-6
+/* A polygon joins a neighbour when the neighbour's corners lie within this fraction of
+ * the union's size from its plane and the normals agree as closely (dimensionless): input
+ * read as floats (Assimp) rounds a flat face's corners by about 1e-7. */
+#define MERGE_FLATNESS 1e-6
+
+/* A corner is dropped as collinear when the turn there is below this (sine of the angle). */
+#define COLLINEAR_SINE 1e-9
 
 typedef struct edge_use {
     uint32_t low, high; /* vertex indices, low < high */
-    uint32_t triangle;
+    uint32_t polygon;
 } edge_use;
 
 static int compare_edges(const void *a, const void *b)
@@ -29,7 +32,86 @@ static int compare_edges(const void *a, const void *b)
         return x->low < y->low ? -1 : 1;
     if (x->high != y->high)
         return x->high < y->high ? -1 : 1;
-    return x->triangle < y->triangle ? -1 : x->triangle > y->triangle;
+    return x->polygon < y->polygon ? -1 : x->polygon > y->polygon;
+}
+
+/* A polygon under construction: scene vertex indices, counter-clockwise. */
+typedef struct draft {
+    uint32_t corner[VF_MAX_VERTICES];
+    unsigned count;
+    rad_vec3 normal;
+    uint32_t merged_into; /* itself while alive */
+} draft;
+
+static uint32_t find_alive(draft *drafts, uint32_t d)
+{
+    while (drafts[d].merged_into != d) {
+        drafts[d].merged_into = drafts[drafts[d].merged_into].merged_into;
+        d = drafts[d].merged_into;
+    }
+    return d;
+}
+
+static rad_vec3 draft_normal(const rad_scene *scene, const uint32_t *corner, unsigned count)
+{
+    rad_vec3 sum = {0, 0, 0};
+    for (unsigned k = 0; k < count; k++)
+        sum = v3_add(sum, v3_cross(scene->positions[corner[k]],
+                                   scene->positions[corner[(k + 1) % count]]));
+    return v3_normalize(sum);
+}
+
+/* Joins b into a across their shared edge when the result is flat, convex and small enough. */
+static bool try_merge(const rad_scene *scene, draft *a, const draft *b)
+{
+    if (v3_dot(a->normal, b->normal) < 1 - MERGE_FLATNESS)
+        return false;
+    /* find the edge a[i] -> a[i+1] that b runs as b[j+1] -> b[j] */
+    for (unsigned i = 0; i < a->count; i++) {
+        uint32_t u = a->corner[i], v = a->corner[(i + 1) % a->count];
+        for (unsigned j = 0; j < b->count; j++) {
+            if (b->corner[j] != v || b->corner[(j + 1) % b->count] != u)
+                continue;
+            uint32_t joined[2 * VF_MAX_VERTICES];
+            unsigned n = 0;
+            for (unsigned k = 0; k <= i; k++)
+                joined[n++] = a->corner[k];
+            /* b's corners from after u round to before v */
+            for (unsigned k = 2; k < b->count; k++)
+                joined[n++] = b->corner[(j + k) % b->count];
+            for (unsigned k = i + 1; k < a->count; k++)
+                joined[n++] = a->corner[k];
+            /* flatness of the union, convexity, and collinear corners dropped */
+            rad_vec3 origin = scene->positions[joined[0]];
+            double size = 0;
+            for (unsigned k = 0; k < n; k++)
+                size = fmax(size, v3_length(v3_sub(scene->positions[joined[k]], origin)));
+            for (unsigned k = 0; k < n; k++)
+                if (fabs(v3_dot(a->normal, v3_sub(scene->positions[joined[k]], origin))) >
+                    MERGE_FLATNESS * size)
+                    return false;
+            uint32_t kept[2 * VF_MAX_VERTICES];
+            unsigned m = 0;
+            for (unsigned k = 0; k < n; k++) {
+                rad_vec3 prev = scene->positions[joined[(k + n - 1) % n]];
+                rad_vec3 here = scene->positions[joined[k]];
+                rad_vec3 next = scene->positions[joined[(k + 1) % n]];
+                rad_vec3 in = v3_sub(here, prev), out = v3_sub(next, here);
+                double turn = v3_dot(a->normal, v3_cross(in, out));
+                double scale = v3_length(in) * v3_length(out);
+                if (turn < -COLLINEAR_SINE * scale)
+                    return false; /* reflex: not convex */
+                if (turn > COLLINEAR_SINE * scale)
+                    kept[m++] = joined[k];
+            }
+            if (m < 3 || m > VF_MAX_VERTICES)
+                return false;
+            memcpy(a->corner, kept, m * sizeof(uint32_t));
+            a->count = m;
+            return true;
+        }
+    }
+    return false;
 }
 
 static void finish_polygon(vf_polygon *polygon)
@@ -47,53 +129,31 @@ static void finish_polygon(vf_polygon *polygon)
     for (unsigned k = 0; k < polygon->count; k++)
         polygon->radius =
             fmax(polygon->radius, v3_length(v3_sub(polygon->vertex[k], polygon->centroid)));
-}
-
-/* The quad a, b, d, c when triangle t = (a, b, c) and its neighbour across edge b-c, with
- * third corner d, are coplanar and their union is convex. */
-static bool try_quad(const rad_scene *scene, uint32_t t, uint32_t u, vf_polygon *quad)
-{
-    const uint32_t *tv = scene->triangles[t].vertex, *uv = scene->triangles[u].vertex;
-    for (unsigned k = 0; k < 3; k++) {
-        uint32_t a = tv[k], b = tv[(k + 1) % 3], c = tv[(k + 2) % 3];
-        for (unsigned m = 0; m < 3; m++) {
-            if (uv[m] != c || uv[(m + 1) % 3] != b)
-                continue;
-            uint32_t d = uv[(m + 2) % 3];
-            rad_vec3 corner[4] = {scene->positions[a], scene->positions[b],
-                                  scene->positions[d], scene->positions[c]};
-            rad_vec3 n = v3_normalize(
-                v3_cross(v3_sub(corner[1], corner[0]), v3_sub(corner[3], corner[0])));
-            double diagonal = v3_length(v3_sub(corner[2], corner[0]));
-            if (fabs(v3_dot(n, v3_sub(corner[2], corner[0]))) > QUAD_FLATNESS * diagonal)
-                return false;
-            for (unsigned e = 0; e < 4; e++) {
-                rad_vec3 edge = v3_sub(corner[(e + 1) % 4], corner[e]);
-                rad_vec3 next = v3_sub(corner[(e + 2) % 4], corner[(e + 1) % 4]);
-                if (v3_dot(n, v3_cross(edge, next)) <= 0)
-                    return false; /* not strictly convex */
-            }
-            memcpy(quad->vertex, corner, sizeof(corner));
-            quad->count = 4;
-            quad->triangle[0] = t;
-            quad->triangle[1] = u;
-            return true;
-        }
+    double running = 0;
+    for (unsigned k = 1; k + 1 < polygon->count; k++) {
+        rad_vec3 a = polygon->vertex[0];
+        running += 0.5 * v3_length(v3_cross(v3_sub(polygon->vertex[k], a),
+                                            v3_sub(polygon->vertex[k + 1], a)));
+        polygon->fan[k - 1] = polygon->area > 0 ? running / polygon->area : 1;
     }
-    return false;
+    polygon->fan[polygon->count - 3] = 1;
 }
 
-/* Polygons of one surface: triangles paired into quads where they can be. */
+/* Polygons of one surface: its triangles merged greedily across shared edges. */
 static uint32_t surface_polygons(const rad_scene *scene, const rad_surface *surface,
-                                 uint32_t index, edge_use *edges, uint8_t *used,
-                                 vf_polygon *out)
+                                 uint32_t index, uint32_t first_source, edge_use *edges,
+                                 draft *drafts, uint32_t *triangle_source, vf_polygon *out)
 {
     uint32_t first = surface->first_triangle, count = surface->triangle_count, made = 0;
     size_t edge_count = 0;
-    for (uint32_t t = first; t < first + count; t++) {
-        used[t - first] = 0;
+    for (uint32_t t = 0; t < count; t++) {
+        draft *d = &drafts[t];
+        memcpy(d->corner, scene->triangles[first + t].vertex, 3 * sizeof(uint32_t));
+        d->count = 3;
+        d->normal = draft_normal(scene, d->corner, 3);
+        d->merged_into = t;
         for (unsigned k = 0; k < 3; k++) {
-            uint32_t a = scene->triangles[t].vertex[k], b = scene->triangles[t].vertex[(k + 1) % 3];
+            uint32_t a = d->corner[k], b = d->corner[(k + 1) % 3];
             edges[edge_count++] = (edge_use){a < b ? a : b, a < b ? b : a, t};
         }
     }
@@ -102,34 +162,36 @@ static uint32_t surface_polygons(const rad_scene *scene, const rad_surface *surf
         /* an edge used by exactly two triangles of this surface */
         if (edges[e].low != edges[e + 1].low || edges[e].high != edges[e + 1].high)
             continue;
-        if (e + 2 < edge_count && edges[e + 2].low == edges[e].low &&
-            edges[e + 2].high == edges[e].high)
+        if ((e + 2 < edge_count && edges[e + 2].low == edges[e].low &&
+             edges[e + 2].high == edges[e].high) ||
+            (e > 0 && edges[e - 1].low == edges[e].low && edges[e - 1].high == edges[e].high))
             continue;
-        if (e > 0 && edges[e - 1].low == edges[e].low && edges[e - 1].high == edges[e].high)
+        uint32_t a = find_alive(drafts, edges[e].polygon);
+        uint32_t b = find_alive(drafts, edges[e + 1].polygon);
+        if (a == b)
             continue;
-        uint32_t t = edges[e].triangle, u = edges[e + 1].triangle;
-        if (used[t - first] || used[u - first])
-            continue;
-        vf_polygon quad = {0};
-        if (!try_quad(scene, t, u, &quad))
-            continue;
-        used[t - first] = used[u - first] = 1;
-        quad.surface = index;
-        finish_polygon(&quad);
-        out[made++] = quad;
+        if (try_merge(scene, &drafts[a], &drafts[b]))
+            drafts[b].merged_into = a;
     }
-    for (uint32_t t = first; t < first + count; t++) {
-        if (used[t - first])
-            continue;
-        vf_polygon triangle = {0};
-        for (unsigned k = 0; k < 3; k++)
-            triangle.vertex[k] = scene->positions[scene->triangles[t].vertex[k]];
-        triangle.count = 3;
-        triangle.triangle[0] = t;
-        triangle.triangle[1] = UINT32_MAX;
-        triangle.surface = index;
-        finish_polygon(&triangle);
-        out[made++] = triangle;
+    for (uint32_t t = 0; t < count; t++) {
+        if (drafts[t].merged_into != t)
+            continue; /* merged into another */
+        vf_polygon polygon = {0};
+        polygon.count = drafts[t].count;
+        for (unsigned k = 0; k < polygon.count; k++)
+            polygon.vertex[k] = scene->positions[drafts[t].corner[k]];
+        polygon.surface = index;
+        polygon.source = first_source + made;
+        finish_polygon(&polygon);
+        drafts[t].merged_into = UINT32_MAX - made; /* remember which polygon it became */
+        out[made++] = polygon;
+    }
+    for (uint32_t t = 0; t < count; t++) {
+        uint32_t d = t;
+        while (drafts[d].merged_into < count && drafts[d].merged_into != d)
+            d = drafts[d].merged_into;
+        uint32_t polygon = UINT32_MAX - drafts[d].merged_into;
+        triangle_source[first + t] = first_source + polygon;
     }
     return made;
 }
@@ -141,7 +203,7 @@ static void reverse_polygon(vf_polygon *polygon)
         polygon->vertex[k] = polygon->vertex[polygon->count - 1 - k];
         polygon->vertex[polygon->count - 1 - k] = swap;
     }
-    polygon->normal = v3_scale(polygon->normal, -1);
+    finish_polygon(polygon);
 }
 
 static void finish_surface(vf_surface *surface, const vf_polygon *polygons, double epsilon)
@@ -196,15 +258,20 @@ rad_status vf_geometry_build(const rad_scene *scene, vf_geometry *geometry, rad_
     geometry->polygons = rad_alloc_array(polygon_capacity ? polygon_capacity : 1,
                                          sizeof(vf_polygon));
     edge_use *edges = rad_alloc_array(3 * largest + 1, sizeof(edge_use));
-    uint8_t *used = rad_alloc_array(largest + 1, 1);
-    if (!geometry->surfaces || !geometry->polygons || !edges || !used) {
+    draft *drafts = rad_alloc_array(largest + 1, sizeof(draft));
+    geometry->triangle_source = rad_alloc_array(scene->triangle_count ? scene->triangle_count : 1,
+                                                sizeof(uint32_t));
+    if (!geometry->surfaces || !geometry->polygons || !edges || !drafts ||
+        !geometry->triangle_source) {
         free(edges);
-        free(used);
+        free(drafts);
         vf_geometry_free(geometry);
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for %zu view-factor polygons",
                         polygon_capacity);
     }
-    uint32_t made = 0;
+    for (uint32_t t = 0; t < scene->triangle_count; t++)
+        geometry->triangle_source[t] = UINT32_MAX;
+    uint32_t made = 0, sources = 0;
     for (uint32_t s = 0; s < scene->surface_count; s++) {
         const rad_surface *surface = &scene->surfaces[s];
         vf_surface *out = &geometry->surfaces[s];
@@ -212,8 +279,9 @@ rad_status vf_geometry_build(const rad_scene *scene, vf_geometry *geometry, rad_
         out->first_polygon = made;
         if (surface->flags & RAD_SURFACE_OBSTRUCTION || surface->triangle_count == 0)
             continue;
-        uint32_t count = surface_polygons(scene, surface, s, edges, used,
-                                          geometry->polygons + made);
+        uint32_t count = surface_polygons(scene, surface, s, sources, edges, drafts,
+                                          geometry->triangle_source, geometry->polygons + made);
+        sources += count;
         if (surface->flags & RAD_SURFACE_TWO_SIDED)
             for (uint32_t k = 0; k < count; k++) {
                 geometry->polygons[made + count + k] = geometry->polygons[made + k];
@@ -225,7 +293,7 @@ rad_status vf_geometry_build(const rad_scene *scene, vf_geometry *geometry, rad_
     }
     geometry->polygon_count = made;
     free(edges);
-    free(used);
+    free(drafts);
     return RAD_OK;
 }
 
@@ -233,5 +301,6 @@ void vf_geometry_free(vf_geometry *geometry)
 {
     free(geometry->polygons);
     free(geometry->surfaces);
+    free(geometry->triangle_source);
     memset(geometry, 0, sizeof(*geometry));
 }

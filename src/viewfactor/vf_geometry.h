@@ -2,26 +2,33 @@
  * vf_geometry.h - the scene as the view-factor engine sees it: convex planar polygons
  * grouped by surface.
  *
- * Every triangle of a radiating surface becomes a polygon; two triangles of one surface that
- * share an edge and together form a flat convex quadrilateral become one quad (a wall given
- * as two triangles is one polygon again, which quarters the pair count). A two-sided surface
- * gets every polygon twice, the second copy reversed. Obstruction surfaces get no polygons:
- * they only block, through the occluder tree and the tracer.
+ * The triangles of a radiating surface are merged into maximal flat convex polygons of at
+ * most VF_MAX_VERTICES corners: neighbours across a shared edge join when they are coplanar
+ * and their union is convex (collinear corners dropped). A wall exported as two triangles,
+ * or as many, is one polygon again, which divides the pair count by the square of what was
+ * merged. A two-sided surface gets every polygon twice, the second copy reversed.
+ * Obstruction surfaces get no polygons: they only block, through the occluder tree and
+ * the tracer.
  */
 #ifndef RAD_VIEWFACTOR_VF_GEOMETRY_H
 #define RAD_VIEWFACTOR_VF_GEOMETRY_H
 
 #include "radiosity.h"
 
+#define VF_MAX_VERTICES 6
+
 typedef struct vf_polygon {
-    rad_vec3 vertex[4];  /* counter-clockwise seen from the front */
-    unsigned count;      /* 3 or 4 */
+    rad_vec3 vertex[VF_MAX_VERTICES]; /* counter-clockwise seen from the front */
+    unsigned count;      /* 3 to VF_MAX_VERTICES */
+    double fan[VF_MAX_VERTICES - 2]; /* cumulative area fractions of the fan triangles
+                                        (0, k, k + 1): uniform sampling */
     rad_vec3 normal;     /* unit front normal */
     double area;
     rad_vec3 centroid;
     double radius;       /* largest distance from the centroid to a corner */
     uint32_t surface;
-    uint32_t triangle[2]; /* the scene triangles it covers; triangle[1] = UINT32_MAX for one */
+    uint32_t source;     /* which merged polygon it is: the two copies of a two-sided
+                            polygon share it, and so do the scene triangles it covers */
 } vf_polygon;
 
 typedef struct vf_surface {
@@ -40,6 +47,8 @@ typedef struct vf_geometry {
     uint32_t polygon_count;
     vf_surface *surfaces; /* one per scene surface; obstructions have no polygons */
     uint32_t surface_count;
+    uint32_t *triangle_source; /* per scene triangle: the source of the polygon covering it,
+                                  UINT32_MAX for obstructions */
     double plane_epsilon; /* in front of a plane means beyond this distance (scene units) */
 } vf_geometry;
 

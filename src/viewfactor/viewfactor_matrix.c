@@ -28,7 +28,7 @@
 #include "viewfactor/vf_geometry.h"
 
 #define DEFAULT_ACCURACY 1e-4
-#define DEFAULT_MAX_RAYS 4096u
+#define DEFAULT_MAX_RAYS 1024u
 
 typedef struct row_entry {
     uint32_t column;
@@ -92,29 +92,42 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
         !vf_polygon_in_front(p, q->normal, v3_dot(q->normal, q->vertex[0]), eps))
         return 0;
     counts->polygon_pairs++;
-    double quadrature_error;
-    double unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
-    if (!(unobstructed > 0))
-        return 0;
+    double quadrature_error, unobstructed;
     uint32_t occluders = occluder_tree_collect(e->tree, p, q, eps, w->occluders,
                                                PAIR_EXACT_MAX_OCCLUDERS);
     if (occluders == 0) {
+        unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
         *bound = quadrature_error;
-        return unobstructed;
+        return fmax(unobstructed, 0);
     }
     counts->obstructed_pairs++;
     if (occluders <= PAIR_EXACT_MAX_OCCLUDERS) {
         double visible, error;
         if (pair_obstructed_exact(p, q, w->occluders, occluders, 0.25 * e->accuracy, eps,
                                   &visible, &error)) {
+            unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
             *bound = error;
-            return fmin(visible, unobstructed);
+            return fmax(fmin(visible, unobstructed), 0);
         }
     }
     counts->sampled_pairs++;
     pair_visibility visibility;
     uint64_t stream = rad_mix64(e->seed ^ rad_mix64(((uint64_t)pi << 32) | qi));
-    pair_sample_visibility(p, q, e->occluders, e->accuracy, e->max_rays, stream, w, &visibility);
+    /* a first look: most pairs behind many occluders are wholly hidden */
+    pair_sample_visibility(p, q, e->occluders, INFINITY, e->max_rays, stream, w, &visibility);
+    counts->rays += visibility.rays;
+    if (visibility.fraction == 0)
+        return 0;
+    unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
+    if (!(unobstructed > 0))
+        return 0;
+    /* The target: the absolute error of F (seen from the smaller polygon, F0 unobstructed)
+     * at most accuracy * sqrt(F0), so that a row's errors, added in quadrature, stay
+     * within accuracy (the F0 of a row sum to at most 1) while small factors take few
+     * rays. */
+    double f0 = fmin(unobstructed / fmin(p->area, q->area), 1);
+    pair_sample_visibility(p, q, e->occluders, e->accuracy / sqrt(f0), e->max_rays, stream, w,
+                           &visibility);
     counts->rays += visibility.rays;
     counts->capped_pairs += visibility.capped;
     *bound = quadrature_error + visibility.bound * unobstructed;
@@ -255,7 +268,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     rad_status status = vf_geometry_build(scene, &geometry, error);
     if (status != RAD_OK)
         return status;
-    status = occluder_tree_build(scene, &tree, error);
+    status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
     uint32_t n = scene->surface_count;
@@ -342,9 +355,8 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         report->rays = totals.rays;
         report->nonzeros = matrix->row_start[n];
         for (uint64_t k = 0; k < matrix->row_start[n]; k++)
-            if (matrix->value[k] > 0)
-                report->largest_error_bound =
-                    fmax(report->largest_error_bound, matrix->error_bound[k] / matrix->value[k]);
+            report->largest_error_bound =
+                fmax(report->largest_error_bound, matrix->error_bound[k]);
         report->seconds = now_seconds() - start;
         report->threads = threads;
     }
