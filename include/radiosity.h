@@ -409,7 +409,9 @@ typedef struct rad_viewfactor_options {
 typedef struct rad_viewfactor_report {
     uint64_t surface_pairs;      /* surface pairs considered */
     uint64_t polygon_pairs;      /* triangle pairs that face each other */
-    uint64_t obstructed_pairs;   /* of those, pairs with something in between */
+    uint64_t hidden_pairs;       /* of those, pairs whose first segments (40, stratified)
+                                    were all blocked: taken as wholly hidden, F = 0 */
+    uint64_t obstructed_pairs;   /* of the others, pairs with something in between */
     uint64_t sampled_pairs;      /* of those, pairs with too many occluders for exact
                                     shadow clipping: visibility sampled */
     uint64_t capped_pairs;       /* sampled pairs that reached max_rays first */

@@ -96,11 +96,11 @@ int command_viewfactors(int argc, char **argv)
     rad_viewfactor_matrix_check(matrix, scene, &check);
     size_t S = scene->surface_count;
     fprintf(stderr,
-            "radiosity: %zu surfaces, %llu polygon pairs (%llu obstructed, %llu of them "
-            "sampled), %llu rays, %llu non-zero factors, %.2f s\n"
+            "radiosity: %zu surfaces, %llu polygon pairs (%llu hidden, %llu obstructed, %llu "
+            "of them sampled), %llu rays, %llu non-zero factors, %.2f s\n"
             "radiosity: F in [%.6g, %.6g]; reciprocity residual %.2e; planar F_ii %.2g; "
             "largest row sum %.6f",
-            S, (unsigned long long)report.polygon_pairs,
+            S, (unsigned long long)report.polygon_pairs, (unsigned long long)report.hidden_pairs,
             (unsigned long long)report.obstructed_pairs,
             (unsigned long long)report.sampled_pairs, (unsigned long long)report.rays,
             (unsigned long long)report.nonzeros, cli_now() - t0, check.smallest, check.largest,
@@ -143,6 +143,7 @@ int command_viewfactors(int argc, char **argv)
         stats_integer(&stats, "surfaces", S);
         stats_integer(&stats, "surface_pairs", report.surface_pairs);
         stats_integer(&stats, "polygon_pairs", report.polygon_pairs);
+        stats_integer(&stats, "hidden_pairs", report.hidden_pairs);
         stats_integer(&stats, "obstructed_pairs", report.obstructed_pairs);
         stats_integer(&stats, "sampled_pairs", report.sampled_pairs);
         stats_integer(&stats, "capped_pairs", report.capped_pairs);

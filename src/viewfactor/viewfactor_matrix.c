@@ -42,7 +42,8 @@ typedef struct pending_row {
 } pending_row;
 
 typedef struct pair_counts {
-    uint64_t surface_pairs, polygon_pairs, obstructed_pairs, sampled_pairs, capped_pairs, rays;
+    uint64_t surface_pairs, polygon_pairs, hidden_pairs, obstructed_pairs, sampled_pairs,
+        capped_pairs, rays;
 } pair_counts;
 
 typedef struct engine {
@@ -93,6 +94,16 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
         return 0;
     counts->polygon_pairs++;
     double quadrature_error, unobstructed;
+    uint64_t stream = rad_mix64(e->seed ^ rad_mix64(((uint64_t)pi << 32) | qi));
+    pair_visibility visibility;
+    /* a first look with a few dozen segments: most pairs of a large scene are wholly
+     * hidden, and need no more work than that */
+    pair_sample_visibility(p, q, e->occluders, INFINITY, e->max_rays, stream, w, &visibility);
+    counts->rays += visibility.rays;
+    if (visibility.fraction == 0) {
+        counts->hidden_pairs++;
+        return 0;
+    }
     uint32_t occluders = occluder_tree_collect(e->tree, p, q, eps, w->occluders,
                                                PAIR_EXACT_MAX_OCCLUDERS);
     if (occluders == 0) {
@@ -111,13 +122,6 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
         }
     }
     counts->sampled_pairs++;
-    pair_visibility visibility;
-    uint64_t stream = rad_mix64(e->seed ^ rad_mix64(((uint64_t)pi << 32) | qi));
-    /* a first look: most pairs behind many occluders are wholly hidden */
-    pair_sample_visibility(p, q, e->occluders, INFINITY, e->max_rays, stream, w, &visibility);
-    counts->rays += visibility.rays;
-    if (visibility.fraction == 0)
-        return 0;
     unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
     if (!(unobstructed > 0))
         return 0;
@@ -327,6 +331,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         {
             totals.surface_pairs += counts.surface_pairs;
             totals.polygon_pairs += counts.polygon_pairs;
+            totals.hidden_pairs += counts.hidden_pairs;
             totals.obstructed_pairs += counts.obstructed_pairs;
             totals.sampled_pairs += counts.sampled_pairs;
             totals.capped_pairs += counts.capped_pairs;
@@ -349,6 +354,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         memset(report, 0, sizeof(*report));
         report->surface_pairs = totals.surface_pairs;
         report->polygon_pairs = totals.polygon_pairs;
+        report->hidden_pairs = totals.hidden_pairs;
         report->obstructed_pairs = totals.obstructed_pairs;
         report->sampled_pairs = totals.sampled_pairs;
         report->capped_pairs = totals.capped_pairs;
