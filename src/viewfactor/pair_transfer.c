@@ -11,6 +11,7 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "formfactor/contour.h"
+#include "trace/ray.h"
 
 /* Deepest subdivision of the outer triangle: 4^12 cells would be far past any need. */
 #define MAX_DEPTH 12
@@ -215,16 +216,7 @@ static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
             double r2 = v3_dot(d, d);
             double cx = v3_dot(p->normal, d), cy = -v3_dot(q->normal, d);
             w->weight[n] = cx > 0 && cy > 0 && r2 > 0 ? cx * cy / (r2 * r2) : 0;
-            rad_ray *ray = &w->rays[n];
-            ray->origin[0] = (float)x.x;
-            ray->origin[1] = (float)x.y;
-            ray->origin[2] = (float)x.z;
-            ray->direction[0] = (float)d.x;
-            ray->direction[1] = (float)d.y;
-            ray->direction[2] = (float)d.z;
-            ray->t_near = RAD_SEGMENT_END_EPSILON;
-            ray->t_far = 1 - RAD_SEGMENT_END_EPSILON;
-            n++;
+            ray_set(&w->rays[n++], x, d, RAD_SEGMENT_END_EPSILON, 1 - RAD_SEGMENT_END_EPSILON);
         }
     }
     return n;

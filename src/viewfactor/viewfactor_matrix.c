@@ -57,29 +57,25 @@ typedef struct engine {
 
 static double now_seconds(void) { return omp_get_wtime(); }
 
-/* Either surface planar with the other wholly behind or on its plane: nothing passes. */
-static bool surfaces_face_away(const vf_geometry *g, const vf_surface *a, const vf_surface *b)
+/* `plane` is flat and `other` lies wholly behind or on its plane. */
+static bool behind_plane(const vf_geometry *g, const vf_surface *plane, const vf_surface *other)
 {
     double e = g->plane_epsilon;
-    if (a->planar) {
-        if (v3_dot(a->normal, b->center) - a->offset + b->radius <= e)
-            return true;
-        bool any = false;
-        for (uint32_t k = 0; k < b->polygon_count && !any; k++)
-            any = vf_polygon_in_front(&g->polygons[b->first_polygon + k], a->normal, a->offset, e);
-        if (!any)
-            return true;
-    }
-    if (b->planar) {
-        if (v3_dot(b->normal, a->center) - b->offset + a->radius <= e)
-            return true;
-        bool any = false;
-        for (uint32_t k = 0; k < a->polygon_count && !any; k++)
-            any = vf_polygon_in_front(&g->polygons[a->first_polygon + k], b->normal, b->offset, e);
-        if (!any)
-            return true;
-    }
-    return false;
+    if (!plane->planar)
+        return false;
+    if (v3_dot(plane->normal, other->center) - plane->offset + other->radius <= e)
+        return true;
+    for (uint32_t k = 0; k < other->polygon_count; k++)
+        if (vf_polygon_in_front(&g->polygons[other->first_polygon + k], plane->normal,
+                                plane->offset, e))
+            return false;
+    return true;
+}
+
+/* Either surface flat with the other wholly behind or on its plane: nothing passes. */
+static bool surfaces_face_away(const vf_geometry *g, const vf_surface *a, const vf_surface *b)
+{
+    return behind_plane(g, a, b) || behind_plane(g, b, a);
 }
 
 /* G_pq and its error bound; 0 when they do not face each other. */
