@@ -469,6 +469,7 @@ static void check_concentric_spheres(void)
     CHECK(fabs(f22 - (1 - ratio)) <= 2 * bound + 1e-4);
     CHECK(bound < 1e-2);
     CHECK_NEAR(f21, 0.25, 0.15); /* coarse meshes: the analytic limit only roughly */
+    CHECK_NEAR(f22, 0.75, 0.05);
 }
 
 int main(void)
