@@ -181,9 +181,84 @@ typedef struct rad_load_options {
  * node's, else the file's name without extension. The first glTF camera becomes the
  * scene's camera. Degenerate triangles are skipped with a warning; non-finite
  * coordinates, a missing material library or glTF buffer, a truncated .glb, an index out
- * of range, unreadable or empty files are errors. */
+ * of range, unreadable or empty files are errors. A View3D input file is read by
+ * rad_scene_load_vs3 below (*.vs3, or View3D content). */
 rad_status rad_scene_load(const char *path, const rad_load_options *options,
                           rad_scene **out, rad_error *error);
+
+/* The control line (`C`) and title (`T`) of a View3D input file, with View3D's defaults
+ * for what the file leaves out. radiosity honours `encl` and `emit` (the CLI applies
+ * --enclosure and --script-f for them) and reads the rest for the record: the engine has
+ * its own accuracy control, and always computes every row and column. */
+typedef struct rad_vs3_control {
+    char title[256];   /* the last T line, "" if none */
+    double eps;        /* integration convergence criterion; 1e-4 */
+    uint32_t max_u;    /* maxU: recursions for unobstructed factors; 12 */
+    uint32_t max_o;    /* maxO: recursions for obstructed factors; 8 */
+    uint32_t min_o;    /* minO: least recursions for obstructed factors; 0 */
+    uint32_t row, col; /* a single row / column to compute (0 = all) */
+    bool enclosure;    /* encl=1: the surfaces form an enclosure */
+    bool emit;         /* emit=1: report script-F factors with the surfaces' emissivities */
+    uint32_t out;      /* View3D's output format: 0 text, 1 binary */
+    uint32_t list;     /* View3D's log detail */
+} rad_vs3_control;
+
+/* Reads a View3D 3.x input file with `F 3` geometry (vertices and surfaces given
+ * separately). Lines (the first letter in either case; a token starting with `!` or `/`
+ * begins a comment, also after data):
+ *   T title            C name=value ...  (eps maxU maxO minO row col encl emit out list)
+ *   F 3                V n x y z
+ *   S|O|M|N n v1 v2 v3 v4 base cmb emit [name]    (v4 = 0 for a triangle)
+ *   E, e or * (End of data): the rest of the file is not read.
+ * Each S or O polygon becomes triangles of the surface named `name` (its number when the
+ * name is missing); counter-clockwise from the front as in View3D. A quadrilateral must
+ * be planar (its fourth vertex within 1e-5 of its size from the plane of the first three)
+ * and convex. `cmb` = K joins the polygon to surface K's (View3D's combination: the same
+ * view factors as its post-processing algebra; the emissivity is the area-weighted mean).
+ * O surfaces get RAD_SURFACE_OBSTRUCTION: they block, they have no row or column.
+ * `base` = K makes a subsurface (a window in wall K): as View3D's post-processing does,
+ * K's own factors and area then exclude the subsurface, which is done here by cutting
+ * the subsurface out of K's polygon into convex pieces. An N (null) surface is cut out of
+ * its base the same way and is kept as an obstruction (it still blocks, it has no row),
+ * which is View3D's "area of the base reduced, null removed from the matrix". Checked,
+ * each with the line number: subsurfaces and null surfaces lie in their base's plane,
+ * inside it, facing the same way (null: the opposite way); base and cmb refer to earlier
+ * surfaces. Not supported (RAD_ERR_UNSUPPORTED naming the line): `F 3a` and other
+ * geometry kinds, and M (mask) surfaces, whose View3D result (the masked part of the base
+ * exchanges only with the mask, F_mask,base = 1) is not a view factor of any geometry
+ * the engine computes. Errors with the line number: a malformed line, an undefined or
+ * repeated vertex, a vertex used twice in one surface, a non-planar or non-convex
+ * quadrilateral, a zero-area surface, a repeated surface number or name, an emissivity
+ * outside (0,1], a bad control value. Unknown control names are warnings. `control`
+ * (optional) receives the C and T lines. rad_scene_load calls this for files named
+ * *.vs3 and for files whose content is View3D's (first data line T, C, F, V, S, O, M or
+ * N, and an `F 3` line). */
+rad_status rad_scene_load_vs3(const char *path, const rad_load_options *options,
+                              rad_scene **out, rad_vs3_control *control, rad_error *error);
+
+/* True when rad_scene_load would read `path` as a View3D file (by name or content, as
+ * above); false too when it cannot be opened. */
+bool rad_scene_is_vs3(const char *path);
+
+/* One input of rad_scene_load_files. */
+typedef struct rad_scene_file {
+    const char *path;
+    uint32_t flags; /* RAD_SURFACE_* for the file's surface */
+} rad_scene_file;
+
+/* Several mesh files (any format rad_scene_load reads) as one scene in which each file is
+ * ONE surface, named after the file's base name without its extension ("walls/north.stl"
+ * is "north"), with `flags` (RAD_SURFACE_OBSTRUCTION for meshes that only block) and the
+ * area-weighted mean emissivity of the file's own surfaces. Two files with the same base
+ * name are RAD_ERR_INVALID. Materials are kept. */
+rad_status rad_scene_load_files(const rad_scene_file *files, uint32_t count,
+                                const rad_load_options *options, rad_scene **out,
+                                rad_error *error);
+
+/* Sets `flags` (ORed in) on the surface named `name`; RAD_ERR_INVALID naming it when the
+ * scene has no such surface. */
+rad_status rad_scene_set_surface_flags(rad_scene *scene, const char *name, uint32_t flags,
+                                       rad_error *error);
 
 /* The Cornell box of the Cornell University Program of Computer Graphics (millimetres,
  * y up), with its official camera. Same geometry and materials as
@@ -451,6 +526,58 @@ typedef struct rad_viewfactor_check {
 
 void rad_viewfactor_matrix_check(const rad_viewfactor_matrix *matrix, const rad_scene *scene,
                                  rad_viewfactor_check *check);
+
+/* An empty matrix to fill by hand (tests, tools, post-processing): n surfaces and room for
+ * `nonzeros` entries, every array zeroed (row_start all 0). The caller fills area,
+ * row_start, column (ascending within a row), value and error_bound. Free with
+ * rad_viewfactor_matrix_destroy. */
+rad_status rad_viewfactor_matrix_create(uint32_t n, uint64_t nonzeros,
+                                        rad_viewfactor_matrix **out, rad_error *error);
+
+/* What the enclosure correction did. Relative changes are |dF_IJ| / F_IJ. */
+typedef struct rad_enclosure_report {
+    double row_deviation_before;   /* max_I |sum_J F_IJ - 1| before the correction */
+    double row_deviation_after;    /* the same after it (about 1e-14) */
+    double largest_relative_change; /* max over stored factors of |dF_IJ| / F_IJ */
+    double reciprocity_after;      /* max |A_I F_IJ - A_J F_JI| / max(A_I F_IJ, A_J F_JI) */
+    uint32_t iterations;           /* conjugate-gradient iterations */
+} rad_enclosure_report;
+
+/* Makes a closed enclosure's rows sum to 1 while keeping reciprocity exact: with the
+ * symmetric transfers G_IJ = A_I F_IJ (the mean of A_I F_IJ and A_J F_JI where they
+ * differ), it finds the correction dG minimising sum over stored entries (I,J) of
+ * dG_IJ^2 / G_IJ^2 (relative changes; factors that are 0 stay 0) subject to
+ * sum_J (G_IJ + dG_IJ) = A_I for every row. Lagrange multipliers give dG_IJ = G_IJ^2
+ * (mu_I + mu_J), diagonal entries (curved surfaces) included, and mu solves the sparse
+ * symmetric positive system sum_J G_IJ^2 (mu_I + mu_J) = A_I - sum_J G_IJ, by
+ * preconditioned conjugate gradients to 1e-14 relative. Values change in place; areas,
+ * the sparsity pattern and the error bounds stay. Surfaces flagged
+ * RAD_SURFACE_OBSTRUCTION in `scene` (NULL: none) are left out. RAD_ERR_INVALID, with
+ * the matrix untouched, when a row is empty (a surface that sees nothing cannot sum to
+ * 1), when F_IJ is stored without F_JI, when the system is singular (a group of surfaces
+ * that see only each other in two alternating sets, as two facing plates with nothing
+ * else: rows can then be scaled in opposite directions) or when a factor would change
+ * sign. */
+rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *matrix,
+                                                 const rad_scene *scene,
+                                                 rad_enclosure_report *report,
+                                                 rad_error *error);
+
+/* Largest matrix rad_viewfactor_matrix_script_f accepts (dense LU, n^3 work). */
+#define RAD_SCRIPT_F_MAX_SURFACES 4096u
+
+/* Grey-body total exchange factors (Hottel's script-F; View3D's `emit` option): with
+ * emissivities eps_I in (0,1] (reflectance 1 - eps_I, diffuse),
+ *   scriptF_IJ = eps_I [ (I - F diag(1 - eps))^-1 F ]_IJ eps_J,
+ * the fraction of the energy emitted by I that is absorbed by J after any number of
+ * diffuse reflections. Reciprocity A_I scriptF_IJ = A_J scriptF_JI holds when it holds
+ * for F; in a closed enclosure each row sums to eps_I. Dense LU with partial pivoting:
+ * more than RAD_SCRIPT_F_MAX_SURFACES surfaces is RAD_ERR_UNSUPPORTED, a singular system
+ * RAD_ERR_INVALID. `*out` is a new matrix (same areas; zeros not stored; error_bound is
+ * F's bound scaled by eps_I eps_J, the first-order bound without the reflections). */
+rad_status rad_viewfactor_matrix_script_f(const rad_viewfactor_matrix *matrix,
+                                          const double *emissivity,
+                                          rad_viewfactor_matrix **out, rad_error *error);
 
 /* ------------------------------------------------------------------------------------ */
 /* Solvers for (I - diag(rho) F) B = E                                                   */
@@ -767,6 +894,45 @@ rad_status rad_solution_match(const rad_solution *solution, const rad_scene *sce
                               const rad_mesh *mesh, rad_error *error);
 
 void rad_solution_destroy(rad_solution *solution);
+
+/* Layouts of a surface view-factor matrix file. */
+typedef enum rad_viewfactor_format {
+    RAD_VIEWFACTOR_CSV = 0,       /* "surface,NAME1,...", then "NAMEi,F_i1,..." (%.9g) */
+    RAD_VIEWFACTOR_MATRIX_MARKET, /* "%%MatrixMarket matrix coordinate real general", then
+                                     "% surface K AREA NAME" comment lines naming the rows
+                                     in order with their areas, "ROWS COLUMNS NONZEROS" and
+                                     one "I J F_IJ" line per stored factor, 1-based, %.17g */
+    RAD_VIEWFACTOR_VIEW3D         /* View3D's text output (its SaveF0 layout, what its
+                                     ViewHT and readers take): the header
+                                     "View3D 3.3 0 ENCL EMIT N" padded to 30 characters,
+                                     the areas (%g), one row of N factors per surface
+                                     (%.6f), the emissivities (%.3f) */
+} rad_viewfactor_format;
+
+/* The format named by a file's extension: .mtx is Matrix Market, anything else CSV
+ * (View3D's layout has no extension of its own: ask for it explicitly). */
+rad_viewfactor_format rad_viewfactor_format_for_path(const char *path);
+
+typedef struct rad_viewfactor_write_options {
+    rad_viewfactor_format format;
+    bool enclosure; /* View3D header's `encl` field: the rows were closed (--enclosure) */
+    bool script_f;  /* View3D header's `emit` field: the values are script-F factors */
+} rad_viewfactor_write_options;
+
+/* Writes the matrix of `scene`'s surfaces (matrix->n == scene->surface_count). Surfaces
+ * flagged RAD_SURFACE_OBSTRUCTION are left out of every layout (rows and columns; Matrix
+ * Market indices count only the surfaces written). options NULL = CSV. Atomic like
+ * rad_image_write. */
+rad_status rad_viewfactor_matrix_write(const rad_scene *scene,
+                                       const rad_viewfactor_matrix *matrix, const char *path,
+                                       const rad_viewfactor_write_options *options,
+                                       rad_error *error);
+
+/* The same to an open stream (standard output, say). */
+rad_status rad_viewfactor_matrix_print(const rad_scene *scene,
+                                       const rad_viewfactor_matrix *matrix, FILE *stream,
+                                       const rad_viewfactor_write_options *options,
+                                       rad_error *error);
 
 /* Writes `size` bytes to path atomically (temporary name, then rename). */
 rad_status rad_write_file_atomic(const char *path, const void *data, size_t size,

@@ -28,7 +28,7 @@ enum { CLI_MAX_GIVEN = 128 };
  * positional arguments. */
 typedef struct cli_args {
     const char *value[64]; /* NULL = not given; "" for a flag given */
-    const char *positional[8];
+    const char *positional[256]; /* viewfactors takes a list of mesh files */
     int positional_count;
     const char *given_value[CLI_MAX_GIVEN];
     int given_option[CLI_MAX_GIVEN];

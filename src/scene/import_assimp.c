@@ -14,6 +14,7 @@
  * textures are decoded once each and triangles of textured materials keep their texture
  * coordinates; (4) takes the first glTF camera, and the up axis and unit from the file's
  * metadata.
+ * View3D input files are recognised here and handed to import_vs3.c.
  */
 #include <assimp/cimport.h>
 #include <assimp/material.h>
@@ -506,6 +507,47 @@ static void one_line(char *text)
             *text = ' ';
 }
 
+/* View3D content: the first data line (not blank, not a `!` or `/` comment) is a View3D
+ * element letter and a blank, and some line of the first 64 KiB reads `F 3`. OBJ files
+ * start with comments (#), mtllib, o, g or v lines and never have an `F 3` line. */
+static bool looks_like_vs3(FILE *file)
+{
+    char line[1024];
+    bool first = true, geometry = false;
+    size_t read = 0;
+    while (read < 65536 && fgets(line, sizeof(line), file)) {
+        read += strlen(line);
+        char *p = line;
+        while (*p == ' ' || *p == '\t')
+            p++;
+        if (!*p || *p == '\n' || *p == '\r' || *p == '!' || *p == '/')
+            continue;
+        if (first) {
+            if (!strchr("TtCcFfVvSsOoMmNn", *p) || !(p[1] == ' ' || p[1] == '\t'))
+                return false;
+            first = false;
+        }
+        if ((p[0] == 'F' || p[0] == 'f') && (p[1] == ' ' || p[1] == '\t')) {
+            char *q = p + 1;
+            while (*q == ' ' || *q == '\t')
+                q++;
+            if (q[0] == '3' && (!q[1] || isspace((unsigned char)q[1]) || q[1] == '!'))
+                geometry = true;
+        }
+    }
+    return geometry;
+}
+
+bool rad_scene_is_vs3(const char *path)
+{
+    FILE *file = fopen(path, "rb");
+    if (!file)
+        return false;
+    bool vs3 = has_extension(path, ".vs3") || looks_like_vs3(file);
+    fclose(file);
+    return vs3;
+}
+
 rad_status rad_scene_load(const char *path, const rad_load_options *options, rad_scene **out,
                           rad_error *error)
 {
@@ -518,6 +560,11 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
         fclose(file);
         return rad_fail(error, RAD_ERR_IO, "%s: cannot open: not a file", path);
     }
+    if (has_extension(path, ".vs3") || looks_like_vs3(file)) {
+        fclose(file);
+        return rad_scene_load_vs3(path, options, out, NULL, error);
+    }
+    rewind(file);
     rad_status status = RAD_OK;
     import_state state = {NULL, NULL, NULL, path, NULL, false, "", options, NULL, NULL, 0};
     gltf_info gltf = {0};

@@ -134,6 +134,31 @@ uint32_t scene_builder_surface(scene_builder *b, const char *name)
     return (uint32_t)b->surface_count++;
 }
 
+uint32_t scene_builder_find_surface(const scene_builder *b, const char *name)
+{
+    if (!b->surface_slot_count)
+        return UINT32_MAX;
+    char clipped[sizeof(b->surfaces[0].name)];
+    snprintf(clipped, sizeof(clipped), "%s", name);
+    size_t mask = b->surface_slot_count - 1;
+    for (size_t s = hash_name(clipped) & mask; b->surface_slots[s]; s = (s + 1) & mask)
+        if (strcmp(b->surfaces[b->surface_slots[s] - 1].name, clipped) == 0)
+            return b->surface_slots[s] - 1;
+    return UINT32_MAX;
+}
+
+void scene_builder_set_surface_flags(scene_builder *b, uint32_t surface, uint32_t flags)
+{
+    if (surface < b->surface_count)
+        b->surfaces[surface].flags = flags;
+}
+
+void scene_builder_set_surface_emissivity(scene_builder *b, uint32_t surface, double emissivity)
+{
+    if (surface < b->surface_count)
+        b->surfaces[surface].emissivity = emissivity;
+}
+
 rad_status scene_builder_triangle(scene_builder *b, uint32_t surface, uint32_t material,
                                   rad_vec3 a, rad_vec3 c1, rad_vec3 c2, rad_error *error)
 {

@@ -24,6 +24,15 @@ uint32_t scene_builder_material(scene_builder *builder, const rad_material *mate
  * memory. Triangles added under the same name from several places join one surface. */
 uint32_t scene_builder_surface(scene_builder *builder, const char *name);
 
+/* Index of the surface with this name, or UINT32_MAX when there is none (nothing is
+ * created). */
+uint32_t scene_builder_find_surface(const scene_builder *builder, const char *name);
+
+/* A surface's RAD_SURFACE_* flags (replaced) and emissivity (default 0.9). */
+void scene_builder_set_surface_flags(scene_builder *builder, uint32_t surface, uint32_t flags);
+void scene_builder_set_surface_emissivity(scene_builder *builder, uint32_t surface,
+                                          double emissivity);
+
 /* Adds a triangle by corner positions, front = counter-clockwise. */
 rad_status scene_builder_triangle(scene_builder *builder, uint32_t surface, uint32_t material,
                                   rad_vec3 a, rad_vec3 b, rad_vec3 c, rad_error *error);
