@@ -243,14 +243,17 @@ bool rad_scene_is_vs3(const char *path);
 /* One input of rad_scene_load_files. */
 typedef struct rad_scene_file {
     const char *path;
-    uint32_t flags; /* RAD_SURFACE_* for the file's surface */
+    uint32_t flags;     /* RAD_SURFACE_* for the file's surface(s), ORed into their own */
+    bool keep_surfaces; /* keep the file's own surfaces (OBJ objects and groups, View3D
+                           surfaces) instead of making the file one surface */
 } rad_scene_file;
 
 /* Several mesh files (any format rad_scene_load reads) as one scene in which each file is
  * ONE surface, named after the file's base name without its extension ("walls/north.stl"
  * is "north"), with `flags` (RAD_SURFACE_OBSTRUCTION for meshes that only block) and the
- * area-weighted mean emissivity of the file's own surfaces. Two files with the same base
- * name are RAD_ERR_INVALID. Materials are kept. */
+ * area-weighted mean emissivity of the file's own surfaces; or, with keep_surfaces, the
+ * file's own surfaces with their names, flags and emissivities. A surface name that two
+ * files give is RAD_ERR_INVALID. Materials are kept. */
 rad_status rad_scene_load_files(const rad_scene_file *files, uint32_t count,
                                 const rad_load_options *options, rad_scene **out,
                                 rad_error *error);

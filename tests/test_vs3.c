@@ -271,8 +271,8 @@ static void test_files(void)
     snprintf(command, sizeof(command), "mkdir -p '%s/other'", test_tmpdir());
     CHECK(system(command) == 0);
     test_write_file("other/north.stl", "solid x\nendsolid x\n");
-    rad_scene_file files[2] = {{test_path("north.obj"), 0},
-                               {test_path("south.obj"), RAD_SURFACE_OBSTRUCTION}};
+    rad_scene_file files[2] = {{test_path("north.obj"), 0, false},
+                               {test_path("south.obj"), RAD_SURFACE_OBSTRUCTION, false}};
     rad_scene *scene = NULL;
     rad_error error = {0};
     CHECK(rad_scene_load_files(files, 2, NULL, &scene, &error) == RAD_OK);
@@ -294,20 +294,34 @@ static void test_files(void)
     CHECK(strstr(error.message, "no surface named 'west'") != NULL);
     rad_scene_destroy(scene);
 
-    rad_scene_file same[2] = {{test_path("north.obj"), 0}, {test_path("other/north.stl"), 0}};
+    rad_scene_file same[2] = {{test_path("north.obj"), 0, false},
+                              {test_path("other/north.stl"), 0, false}};
     scene = NULL;
     CHECK(rad_scene_load_files(same, 2, NULL, &scene, &error) == RAD_ERR_INVALID);
     CHECK(scene == NULL);
-    CHECK(strstr(error.message, "also named 'north'") != NULL);
+    CHECK(strstr(error.message, "surface name 'north' is also used") != NULL);
 
     /* a .vs3 among the files becomes one surface too, with its area-weighted emissivity */
     test_write_file("box.vs3", cube_vs3);
-    rad_scene_file mixed[2] = {{test_path("north.obj"), 0}, {test_path("box.vs3"), 0}};
+    rad_scene_file mixed[2] = {{test_path("north.obj"), 0, false}, {test_path("box.vs3"), 0, false}};
     CHECK(rad_scene_load_files(mixed, 2, NULL, &scene, &error) == RAD_OK);
     CHECK(scene && scene->surface_count == 2);
     if (scene) {
         CHECK_NEAR(surface_area(scene, "box"), 6.0, 1e-12);
         CHECK_NEAR(scene->surfaces[find_surface(scene, "box")].emissivity, 0.5, 1e-12);
+    }
+    rad_scene_destroy(scene);
+
+    /* a file kept whole: its own surfaces; an obstruction file beside it */
+    rad_scene_file kept[2] = {{test_path("south.obj"), 0, true},
+                              {test_path("north.obj"), RAD_SURFACE_OBSTRUCTION, false}};
+    CHECK(rad_scene_load_files(kept, 2, NULL, &scene, &error) == RAD_OK);
+    CHECK(scene && scene->surface_count == 3);
+    if (scene) {
+        CHECK_NEAR(surface_area(scene, "part1"), 0.5, 1e-12);
+        CHECK_NEAR(surface_area(scene, "part2"), 0.5, 1e-12);
+        CHECK(scene->surfaces[find_surface(scene, "north")].flags == RAD_SURFACE_OBSTRUCTION);
+        CHECK(scene->surfaces[find_surface(scene, "part1")].flags == 0);
     }
     rad_scene_destroy(scene);
 }

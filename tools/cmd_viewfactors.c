@@ -1,6 +1,8 @@
 /*
- * cmd_viewfactors.c - `radiosity viewfactors SCENE [-o OUT.csv]`: the surface-to-surface
- * view-factor matrix, a surface being an OBJ object or group.
+ * cmd_viewfactors.c - `radiosity viewfactors SCENE... [-o OUT]`: the surface-to-surface
+ * view-factor matrix, a surface being an OBJ object or group, a View3D surface, or a whole
+ * mesh file when several are given; then the optional enclosure correction and script-F
+ * factors, written as CSV, Matrix Market or View3D's text layout.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -9,45 +11,141 @@
 #include "cli.h"
 
 static const char usage[] =
-    "usage: radiosity viewfactors SCENE [-o OUT.csv] [options]\n"
+    "usage: radiosity viewfactors SCENE [MESH...] [-o OUT.csv|OUT.mtx] [options]\n"
     "\n"
-    "Computes the view factor F_ij between every pair of surfaces of SCENE (an OBJ object\n"
-    "or group is a surface): the fraction of the energy leaving surface i that reaches\n"
-    "surface j, with obstructions. Surfaces are one-sided: the front is the side from\n"
+    "Computes the view factor F_ij between every pair of surfaces: the fraction of the\n"
+    "energy leaving surface i that reaches surface j, with obstructions. One SCENE: its\n"
+    "surfaces are its OBJ objects or groups, or the surfaces of a View3D input file (.vs3,\n"
+    "F 3 geometry; its control line's encl=1 and emit=1 act as --enclosure and\n"
+    "--script-f). Several files (OBJ, STL, PLY, ...): each file is one surface, named after\n"
+    "the file without its extension. Surfaces are one-sided: the front is the side from\n"
     "which the vertices run counter-clockwise; a surface need not be flat (a cylinder\n"
     "given as a mesh is one surface and may see itself). Unobstructed polygon pairs are\n"
     "integrated analytically to --accuracy; pairs with something in between sample\n"
-    "visibility until their error bound meets it (or --max-rays). Output: CSV, first row\n"
-    "'surface,NAME1,...,NAMEn', then one row per surface; to stdout without -o.\n"
-    "A summary (the invariants: range, reciprocity, row sums; error bounds) goes to stderr.\n"
+    "visibility until their error bound meets it (or --max-rays). Output by the extension\n"
+    "of -o: .mtx is Matrix Market (sparse coordinates), anything else CSV (first row\n"
+    "'surface,NAME1,...,NAMEn', then one row per surface), or --format; CSV to stdout\n"
+    "without -o. Obstruction surfaces have no row or column. A summary (the invariants:\n"
+    "range, reciprocity, row sums; error bounds) goes to stderr.\n"
     "\n"
-    "  -o, --output FILE    write the CSV here (atomically)\n"
-    "  --accuracy E         relative error target of each factor (default 1e-4)\n"
-    "  --max-rays N         visibility rays per sampled polygon pair at most\n"
-    "                       (default 1024)\n"
+    "  -o, --output FILE       write the matrix here (atomically)\n"
+    "  --format F              csv, mtx or view3d (View3D's text output: header, areas,\n"
+    "                          rows, emissivities); default: by the extension of -o\n"
+    "  --obstruction FILE      a mesh that only blocks (one surface, no row); repeatable\n"
+    "  --two-sided NAME        surface NAME radiates from both sides; repeatable\n"
+    "  --enclosure             close the enclosure: rows sum to 1, reciprocity kept\n"
+    "                          (least-squares correction; its size is reported)\n"
+    "  --script-f              grey-body total exchange factors (Hottel's script-F) with\n"
+    "                          the surfaces' emissivities (View3D emit field; default 0.9)\n"
+    "  --accuracy E            relative error target of each factor (default 1e-4)\n"
+    "  --max-rays N            visibility rays per sampled polygon pair at most\n"
+    "                          (default 1024)\n"
     CLI_SCENE_HELP
-    "  --threads N          worker threads (default: all cores)\n"
-    "  --seed N             seed of the sample points (default 1)\n"
-    "  --stats FILE.json    write counts, times, invariants and error bounds\n"
-    "  -h, --help           this text\n";
+    "  --threads N             worker threads (default: all cores)\n"
+    "  --seed N                seed of the sample points (default 1)\n"
+    "  --stats FILE.json       write counts, times, invariants and error bounds\n"
+    "  -h, --help              this text\n";
 
-enum { OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_COUNT };
+enum {
+    OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_FORMAT, OPT_ENCLOSURE, OPT_SCRIPT_F, OPT_COUNT
+};
 
 static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS, CLI_SCENE_OPTIONS, [OPT_ACCURACY] = {"accuracy", 0, true},
-    [OPT_MAX_RAYS] = {"max-rays", 0, true}};
+    [OPT_MAX_RAYS] = {"max-rays", 0, true},   [OPT_FORMAT] = {"format", 0, true},
+    [OPT_ENCLOSURE] = {"enclosure", 0, false}, [OPT_SCRIPT_F] = {"script-f", 0, false}};
+
+/* The options that may be given several times, taken out of argv before cli_parse. */
+typedef struct repeated_options {
+    const char *obstruction[256];
+    int obstruction_count;
+    const char *two_sided[256];
+    int two_sided_count;
+} repeated_options;
+
+/* Moves --obstruction FILE and --two-sided NAME (or --NAME=VALUE) out of argv into
+ * `repeated`; returns the new argc, or -1 after printing a usage error. */
+static int take_repeated(int argc, char **argv, repeated_options *repeated)
+{
+    int kept = 0;
+    for (int a = 0; a < argc; a++) {
+        const char *names[2] = {"--obstruction", "--two-sided"};
+        int which = -1;
+        const char *value = NULL;
+        for (int k = 0; k < 2; k++) {
+            size_t n = strlen(names[k]);
+            if (strncmp(argv[a], names[k], n) == 0 && (argv[a][n] == 0 || argv[a][n] == '=')) {
+                which = k;
+                value = argv[a][n] == '=' ? argv[a] + n + 1 : NULL;
+            }
+        }
+        if (which < 0) {
+            argv[kept++] = argv[a];
+            continue;
+        }
+        if (!value) {
+            if (a + 1 >= argc) {
+                cli_error("viewfactors: %s needs a value (see 'radiosity viewfactors --help')",
+                          names[which]);
+                return -1;
+            }
+            value = argv[++a];
+        }
+        const char **list = which == 0 ? repeated->obstruction : repeated->two_sided;
+        int *count = which == 0 ? &repeated->obstruction_count : &repeated->two_sided_count;
+        if (*count == 256) {
+            cli_error("viewfactors: %s given more than 256 times", names[which]);
+            return -1;
+        }
+        list[(*count)++] = value;
+    }
+    return kept;
+}
+
+/* The scene: one SCENE with its own surfaces (a View3D file with its control line), or
+ * several files, each one surface, plus the obstruction meshes. */
+static rad_status load_surfaces(const cli_args *args, const repeated_options *repeated,
+                                rad_scene **scene, rad_vs3_control *control, bool *is_vs3,
+                                rad_error *error)
+{
+    rad_load_options load = {cli_log, NULL};
+    *is_vs3 = false;
+    if (args->positional_count == 1 && repeated->obstruction_count == 0) {
+        if (rad_scene_is_vs3(args->positional[0])) {
+            *is_vs3 = true;
+            return rad_scene_load_vs3(args->positional[0], &load, scene, control, error);
+        }
+        return cli_load_scene(args->positional[0], scene, error);
+    }
+    rad_scene_file files[512];
+    uint32_t count = 0;
+    for (int k = 0; k < args->positional_count; k++)
+        files[count++] = (rad_scene_file){args->positional[k], 0, args->positional_count == 1};
+    for (int k = 0; k < repeated->obstruction_count; k++)
+        files[count++] = (rad_scene_file){repeated->obstruction[k], RAD_SURFACE_OBSTRUCTION, false};
+    return rad_scene_load_files(files, count, &load, scene, error);
+}
 
 int command_viewfactors(int argc, char **argv)
 {
     cli_args args;
-    if (!cli_parse("viewfactors", argc, argv, options, OPT_COUNT, &args))
+    repeated_options repeated = {0};
+    argc = take_repeated(argc, argv, &repeated);
+    if (argc < 0 || !cli_parse("viewfactors", argc, argv, options, OPT_COUNT, &args))
         return EXIT_USAGE;
     if (args.value[OPT_HELP]) {
         fputs(usage, stdout);
         return EXIT_OK;
     }
-    if (args.positional_count != 1) {
-        cli_error("viewfactors: give exactly one SCENE (see 'radiosity viewfactors --help')");
+    if (args.positional_count < 1) {
+        cli_error("viewfactors: give a SCENE or mesh files (see 'radiosity viewfactors --help')");
+        return EXIT_USAGE;
+    }
+    if ((args.value[OPT_EMIT] || args.value[OPT_ALBEDO]) &&
+        (args.positional_count > 1 || repeated.obstruction_count > 0 ||
+         rad_scene_is_vs3(args.positional[0]))) {
+        cli_error("viewfactors: --emit and --albedo apply to one OBJ (or other mesh) scene "
+                  "only; they do not change view factors");
         return EXIT_USAGE;
     }
     cli_shared shared;
@@ -74,6 +172,22 @@ int command_viewfactors(int argc, char **argv)
         vf.max_rays = (uint32_t)value;
     }
     const char *output = shared.output, *stats_path = shared.stats_path;
+    rad_viewfactor_write_options write = {RAD_VIEWFACTOR_CSV, false, false};
+    if (output)
+        write.format = rad_viewfactor_format_for_path(output);
+    if (args.value[OPT_FORMAT]) {
+        const char *format = args.value[OPT_FORMAT];
+        if (strcmp(format, "csv") == 0)
+            write.format = RAD_VIEWFACTOR_CSV;
+        else if (strcmp(format, "mtx") == 0)
+            write.format = RAD_VIEWFACTOR_MATRIX_MARKET;
+        else if (strcmp(format, "view3d") == 0)
+            write.format = RAD_VIEWFACTOR_VIEW3D;
+        else {
+            cli_error("--format: '%s' is not csv, mtx or view3d", format);
+            return EXIT_USAGE;
+        }
+    }
     if ((output && !cli_output_writable(output)) ||
         (stats_path && !cli_output_writable(stats_path)))
         return EXIT_ERROR;
@@ -82,10 +196,28 @@ int command_viewfactors(int argc, char **argv)
     rad_error error = {0};
     rad_scene *scene = NULL;
     rad_viewfactor_matrix *matrix = NULL;
-    double *dense = NULL;
+    double *emissivity = NULL;
     rad_viewfactor_report report = {0};
+    rad_enclosure_report enclosure = {0};
+    rad_vs3_control control = {0};
+    bool is_vs3 = false;
     double t0 = cli_now();
-    rad_status status = cli_load_scene(args.positional[0], &scene, &error);
+    rad_status status = load_surfaces(&args, &repeated, &scene, &control, &is_vs3, &error);
+    for (int k = 0; k < repeated.two_sided_count && status == RAD_OK; k++)
+        status = rad_scene_set_surface_flags(scene, repeated.two_sided[k], RAD_SURFACE_TWO_SIDED,
+                                             &error);
+    if (status == RAD_OK && is_vs3 && (control.row || control.col))
+        cli_warn("%s: the control line's row/col are ignored: every factor is computed",
+                 scene->source);
+    write.enclosure = args.value[OPT_ENCLOSURE] || (is_vs3 && control.enclosure);
+    write.script_f = args.value[OPT_SCRIPT_F] || (is_vs3 && control.emit);
+    if (status == RAD_OK && write.script_f && scene->surface_count > RAD_SCRIPT_F_MAX_SURFACES) {
+        snprintf(error.message, sizeof(error.message),
+                 "%s: --script-f: script-F factors are computed densely, for at most %u "
+                 "surfaces (this scene has %u)",
+                 scene->source, RAD_SCRIPT_F_MAX_SURFACES, scene->surface_count);
+        status = RAD_ERR_UNSUPPORTED;
+    }
     if (status == RAD_OK)
         status = rad_viewfactor_matrix_compute(scene, &vf, &matrix, &report, &error);
     if (status != RAD_OK)
@@ -119,23 +251,41 @@ int command_viewfactors(int argc, char **argv)
         goto fail;
     }
 
-    dense = calloc(S ? S * S : 1, sizeof(*dense));
-    if (!dense) {
-        snprintf(error.message, sizeof(error.message), "out of memory for %zu surfaces", S);
+    if (write.enclosure) {
+        if (!check.closed)
+            cli_warn("%s: --enclosure: the surfaces' triangles do not share every edge; the "
+                     "rows are closed anyway",
+                     scene->source);
+        status = rad_viewfactor_matrix_close_enclosure(matrix, scene, &enclosure, &error);
+        if (status != RAD_OK)
+            goto fail;
+        fprintf(stderr,
+                "radiosity: enclosure correction: largest relative change of a factor %.3g; "
+                "largest |row sum - 1| %.3g before, %.2g after; reciprocity residual %.2g\n",
+                enclosure.largest_relative_change, enclosure.row_deviation_before,
+                enclosure.row_deviation_after, enclosure.reciprocity_after);
+    }
+    if (write.script_f) {
+        emissivity = calloc(S ? S : 1, sizeof(*emissivity));
+        if (!emissivity) {
+            snprintf(error.message, sizeof(error.message), "out of memory for %zu surfaces", S);
+            goto fail;
+        }
+        for (size_t I = 0; I < S; I++)
+            emissivity[I] = scene->surfaces[I].emissivity;
+        rad_viewfactor_matrix *exchange = NULL;
+        status = rad_viewfactor_matrix_script_f(matrix, emissivity, &exchange, &error);
+        if (status != RAD_OK)
+            goto fail;
+        rad_viewfactor_matrix_destroy(matrix);
+        matrix = exchange;
+        fprintf(stderr, "radiosity: script-F total exchange factors with the surfaces' "
+                        "emissivities\n");
+    }
+    status = output ? rad_viewfactor_matrix_write(scene, matrix, output, &write, &error)
+                    : rad_viewfactor_matrix_print(scene, matrix, stdout, &write, &error);
+    if (status != RAD_OK)
         goto fail;
-    }
-    for (size_t I = 0; I < S; I++)
-        for (uint64_t k = matrix->row_start[I]; k < matrix->row_start[I + 1]; k++)
-            dense[I * S + matrix->column[k]] = matrix->value[k];
-    if (output) {
-        status = rad_viewfactors_write_csv(scene, dense, output, &error);
-        if (status != RAD_OK)
-            goto fail;
-    } else {
-        status = rad_viewfactors_print_csv(scene, dense, stdout, &error);
-        if (status != RAD_OK)
-            goto fail;
-    }
     if (stats_path) {
         cli_stats stats;
         stats_begin(&stats);
@@ -157,6 +307,16 @@ int command_viewfactors(int argc, char **argv)
         stats_number(&stats, "largest_row_sum", check.largest_row_sum);
         stats_number(&stats, "row_sum_deviation", check.row_sum_deviation);
         stats_integer(&stats, "closed_enclosure", check.closed);
+        stats_bool(&stats, "enclosure_corrected", write.enclosure);
+        if (write.enclosure) {
+            stats_number(&stats, "enclosure_largest_relative_change",
+                         enclosure.largest_relative_change);
+            stats_number(&stats, "enclosure_row_sum_deviation_before",
+                         enclosure.row_deviation_before);
+            stats_number(&stats, "enclosure_row_sum_deviation_after",
+                         enclosure.row_deviation_after);
+        }
+        stats_bool(&stats, "script_f", write.script_f);
         stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
         if (!stats_write(&stats, stats_path))
             exit_code = EXIT_ERROR;
@@ -166,7 +326,7 @@ fail:
     cli_error("%s", error.message);
     exit_code = EXIT_ERROR;
 done:
-    free(dense);
+    free(emissivity);
     rad_viewfactor_matrix_destroy(matrix);
     rad_scene_destroy(scene);
     return exit_code;
