@@ -231,8 +231,8 @@ typedef struct rad_vs3_control {
  * quadrilateral, a zero-area surface, a repeated surface number or name, an emissivity
  * outside (0,1], a bad control value. Unknown control names are warnings. `control`
  * (optional) receives the C and T lines. rad_scene_load calls this for files named
- * *.vs3 and for files whose content is View3D's (first data line T, C, F, V, S, O, M or
- * N, and an `F 3` line). */
+ * *.vs3 and for files whose content is View3D's (first data line T, C or F, and a line
+ * `F 3` alone). */
 rad_status rad_scene_load_vs3(const char *path, const rad_load_options *options,
                               rad_scene **out, rad_vs3_control *control, rad_error *error);
 

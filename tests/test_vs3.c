@@ -113,6 +113,9 @@ static void test_cube(void)
     path = test_write_file("cube-input.txt", cube_vs3);
     CHECK(rad_scene_is_vs3(path));
     CHECK(!rad_scene_is_vs3(test_write_file("plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")));
+    CHECK(!rad_scene_is_vs3(test_write_file("faces.obj", "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                                         "v 0 0 1\nf 3 2 1\nf 3 4 1\n")));
+    CHECK(!rad_scene_is_vs3(test_write_file("titled.obj", "T x\nv 0 0 0\nf 3 1 2\n")));
     CHECK(!rad_scene_is_vs3(test_path("missing.vs3")));
     CHECK(rad_scene_load(path, NULL, &scene, &error) == RAD_OK);
     CHECK(scene && scene->surface_count == 6);

@@ -507,9 +507,10 @@ static void one_line(char *text)
             *text = ' ';
 }
 
-/* View3D content: the first data line (not blank, not a `!` or `/` comment) is a View3D
- * element letter and a blank, and some line of the first 64 KiB reads `F 3`. OBJ files
- * start with comments (#), mtllib, o, g or v lines and never have an `F 3` line. */
+/* View3D content: the first data line (not blank, not a `!` or `/` comment) starts with
+ * T, C or F and a blank, and some line of the first 64 KiB is `F 3` alone (a comment may
+ * follow). OBJ files start with comments (#), mtllib, o, g or v lines, and their face
+ * lines have three vertices or more. */
 static bool looks_like_vs3(FILE *file)
 {
     char line[1024];
@@ -523,7 +524,7 @@ static bool looks_like_vs3(FILE *file)
         if (!*p || *p == '\n' || *p == '\r' || *p == '!' || *p == '/')
             continue;
         if (first) {
-            if (!strchr("TtCcFfVvSsOoMmNn", *p) || !(p[1] == ' ' || p[1] == '\t'))
+            if (!strchr("TtCcFf", *p) || !(p[1] == ' ' || p[1] == '\t'))
                 return false;
             first = false;
         }
@@ -531,8 +532,12 @@ static bool looks_like_vs3(FILE *file)
             char *q = p + 1;
             while (*q == ' ' || *q == '\t')
                 q++;
-            if (q[0] == '3' && (!q[1] || isspace((unsigned char)q[1]) || q[1] == '!'))
-                geometry = true;
+            if (q[0] == '3') {
+                q++;
+                while (*q == ' ' || *q == '\t' || *q == '\r' || *q == '\n')
+                    q++;
+                geometry |= !*q || *q == '!' || *q == '/';
+            }
         }
     }
     return geometry;
