@@ -221,12 +221,14 @@ typedef struct rad_vs3_control {
  * the subsurface out of K's polygon into convex pieces. An N (null) surface is cut out of
  * its base the same way and is kept as an obstruction (it still blocks, it has no row),
  * which is View3D's "area of the base reduced, null removed from the matrix". Checked,
- * each with the line number: subsurfaces and null surfaces lie in their base's plane,
- * inside it, facing the same way (null: the opposite way); base and cmb refer to earlier
- * surfaces. Not supported (RAD_ERR_UNSUPPORTED naming the line): `F 3a` and other
- * geometry kinds, and M (mask) surfaces, whose View3D result (the masked part of the base
- * exchanges only with the mask, F_mask,base = 1) is not a view factor of any geometry
- * the engine computes. Errors with the line number: a malformed line, an undefined or
+ * each with the line number: subsurfaces, null and mask surfaces lie in their base's
+ * plane, inside it, facing the same way (null, mask: the opposite way, with a radiating
+ * S base); base and cmb refer to earlier surfaces. An M (mask) surface lies on its base facing it: View3D makes the masked part
+ * of the base exchange with the mask only (F_mask,base = 1). It is cut out of its base
+ * like a null surface and kept as an obstruction for the computation; then
+ * rad_viewfactor_matrix_apply_vs3_masks gives the mask its row and column and the base its
+ * whole area. Not supported (RAD_ERR_UNSUPPORTED naming the line): `F 3a` and other
+ * geometry kinds. Errors with the line number: a malformed line, an undefined or
  * repeated vertex, a vertex used twice in one surface, a non-planar or non-convex
  * quadrilateral, a zero-area surface, a repeated surface number or name, an emissivity
  * outside (0,1], a bad control value. Unknown control names are warnings. `control`
@@ -581,6 +583,17 @@ rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *matrix,
 rad_status rad_viewfactor_matrix_script_f(const rad_viewfactor_matrix *matrix,
                                           const double *emissivity,
                                           rad_viewfactor_matrix **out, rad_error *error);
+
+/* View3D's mask factors, after rad_viewfactor_matrix_compute on the scene that
+ * rad_scene_load_vs3 read from `path` (the file is read again for its M lines): each mask
+ * M of base B gets the row F_MB = 1 and area A_M; B's area becomes its whole polygon's,
+ * A_B = A_cut + sum A_M, its computed factors are scaled by A_cut / A_B and F_BM =
+ * A_M / A_B, so reciprocity holds; other surfaces keep their factors (F_JM = 0). The
+ * masks lose RAD_SURFACE_OBSTRUCTION in `scene`. *matrix is replaced (the old one is
+ * freed) when the file has masks, untouched otherwise. */
+rad_status rad_viewfactor_matrix_apply_vs3_masks(const char *path, rad_scene *scene,
+                                                 rad_viewfactor_matrix **matrix,
+                                                 rad_error *error);
 
 /* ------------------------------------------------------------------------------------ */
 /* Solvers for (I - diag(rho) F) B = E                                                   */

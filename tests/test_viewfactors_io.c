@@ -293,6 +293,37 @@ static void test_enclosure_and_script_f(void)
     CHECK(strncmp(test_read_text(test_path("stdout.txt")), "surface,zeq0,xeq0,", 18) == 0);
 }
 
+/* A mask (View3D M) against the same geometry with a null surface (N): the base keeps
+ * its whole area and its view of the ceiling is the null version's times A_cut / A_whole;
+ * the mask sees only its base. */
+static void test_mask(void)
+{
+    const char *geometry = "F 3\nV 1 0 0 0\nV 2 2 0 0\nV 3 2 2 0\nV 4 0 2 0\n"
+                           "V 5 0 0 1\nV 6 2 0 1\nV 7 2 2 1\nV 8 0 2 1\n"
+                           "V 9 0.5 0.5 0\nV 10 1.5 0.5 0\nV 11 1.5 1.5 0\nV 12 0.5 1.5 0\n"
+                           "S 1 1 2 3 4 0 0 0.9 floor\nS 3 5 8 7 6 0 0 0.9 ceiling\n";
+    char text[1024];
+    snprintf(text, sizeof(text), "%sM 2 12 11 10 9 1 0 0.4 rug\n", geometry);
+    test_write_file("mask.vs3", text);
+    snprintf(text, sizeof(text), "%sN 2 12 11 10 9 1 0 0.4 rug\n", geometry);
+    test_write_file("null.vs3", text);
+    matrix m, n;
+    if (!run_mtx("mask.vs3", "mask.mtx", &m) || !run_mtx("null.vs3", "null.mtx", &n))
+        return;
+    CHECK(m.n == 3 && n.n == 2);
+    CHECK_NEAR(m.area[index_of(&m, "floor")], 4.0, 1e-12);
+    CHECK_NEAR(n.area[index_of(&n, "floor")], 3.0, 1e-12);
+    CHECK_NEAR(factor(&m, "floor", "ceiling"), factor(&n, "floor", "ceiling") * 3 / 4, 1e-9);
+    CHECK_NEAR(factor(&m, "ceiling", "floor"), factor(&n, "ceiling", "floor"), 1e-9);
+    CHECK_NEAR(factor(&m, "rug", "floor"), 1.0, 1e-12);
+    CHECK_NEAR(factor(&m, "floor", "rug"), 0.25, 1e-12);
+    CHECK(factor(&m, "rug", "ceiling") == 0 && factor(&m, "ceiling", "rug") == 0);
+    /* the ceiling sees the floor less the rug: less than the whole floor would give */
+    double whole = parallel_squares(0.5); /* 2 x 2 squares 1 apart: X = Y = 2 */
+    CHECK(factor(&m, "ceiling", "floor") < whole);
+    CHECK(factor(&m, "ceiling", "floor") > 0.5 * whole);
+}
+
 static void expect_bad(const char *name, const char *body, int line, const char *words)
 {
     test_write_file(name, body);
@@ -329,6 +360,7 @@ int main(void)
     test_obstruction();
     test_two_sided();
     test_enclosure_and_script_f();
+    test_mask();
     test_bad_input();
     return test_finish("test_viewfactors_io");
 }

@@ -251,8 +251,10 @@ static void test_errors(void)
                  "surface 1 is already defined on line 6");
     expect_error(SQUARE "V 2 5 5 5\n", RAD_ERR_PARSE, 6, "vertex 2 is already defined on line 3");
     expect_error(SQUARE "S 1 1 2 3 4 0 0 1.5 a\n", RAD_ERR_PARSE, 6, "emissivity");
-    expect_error(SQUARE "S 1 1 2 3 4 0 0 0.9 a\nM 2 1 4 3 2 1 0 0.9 m\n", RAD_ERR_UNSUPPORTED, 7,
-                 "mask");
+    expect_error(SQUARE "S 1 1 2 3 4 0 0 0.9 a\nM 2 1 2 3 4 1 0 0.9 m\n", RAD_ERR_PARSE, 7,
+                 "must face opposite to its base surface 1");
+    expect_error(SQUARE "M 1 1 2 3 4 0 0 0.9 m\n", RAD_ERR_PARSE, 6,
+                 "mask surface 1 needs a base");
     expect_error("F 3a\n", RAD_ERR_UNSUPPORTED, 1, "F 3a");
     expect_error(SQUARE "S 1 1 2 3 4 0 0 0.9 a\nS 2 1 2 3 0 5 0 0.9 b\n", RAD_ERR_PARSE, 7,
                  "base 5 is not a surface defined before it");
@@ -329,8 +331,68 @@ static void test_files(void)
     rad_scene_destroy(scene);
 }
 
+/* A 2 x 2 floor with a 1 x 1 mask lying on it, facing it, under a 2 x 2 ceiling: the
+ * mask's factors are set after the computation (here a matrix made by hand). */
+static void test_masks(void)
+{
+    const char *text = "F 3\nV 1 0 0 0\nV 2 2 0 0\nV 3 2 2 0\nV 4 0 2 0\n"
+                       "V 5 0 0 1\nV 6 2 0 1\nV 7 2 2 1\nV 8 0 2 1\n"
+                       "V 9 0.5 0.5 0\nV 10 1.5 0.5 0\nV 11 1.5 1.5 0\nV 12 0.5 1.5 0\n"
+                       "S 1 1 2 3 4 0 0 0.9 floor\n"
+                       "M 2 12 11 10 9 1 0 0.4 rug\n"
+                       "S 3 5 8 7 6 0 0 0.9 ceiling\n";
+    const char *path = test_write_file("masked.vs3", text);
+    rad_scene *scene = NULL;
+    rad_error error = {0};
+    CHECK(rad_scene_load_vs3(path, NULL, &scene, NULL, &error) == RAD_OK);
+    if (!scene) {
+        fprintf(stderr, "%s\n", error.message);
+        return;
+    }
+    CHECK(scene->surface_count == 3);
+    CHECK_NEAR(surface_area(scene, "floor"), 3.0, 1e-12); /* the mask is cut out */
+    CHECK_NEAR(surface_area(scene, "rug"), 1.0, 1e-12);
+    CHECK(scene->surfaces[1].flags == RAD_SURFACE_OBSTRUCTION);
+    rad_viewfactor_matrix *m = NULL;
+    CHECK(rad_viewfactor_matrix_create(3, 2, &m, &error) == RAD_OK);
+    if (!m) {
+        rad_scene_destroy(scene);
+        return;
+    }
+    m->area[0] = 3;
+    m->area[2] = 4;
+    m->row_start[0] = 0;
+    m->row_start[1] = 1;
+    m->row_start[2] = 1;
+    m->row_start[3] = 2;
+    m->column[0] = 2;
+    m->value[0] = 0.3;
+    m->error_bound[0] = 4e-5;
+    m->column[1] = 0;
+    m->value[1] = 0.3 * 3 / 4;
+    CHECK(rad_viewfactor_matrix_apply_vs3_masks(path, scene, &m, &error) == RAD_OK);
+    CHECK(scene->surfaces[1].flags == 0);
+    CHECK(m->n == 3 && m->row_start[3] == 4);
+    CHECK_NEAR(m->area[0], 4.0, 1e-12);
+    CHECK_NEAR(m->area[1], 1.0, 1e-12);
+    CHECK_NEAR(m->area[2], 4.0, 1e-12);
+    CHECK_NEAR(rad_viewfactor_matrix_get(m, 0, 2), 0.3 * 3 / 4, 1e-12);
+    CHECK_NEAR(m->error_bound[1], 4e-5 * 3 / 4, 1e-12);
+    CHECK_NEAR(rad_viewfactor_matrix_get(m, 0, 1), 1.0 / 4, 1e-12);
+    CHECK_NEAR(rad_viewfactor_matrix_get(m, 1, 0), 1.0, 1e-12);
+    CHECK(rad_viewfactor_matrix_get(m, 1, 2) == 0 && rad_viewfactor_matrix_get(m, 2, 1) == 0);
+    CHECK_NEAR(rad_viewfactor_matrix_get(m, 2, 0), 0.3 * 3 / 4, 1e-12);
+    for (uint32_t I = 0; I < 3; I++) /* reciprocity */
+        for (uint32_t J = 0; J < 3; J++)
+            CHECK_NEAR(m->area[I] * rad_viewfactor_matrix_get(m, I, J),
+                       m->area[J] * rad_viewfactor_matrix_get(m, J, I), 1e-12);
+    rad_viewfactor_matrix_destroy(m);
+    rad_scene_destroy(scene);
+}
+
 int main(void)
 {
+    test_masks();
     test_cube();
     test_combined_and_triangles();
     test_subsurfaces();

@@ -251,6 +251,11 @@ int command_viewfactors(int argc, char **argv)
         goto fail;
     }
 
+    if (is_vs3) {
+        status = rad_viewfactor_matrix_apply_vs3_masks(args.positional[0], scene, &matrix, &error);
+        if (status != RAD_OK)
+            goto fail;
+    }
     if (write.enclosure) {
         if (!check.closed)
             cli_warn("%s: --enclosure: the surfaces' triangles do not share every edge; the "

@@ -9,7 +9,9 @@
  * into convex pieces around them: each hole is convex, so the base minus the hole is,
  * edge by edge of the hole, "outside this edge and inside the previous ones", a convex
  * piece each. That is what View3D's post-processing computes with view-factor algebra
- * (the base's factors and area less the subsurface's).
+ * (the base's factors and area less the subsurface's). Masks are cut out the same way and
+ * kept as obstructions; rad_viewfactor_matrix_apply_vs3_masks then gives them View3D's
+ * factors after the computation.
  */
 #include <ctype.h>
 #include <errno.h>
@@ -325,12 +327,8 @@ static rad_status parse_file(vs3_reader *r, FILE *file, rad_error *error)
             status = parse_surface(r, VS3_NULL, token, count, number, error);
             break;
         case 'M':
-            return rad_fail(error, RAD_ERR_UNSUPPORTED,
-                            "%s:%lu: mask surfaces (M) are not supported: View3D makes the "
-                            "masked part of the base exchange only with the mask, which no "
-                            "geometry reproduces; give the mask's area as a null surface (N) "
-                            "or a subsurface (S with base) instead",
-                            r->path, number);
+            status = parse_surface(r, VS3_MASK, token, count, number, error);
+            break;
         default:
             return rad_fail(error, RAD_ERR_PARSE,
                             "%s:%lu: '%c' is not a View3D line (T, C, F, V, S, O, M, N, ! or "
@@ -433,7 +431,7 @@ static rad_status check_inside_base(vs3_reader *r, const vs3_polygon *p, const v
                             r->path, p->line, p->number, base->number);
     }
     double facing = v3_dot(p->normal, base->normal);
-    bool opposite = p->kind == VS3_NULL;
+    bool opposite = p->kind == VS3_NULL || p->kind == VS3_MASK;
     if (opposite ? facing > -1 + RAD_REGION_NORMAL : facing < 1 - RAD_REGION_NORMAL)
         return rad_fail(error, RAD_ERR_PARSE,
                         "%s:%lu: surface %u must face %s its base surface %u", r->path, p->line,
@@ -475,10 +473,15 @@ static rad_status resolve(vs3_reader *r, rad_error *error)
         if (p->base) {
             p->base_index = r->polygon_by_number[p->base] - 1;
             const vs3_polygon *base = &r->polygon[p->base_index];
-            if (base->kind == VS3_NULL)
+            if (base->kind == VS3_NULL || base->kind == VS3_MASK)
                 return rad_fail(error, RAD_ERR_PARSE,
-                                "%s:%lu: surface %u: base %u is a null surface", r->path, p->line,
-                                p->number, p->base);
+                                "%s:%lu: surface %u: base %u is a %s surface", r->path, p->line,
+                                p->number, p->base, base->kind == VS3_NULL ? "null" : "mask");
+            if ((p->kind == VS3_MASK || p->kind == VS3_NULL) && base->kind != VS3_SURFACE)
+                return rad_fail(error, RAD_ERR_PARSE,
+                                "%s:%lu: surface %u: the base of a mask or null surface must be "
+                                "a radiating surface (S)",
+                                r->path, p->line, p->number);
             if (p->kind == VS3_OBSTRUCTION)
                 return rad_fail(error, RAD_ERR_UNSUPPORTED,
                                 "%s:%lu: obstruction surface %u with a base is not supported",
@@ -486,15 +489,15 @@ static rad_status resolve(vs3_reader *r, rad_error *error)
             rad_status status = check_inside_base(r, p, base, error);
             if (status != RAD_OK)
                 return status;
-        } else if (p->kind == VS3_NULL) {
-            return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: null surface %u needs a base surface",
-                            r->path, p->line, p->number);
+        } else if (p->kind == VS3_NULL || p->kind == VS3_MASK) {
+            return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: %s surface %u needs a base surface",
+                            r->path, p->line, p->kind == VS3_NULL ? "null" : "mask", p->number);
         }
         if (p->cmb) {
             vs3_polygon *target = &r->polygon[r->polygon_by_number[p->cmb] - 1];
             p->root = target->root; /* a chain of combinations ends at its first surface */
             const vs3_polygon *root = &r->polygon[p->root];
-            if (p->kind == VS3_NULL || root->kind != p->kind)
+            if (p->kind == VS3_NULL || p->kind == VS3_MASK || root->kind != p->kind)
                 return rad_fail(error, RAD_ERR_PARSE,
                                 "%s:%lu: surface %u combines with surface %u of another kind",
                                 r->path, p->line, p->number, p->cmb);
@@ -568,8 +571,8 @@ static rad_status add_polygon(vs3_reader *r, scene_builder *builder, size_t inde
             continue;
         rad_vec3 corner[4];
         for (uint32_t k = 0; k < hole->corner_count; k++) /* counter-clockwise like p */
-            corner[k] = hole->kind == VS3_NULL ? hole->corner[hole->corner_count - 1 - k]
-                                               : hole->corner[k];
+            corner[k] = hole->kind == VS3_SURFACE ? hole->corner[k]
+                                                  : hole->corner[hole->corner_count - 1 - k];
         size_t old_count = count;
         for (size_t q = 0; q < old_count; q++) {
             vs3_piece rest = pieces[q];
@@ -688,6 +691,121 @@ rad_status rad_scene_load_vs3(const char *path, const rad_load_options *options,
     if (status == RAD_OK && control)
         *control = r.control;
     scene_builder_destroy(builder);
+    reader_free(&r);
+    return status;
+}
+
+/* The scene surface named `name`, or UINT32_MAX. */
+static uint32_t scene_surface(const rad_scene *scene, const char *name)
+{
+    for (uint32_t s = 0; s < scene->surface_count; s++)
+        if (strcmp(scene->surfaces[s].name, name) == 0)
+            return s;
+    return UINT32_MAX;
+}
+
+rad_status rad_viewfactor_matrix_apply_vs3_masks(const char *path, rad_scene *scene,
+                                                 rad_viewfactor_matrix **matrix,
+                                                 rad_error *error)
+{
+    vs3_reader r;
+    memset(&r, 0, sizeof(r));
+    r.path = path;
+    rad_viewfactor_matrix *m = *matrix, *result = NULL;
+    uint32_t n = m->n;
+    uint32_t *base_of = NULL;   /* per surface: the base a mask masks, UINT32_MAX if none */
+    double *extra = NULL;       /* per surface: masked area to add back to a base */
+    rad_status status = RAD_OK;
+    FILE *file = fopen(path, "r");
+    if (!file)
+        return rad_fail(error, RAD_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    status = parse_file(&r, file, error);
+    fclose(file);
+    if (status == RAD_OK)
+        status = resolve(&r, error);
+    if (status != RAD_OK)
+        goto done;
+    if (n != scene->surface_count) {
+        status = rad_fail(error, RAD_ERR_INVALID, "%s: the matrix has %u surfaces, the scene %u",
+                          path, n, scene->surface_count);
+        goto done;
+    }
+    base_of = rad_alloc_array(n, sizeof(*base_of));
+    extra = rad_alloc_array(n, sizeof(*extra));
+    if (!base_of || !extra) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", path);
+        goto done;
+    }
+    for (uint32_t I = 0; I < n; I++)
+        base_of[I] = UINT32_MAX;
+    uint64_t added = 0;
+    for (size_t i = 0; i < r.polygon_count; i++) {
+        const vs3_polygon *p = &r.polygon[i];
+        if (p->kind != VS3_MASK)
+            continue;
+        const vs3_polygon *base = &r.polygon[r.polygon[p->base_index].root];
+        uint32_t M = scene_surface(scene, p->name), B = scene_surface(scene, base->name);
+        if (M == UINT32_MAX || B == UINT32_MAX) {
+            status = rad_fail(error, RAD_ERR_INVALID,
+                              "%s:%lu: mask '%s' or its base '%s' is not a surface of the scene",
+                              path, p->line, p->name, base->name);
+            goto done;
+        }
+        base_of[M] = B;
+        extra[B] += p->area;
+        extra[M] = p->area;
+        added += 2;
+    }
+    if (!added)
+        goto done;
+    status = rad_viewfactor_matrix_create(n, m->row_start[n] + added, &result, error);
+    if (status != RAD_OK)
+        goto done;
+    uint64_t k = 0;
+    for (uint32_t I = 0; I < n; I++) {
+        result->row_start[I] = k;
+        if (base_of[I] != UINT32_MAX) { /* a mask sees only its base */
+            result->area[I] = extra[I];
+            result->column[k] = base_of[I];
+            result->value[k++] = 1;
+            continue;
+        }
+        if (!(extra[I] > 0)) { /* neither mask nor base: as computed */
+            result->area[I] = m->area[I];
+            for (uint64_t e = m->row_start[I]; e < m->row_start[I + 1]; e++, k++) {
+                result->column[k] = m->column[e];
+                result->value[k] = m->value[e];
+                result->error_bound[k] = m->error_bound[e];
+            }
+            continue;
+        }
+        /* a base: its cut part's factors, over the whole area; then its masks */
+        double whole = m->area[I] + extra[I];
+        double scale = m->area[I] / whole;
+        result->area[I] = whole;
+        uint64_t e = m->row_start[I];
+        for (uint32_t J = 0; J < n; J++) {
+            bool masked = base_of[J] == I;
+            bool stored = e < m->row_start[I + 1] && m->column[e] == J;
+            if (!masked && !stored)
+                continue;
+            result->column[k] = J;
+            result->value[k] = masked ? extra[J] / whole : m->value[e] * scale;
+            result->error_bound[k] = masked ? 0 : m->error_bound[e] * scale;
+            k++;
+            if (stored)
+                e++;
+        }
+    }
+    result->row_start[n] = k;
+    for (uint32_t I = 0; I < n; I++)
+        if (base_of[I] != UINT32_MAX)
+            scene->surfaces[I].flags &= ~(uint32_t)RAD_SURFACE_OBSTRUCTION;
+    rad_viewfactor_matrix_destroy(m);
+    *matrix = result;
+done:
+    free(base_of);
+    free(extra);
     reader_free(&r);
     return status;
 }
