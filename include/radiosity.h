@@ -255,7 +255,8 @@ typedef struct rad_scene_file {
  * is "north"), with `flags` (RAD_SURFACE_OBSTRUCTION for meshes that only block) and the
  * area-weighted mean emissivity of the file's own surfaces; or, with keep_surfaces, the
  * file's own surfaces with their names, flags and emissivities. A surface name that two
- * files give is RAD_ERR_INVALID. Materials are kept. */
+ * files give is RAD_ERR_INVALID. Materials are kept without their albedo textures (view
+ * factors do not depend on them). */
 rad_status rad_scene_load_files(const rad_scene_file *files, uint32_t count,
                                 const rad_load_options *options, rad_scene **out,
                                 rad_error *error);

@@ -66,7 +66,9 @@ static rad_status append_file(scene_builder *builder, const rad_scene_file *file
     if (!surface)
         status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", file->path);
     for (uint32_t m = 0; m < part->material_count && status == RAD_OK; m++) {
-        uint32_t index = scene_builder_material(builder, &part->materials[m]);
+        rad_material material = part->materials[m];
+        material.albedo_texture = 0; /* textures are not carried over (see radiosity.h) */
+        uint32_t index = scene_builder_material(builder, &material);
         if (m == 0)
             first_material = index;
         if (index == UINT32_MAX)
