@@ -1,8 +1,10 @@
 /*
  * script_f.c - Hottel's total exchange factors for grey diffuse surfaces:
  *   scriptF = diag(eps) (I - F diag(1 - eps))^-1 F diag(eps).
- * (I - F diag(rho)) X = F is solved densely: LU with partial pivoting, then all n right-
- * hand sides at once, rows updated in parallel. O(n^3): hence the size limit.
+ * (I - F diag(rho)) X = F is solved densely: LU with partial pivoting (the elimination in
+ * parallel once its columns are long), then all n right-hand sides, in parallel by blocks
+ * of columns. O(n^3): hence the size limit. The result does not depend on the thread
+ * count: every value is computed by the same operations in the same order.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -13,6 +15,11 @@
 
 /* A pivot this small relative to the matrix's largest entry means a singular system. */
 #define SCRIPT_F_SINGULAR_PIVOT 1e-13
+/* The elimination of one column runs in parallel when its update has at least this many
+ * multiply-adds (below, the barrier costs more than it saves on a loaded machine). */
+#define SCRIPT_F_PARALLEL_WORK 2000000u
+/* Right-hand sides are solved in blocks of this many columns, one thread per block. */
+enum { SCRIPT_F_COLUMN_BLOCK = 64 };
 
 rad_status rad_viewfactor_matrix_script_f(const rad_viewfactor_matrix *m,
                                           const double *emissivity,
@@ -51,7 +58,7 @@ rad_status rad_viewfactor_matrix_script_f(const rad_viewfactor_matrix *m,
     for (size_t i = 0; i < nn; i++)
         largest = fmax(largest, fabs(A[i]));
 
-    /* LU with partial pivoting, rows of X swapped along */
+    /* LU with partial pivoting, L below the diagonal; rows of X swapped along */
     for (uint32_t k = 0; k < n; k++) {
         uint32_t p = k;
         for (uint32_t i = k + 1; i < n; i++)
@@ -74,37 +81,54 @@ rad_status rad_viewfactor_matrix_script_f(const rad_viewfactor_matrix *m,
                 X[(size_t)p * n + j] = t;
             }
         const double *row_k = A + (size_t)k * n;
-        const double *x_k = X + (size_t)k * n;
         double inverse = 1 / row_k[k];
-#pragma omp parallel for schedule(static)
+        /* one parallel region per column costs a barrier each: worth it only when the
+         * trailing update is large */
+#pragma omp parallel for schedule(static) if ((uint64_t)(n - k) * n > SCRIPT_F_PARALLEL_WORK)
         for (int64_t i = (int64_t)k + 1; i < (int64_t)n; i++) {
             double *row_i = A + (size_t)i * n;
             double factor = row_i[k] * inverse;
+            row_i[k] = factor; /* L, kept for the substitutions */
             if (factor == 0)
                 continue;
-            row_i[k] = 0;
             for (uint32_t j = k + 1; j < n; j++)
                 row_i[j] -= factor * row_k[j];
-            double *x_i = X + (size_t)i * n;
-            for (uint32_t j = 0; j < n; j++) /* forward substitution, fused */
-                x_i[j] -= factor * x_k[j];
         }
     }
-    /* back substitution on all right-hand sides at once */
-    for (uint32_t k = n; k-- > 0;) {
-        double *x_k = X + (size_t)k * n;
-        const double *row_k = A + (size_t)k * n;
-        for (uint32_t i = k + 1; i < n; i++) {
-            double a = row_k[i];
-            if (a == 0)
-                continue;
-            const double *x_i = X + (size_t)i * n;
-            for (uint32_t j = 0; j < n; j++)
-                x_k[j] -= a * x_i[j];
+    /* forward and back substitution, the right-hand sides split into blocks of columns:
+     * one parallel region, no barrier inside */
+    int64_t blocks = ((int64_t)n + SCRIPT_F_COLUMN_BLOCK - 1) / SCRIPT_F_COLUMN_BLOCK;
+#pragma omp parallel for schedule(dynamic) if (n >= SCRIPT_F_COLUMN_BLOCK * 2)
+    for (int64_t block = 0; block < blocks; block++) {
+        uint32_t j0 = (uint32_t)block * SCRIPT_F_COLUMN_BLOCK;
+        uint32_t j1 = j0 + SCRIPT_F_COLUMN_BLOCK < n ? j0 + SCRIPT_F_COLUMN_BLOCK : n;
+        for (uint32_t i = 1; i < n; i++) { /* L y = P F (rows of X were swapped) */
+            const double *row_i = A + (size_t)i * n;
+            double *x_i = X + (size_t)i * n;
+            for (uint32_t k = 0; k < i; k++) {
+                double l = row_i[k];
+                if (l == 0)
+                    continue;
+                const double *x_k = X + (size_t)k * n;
+                for (uint32_t j = j0; j < j1; j++)
+                    x_i[j] -= l * x_k[j];
+            }
         }
-        double inverse = 1 / row_k[k];
-        for (uint32_t j = 0; j < n; j++)
-            x_k[j] *= inverse;
+        for (uint32_t k = n; k-- > 0;) { /* U x = y */
+            double *x_k = X + (size_t)k * n;
+            const double *row_k = A + (size_t)k * n;
+            for (uint32_t i = k + 1; i < n; i++) {
+                double a = row_k[i];
+                if (a == 0)
+                    continue;
+                const double *x_i = X + (size_t)i * n;
+                for (uint32_t j = j0; j < j1; j++)
+                    x_k[j] -= a * x_i[j];
+            }
+            double inverse = 1 / row_k[k];
+            for (uint32_t j = j0; j < j1; j++)
+                x_k[j] *= inverse;
+        }
     }
 
     uint64_t nonzeros = 0;
