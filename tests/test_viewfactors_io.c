@@ -1,7 +1,8 @@
 /*
  * test_viewfactors_io.c - `radiosity viewfactors` with View3D input files, several mesh
  * files, --obstruction, --two-sided, --enclosure, --script-f and the output layouts.
- * Each .vs3 shape (quadrilaterals, triangles, obstruction surfaces, combined surfaces) is
+ * Each .vs3 shape (quadrilaterals, triangles, obstruction surfaces, combined surfaces,
+ * subsurfaces) is
  * written here together with the same geometry as OBJ, and the two matrices must agree
  * within the engine's error bound; values are also held to closed forms
  * (shared/docs/VALIDATION.md) where one exists. Bad .vs3 input: one line naming the file
@@ -293,6 +294,38 @@ static void test_enclosure_and_script_f(void)
     CHECK(strncmp(test_read_text(test_path("stdout.txt")), "surface,zeq0,xeq0,", 18) == 0);
 }
 
+/* A subsurface (a 1 x 1 window in a 3 x 3 wall, View3D base = the wall) facing a parallel
+ * 3 x 3 plate: the same factors as an OBJ giving the wall as four rectangles around the
+ * window, and view-factor algebra: A_wall F_wall,plate + A_window F_window,plate is the
+ * whole wall's transfer. */
+static void test_subsurface(void)
+{
+    test_write_file("window.vs3",
+                    "F 3\nV 1 0 0 0\nV 2 3 0 0\nV 3 3 3 0\nV 4 0 3 0\n"
+                    "V 5 1 1 0\nV 6 2 1 0\nV 7 2 2 0\nV 8 1 2 0\n"
+                    "V 9 0 0 1\nV 10 3 0 1\nV 11 3 3 1\nV 12 0 3 1\n"
+                    "S 1 1 2 3 4 0 0 0.9 wall\nS 2 5 6 7 8 1 0 0.9 window\n"
+                    "S 3 9 12 11 10 0 0 0.9 plate\n");
+    test_write_file("window.obj",
+                    "v 0 0 0\nv 3 0 0\nv 3 3 0\nv 0 3 0\nv 1 1 0\nv 2 1 0\nv 2 2 0\nv 1 2 0\n"
+                    "v 0 0 1\nv 3 0 1\nv 3 3 1\nv 0 3 1\n"
+                    "v 1 0 0\nv 2 0 0\nv 1 3 0\nv 2 3 0\n"
+                    "o wall\nf 1 13 15 4\nf 13 14 6 5\nf 14 2 3 16\nf 8 7 16 15\n"
+                    "o window\nf 5 6 7 8\no plate\nf 9 12 11 10\n");
+    test_write_file("whole.obj", "v 0 0 0\nv 3 0 0\nv 3 3 0\nv 0 3 0\nv 0 0 1\nv 3 0 1\n"
+                                 "v 3 3 1\nv 0 3 1\no wall\nf 1 2 3 4\no plate\nf 5 8 7 6\n");
+    matrix a, b, whole;
+    if (!run_mtx("window.vs3", "window-vs3.mtx", &a) ||
+        !run_mtx("window.obj", "window-obj.mtx", &b) || !run_mtx("whole.obj", "whole.mtx", &whole))
+        return;
+    CHECK(a.n == 3);
+    check_same(&a, &b, 2e-4);
+    CHECK_NEAR(a.area[index_of(&a, "wall")], 8.0, 1e-12);
+    CHECK_NEAR(8 * factor(&a, "wall", "plate") + 1 * factor(&a, "window", "plate"),
+               9 * factor(&whole, "wall", "plate"), 2e-4);
+    CHECK_NEAR(factor(&whole, "wall", "plate"), parallel_squares(1.0 / 3), 1e-4);
+}
+
 /* A mask (View3D M) against the same geometry with a null surface (N): the base keeps
  * its whole area and its view of the ceiling is the null version's times A_cut / A_whole;
  * the mask sees only its base. */
@@ -360,6 +393,7 @@ int main(void)
     test_obstruction();
     test_two_sided();
     test_enclosure_and_script_f();
+    test_subsurface();
     test_mask();
     test_bad_input();
     return test_finish("test_viewfactors_io");
