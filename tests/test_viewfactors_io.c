@@ -2,9 +2,8 @@
  * test_viewfactors_io.c - `radiosity viewfactors` with View3D input files, several mesh
  * files, --obstruction, --two-sided, --enclosure, --script-f and the output layouts.
  * Each .vs3 shape (quadrilaterals, triangles, obstruction surfaces, combined surfaces,
- * subsurfaces) is
- * written here together with the same geometry as OBJ, and the two matrices must agree
- * within the engine's error bound; values are also held to closed forms
+ * subsurfaces) is written here together with the same geometry as OBJ, and the two
+ * matrices must agree within the engine's error bound; values are also held to closed forms
  * (shared/docs/VALIDATION.md) where one exists. Bad .vs3 input: one line naming the file
  * and line, exit code 1, no output file.
  */
