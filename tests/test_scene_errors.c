@@ -121,5 +121,22 @@ int main(void)
     CHECK(strstr(out, "albedo (0.25, 0.5, 0.75)") != NULL);
     CHECK(strstr(out, "tex.obj: material 'painted': texture 'nowhere.png' not found") != NULL);
 
+    /* the light's power in Ka (as in the wild Cornell box file): a warning naming the
+     * material and the --emit that lights it; Ka at most 1 (a reflectance) is no warning */
+    test_write_file("ka.mtl", "newmtl bulb\nKa 20 20 20\nKd 1 1 1\n"
+                              "newmtl wall\nKa 0.5 0.5 0.5\nKd 0.5 0.5 0.5\n");
+    test_write_file("ka.obj", "mtllib ka.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                              "usemtl bulb\nf 1 2 3\nusemtl wall\nf 1 3 4\n");
+    CHECK(test_run_tool("info ka.obj") == 0);
+    out = test_read_text(test_path("stdout.txt"));
+    CHECK(strstr(out, "warnings: 1\n") != NULL);
+    CHECK(strstr(out, "ka.obj: material 'bulb' has an ambient colour Ka (20, 20, 20) above 1 "
+                      "but no Ke: it does not emit (--emit bulb=R,G,B makes it a light)") != NULL);
+    CHECK(strstr(out, "'wall'") == NULL);
+    CHECK(test_run_tool("render ka.obj -o ka.pfm --size 8x8") == 0);
+    const char *err = test_read_text(test_path("stderr.txt"));
+    CHECK(strstr(err, "material 'bulb' has an ambient colour Ka") != NULL);
+    CHECK(strstr(err, "no surface emits light") != NULL && strstr(err, "--emit NAME=R,G,B") != NULL);
+
     return test_finish("test_scene_errors");
 }

@@ -194,6 +194,16 @@ int main(void)
     run_ok("render --solution cornell.sol -o other-view.pfm --eye 100,400,200 "
            "--target 400,100,500 " VIEW);
     CHECK(!same_files("saved.pfm", "other-view.pfm"));
+    /* a plain --solution run warns of nothing; the solver's and the form factors' options
+     * do nothing then: a warning names them, and the image is the saved one */
+    run_ok("render --solution cornell.sol -o saved-again.pfm " VIEW);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "warning") == NULL);
+    run_ok("render --solution cornell.sol -o ignored.pfm --solver shoot --tolerance 0.1 "
+           "--visibility-rays 4 " VIEW);
+    CHECK(same_files("saved.pfm", "ignored.pfm"));
+    CHECK(strstr(test_read_text(test_path("stderr.txt")),
+                 "radiosity: warning: cornell.sol: the solution is read from this file, nothing "
+                 "is solved: --solver, --tolerance, --visibility-rays ignored\n") != NULL);
     /* the lit mesh from a saved solution is the lit mesh from a solve */
     run_ok("solve -o solved.ply --patch-size 100");
     run_ok("solve -o read.ply --solution cornell.sol");
@@ -204,7 +214,14 @@ int main(void)
     expect_refusal("render furnace.obj --solution cornell.sol -o out.pfm " VIEW, "cornell.sol",
                    "another scene");
     expect_refusal("render --solution cornell.sol --patch-size 90 -o out.pfm " VIEW,
-                   "cornell.sol", "patch-size");
+                   "cornell.sol", "solved with --patch-size 100, not 90");
+    /* --emit and --albedo make another scene: its solution would be wrong */
+    expect_refusal("render --solution cornell.sol --emit light=8,6,2 -o out.pfm " VIEW,
+                   "cornell.sol", "another scene");
+    expect_refusal("render --solution cornell.sol --albedo floor=0.5,0.5,0.5 -o out.pfm " VIEW,
+                   "cornell.sol", "another scene");
+    expect_refusal("solve --solution cornell.sol --emit light=17,12,4.5 -o out.ply",
+                   "cornell.sol", "another scene");
     size_t size;
     uint8_t *bytes = read_file(test_path("cornell.sol"), &size);
     CHECK(bytes && size > 200);

@@ -51,6 +51,24 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
                   "is saved already");
         return false;
     }
+    if (solve->solution_path) {
+        /* nothing is solved: options of the form factors and the solver have no effect */
+        static const int unused[] = {OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS,
+                                     OPT_VISIBILITY_RAYS, OPT_QUADRATURE};
+        static const char *const names[] = {"--solver", "--tolerance", "--max-iterations",
+                                            "--visibility-rays", "--quadrature"};
+        char given[128] = "";
+        for (size_t k = 0; k < sizeof(unused) / sizeof(unused[0]); k++)
+            if (args->value[unused[k]]) {
+                size_t length = strlen(given);
+                snprintf(given + length, sizeof(given) - length, "%s%s", length ? ", " : "",
+                         names[k]);
+            }
+        if (given[0])
+            cli_warn("%s: the solution is read from this file, nothing is solved: %s "
+                     "ignored",
+                     solve->solution_path, given);
+    }
     return true;
 }
 
@@ -115,7 +133,7 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         goto done;
     if (!rad_scene_has_emitter(out->scene))
         cli_warn("%s: no surface emits light (no material with non-zero Ke): the result will "
-                 "be black",
+                 "be black (--emit NAME=R,G,B makes a surface a light)",
                  out->scene->source);
     double t_load = cli_now();
     out->seconds_load = t_load - t0;
@@ -127,10 +145,17 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
             goto done;
         if (patch_size > 0 && patch_size != solution->patch_size) {
             status = error->status = RAD_ERR_INVALID;
+            /* the fewest digits (6 or more) that tell the two sizes apart */
+            int digits = 6;
+            char saved[32], given[32];
+            do {
+                snprintf(saved, sizeof(saved), "%.*g", digits, solution->patch_size);
+                snprintf(given, sizeof(given), "%.*g", digits, patch_size);
+            } while (strcmp(saved, given) == 0 && ++digits <= 17);
             snprintf(error->message, sizeof(error->message),
-                     "%s: solved with --patch-size %.17g, not %.17g (leave --patch-size out "
+                     "%s: solved with --patch-size %s, not %s (leave --patch-size out "
                      "to use the file's)",
-                     solve->solution_path, solution->patch_size, patch_size);
+                     solve->solution_path, saved, given);
             goto done;
         }
         patch_size = solution->patch_size;

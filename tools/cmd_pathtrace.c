@@ -139,7 +139,7 @@ int command_pathtrace(int argc, char **argv)
     t_load = cli_now();
     if (!rad_scene_has_emitter(scene))
         cli_warn("%s: no surface emits light (no material with non-zero Ke): the image will "
-                 "be black",
+                 "be black (--emit NAME=R,G,B makes a surface a light)",
                  scene->source);
     rad_camera camera = cli_view_camera(&s.view, scene);
 

@@ -307,6 +307,17 @@ static rad_status map_material(import_state *state, unsigned index, uint32_t *ou
                 if (aiGetMaterialFloatArray(m, AI_MATKEY_SHININESS, &shininess, &one) ==
                     aiReturn_SUCCESS)
                     material.shininess = shininess;
+                /* files in the wild put a light's power in the ambient colour (MTL Ka),
+                 * which no reflectance can exceed 1: say so, and how to make it emit */
+                rad_rgb ambient = material_color(m, AI_MATKEY_COLOR_AMBIENT, (rad_rgb){0, 0, 0});
+                if (fmax(ambient.r, fmax(ambient.g, ambient.b)) > 1 &&
+                    fmax(material.emission.r, fmax(material.emission.g, material.emission.b)) <= 0)
+                    rad_warn(state->options ? state->options->log : NULL,
+                             state->options ? state->options->log_user : NULL,
+                             "%s: material '%s' has an ambient colour Ka (%g, %g, %g) above 1 "
+                             "but no Ke: it does not emit (--emit %s=R,G,B makes it a light)",
+                             state->path, material.name, ambient.r, ambient.g, ambient.b,
+                             material.name);
             }
         }
         if (!is_default)
