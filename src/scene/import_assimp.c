@@ -34,6 +34,7 @@
 #include "core/error.h"
 #include "core/vec3.h"
 #include "scene/gltf_json.h"
+#include "scene/ply_check.h"
 #include "scene/scene_builder.h"
 #include "scene/texture.h"
 
@@ -587,8 +588,11 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
     bool is_gltf = has_extension(path, ".gltf") || has_extension(path, ".glb");
     if (has_extension(path, ".obj"))
         status = check_obj(path, file, error);
-    else if (has_extension(path, ".ply"))
+    else if (has_extension(path, ".ply")) {
         state.ply_without_materials = !ply_has_materials(file);
+        rewind(file);
+        status = ply_check(path, file, error);
+    }
     fclose(file);
     if (status == RAD_OK && is_gltf) {
         status = gltf_info_read(path, &gltf, error);

@@ -1,0 +1,185 @@
+/*
+ * ply_check.c - a PLY file holds every row its header declares. See ply_check.h.
+ */
+#include "ply_check.h"
+
+#include <ctype.h>
+#include <limits.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+
+enum { PLY_MAX_ELEMENTS = 16, PLY_MAX_PROPERTIES = 64 };
+
+typedef enum ply_format { PLY_ASCII, PLY_LITTLE, PLY_BIG } ply_format;
+
+typedef struct ply_property {
+    int size;       /* bytes of a scalar, or of the list's items */
+    int count_size; /* bytes of a list's count; 0 = a scalar */
+} ply_property;
+
+typedef struct ply_element {
+    char name[64];
+    unsigned long long rows;
+    int property_count;
+    ply_property properties[PLY_MAX_PROPERTIES];
+} ply_element;
+
+/* Bytes of a PLY scalar type, 0 if unknown. */
+static int type_size(const char *type)
+{
+    static const struct {
+        const char *name;
+        int size;
+    } types[] = {{"char", 1},  {"uchar", 1},  {"int8", 1},   {"uint8", 1},   {"short", 2},
+                 {"ushort", 2}, {"int16", 2},  {"uint16", 2}, {"int", 4},     {"uint", 4},
+                 {"int32", 4},  {"uint32", 4}, {"float", 4},  {"float32", 4}, {"double", 8},
+                 {"float64", 8}};
+    for (size_t k = 0; k < sizeof(types) / sizeof(types[0]); k++)
+        if (strcmp(type, types[k].name) == 0)
+            return types[k].size;
+    return 0;
+}
+
+/* A list count of `size` bytes, in the file's byte order. */
+static unsigned long long binary_count(const unsigned char *bytes, int size, ply_format format)
+{
+    unsigned long long value = 0;
+    for (int k = 0; k < size; k++)
+        value = value << 8 | bytes[format == PLY_BIG ? k : size - 1 - k];
+    return value;
+}
+
+/* The next whitespace-separated token of an ASCII body, counting lines; false at the end. */
+static bool next_token(FILE *file, char *token, size_t size, unsigned long *line)
+{
+    int c;
+    while ((c = getc(file)) != EOF && isspace(c))
+        *line += c == '\n';
+    if (c == EOF)
+        return false;
+    size_t n = 0;
+    for (; c != EOF && !isspace(c); c = getc(file))
+        if (n + 1 < size)
+            token[n++] = (char)c;
+    token[n] = 0;
+    if (c == '\n')
+        ungetc(c, file);
+    return true;
+}
+
+static rad_status check_body(const char *path, FILE *file, ply_format format,
+                             const ply_element *elements, int element_count,
+                             unsigned long line, rad_error *error)
+{
+    for (int e = 0; e < element_count; e++) {
+        const ply_element *element = &elements[e];
+        for (unsigned long long row = 0; row < element->rows; row++)
+            for (int p = 0; p < element->property_count; p++) {
+                const ply_property *property = &element->properties[p];
+                unsigned long long items = 1;
+                bool ended = false;
+                if (format == PLY_ASCII) {
+                    char token[64];
+                    ended = !next_token(file, token, sizeof(token), &line);
+                    if (!ended && property->count_size) {
+                        char *end;
+                        items = strtoull(token, &end, 10);
+                        if (*end || token[0] == '-')
+                            return rad_fail(error, RAD_ERR_PARSE,
+                                            "%s:%lu: %s %llu: list length '%s' is not a count",
+                                            path, line, element->name, row, token);
+                    } else
+                        items = 0;
+                    for (unsigned long long k = 0; k < items && !ended; k++)
+                        ended = !next_token(file, token, sizeof(token), &line);
+                } else {
+                    unsigned char bytes[8];
+                    if (property->count_size) {
+                        ended = fread(bytes, 1, (size_t)property->count_size, file) !=
+                                (size_t)property->count_size;
+                        items = ended ? 0 : binary_count(bytes, property->count_size, format);
+                    }
+                    /* skip the items, then read their last byte: fseek passes the end */
+                    ended = ended || items > (unsigned long long)LONG_MAX / 8 ||
+                            fseek(file, (long)(items * (unsigned)property->size), SEEK_CUR) != 0 ||
+                            (items && (fseek(file, -1, SEEK_CUR) != 0 ||
+                                       fread(bytes, 1, 1, file) != 1));
+                }
+                if (ended)
+                    return rad_fail(error, RAD_ERR_PARSE,
+                                    "%s: truncated: the header declares %llu rows of element '%s', "
+                                    "the file holds %llu",
+                                    path, element->rows, element->name, row);
+            }
+    }
+    return RAD_OK;
+}
+
+rad_status ply_check(const char *path, FILE *file, rad_error *error)
+{
+    ply_element *element_list = calloc(PLY_MAX_ELEMENTS, sizeof(*element_list));
+    if (!element_list)
+        return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", path);
+    char line_text[1024];
+    unsigned long line = 0;
+    int element_count = 0;
+    ply_format format = PLY_ASCII;
+    bool has_format = false, ended = false;
+    rad_status status = RAD_OK;
+    while (status == RAD_OK && fgets(line_text, sizeof(line_text), file)) {
+        line++;
+        char word[64] = "", a[64] = "", b[64] = "", c[64] = "";
+        int n = sscanf(line_text, "%63s %63s %63s %63s", word, a, b, c);
+        if (n < 1 || strcmp(word, "ply") == 0 || strcmp(word, "comment") == 0 ||
+            strcmp(word, "obj_info") == 0)
+            continue;
+        if (strcmp(word, "end_header") == 0) {
+            ended = true;
+            break;
+        }
+        if (strcmp(word, "format") == 0) {
+            has_format = true;
+            if (strcmp(a, "ascii") == 0)
+                format = PLY_ASCII;
+            else if (strcmp(a, "binary_little_endian") == 0)
+                format = PLY_LITTLE;
+            else if (strcmp(a, "binary_big_endian") == 0)
+                format = PLY_BIG;
+            else
+                status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: unknown PLY format '%s'", path,
+                                  line, a);
+        } else if (strcmp(word, "element") == 0) {
+            char *end;
+            unsigned long long rows = strtoull(b, &end, 10);
+            if (n < 3 || *end || b[0] == '-')
+                status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: element '%s' has no row count",
+                                  path, line, a);
+            else if (element_count == PLY_MAX_ELEMENTS)
+                status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: more than %d elements", path,
+                                  line, PLY_MAX_ELEMENTS);
+            else {
+                ply_element *e = &element_list[element_count++];
+                snprintf(e->name, sizeof(e->name), "%s", a);
+                e->rows = rows;
+            }
+        } else if (strcmp(word, "property") == 0) {
+            ply_element *e = element_count ? &element_list[element_count - 1] : NULL;
+            bool list = strcmp(a, "list") == 0;
+            int size = type_size(list ? c : a), count_size = list ? type_size(b) : 0;
+            if (!e || e->property_count == PLY_MAX_PROPERTIES || !size || (list && !count_size))
+                status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: bad property line", path, line);
+            else
+                e->properties[e->property_count++] = (ply_property){size, count_size};
+        }
+    }
+    if (status == RAD_OK && (!has_format || !ended))
+        status = rad_fail(error, RAD_ERR_PARSE, "%s: not a PLY file (no %s)", path,
+                          has_format ? "end_header" : "format line");
+    if (status == RAD_OK)
+        status = check_body(path, file, format, element_list, element_count, line + 1, error);
+    free(element_list);
+    return status;
+}
