@@ -5,6 +5,7 @@
  * --emit naming nothing. Each error: one line "radiosity: FILE: ...", exit 1, and no
  * output file (nor temporary file) left behind.
  */
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -161,6 +162,37 @@ int main(void)
     expect_error("binary PLY cut in its last face", "render cut-binary.ply -o out.png",
                  "cut-binary.ply: truncated: the header declares 1 rows of element 'face', "
                  "the file holds 0");
+
+    /* STL cut short: ASCII between two facets (Assimp 5.2 took what it had), and binary
+     * (84 + 50 n bytes), whose header may start with "solid" and still be binary */
+    test_write_file("cut-ascii.stl", "solid square\nfacet normal 0 0 1\nouter loop\n"
+                                     "vertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\n"
+                                     "endfacet\nfacet normal 0 0 1\nouter loop\n");
+    expect_error("ASCII STL cut short", "render cut-ascii.stl -o out.png",
+                 "cut-ascii.stl: truncated: an ASCII STL ends with 'endsolid', this one with "
+                 "'outer loop'");
+    unsigned char stl[84 + 2 * 50] = "solid, but binary";
+    stl[80] = 2; /* two triangles: (0,0,0) (1,0,0) (0,1,0), and (1,0,0) (1,1,0) (0,1,0) */
+    const float corners[2][9] = {{0, 0, 0, 1, 0, 0, 0, 1, 0}, {1, 0, 0, 1, 1, 0, 0, 1, 0}};
+    for (int t = 0; t < 2; t++)
+        for (int k = 0; k < 9; k++) {
+            uint32_t bits;
+            memcpy(&bits, &corners[t][k], 4);
+            for (int b = 0; b < 4; b++) /* little-endian, after the 12-byte normal */
+                stl[84 + 50 * t + 12 + 4 * k + b] = (unsigned char)(bits >> 8 * b);
+        }
+    for (int cut = 0; cut < 2; cut++) {
+        FILE *stl_file = fopen(test_path(cut ? "cut-binary.stl" : "binary.stl"), "wb");
+        if (stl_file) {
+            fwrite(stl, 1, sizeof(stl) - (cut ? 30 : 0), stl_file);
+            fclose(stl_file);
+        }
+    }
+    CHECK(test_run_tool("info binary.stl") == 0);
+    CHECK(strstr(test_read_text(test_path("stdout.txt")), "area: 1\n") != NULL);
+    expect_error("binary STL cut short", "render cut-binary.stl -o out.png",
+                 "cut-binary.stl: truncated or damaged: a binary STL of 2 triangles has 184 "
+                 "bytes, this file 154");
 
     /* the light's power in Ka (as in the wild Cornell box file): a warning naming the
      * material and the --emit that lights it; Ka at most 1 (a reflectance) is no warning */

@@ -62,6 +62,53 @@ static void folder_of(const char *path, char *folder, size_t size)
     folder[n] = 0;
 }
 
+/* STL: an ASCII file ends with `endsolid` (Assimp 5.2 loads one cut short between facets
+ * as if whole). Binary files (84 + 50 n bytes, whatever their first word) are Assimp's. */
+static rad_status check_stl(const char *path, FILE *file, rad_error *error)
+{
+    unsigned char head[84];
+    size_t got = fread(head, 1, sizeof(head), file);
+    if (fseek(file, 0, SEEK_END) != 0)
+        return RAD_OK;
+    long size = ftell(file);
+    bool text = true;
+    for (size_t k = 0; k < got; k++)
+        text = text && (isprint(head[k]) || isspace(head[k]));
+    if (got == sizeof(head)) {
+        unsigned long count = (unsigned long)head[80] | (unsigned long)head[81] << 8 |
+                              (unsigned long)head[82] << 16 | (unsigned long)head[83] << 24;
+        if ((unsigned long long)size == 84 + 50ull * count)
+            return RAD_OK;
+        if (!text)
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s: truncated or damaged: a binary STL of %lu triangles has %llu "
+                            "bytes, this file %ld",
+                            path, count, 84 + 50ull * count, size);
+    }
+    size_t start = 0;
+    while (start < got && isspace(head[start]))
+        start++;
+    if (got - start < 5 || strncasecmp((const char *)head + start, "solid", 5) != 0)
+        return RAD_OK; /* neither: Assimp says what it is not */
+    char tail[256];
+    long from = size > (long)sizeof(tail) - 1 ? size - (long)sizeof(tail) + 1 : 0;
+    if (fseek(file, from, SEEK_SET) != 0)
+        return RAD_OK;
+    size_t n = fread(tail, 1, sizeof(tail) - 1, file);
+    while (n > 0 && isspace((unsigned char)tail[n - 1]))
+        n--;
+    tail[n] = 0;
+    char *last = strrchr(tail, '\n');
+    last = last ? last + 1 : tail;
+    while (isspace((unsigned char)*last))
+        last++;
+    if (strncasecmp(last, "endsolid", 8) != 0)
+        return rad_fail(error, RAD_ERR_PARSE,
+                        "%s: truncated: an ASCII STL ends with 'endsolid', this one with '%.40s'",
+                        path, last);
+    return RAD_OK;
+}
+
 /* OBJ checks Assimp does not make: material libraries exist, vertex coordinates finite. */
 static rad_status check_obj(const char *path, FILE *file, rad_error *error)
 {
@@ -588,6 +635,8 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
     bool is_gltf = has_extension(path, ".gltf") || has_extension(path, ".glb");
     if (has_extension(path, ".obj"))
         status = check_obj(path, file, error);
+    else if (has_extension(path, ".stl"))
+        status = check_stl(path, file, error);
     else if (has_extension(path, ".ply")) {
         state.ply_without_materials = !ply_has_materials(file);
         rewind(file);
