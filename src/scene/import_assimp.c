@@ -109,18 +109,61 @@ static rad_status check_stl(const char *path, FILE *file, rad_error *error)
     return RAD_OK;
 }
 
-/* OBJ checks Assimp does not make: material libraries exist, vertex coordinates finite. */
+/* An OBJ face's vertex indices (the first number of each v/vt/vn corner): 0, or a relative
+ * index before the first vertex, is an error at this line; the largest absolute index is
+ * kept to be checked against the vertex count at the end. */
+static rad_status check_obj_face(const char *path, unsigned long number, const char *corners,
+                                 unsigned long vertices, long long *largest,
+                                 unsigned long *largest_line, rad_error *error)
+{
+    const char *cursor = corners;
+    for (;;) {
+        while (isspace((unsigned char)*cursor))
+            cursor++;
+        if (!*cursor)
+            return RAD_OK;
+        char *end;
+        long long index = strtoll(cursor, &end, 10);
+        if (end == cursor)
+            return RAD_OK; /* malformed: Assimp reports it */
+        if (index == 0 || (index < 0 && (unsigned long long)-index > vertices))
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s:%lu: face vertex %lld: %s", path, number, index,
+                            index == 0 ? "OBJ indices start at 1"
+                                       : "before the first vertex");
+        if (index > *largest) {
+            *largest = index;
+            *largest_line = number;
+        }
+        while (*end && !isspace((unsigned char)*end))
+            end++; /* the corner's /vt/vn */
+        cursor = end;
+    }
+}
+
+/* OBJ checks Assimp does not make (or makes without a line number): material libraries
+ * exist, vertex coordinates finite, face indices name vertices of the file. */
 static rad_status check_obj(const char *path, FILE *file, rad_error *error)
 {
     char folder[4096];
     folder_of(path, folder, sizeof(folder));
     char line[8192];
-    unsigned long number = 0;
+    unsigned long number = 0, vertices = 0, largest_line = 0;
+    long long largest = 0;
     while (fgets(line, sizeof(line), file)) {
         number++;
         char *p = line;
         while (*p == ' ' || *p == '\t')
             p++;
+        if (p[0] == 'f' && (p[1] == ' ' || p[1] == '\t')) {
+            rad_status status = check_obj_face(path, number, p + 2, vertices, &largest,
+                                               &largest_line, error);
+            if (status != RAD_OK)
+                return status;
+            continue;
+        }
+        if (p[0] == 'v' && (p[1] == ' ' || p[1] == '\t'))
+            vertices++;
         if (strncmp(p, "mtllib", 6) == 0 && isspace((unsigned char)p[6])) {
             char *name = p + 6;
             while (isspace((unsigned char)*name))
@@ -156,6 +199,9 @@ static rad_status check_obj(const char *path, FILE *file, rad_error *error)
             }
         }
     }
+    if ((unsigned long long)largest > vertices)
+        return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: face vertex %lld: the file has %lu vertices",
+                        path, largest_line, largest, vertices);
     return RAD_OK;
 }
 
