@@ -159,8 +159,9 @@ typedef struct rad_scene {
     rad_camera camera; /* valid when has_camera */
     rad_vec3 up;        /* the file's up direction, unit length: (0,1,0) unless the file says
                            otherwise (FBX UpAxis metadata); the default camera keeps it up */
-    double unit_metres; /* metres per scene unit when the file says (glTF: 1; FBX:
-                           UnitScaleFactor / 100), else 0. Coordinates are never rescaled */
+    double unit_metres; /* metres per scene unit when the file says (glTF: 1; Collada: 1,
+                           Assimp having applied its <unit> and <up_axis>; FBX:
+                           UnitScaleFactor / 100), else 0. This library never rescales */
     char source[512];  /* file the scene came from, or "(built-in Cornell box)" */
 } rad_scene;
 

@@ -451,6 +451,8 @@ static void exported_formats(void)
         if (!export_obj(formats[k][0], formats[k][1]))
             continue;
         rad_scene *scene = load(formats[k][1]);
+        if (scene && k == 0)
+            CHECK(scene->unit_metres == 1); /* Collada: metres unless it says otherwise */
         if (scene && solve_faces(formats[k][1], scene, got)) {
             if (k == 0)
                 compare_faces(formats[k][1], got, reference);
@@ -459,6 +461,41 @@ static void exported_formats(void)
         }
         rad_scene_destroy(scene);
     }
+    /* Collada in centimetres, z up: Assimp scales and turns it into y-up metres, so the
+     * unit box is 1 cm on a side; the file's z becomes y (its back, z = 1, at y = 0.01)
+     * and its y becomes -z (its ceiling, y = 1, at z = -0.01) */
+    const char *dae = test_read_text(test_path("box.dae"));
+    const char *unit = strstr(dae, "<unit "), *unit_end = unit ? strstr(unit, "/>") : NULL;
+    const char *up = strstr(dae, "<up_axis>Y_UP</up_axis>");
+    CHECK(unit && unit_end && up && unit < up);
+    if (unit && unit_end && up && unit < up) {
+        FILE *file = fopen(test_path("box-cm.dae"), "wb");
+        if (file) {
+            fwrite(dae, 1, (size_t)(unit - dae), file);
+            fputs("<unit name=\"centimeter\" meter=\"0.01\"/>", file);
+            fwrite(unit_end + 2, 1, (size_t)(up - unit_end - 2), file);
+            fputs("<up_axis>Z_UP</up_axis>", file);
+            fputs(up + strlen("<up_axis>Y_UP</up_axis>"), file);
+            fclose(file);
+        }
+        rad_scene *cm = load("box-cm.dae");
+        if (cm) {
+            CHECK(cm->unit_metres == 1);
+            CHECK(cm->up.y == 1);
+            CHECK_NEAR(rad_scene_area(cm), 6e-4, 1e-6); /* Assimp holds floats */
+            for (uint32_t s = 0; s < cm->surface_count; s++) {
+                const rad_triangle *t = &cm->triangles[cm->surfaces[s].first_triangle];
+                for (int c = 0; c < 3; c++) {
+                    if (strcmp(cm->surfaces[s].name, "back") == 0)
+                        CHECK_NEAR(cm->positions[t->vertex[c]].y, 0.01, 1e-6);
+                    if (strcmp(cm->surfaces[s].name, "ceiling") == 0)
+                        CHECK_NEAR(cm->positions[t->vertex[c]].z, -0.01, 1e-6);
+                }
+            }
+            rad_scene_destroy(cm);
+        }
+    }
+
     /* FBX (ASCII): z up, metres (100 cm per unit); Assimp's FBX round trip loses Ke, which
      * the material's name sets again */
     if (!export_obj("fbxa", "box.fbx"))

@@ -588,12 +588,14 @@ static bool metadata_number(const struct aiScene *ai, const char *key, double *o
     return false;
 }
 
-/* Up axis and unit: glTF is y-up metres by definition; FBX says UpAxis (0,1,2), UpAxisSign
- * and UnitScaleFactor (centimetres per unit) in Assimp's metadata. */
-static void take_frame(const struct aiScene *ai, bool is_gltf, scene_builder *builder)
+/* Up axis and unit: glTF is y-up metres by definition; Collada becomes y-up metres in
+ * Assimp, which scales by its <unit meter> and turns its <up_axis> in the root node; FBX
+ * says UpAxis (0,1,2), UpAxisSign and UnitScaleFactor (centimetres per unit) in Assimp's
+ * metadata. */
+static void take_frame(const struct aiScene *ai, bool metres_y_up, scene_builder *builder)
 {
     rad_vec3 up = {0, 1, 0};
-    double unit = is_gltf ? 1 : 0, axis, sign = 1, centimetres;
+    double unit = metres_y_up ? 1 : 0, axis, sign = 1, centimetres;
     if (metadata_number(ai, "UpAxis", &axis) && axis >= 0 && axis <= 2) {
         metadata_number(ai, "UpAxisSign", &sign);
         up = (rad_vec3){0, 0, 0};
@@ -734,7 +736,7 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
     }
     if (is_gltf)
         take_gltf_camera(ai, builder);
-    take_frame(ai, is_gltf, builder);
+    take_frame(ai, is_gltf || has_extension(path, ".dae"), builder);
     status = scene_builder_finish(builder, out, error);
     builder = NULL;
 done:
