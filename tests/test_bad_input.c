@@ -103,6 +103,19 @@ int main(void)
         rad_image_destroy(image);
     }
 
+    /* a closed room seen from outside (the default view): every surface shows its back,
+     * the image is black although the room is lit: a warning says where to put the camera;
+     * from inside, no warning */
+    test_write_furnace("room.obj");
+    code = test_run_tool("render room.obj -o room.pfm --size 16x16 --patch-size 0.5");
+    CHECK(code == 0);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")),
+                 "warning: room.obj: the image is black: the camera at (0.5, 0.5, ") != NULL);
+    code = test_run_tool("render room.obj -o room.pfm --size 16x16 --patch-size 0.5 "
+                         "--eye 0.5,0.5,0.9 --target 0.5,0.5,0");
+    CHECK(code == 0);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "the image is black") == NULL);
+
     /* degenerate triangles: skipped with a warning naming how many and where */
     test_write_file("degenerate.obj",
                     "mtllib lamp.mtl\nusemtl lamp\no panel\n"

@@ -142,6 +142,18 @@ int command_render(int argc, char **argv)
     if (status != RAD_OK)
         goto fail;
     t_render = cli_now();
+    if (rad_scene_has_emitter(solved.scene)) {
+        /* lit surfaces, a black image: the camera sees only backs (surfaces are one-sided),
+         * as the default view from outside a closed room does */
+        size_t lit = 0, values = (size_t)image->width * image->height * 3;
+        for (size_t k = 0; k < values && !lit; k++)
+            lit = image->rgb[k] > 0;
+        if (!lit)
+            cli_warn("%s: the image is black: the camera at (%g, %g, %g) sees no front of a "
+                     "lit surface (from outside a closed scene only backs show; place it "
+                     "inside with --eye and --target)",
+                     solved.scene->source, camera.eye.x, camera.eye.y, camera.eye.z);
+    }
     status = rad_image_write(image, s.output, &s.view.write, &error);
     if (status != RAD_OK)
         goto fail;
