@@ -655,6 +655,72 @@ rad_status rad_system_from_mesh(const rad_scene *scene, const rad_mesh *mesh,
 void rad_system_free_arrays(rad_system *system);
 
 /* ------------------------------------------------------------------------------------ */
+/* Hierarchical radiosity (Hanrahan, Salzman and Aupperle 1991, with clusters)          */
+
+/* The mesh's patches are the finest elements. Above them: a binary tree over each plane
+ * (consecutive coplanar patches of one surface and material, e.g. one input polygon's
+ * cells), and clusters (a bounding-volume tree) over the planes. Linking starts from the
+ * root cluster linked to itself; a link is split (the larger node, or the cluster) while
+ * B_source x F x A_receiver exceeds the threshold. Each link carries a form-factor estimate
+ * (point-to-disk kernel between centres; clusters use the isotropic mean cosine 1/4;
+ * patch-to-patch links use Lambert's contour formula) times a visibility fraction from a
+ * few segments traced between the two nodes (4 first, 16 when they disagree; links
+ * found fully hidden are dropped). Jacobi gathering over the links with push-pull between
+ * levels alternates with refinement until nothing refines and the change is below the
+ * tolerance. The result is one B per mesh patch, so rad_reconstruct_vertices and
+ * rad_render display it smoothly. Deterministic: every random number comes from (seed,
+ * receiver, source), every sum has a fixed order, so B is bitwise the same for any thread
+ * count. */
+typedef struct rad_hierarchy_options {
+    double refine_threshold;  /* BFA threshold, as a fraction of the scene's emitted power
+                                 per patch; 0 = 0.05. Smaller = more links, more accurate */
+    uint32_t visibility_rays; /* segments per link when the first 4 disagree; 0 = 16 */
+    double tolerance;         /* relative change of a sweep (area-weighted); 0 = 1e-4 */
+    uint32_t max_sweeps;      /* 0 = 1000 */
+    uint64_t max_memory;      /* bytes the link store may use (both of its buffers); 0 =
+                                 half the machine's memory. Refinement stops where it is
+                                 when the next step would exceed it (report.memory_capped) */
+    uint64_t seed;
+    int threads;              /* 0 = all cores */
+    /* When non-NULL and it becomes non-zero (a SIGINT handler, say), refinement and
+     * gathering stop at the next sweep and the current solution is returned (report.
+     * interrupted); B is then a valid, less converged answer. */
+    const volatile int *stop;
+    rad_progress_fn progress;
+    void *progress_user;
+} rad_hierarchy_options;
+
+typedef struct rad_hierarchy_report {
+    uint64_t elements;       /* nodes inside planes (mesh patches included) */
+    uint64_t clusters;       /* nodes above the planes */
+    uint64_t leaves;         /* mesh patches */
+    uint64_t links;          /* links at the end */
+    uint64_t links_partial;  /* of which partly visible */
+    uint64_t rays;           /* visibility segments traced */
+    uint64_t link_bytes;     /* the most the link store held, bytes */
+    uint32_t passes;         /* refinement passes (each splits links one level) */
+    uint32_t sweeps;         /* Jacobi sweeps with push-pull */
+    double residual;         /* relative change of the last sweep: sum A |B_new - B|_1 /
+                                sum A |E|_1 over the patches */
+    bool converged;          /* residual <= tolerance and nothing left to refine */
+    bool memory_capped;      /* refinement stopped at max_memory */
+    bool interrupted;        /* options.stop was raised */
+    double seconds_build;    /* element and cluster trees */
+    double seconds_refine;   /* link refinement, visibility included */
+    double seconds_gather;   /* sweeps and push-pull */
+    int threads;
+} rad_hierarchy_report;
+
+/* Solves the mesh's radiosity hierarchically: B receives mesh->patch_count exitances.
+ * `occluders` is a tracer over the scene's triangles (RAD_TRACER_EMBREE_FAST is the
+ * intended one). RAD_ERR_INVALID for a negative thread count or bad threshold,
+ * RAD_ERR_NOMEM when even the first links do not fit max_memory. */
+rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
+                                  const rad_tracer *occluders,
+                                  const rad_hierarchy_options *options, rad_rgb *B,
+                                  rad_hierarchy_report *report, rad_error *error);
+
+/* ------------------------------------------------------------------------------------ */
 /* Images                                                                                */
 
 /* Linear RGB radiance, row-major from the top-left pixel. */

@@ -51,7 +51,7 @@ enum {
     OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE, /* VIEW */
     OPT_EXR_FLOAT,
     OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_SOLUTION,        /* SOLVE */
-    OPT_SAVE_SOLUTION,
+    OPT_SAVE_SOLUTION, OPT_REFINE_THRESHOLD, OPT_MAX_MEMORY,
     OPT_EMIT, OPT_ALBEDO,                                               /* SCENE */
     OPT_OWN
 };
@@ -75,7 +75,35 @@ enum {
 #define CLI_SOLVE_OPTIONS                                                                  \
     [OPT_SOLVER] = {"solver", 0, true}, [OPT_TOLERANCE] = {"tolerance", 0, true},          \
     [OPT_MAX_ITERATIONS] = {"max-iterations", 0, true},                                    \
-    [OPT_SOLUTION] = {"solution", 0, true}, [OPT_SAVE_SOLUTION] = {"save-solution", 0, true}
+    [OPT_SOLUTION] = {"solution", 0, true}, [OPT_SAVE_SOLUTION] = {"save-solution", 0, true}, \
+    [OPT_REFINE_THRESHOLD] = {"refine-threshold", 0, true},                                \
+    [OPT_MAX_MEMORY] = {"max-memory", 0, true}
+
+/* The SOLVE options' help, the same for every command that solves. */
+#define CLI_SOLVER_HELP                                                                    \
+    "  --solver NAME        gather (Jacobi), gauss-seidel, shoot, direct (LU, small\n"       \
+    "                       scenes only), or hierarchical (links between element and\n"     \
+    "                       cluster trees, no n x n matrix: large scenes). Default:\n"      \
+    "                       gather, or hierarchical when the mesh has more than 4096\n"     \
+    "                       patches\n"                                                      \
+    "  --refine-threshold X hierarchical: split a link while B x F x A exceeds X times\n"   \
+    "                       the emitted power per patch (default 0.05; smaller = finer)\n"  \
+    "  --max-memory SIZE    hierarchical: bytes the links may use (K, M, G suffixes;\n"     \
+    "                       default half the machine's memory); refinement stops there\n"   \
+    "                       and the run says so\n"                                          \
+    "  --tolerance X        relative residual, or unshot fraction for shoot, or change of\n" \
+    "                       a sweep for hierarchical (default 1e-4)\n"                     \
+    "  --max-iterations N   sweeps, or shots for shoot (default 10000 sweeps, 1000 n\n"     \
+    "                       shots for n patches)\n"                                         \
+    "  --patch-size L       longest patch edge in scene units (default: about 3000\n"       \
+    "                       patches, 30000 with --solver hierarchical, or the one\n"        \
+    "                       --solution's file was solved with)\n"
+
+/* What Ctrl-C does, for the help of every command that solves. */
+#define CLI_INTERRUPT_HELP                                                                 \
+    "Ctrl-C during a hierarchical solve stops refinement and gathering at the next sweep\n"  \
+    "and the run goes on with the solution so far (written by --save-solution, rendered\n"   \
+    "or written as a lit mesh); a second Ctrl-C ends the run at once.\n"
 
 #define CLI_SCENE_OPTIONS                                                                  \
     [OPT_EMIT] = {"emit", 0, true}, [OPT_ALBEDO] = {"albedo", 0, true}
@@ -170,6 +198,9 @@ bool stats_write(cli_stats *stats, const char *path);
 /* What the SOLVE options say (cli_solve.c). */
 typedef struct cli_solve {
     rad_solve_options options;      /* solver, tolerance, iterations, threads, progress */
+    bool hierarchical;              /* --solver hierarchical */
+    bool solver_given;              /* --solver was given (else: hierarchical when large) */
+    rad_hierarchy_options hierarchy; /* threshold, memory, tolerance, sweeps, rays, seed */
     const char *solution_path;      /* --solution: read B from this file instead of solving */
     const char *save_solution_path; /* --save-solution: write B to this file */
 } cli_solve;
@@ -184,6 +215,8 @@ typedef struct cli_solved {
     rad_mesh *mesh;
     rad_rgb *B;     /* mesh->patch_count exitances */
     bool from_file; /* B came from --solution: no form factors, no solve */
+    bool hierarchical; /* solved by rad_solve_hierarchical (report in `hierarchy`) */
+    rad_hierarchy_report hierarchy;
     rad_formfactor_report formfactors;
     rad_solve_report report;
     rad_formfactor_check check;

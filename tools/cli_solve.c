@@ -3,16 +3,52 @@
  * form factors -> solution (or a solution file read back), with its --stats fields.
  * See cli.h.
  */
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
 
+/* Above this many patches the dense n x n matrix (64 MB of factors and 8 M patch pairs at
+ * 4096) stops paying: without --solver, the hierarchical solver takes over. */
+#define DENSE_MAX_PATCHES 4096u
+/* Leaf patches the hierarchical solver's default patch size aims at. */
+#define HIERARCHICAL_TARGET_PATCHES 30000u
+
+/* Parses a byte count with an optional K, M or G suffix (powers of 1024). */
+static bool parse_bytes(const char *name, const char *text, uint64_t *out)
+{
+    char *end = NULL;
+    double value = strtod(text, &end);
+    double scale = 1;
+    if (end && *end) {
+        if ((end[0] == 'K' || end[0] == 'k') && !end[1])
+            scale = 1024.0;
+        else if ((end[0] == 'M' || end[0] == 'm') && !end[1])
+            scale = 1024.0 * 1024;
+        else if ((end[0] == 'G' || end[0] == 'g') && !end[1])
+            scale = 1024.0 * 1024 * 1024;
+        else
+            end = NULL;
+    }
+    if (!end || end == text || !(value >= 1) || !(value * scale < 1.8e19)) {
+        cli_error("--%s: '%s' is not a size in bytes (a number, optionally followed by K, M "
+                  "or G)",
+                  name, text);
+        return false;
+    }
+    *out = (uint64_t)(value * scale);
+    return true;
+}
+
 bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *solve)
 {
     memset(solve, 0, sizeof(*solve));
     const char *solver = args->value[OPT_SOLVER] ? args->value[OPT_SOLVER] : "gather";
-    if (strcmp(solver, "gather") == 0 || strcmp(solver, "jacobi") == 0)
+    solve->solver_given = args->value[OPT_SOLVER] != NULL;
+    if (strcmp(solver, "hierarchical") == 0)
+        solve->hierarchical = true;
+    else if (strcmp(solver, "gather") == 0 || strcmp(solver, "jacobi") == 0)
         solve->options.solver = RAD_SOLVER_JACOBI;
     else if (strcmp(solver, "gauss-seidel") == 0)
         solve->options.solver = RAD_SOLVER_GAUSS_SEIDEL;
@@ -21,7 +57,8 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
     else if (strcmp(solver, "direct") == 0)
         solve->options.solver = RAD_SOLVER_DIRECT;
     else {
-        cli_error("--solver: '%s' is not gather, gauss-seidel, shoot or direct", solver);
+        cli_error("--solver: '%s' is not gather, gauss-seidel, shoot, direct or hierarchical",
+                  solver);
         return false;
     }
     solve->options.ambient = true;
@@ -44,6 +81,25 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
     }
     solve->options.threads = shared->threads;
     solve->options.progress = cli_progress;
+    if (args->value[OPT_REFINE_THRESHOLD]) {
+        double number;
+        if (!cli_parse_double("refine-threshold", args->value[OPT_REFINE_THRESHOLD], &number))
+            return false;
+        if (!(number > 0)) {
+            cli_error("--refine-threshold: must be positive");
+            return false;
+        }
+        solve->hierarchy.refine_threshold = number;
+    }
+    if (args->value[OPT_MAX_MEMORY] &&
+        !parse_bytes("max-memory", args->value[OPT_MAX_MEMORY], &solve->hierarchy.max_memory))
+        return false;
+    solve->hierarchy.tolerance = solve->options.tolerance;
+    solve->hierarchy.max_sweeps = solve->options.max_iterations;
+    solve->hierarchy.visibility_rays = shared->formfactor.visibility_rays;
+    solve->hierarchy.seed = shared->seed;
+    solve->hierarchy.threads = shared->threads;
+    solve->hierarchy.progress = cli_progress;
     solve->solution_path = args->value[OPT_SOLUTION];
     solve->save_solution_path = args->value[OPT_SAVE_SOLUTION];
     if (solve->solution_path && solve->save_solution_path) {
@@ -81,6 +137,53 @@ static const char *solver_name(rad_solver solver)
     case RAD_SOLVER_DIRECT: return "direct";
     }
     return "unknown";
+}
+
+static volatile sig_atomic_t interrupt_requested;
+
+static void on_interrupt(int signal_number)
+{
+    (void)signal_number;
+    interrupt_requested = 1;
+    signal(SIGINT, SIG_DFL); /* a second Ctrl-C ends the run at once */
+}
+
+/* B from the hierarchical solver; Ctrl-C stops it cleanly with the solution so far. */
+static rad_status solve_hierarchical(const cli_solve *solve, cli_solved *out, rad_error *error)
+{
+    rad_tracer *occluders = NULL;
+    double t0 = cli_now();
+    rad_status status =
+        rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, out->scene, &occluders, error);
+    if (status != RAD_OK)
+        return status;
+    rad_hierarchy_options options = solve->hierarchy;
+    interrupt_requested = 0;
+    options.stop = &interrupt_requested;
+    void (*previous)(int) = signal(SIGINT, on_interrupt);
+    status = rad_solve_hierarchical(out->scene, out->mesh, occluders, &options, out->B,
+                                    &out->hierarchy, error);
+    signal(SIGINT, previous == SIG_ERR ? SIG_DFL : previous);
+    rad_tracer_destroy(occluders);
+    cli_progress_end();
+    out->hierarchical = true;
+    out->seconds_solve = cli_now() - t0;
+    if (status != RAD_OK)
+        return status;
+    const rad_hierarchy_report *r = &out->hierarchy;
+    if (r->interrupted)
+        cli_warn("interrupted: refinement and gathering stopped after %u passes and %u sweeps "
+                 "(change %.3g); going on with the solution so far",
+                 r->passes, r->sweeps, r->residual);
+    else if (!r->converged)
+        cli_warn("the hierarchical solver stopped at its sweep limit (%u) with change %.3g, "
+                 "above the tolerance",
+                 r->sweeps, r->residual);
+    if (r->memory_capped)
+        cli_warn("--max-memory: the links reached the budget (%.1f MB of links); refinement "
+                 "stopped there, so the answer is coarser than the threshold asks",
+                 r->link_bytes / 1048576.0);
+    return RAD_OK;
 }
 
 /* B from the form factors and the solver. */
@@ -161,11 +264,14 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         patch_size = solution->patch_size;
     }
     if (!(patch_size > 0))
-        patch_size = rad_mesh_default_patch_size(out->scene, target_patches);
+        patch_size = rad_mesh_default_patch_size(
+            out->scene, solve->hierarchical ? HIERARCHICAL_TARGET_PATCHES : target_patches);
     status = rad_mesh_build(out->scene, patch_size, &out->mesh, error);
     if (status != RAD_OK)
         goto done;
     out->seconds_mesh = cli_now() - t_load;
+    bool hierarchical = solve->hierarchical ||
+                        (!solve->solver_given && out->mesh->patch_count > DENSE_MAX_PATCHES);
 
     if (solution) {
         status = rad_solution_match(solution, out->scene, out->mesh, error);
@@ -182,7 +288,8 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         snprintf(error->message, sizeof(error->message), "out of memory");
         goto done;
     }
-    status = solve_here(shared, solve, out, error);
+    status = hierarchical ? solve_hierarchical(solve, out, error)
+                          : solve_here(shared, solve, out, error);
     if (status != RAD_OK || !solve->save_solution_path)
         goto done;
     double t_save = cli_now();
@@ -217,6 +324,31 @@ void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *st
         stats_string(stats, "solution", solve->solution_path);
         return;
     }
+    if (s->hierarchical) {
+        const rad_hierarchy_report *h = &s->hierarchy;
+        stats_string(stats, "solver", "hierarchical");
+        stats_integer(stats, "leaves", h->leaves);
+        stats_integer(stats, "elements", h->elements);
+        stats_integer(stats, "clusters", h->clusters);
+        stats_integer(stats, "links", h->links);
+        stats_integer(stats, "links_partial", h->links_partial);
+        stats_integer(stats, "link_bytes", h->link_bytes);
+        stats_integer(stats, "rays_cast", h->rays);
+        stats_integer(stats, "refinement_passes", h->passes);
+        stats_integer(stats, "iterations", h->sweeps);
+        stats_integer(stats, "threads", (unsigned long long)h->threads);
+        stats_number(stats, "final_residual", h->residual);
+        stats_bool(stats, "converged", h->converged);
+        stats_bool(stats, "memory_capped", h->memory_capped);
+        stats_bool(stats, "interrupted", h->interrupted);
+        stats_number(stats, "seconds_hierarchy", h->seconds_build);
+        stats_number(stats, "seconds_refine", h->seconds_refine);
+        stats_number(stats, "seconds_gather", h->seconds_gather);
+        stats_number(stats, "seconds_solve", s->seconds_solve);
+        if (solve->save_solution_path)
+            stats_number(stats, "seconds_save_solution", s->seconds_save);
+        return;
+    }
     const rad_formfactor_report *ff = &s->formfactors;
     stats_integer(stats, "patch_pairs", ff->pairs);
     stats_integer(stats, "patch_pairs_facing", ff->pairs_facing);
@@ -249,6 +381,17 @@ void cli_solved_summary(const cli_solved *s, const cli_solve *solve, char *text,
     if (s->from_file) {
         snprintf(text, size, "%u patches, solution read from %s", s->mesh->patch_count,
                  solve->solution_path);
+        return;
+    }
+    if (s->hierarchical) {
+        const rad_hierarchy_report *h = &s->hierarchy;
+        snprintf(text, size,
+                 "%u patches, %llu elements, %llu clusters, %llu links, %.1f M rays, %u sweeps "
+                 "(change %.2g)%s, peak %.0f MB",
+                 s->mesh->patch_count, (unsigned long long)h->elements,
+                 (unsigned long long)h->clusters, (unsigned long long)h->links, h->rays / 1e6,
+                 h->sweeps, h->residual, h->memory_capped ? ", memory capped" : "",
+                 rad_peak_memory_bytes() / 1048576.0);
         return;
     }
     char solved[64];

@@ -32,13 +32,7 @@ static const char usage[] =
     "                       of solving; refused if FILE belongs to another scene (--emit,\n"
     "                       --albedo) or meshing; the solver options are then ignored\n"
     "  --save-solution FILE also write the solution to FILE, for later --solution runs\n"
-    "  --solver NAME        gather (Jacobi, default), gauss-seidel, shoot, or direct (LU,\n"
-    "                       small scenes only)\n"
-    "  --tolerance X        relative residual, or unshot fraction for shoot (default 1e-4)\n"
-    "  --max-iterations N   sweeps, or shots for shoot (default 10000 sweeps, 1000 n\n"
-    "                       shots for n patches)\n"
-    "  --patch-size L       longest patch edge in scene units (default: about 3000 patches,\n"
-    "                       or the one --solution's file was solved with)\n"
+    CLI_SOLVER_HELP
     "  --visibility-rays N  most occlusion rays per patch pair (default 16; 4 first,\n"
     "                       all N only where those 4 disagree)\n"
     "  --quadrature M       M x M points per patch for the analytic form factor (default 1)\n"
@@ -46,7 +40,8 @@ static const char usage[] =
     "  --threads N          worker threads (default: all cores)\n"
     "  --seed N             seed of every random choice (default 1)\n"
     "  --stats FILE.json    write counts, times, residuals and peak memory\n"
-    "  -h, --help           this text\n";
+    "  -h, --help           this text\n"
+    "\n" CLI_INTERRUPT_HELP;
 
 enum { OPT_SPECULAR = OPT_OWN, OPT_MAX_DEPTH, OPT_COUNT };
 

@@ -1,0 +1,104 @@
+/*
+ * hierarchy.h - the element and cluster tree, links, and their estimates (internal).
+ *
+ * One binary tree over the mesh's patches, stored in preorder (a parent before its
+ * children), so push (top-down) is a forward loop and pull (bottom-up) a backward one:
+ *   - leaves are the mesh patches;
+ *   - "planar" nodes group patches of one plane (a run of consecutive coplanar patches of
+ *     one surface and material: an input polygon's cells, or a flat region);
+ *   - clusters are the nodes above the planes (a bounding-volume tree, median splits).
+ * A link (receiver <- source) carries the irradiance the receiver gets per unit radiosity
+ * of the source: the form-factor estimate F times the visible fraction.
+ */
+#ifndef RAD_HIERARCHY_HIERARCHY_H
+#define RAD_HIERARCHY_HIERARCHY_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "radiosity.h"
+
+#define HNODE_NONE UINT32_MAX
+
+typedef struct hnode {
+    rad_vec3 centroid; /* area-weighted */
+    rad_vec3 normal;   /* unit, area-weighted mean; meaningful for planar nodes */
+    rad_vec3 lo, hi;   /* bounding box */
+    double area;
+    double radius;     /* bounding sphere about the centroid */
+    uint32_t first, count; /* range of hier_tree.order (patches below) */
+    uint32_t child[2];     /* HNODE_NONE for a leaf */
+    uint32_t parent;       /* HNODE_NONE for the root */
+    uint32_t patch;        /* the mesh patch of a leaf, else HNODE_NONE */
+    bool planar;
+} hnode;
+
+typedef struct hier_tree {
+    hnode *nodes;
+    uint32_t node_count;
+    uint32_t *order;      /* patches in leaf order */
+    double *cumulative;   /* cumulative[k] = area of order[0..k], for sampling */
+    uint32_t planar_count, cluster_count;
+    double plane_epsilon; /* scene units: the front-of-plane guard */
+} hier_tree;
+
+/* Builds the tree over every patch of the mesh. 0 on allocation failure. */
+int hier_tree_build(const rad_mesh *mesh, hier_tree *tree);
+void hier_tree_free(hier_tree *tree);
+
+typedef struct hlink {
+    uint32_t receiver, source;
+    float transfer;   /* F(receiver <- source) x visibility */
+    float visibility; /* visible fraction: 1 full, in (0,1) partial */
+} hlink;
+
+/* What refinement needs to know about a link, computed from geometry alone. */
+typedef struct link_estimate {
+    double factor;      /* form-factor estimate F(receiver <- source), unoccluded */
+    double factor_bound; /* an upper bound of F times A_receiver (the transfer area) */
+} link_estimate;
+
+/* Geometry of a link between two distinct nodes (contour formula for two patches). */
+link_estimate hier_estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
+                            uint32_t source);
+
+/* A point uniform in area on the patches below node, lifted off folded quads, and the
+ * normal of its patch; u1..u3 in [0,1). */
+rad_vec3 hier_sample_point(const rad_mesh *mesh, const hier_tree *tree, uint32_t node,
+                           double u1, double u2, double u3, rad_vec3 *normal);
+
+/* The links, in two buffers of `capacity` (the second is scratch for refinement and for
+ * sorting by receiver). */
+typedef struct link_store {
+    hlink *links, *spare;
+    size_t count, capacity;
+    uint64_t max_bytes;  /* budget for both buffers */
+    uint64_t peak_bytes; /* the most both buffers held */
+} link_store;
+
+typedef struct refine_context {
+    const rad_mesh *mesh;
+    const hier_tree *tree;
+    const rad_tracer *occluders;
+    const rad_rgb *node_radiosity; /* pulled B of every node */
+    double epsilon;                /* absolute BFA threshold (power) */
+    unsigned visibility_rays;      /* segments for a link the first 4 found partial */
+    uint64_t seed;
+    int threads;
+} refine_context;
+
+typedef struct refine_result {
+    size_t split;  /* links replaced by their children */
+    bool capped;   /* some links wanted to split but the budget said no */
+    uint64_t rays;
+} refine_result;
+
+/* One refinement pass: every link whose BFA bound exceeds epsilon (a quarter of it for
+ * partly visible links) is replaced by its children one level down: the larger node
+ * split, and a cluster's link to itself by its children's four pairs. Children get a
+ * form-factor estimate and a visibility fraction; hidden and facing-away children are
+ * dropped. Deterministic: the output order is fixed by the input order. 0 when memory
+ * could not be allocated (the store is left as it was). */
+int hier_refine_pass(const refine_context *context, link_store *store, refine_result *result);
+
+#endif

@@ -1,0 +1,426 @@
+/*
+ * refine.c - one level of link refinement (Hanrahan, Salzman and Aupperle 1991).
+ *
+ * Phase 1 (parallel over links, cheap): each link decides from geometry and the current
+ * radiosity whether it splits and into how many children. When the children would not fit
+ * the budget, the links with the largest bounds split first and the rest stay (the run is
+ * then "capped"). Phase 2 (parallel over fixed chunks of links): children are estimated and
+ * their visibility traced, written at positions fixed by the chunk's place, then chunks are
+ * compacted in order. Nothing depends on the thread count.
+ */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/random.h"
+#include "core/tolerance.h"
+#include "core/vec3.h"
+#include "hierarchy/hierarchy.h"
+
+#define CHUNK_LINKS 1024u   /* parent links per phase-2 chunk */
+#define FIRST_RAYS 4u       /* segments every new link gets */
+#define MAX_RAYS 64u
+#define PARTIAL_FACTOR 0.25 /* partly visible links refine at a quarter of the threshold */
+
+enum { KEEP = 0, SPLIT_RECEIVER = 1, SPLIT_SOURCE = 2, SPLIT_SELF = 3 };
+
+static unsigned children_of(uint8_t action)
+{
+    return action == KEEP ? 1 : action == SPLIT_SELF ? 4 : 2;
+}
+
+static double brightest(rad_rgb b) { return fmax(b.r, fmax(b.g, b.b)); }
+
+static uint8_t decide(const refine_context *c, const hlink *link, float *bound)
+{
+    const hnode *nodes = c->tree->nodes;
+    const hnode *p = &nodes[link->receiver], *q = &nodes[link->source];
+    if (link->receiver == link->source) {
+        *bound = INFINITY;
+        return SPLIT_SELF; /* only clusters link to themselves */
+    }
+    bool p_leaf = p->child[0] == HNODE_NONE, q_leaf = q->child[0] == HNODE_NONE;
+    if (p_leaf && q_leaf) {
+        *bound = 0;
+        return KEEP;
+    }
+    link_estimate e = hier_estimate(c->mesh, c->tree, link->receiver, link->source);
+    double error = brightest(c->node_radiosity[link->source]) * e.factor_bound;
+    bool partial = link->visibility < 1;
+    *bound = (float)error;
+    if (!(error > c->epsilon * (partial ? PARTIAL_FACTOR : 1)))
+        return KEEP;
+    if (p_leaf)
+        return SPLIT_SOURCE;
+    if (q_leaf)
+        return SPLIT_RECEIVER;
+    /* a cluster receiving pushes one mean irradiance to surfaces of every orientation:
+     * split it first; then the larger */
+    if (!p->planar)
+        return SPLIT_RECEIVER;
+    if (!q->planar)
+        return SPLIT_SOURCE;
+    return p->radius >= q->radius ? SPLIT_RECEIVER : SPLIT_SOURCE;
+}
+
+typedef struct pending {
+    uint32_t slot;  /* index into the chunk's output */
+    uint32_t first; /* its first ray in the batch */
+    double factor;  /* the geometric estimate; < 0: sample the kernel (larger nodes) */
+    double planes;  /* two planes' centre estimate (< 0 for clusters): used when every
+                       segment is open, where it has no sampling noise */
+} pending;
+
+typedef struct thread_buffers {
+    rad_ray *rays;
+    uint8_t *occluded;
+    double *kernel;
+    pending *pend;
+    rad_ray *more_rays;
+    uint8_t *more_occluded;
+    double *more_kernel;
+} thread_buffers;
+
+static unsigned greatest_divisor(unsigned a, unsigned b)
+{
+    while (b) {
+        unsigned t = a % b;
+        a = b;
+        b = t;
+    }
+    return a;
+}
+
+/* Segments between area-uniform points of the two nodes, and at each the transfer kernel
+ * A_source cos cos / (pi r^2), capped at 1 (a factor never exceeds 1): the mean over the
+ * segments is the Monte Carlo form factor, unbiased but for the cap. */
+static void make_rays(const refine_context *c, uint32_t receiver, uint32_t source,
+                      unsigned round, unsigned count, rad_ray *rays, double *kernel)
+{
+    double area = c->tree->nodes[source].area;
+    rad_rng rng = rad_rng_seed(c->seed + round, receiver, source);
+    /* stratified along each node's leaf order (spatially coherent), strata of the source
+     * paired with the receiver's by a random stride prime to their count */
+    unsigned stride = 1 + (unsigned)(rad_rng_next(&rng) % count);
+    while (greatest_divisor(stride, count) != 1)
+        stride--;
+    unsigned offset = (unsigned)(rad_rng_next(&rng) % count);
+    for (unsigned k = 0; k < count; k++) {
+        double u[6];
+        for (int m = 0; m < 6; m++)
+            u[m] = rad_rng_uniform(&rng);
+        u[0] = (k + u[0]) / count;
+        u[3] = ((k * stride + offset) % count + u[3]) / count;
+        rad_vec3 na, nb;
+        rad_vec3 a = hier_sample_point(c->mesh, c->tree, receiver, u[0], u[1], u[2], &na);
+        rad_vec3 b = hier_sample_point(c->mesh, c->tree, source, u[3], u[4], u[5], &nb);
+        rad_vec3 d = v3_sub(b, a);
+        double r2 = v3_dot(d, d), r = sqrt(r2);
+        double cos_a = r > 0 ? fmax(0, v3_dot(na, d) / r) : 0;
+        double cos_b = r > 0 ? fmax(0, -v3_dot(nb, d) / r) : 0;
+        kernel[k] = area * cos_a * cos_b / (RAD_PI * r2 + 0.25 * area);
+        rad_ray *ray = &rays[k];
+        ray->origin[0] = (float)a.x;
+        ray->origin[1] = (float)a.y;
+        ray->origin[2] = (float)a.z;
+        ray->direction[0] = (float)(b.x - a.x);
+        ray->direction[1] = (float)(b.y - a.y);
+        ray->direction[2] = (float)(b.z - a.z);
+        ray->t_near = RAD_SEGMENT_END_EPSILON;
+        ray->t_far = 1.0f - RAD_SEGMENT_END_EPSILON;
+        if (!(ray->direction[0] != 0 || ray->direction[1] != 0 || ray->direction[2] != 0)) {
+            ray->direction[0] = 1; /* coincident points: an empty segment */
+            ray->t_near = 1;
+            ray->t_far = 0;
+        }
+    }
+}
+
+/* Children of one chunk of parent links, written to out; returns how many are live. */
+static size_t refine_chunk(const refine_context *c, const hlink *links, const uint8_t *action,
+                           size_t begin, size_t end, hlink *out, thread_buffers *tb,
+                           uint64_t *rays_cast)
+{
+    const hnode *nodes = c->tree->nodes;
+    size_t slot = 0;
+    uint32_t pending_count = 0, ray_count = 0;
+    for (size_t l = begin; l < end; l++) {
+        const hlink *link = &links[l];
+        if (action[l] == KEEP) {
+            out[slot++] = *link;
+            continue;
+        }
+        uint32_t pairs[4][2];
+        unsigned n = 0;
+        const hnode *p = &nodes[link->receiver], *q = &nodes[link->source];
+        if (action[l] == SPLIT_SELF) {
+            for (int a = 0; a < 2; a++)
+                for (int b = 0; b < 2; b++) {
+                    pairs[n][0] = p->child[a];
+                    pairs[n][1] = p->child[b];
+                    n++;
+                }
+        } else if (action[l] == SPLIT_RECEIVER) {
+            for (int a = 0; a < 2; a++, n++) {
+                pairs[n][0] = p->child[a];
+                pairs[n][1] = link->source;
+            }
+        } else {
+            for (int b = 0; b < 2; b++, n++) {
+                pairs[n][0] = link->receiver;
+                pairs[n][1] = q->child[b];
+            }
+        }
+        for (unsigned k = 0; k < n; k++) {
+            hlink *child = &out[slot];
+            child->receiver = pairs[k][0];
+            child->source = pairs[k][1];
+            child->transfer = 0;
+            child->visibility = 1;
+            if (child->receiver == child->source) {
+                if (nodes[child->receiver].planar) /* a plane sends nothing to itself */
+                    child->receiver = HNODE_NONE;
+                slot++;
+                continue;
+            }
+            link_estimate e = hier_estimate(c->mesh, c->tree, child->receiver, child->source);
+            if (!(e.factor > 0) && !(e.factor_bound > 0)) {
+                child->receiver = HNODE_NONE;
+                slot++;
+                continue;
+            }
+            /* two patches: the contour formula times the visible fraction; larger nodes: the
+             * kernel sampled at the segments' ends, unbiased whatever the shadows */
+            bool sampled = nodes[child->receiver].patch == HNODE_NONE ||
+                           nodes[child->source].patch == HNODE_NONE;
+            bool planes = nodes[child->receiver].planar && nodes[child->source].planar;
+            tb->pend[pending_count] = (pending){(uint32_t)slot, ray_count,
+                                                sampled ? -1.0 : e.factor,
+                                                planes ? e.factor : -1.0};
+            make_rays(c, child->receiver, child->source, 0, FIRST_RAYS, &tb->rays[ray_count],
+                      &tb->kernel[ray_count]);
+            ray_count += FIRST_RAYS;
+            pending_count++;
+            slot++;
+        }
+    }
+    if (ray_count > 0)
+        rad_tracer_occluded(c->occluders, tb->rays, ray_count, tb->occluded);
+    *rays_cast += ray_count;
+    unsigned extra = c->visibility_rays > FIRST_RAYS ? c->visibility_rays - FIRST_RAYS : 0;
+    for (uint32_t k = 0; k < pending_count; k++) {
+        const pending *pd = &tb->pend[k];
+        hlink *child = &out[pd->slot];
+        unsigned visible = 0, total = FIRST_RAYS;
+        double kernel_sum = 0;
+        for (unsigned r = 0; r < FIRST_RAYS; r++) {
+            bool open = !tb->occluded[pd->first + r];
+            visible += open;
+            kernel_sum += open ? tb->kernel[pd->first + r] : 0;
+        }
+        if (visible < FIRST_RAYS && extra > 0 && (visible > 0 || pd->factor < 0)) {
+            make_rays(c, child->receiver, child->source, 1, extra, tb->more_rays, tb->more_kernel);
+            rad_tracer_occluded(c->occluders, tb->more_rays, extra, tb->more_occluded);
+            *rays_cast += extra;
+            for (unsigned r = 0; r < extra; r++) {
+                bool open = !tb->more_occluded[r];
+                visible += open;
+                kernel_sum += open ? tb->more_kernel[r] : 0;
+            }
+            total += extra;
+        }
+        bool leaves = nodes[child->receiver].patch != HNODE_NONE &&
+                      nodes[child->source].patch != HNODE_NONE;
+        if (visible == 0 && leaves) {
+            child->receiver = HNODE_NONE; /* fully hidden */
+            continue;
+        }
+        /* a hidden pair of larger nodes stays (transfer 0) so that refinement can still
+         * find what a few segments missed */
+        double fraction = (double)visible / total;
+        child->visibility = (float)fraction;
+        double sampled = visible == total && pd->planes >= 0 ? pd->planes : kernel_sum / total;
+        child->transfer = (float)(pd->factor >= 0 ? pd->factor * fraction : sampled);
+    }
+    size_t live = 0;
+    for (size_t k = 0; k < slot; k++)
+        if (out[k].receiver != HNODE_NONE)
+            out[live++] = out[k];
+    return live;
+}
+
+typedef struct ranked {
+    float bound;
+    uint32_t pad;
+    size_t index;
+} ranked;
+
+static int compare_ranked(const void *a, const void *b)
+{
+    const ranked *x = a, *y = b;
+    if (x->bound != y->bound)
+        return x->bound > y->bound ? -1 : 1;
+    return x->index < y->index ? -1 : x->index > y->index;
+}
+
+static int grow_store(link_store *store, size_t needed)
+{
+    if (needed <= store->capacity)
+        return 1;
+    size_t capacity = store->capacity + store->capacity / 2;
+    if (capacity < needed)
+        capacity = needed;
+    if ((uint64_t)capacity * 2 * sizeof(hlink) > store->max_bytes)
+        capacity = needed;
+    hlink *a = realloc(store->links, capacity * sizeof(hlink));
+    if (!a)
+        return 0;
+    store->links = a;
+    hlink *b = realloc(store->spare, capacity * sizeof(hlink));
+    if (!b)
+        return 0;
+    store->spare = b;
+    store->capacity = capacity;
+    uint64_t bytes = (uint64_t)capacity * 2 * sizeof(hlink);
+    if (bytes > store->peak_bytes)
+        store->peak_bytes = bytes;
+    return 1;
+}
+
+int hier_refine_pass(const refine_context *c, link_store *store, refine_result *result)
+{
+    memset(result, 0, sizeof(*result));
+    size_t n = store->count;
+    if (n == 0)
+        return 1;
+    uint8_t *action = rad_alloc_array(n, 1);
+    float *bound = rad_alloc_array(n, sizeof(float));
+    size_t chunks = (n + CHUNK_LINKS - 1) / CHUNK_LINKS;
+    size_t *chunk_start = rad_alloc_array(chunks + 1, sizeof(size_t));
+    size_t *chunk_live = rad_alloc_array(chunks, sizeof(size_t));
+    if (!action || !bound || !chunk_start || !chunk_live) {
+        free(action);
+        free(bound);
+        free(chunk_start);
+        free(chunk_live);
+        return 0;
+    }
+    const hlink *links = store->links;
+#pragma omp parallel for num_threads(c->threads) schedule(static, 4096)
+    for (size_t l = 0; l < n; l++)
+        action[l] = decide(c, &links[l], &bound[l]);
+
+    size_t total = 0, split = 0;
+    for (size_t l = 0; l < n; l++) {
+        total += children_of(action[l]);
+        split += action[l] != KEEP;
+    }
+    size_t fits = (size_t)(store->max_bytes / (2 * sizeof(hlink)));
+    int ok = 1;
+    if (total > fits) { /* the largest bounds first, while the children fit */
+        result->capped = true;
+        ranked *order = rad_alloc_array(split ? split : 1, sizeof(ranked));
+        if (!order) {
+            ok = 0;
+        } else {
+            size_t m = 0;
+            for (size_t l = 0; l < n; l++)
+                if (action[l] != KEEP)
+                    order[m++] = (ranked){bound[l], 0, l};
+            qsort(order, m, sizeof(ranked), compare_ranked);
+            total = n;
+            split = 0;
+            for (size_t k = 0; k < m; k++) {
+                size_t more = children_of(action[order[k].index]) - 1;
+                if (total + more <= fits) {
+                    total += more;
+                    split++;
+                } else {
+                    action[order[k].index] = KEEP;
+                }
+            }
+            free(order);
+        }
+    }
+    if (ok && split > 0 && !grow_store(store, total))
+        ok = 0;
+    if (!ok || split == 0) {
+        free(action);
+        free(bound);
+        free(chunk_start);
+        free(chunk_live);
+        result->split = 0;
+        return ok;
+    }
+    chunk_start[0] = 0;
+    for (size_t k = 0; k < chunks; k++) {
+        size_t end = (k + 1) * CHUNK_LINKS < n ? (k + 1) * CHUNK_LINKS : n;
+        size_t sum = 0;
+        for (size_t l = k * CHUNK_LINKS; l < end; l++)
+            sum += children_of(action[l]);
+        chunk_start[k + 1] = chunk_start[k] + sum;
+    }
+    uint64_t rays = 0;
+    int failed = 0;
+    unsigned extra_rays = c->visibility_rays > MAX_RAYS ? MAX_RAYS : c->visibility_rays;
+    links = store->links;
+    hlink *out = store->spare;
+#pragma omp parallel num_threads(c->threads) reduction(+ : rays) reduction(| : failed)
+    {
+        thread_buffers tb;
+        size_t most = 4 * (size_t)CHUNK_LINKS;
+        tb.rays = rad_alloc_array(most * FIRST_RAYS, sizeof(rad_ray));
+        tb.occluded = rad_alloc_array(most * FIRST_RAYS, 1);
+        tb.kernel = rad_alloc_array(most * FIRST_RAYS, sizeof(double));
+        tb.more_kernel = rad_alloc_array(MAX_RAYS, sizeof(double));
+        tb.pend = rad_alloc_array(most, sizeof(pending));
+        tb.more_rays = rad_alloc_array(MAX_RAYS, sizeof(rad_ray));
+        tb.more_occluded = rad_alloc_array(MAX_RAYS, 1);
+        bool have = tb.rays && tb.occluded && tb.kernel && tb.pend && tb.more_rays &&
+                    tb.more_occluded && tb.more_kernel;
+        refine_context local = *c;
+        local.visibility_rays = extra_rays;
+#pragma omp for schedule(dynamic, 1)
+        for (size_t k = 0; k < chunks; k++) {
+            if (!have) {
+                failed |= 1;
+                continue;
+            }
+            size_t end = (k + 1) * CHUNK_LINKS < n ? (k + 1) * CHUNK_LINKS : n;
+            chunk_live[k] = refine_chunk(&local, links, action, k * CHUNK_LINKS, end,
+                                         out + chunk_start[k], &tb, &rays);
+        }
+        free(tb.rays);
+        free(tb.occluded);
+        free(tb.kernel);
+        free(tb.more_kernel);
+        free(tb.pend);
+        free(tb.more_rays);
+        free(tb.more_occluded);
+    }
+    if (failed) {
+        free(action);
+        free(bound);
+        free(chunk_start);
+        free(chunk_live);
+        return 0;
+    }
+    size_t live = 0;
+    for (size_t k = 0; k < chunks; k++) {
+        if (live != chunk_start[k])
+            memmove(out + live, out + chunk_start[k], chunk_live[k] * sizeof(hlink));
+        live += chunk_live[k];
+    }
+    store->spare = store->links;
+    store->links = out;
+    store->count = live;
+    result->split = split;
+    result->rays = rays;
+    free(action);
+    free(bound);
+    free(chunk_start);
+    free(chunk_live);
+    return 1;
+}

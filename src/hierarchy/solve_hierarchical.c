@@ -1,0 +1,289 @@
+/*
+ * solve_hierarchical.c - rad_solve_hierarchical: refinement alternating with Jacobi
+ * gathering over links and push-pull between levels.
+ *
+ * A sweep: every node gathers H = sum over its links of transfer x B(source) (parallel over
+ * nodes, links sorted by receiver); push adds each node's H to everything below it
+ * (preorder: one forward loop); every patch takes B = E + rho H; pull makes every node's B
+ * the area-weighted mean of its children's (one backward loop). The outer loop refines the
+ * links one level with the newest B and sweeps twice, until nothing splits; then it sweeps
+ * to the tolerance and checks refinement once more with the converged B.
+ */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/memory.h"
+#include "core/rgb.h"
+#include "hierarchy/hierarchy.h"
+
+#define DEFAULT_THRESHOLD 0.05
+#define DEFAULT_TOLERANCE 1e-4
+#define DEFAULT_MAX_SWEEPS 1000u
+#define DEFAULT_VISIBILITY_RAYS 16u
+#define SWEEPS_PER_PASS 2u
+#define MAX_PASSES 256u
+
+typedef struct hsolver {
+    const rad_scene *scene;
+    const rad_mesh *mesh;
+    hier_tree tree;
+    rad_rgb *emission, *albedo; /* per patch */
+    rad_rgb *node_B, *gathered, *down;
+    rad_rgb *patch_B;           /* per patch */
+    size_t *offsets;            /* links by receiver: node k's are [offsets[k], offsets[k+1]) */
+    link_store store;
+    double emitted;             /* sum A |E|_1 */
+    int threads;
+} hsolver;
+
+static double now_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void pull(hsolver *s)
+{
+    const hier_tree *t = &s->tree;
+    for (uint32_t k = t->node_count; k-- > 0;) {
+        const hnode *n = &t->nodes[k];
+        if (n->patch != HNODE_NONE) {
+            s->node_B[k] = s->patch_B[n->patch];
+            continue;
+        }
+        const hnode *a = &t->nodes[n->child[0]], *b = &t->nodes[n->child[1]];
+        double wa = n->area > 0 ? a->area / n->area : 0.5, wb = n->area > 0 ? b->area / n->area : 0.5;
+        s->node_B[k] = rgb_add(rgb_scale(s->node_B[n->child[0]], wa),
+                               rgb_scale(s->node_B[n->child[1]], wb));
+    }
+}
+
+/* Stable counting sort of the links by receiver into the spare buffer, then swap. */
+static void sort_by_receiver(hsolver *s)
+{
+    link_store *st = &s->store;
+    uint32_t nodes = s->tree.node_count;
+    memset(s->offsets, 0, ((size_t)nodes + 1) * sizeof(size_t));
+    for (size_t l = 0; l < st->count; l++)
+        s->offsets[st->links[l].receiver + 1]++;
+    for (uint32_t k = 0; k < nodes; k++)
+        s->offsets[k + 1] += s->offsets[k];
+    for (size_t l = 0; l < st->count; l++)
+        st->spare[s->offsets[st->links[l].receiver]++] = st->links[l];
+    for (uint32_t k = nodes; k > 0; k--)
+        s->offsets[k] = s->offsets[k - 1];
+    s->offsets[0] = 0;
+    hlink *swap = st->links;
+    st->links = st->spare;
+    st->spare = swap;
+}
+
+/* One Jacobi sweep with push-pull; returns the relative change. */
+static double sweep(hsolver *s)
+{
+    const hier_tree *t = &s->tree;
+    const hlink *links = s->store.links;
+    int64_t nodes = t->node_count;
+#pragma omp parallel for num_threads(s->threads) schedule(dynamic, 256)
+    for (int64_t k = 0; k < nodes; k++) {
+        rad_rgb sum = {0, 0, 0};
+        for (size_t l = s->offsets[k]; l < s->offsets[k + 1]; l++)
+            rgb_add_to(&sum, rgb_scale(s->node_B[links[l].source], links[l].transfer));
+        s->gathered[k] = sum;
+    }
+    double change = 0;
+    for (uint32_t k = 0; k < t->node_count; k++) {
+        const hnode *n = &t->nodes[k];
+        s->down[k] = n->parent == HNODE_NONE ? s->gathered[k]
+                                             : rgb_add(s->down[n->parent], s->gathered[k]);
+        if (n->patch != HNODE_NONE) {
+            uint32_t p = n->patch;
+            rad_rgb b = rgb_add(s->emission[p], rgb_mul(s->albedo[p], s->down[k]));
+            change += n->area * (fabs(b.r - s->patch_B[p].r) + fabs(b.g - s->patch_B[p].g) +
+                                 fabs(b.b - s->patch_B[p].b));
+            s->patch_B[p] = b;
+        }
+    }
+    pull(s);
+    return s->emitted > 0 ? change / s->emitted : 0;
+}
+
+static void hsolver_free(hsolver *s)
+{
+    hier_tree_free(&s->tree);
+    free(s->emission);
+    free(s->albedo);
+    free(s->node_B);
+    free(s->gathered);
+    free(s->down);
+    free(s->patch_B);
+    free(s->offsets);
+    free(s->store.links);
+    free(s->store.spare);
+}
+
+static bool stopped(const rad_hierarchy_options *o) { return o->stop && *o->stop; }
+
+rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
+                                  const rad_tracer *occluders,
+                                  const rad_hierarchy_options *options, rad_rgb *B,
+                                  rad_hierarchy_report *report, rad_error *error)
+{
+    rad_hierarchy_options o = {0};
+    if (options)
+        o = *options;
+    rad_hierarchy_report rep = {0};
+    if (o.threads < 0)
+        return rad_fail(error, RAD_ERR_INVALID, "threads must be 0 (all cores) or positive");
+    if (!(o.refine_threshold >= 0) || !isfinite(o.refine_threshold))
+        return rad_fail(error, RAD_ERR_INVALID, "the refinement threshold must be >= 0");
+    if (!(o.tolerance >= 0))
+        return rad_fail(error, RAD_ERR_INVALID, "the tolerance must be >= 0");
+    double threshold = o.refine_threshold > 0 ? o.refine_threshold : DEFAULT_THRESHOLD;
+    double tolerance = o.tolerance > 0 ? o.tolerance : DEFAULT_TOLERANCE;
+    uint32_t max_sweeps = o.max_sweeps ? o.max_sweeps : DEFAULT_MAX_SWEEPS;
+    unsigned rays = o.visibility_rays ? o.visibility_rays : DEFAULT_VISIBILITY_RAYS;
+    uint64_t budget = o.max_memory;
+    if (budget == 0)
+        budget = rad_physical_memory_bytes() / 2;
+    if (budget == 0)
+        budget = UINT64_MAX;
+
+    hsolver s;
+    memset(&s, 0, sizeof(s));
+    s.scene = scene;
+    s.mesh = mesh;
+    s.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+    rep.threads = s.threads;
+    uint32_t n = mesh->patch_count;
+    double t0 = now_seconds();
+    if (n == 0) {
+        if (report)
+            *report = rep;
+        return RAD_OK;
+    }
+    if (!hier_tree_build(mesh, &s.tree))
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory building the element tree");
+    uint32_t nodes = s.tree.node_count;
+    s.emission = rad_alloc_array(n, sizeof(rad_rgb));
+    s.albedo = rad_alloc_array(n, sizeof(rad_rgb));
+    s.patch_B = rad_alloc_array(n, sizeof(rad_rgb));
+    s.node_B = rad_alloc_array(nodes, sizeof(rad_rgb));
+    s.gathered = rad_alloc_array(nodes, sizeof(rad_rgb));
+    s.down = rad_alloc_array(nodes, sizeof(rad_rgb));
+    s.offsets = rad_alloc_array((size_t)nodes + 1, sizeof(size_t));
+    if (!s.emission || !s.albedo || !s.patch_B || !s.node_B || !s.gathered || !s.down ||
+        !s.offsets) {
+        hsolver_free(&s);
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the hierarchy");
+    }
+    double brightest_total = 0;
+    for (uint32_t p = 0; p < n; p++) {
+        const rad_material *m = &scene->materials[mesh->patches[p].material];
+        s.emission[p] = rgb_scale(m->emission, 3.14159265358979323846);
+        s.albedo[p] = m->albedo;
+        s.patch_B[p] = s.emission[p];
+        double a = mesh->patches[p].area;
+        s.emitted += a * (s.emission[p].r + s.emission[p].g + s.emission[p].b);
+        brightest_total += a * fmax(s.emission[p].r, fmax(s.emission[p].g, s.emission[p].b));
+    }
+    pull(&s);
+    rep.leaves = n;
+    rep.elements = s.tree.planar_count;
+    rep.clusters = s.tree.cluster_count;
+    rep.seconds_build = now_seconds() - t0;
+
+    s.store.max_bytes = budget;
+    bool root_cluster = !s.tree.nodes[0].planar;
+    if (root_cluster && s.emitted > 0) {
+        if (2 * sizeof(hlink) > budget) {
+            hsolver_free(&s);
+            return rad_fail(error, RAD_ERR_NOMEM, "--max-memory: %llu bytes cannot hold a link",
+                            (unsigned long long)budget);
+        }
+        s.store.links = malloc(sizeof(hlink));
+        s.store.spare = malloc(sizeof(hlink));
+        if (!s.store.links || !s.store.spare) {
+            hsolver_free(&s);
+            return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the links");
+        }
+        s.store.capacity = 1;
+        s.store.count = 1;
+        s.store.links[0] = (hlink){0, 0, 0, 1};
+        s.store.peak_bytes = 2 * sizeof(hlink);
+    }
+    refine_context rc = {mesh, &s.tree, occluders, s.node_B,
+                         threshold * brightest_total / n, rays, o.seed, s.threads};
+
+    double residual = s.emitted > 0 ? 1 : 0;
+    bool refining = s.store.count > 0, converged = false;
+    uint32_t quiet_passes = 0;
+    while (!stopped(&o) && rep.sweeps < max_sweeps) {
+        size_t split = 0;
+        if (refining && !rep.memory_capped && rep.passes < MAX_PASSES) {
+            double tr = now_seconds();
+            refine_result rr;
+            if (!hier_refine_pass(&rc, &s.store, &rr)) {
+                hsolver_free(&s);
+                return rad_fail(error, RAD_ERR_NOMEM, "out of memory refining the links");
+            }
+            rep.passes++;
+            rep.rays += rr.rays;
+            split = rr.split;
+            if (rr.capped)
+                rep.memory_capped = true;
+            rep.seconds_refine += now_seconds() - tr;
+            if (o.progress)
+                o.progress(o.progress_user, "refine",
+                           fmin(0.99, rep.passes / (2.0 * log2((double)nodes + 2) + 4)));
+        }
+        double tg = now_seconds();
+        sort_by_receiver(&s);
+        if (split > 0) {
+            quiet_passes = 0;
+            for (unsigned k = 0; k < SWEEPS_PER_PASS && rep.sweeps < max_sweeps; k++) {
+                residual = sweep(&s);
+                rep.sweeps++;
+            }
+            rep.seconds_gather += now_seconds() - tg;
+            continue;
+        }
+        /* nothing split: sweep to the tolerance, then look once more */
+        double first = residual;
+        while (residual > tolerance && rep.sweeps < max_sweeps && !stopped(&o)) {
+            residual = sweep(&s);
+            rep.sweeps++;
+            if (o.progress && first > tolerance && residual > 0)
+                o.progress(o.progress_user, "gather",
+                           fmin(0.99, fmax(0, log(first / residual) / log(first / tolerance))));
+        }
+        rep.seconds_gather += now_seconds() - tg;
+        if (residual <= tolerance && (quiet_passes > 0 || !refining || rep.memory_capped ||
+                                      rep.passes >= MAX_PASSES)) {
+            converged = true;
+            break;
+        }
+        quiet_passes++;
+        refining = s.store.count > 0;
+    }
+    if (o.progress)
+        o.progress(o.progress_user, "gather", 1);
+    rep.interrupted = stopped(&o);
+    rep.converged = converged && !rep.interrupted;
+    rep.residual = residual;
+    rep.links = s.store.count;
+    for (size_t l = 0; l < s.store.count; l++)
+        rep.links_partial += s.store.links[l].visibility < 1;
+    rep.link_bytes = s.store.peak_bytes;
+    memcpy(B, s.patch_B, (size_t)n * sizeof(rad_rgb));
+    hsolver_free(&s);
+    if (report)
+        *report = rep;
+    return RAD_OK;
+}

@@ -1,0 +1,146 @@
+/*
+ * test_hierarchical.c - the hierarchical solver against the dense one on the Cornell box
+ * (~2000 patches): area-weighted mean radiance per surface within 1 %, image RMSE within
+ * 2 % of the mean; bitwise the same for 1 and 2 threads; a small --max-memory budget caps
+ * refinement, says so, and stays within 5 %.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testlib.h"
+
+typedef struct dense_reference {
+    rad_rgb *B;
+} dense_reference;
+
+static void fail_on(rad_status status, const rad_error *error, const char *what)
+{
+    if (status != RAD_OK) {
+        fprintf(stderr, "%s: %s\n", what, error->message);
+        exit(1);
+    }
+}
+
+/* Area-weighted mean of B's luminance-free channel sum per surface. */
+static void surface_means(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
+                          double *mean)
+{
+    double *area = calloc(scene->surface_count, sizeof(double));
+    for (uint32_t s = 0; s < scene->surface_count; s++)
+        mean[s] = 0;
+    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        const rad_patch *patch = &mesh->patches[p];
+        mean[patch->surface] += patch->area * (B[p].r + B[p].g + B[p].b) / 3;
+        area[patch->surface] += patch->area;
+    }
+    for (uint32_t s = 0; s < scene->surface_count; s++)
+        mean[s] = area[s] > 0 ? mean[s] / area[s] : 0;
+    free(area);
+}
+
+static double image_rmse_relative(const rad_mesh *mesh, const rad_rgb *a, const rad_rgb *b,
+                                  const rad_camera *camera)
+{
+    rad_error error;
+    rad_image *ia = test_new_image(128, 128), *ib = test_new_image(128, 128);
+    rad_render_options options = {.samples_per_pixel = 4, .edge_samples = 4, .seed = 1};
+    fail_on(rad_render(mesh, a, camera, &options, ia, &error), &error, "render");
+    fail_on(rad_render(mesh, b, camera, &options, ib, &error), &error, "render");
+    rad_image_difference d;
+    fail_on(rad_image_compare(ia, ib, NULL, &d, NULL, &error), &error, "compare");
+    double mean = (d.mean_b.r + d.mean_b.g + d.mean_b.b) / 3;
+    rad_image_destroy(ia);
+    rad_image_destroy(ib);
+    return d.rmse / mean;
+}
+
+int main(void)
+{
+    rad_error error;
+    rad_scene *scene = NULL;
+    fail_on(rad_scene_cornell_box(&scene, &error), &error, "cornell");
+    rad_mesh *mesh = NULL;
+    fail_on(rad_mesh_build(scene, rad_mesh_default_patch_size(scene, 2000), &mesh, &error),
+            &error, "mesh");
+    printf("patches: %u\n", mesh->patch_count);
+    CHECK(mesh->patch_count > 1500 && mesh->patch_count < 2600);
+    rad_tracer *tracer = NULL;
+    fail_on(rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &tracer, &error), &error,
+            "tracer");
+
+    /* the dense reference: every F_ij, Gauss-Seidel to 1e-7 */
+    rad_formfactor_options ff_options = {.seed = 1};
+    rad_formfactors *ff = NULL;
+    fail_on(rad_formfactors_compute(mesh, tracer, &ff_options, &ff, NULL, &error), &error, "ff");
+    rad_system system;
+    fail_on(rad_system_from_mesh(scene, mesh, ff, &system, &error), &error, "system");
+    rad_rgb *dense = calloc(mesh->patch_count, sizeof(rad_rgb));
+    rad_solve_options solve = {.solver = RAD_SOLVER_GAUSS_SEIDEL, .tolerance = 1e-7};
+    fail_on(rad_solve(&system, &solve, dense, NULL, &error), &error, "solve");
+    rad_system_free_arrays(&system);
+    rad_formfactors_destroy(ff);
+
+    rad_rgb *hier = calloc(mesh->patch_count, sizeof(rad_rgb));
+    rad_rgb *hier1 = calloc(mesh->patch_count, sizeof(rad_rgb));
+    rad_hierarchy_options options = {.seed = 1, .threads = 2};
+    rad_hierarchy_report report;
+    fail_on(rad_solve_hierarchical(scene, mesh, tracer, &options, hier, &report, &error), &error,
+            "hierarchical");
+    printf("elements %llu clusters %llu links %llu partial %llu rays %llu passes %u sweeps %u "
+           "residual %.3g\n",
+           (unsigned long long)report.elements, (unsigned long long)report.clusters,
+           (unsigned long long)report.links, (unsigned long long)report.links_partial,
+           (unsigned long long)report.rays, report.passes, report.sweeps, report.residual);
+    CHECK(report.converged);
+    CHECK(!report.memory_capped);
+    CHECK(report.leaves == mesh->patch_count);
+    CHECK(report.links < (uint64_t)mesh->patch_count * mesh->patch_count / 4);
+
+    double *mean_dense = calloc(scene->surface_count, sizeof(double));
+    double *mean_hier = calloc(scene->surface_count, sizeof(double));
+    surface_means(scene, mesh, dense, mean_dense);
+    surface_means(scene, mesh, hier, mean_hier);
+    for (uint32_t s = 0; s < scene->surface_count; s++) {
+        printf("%-12s dense %10.4f hierarchical %10.4f (%+.2f %%)\n", scene->surfaces[s].name,
+               mean_dense[s], mean_hier[s], 100 * (mean_hier[s] / mean_dense[s] - 1));
+        CHECK_NEAR(mean_hier[s], mean_dense[s], 0.01);
+    }
+    double rmse = image_rmse_relative(mesh, hier, dense, &scene->camera);
+    printf("image rmse / mean: %.4f\n", rmse);
+    CHECK(rmse < 0.02);
+
+    /* the same bits for one thread */
+    options.threads = 1;
+    rad_hierarchy_report report1;
+    fail_on(rad_solve_hierarchical(scene, mesh, tracer, &options, hier1, &report1, &error),
+            &error, "hierarchical 1 thread");
+    CHECK(memcmp(hier, hier1, mesh->patch_count * sizeof(rad_rgb)) == 0);
+    CHECK(report1.links == report.links && report1.rays == report.rays);
+
+    /* a budget a third of what the links want: capped, reported, still within 5 % */
+    options.threads = 2;
+    options.max_memory = report.link_bytes / 3;
+    fail_on(rad_solve_hierarchical(scene, mesh, tracer, &options, hier1, &report1, &error),
+            &error, "hierarchical capped");
+    printf("capped: links %llu, link bytes %llu of %llu\n", (unsigned long long)report1.links,
+           (unsigned long long)report1.link_bytes, (unsigned long long)options.max_memory);
+    CHECK(report1.memory_capped);
+    CHECK(report1.link_bytes <= options.max_memory);
+    surface_means(scene, mesh, hier1, mean_hier);
+    for (uint32_t s = 0; s < scene->surface_count; s++) {
+        printf("%-12s capped %+.2f %%\n", scene->surfaces[s].name,
+               100 * (mean_hier[s] / mean_dense[s] - 1));
+        CHECK_NEAR(mean_hier[s], mean_dense[s], 0.05);
+    }
+
+    free(mean_dense);
+    free(mean_hier);
+    free(dense);
+    free(hier);
+    free(hier1);
+    rad_tracer_destroy(tracer);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+    return test_finish("test_hierarchical");
+}
