@@ -134,6 +134,18 @@ int main(void)
         CHECK_NEAR(mean_hier[s], mean_dense[s], 0.05);
     }
 
+    /* a raised stop flag (Ctrl-C in the tool): a clean return with a usable solution */
+    volatile int stop = 1;
+    options.max_memory = 0;
+    options.stop = &stop;
+    fail_on(rad_solve_hierarchical(scene, mesh, tracer, &options, hier1, &report1, &error),
+            &error, "hierarchical stopped");
+    CHECK(report1.interrupted && !report1.converged);
+    bool usable = true;
+    for (uint32_t p = 0; p < mesh->patch_count; p++)
+        usable = usable && isfinite(hier1[p].r) && hier1[p].r >= 0;
+    CHECK(usable);
+
     free(mean_dense);
     free(mean_hier);
     free(dense);

@@ -147,5 +147,35 @@ int main(void)
     double lo = fmin(per_triangle[0], fmin(per_triangle[1], per_triangle[2]));
     double hi = fmax(per_triangle[0], fmax(per_triangle[1], per_triangle[2]));
     CHECK(hi <= 2 * lo);
+
+    /* the tool: --solver hierarchical, its --stats, the budget, the saved solution */
+    char command[1024];
+    snprintf(command, sizeof(command),
+             "render %s --solver hierarchical -o %s --size 48x48 --spp 1 --stats %s",
+             test_path("room2.obj"), test_path("room.pfm"), test_path("stats.json"));
+    CHECK(test_run_tool(command) == 0);
+    const char *stats = test_read_text(test_path("stats.json"));
+    CHECK(strstr(stats, "\"solver\": \"hierarchical\"") != NULL);
+    CHECK(strstr(stats, "\"links\":") != NULL && strstr(stats, "\"clusters\":") != NULL);
+    CHECK(strstr(stats, "\"memory_capped\": false") != NULL);
+    CHECK(test_file_exists(test_path("room.pfm")));
+    snprintf(command, sizeof(command),
+             "solve %s --solver hierarchical --max-memory 4K -o %s --save-solution %s "
+             "--stats %s",
+             test_path("room2.obj"), test_path("room.ply"), test_path("room.solution"),
+             test_path("stats.json"));
+    CHECK(test_run_tool(command) == 0);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "--max-memory") != NULL);
+    stats = test_read_text(test_path("stats.json"));
+    CHECK(strstr(stats, "\"memory_capped\": true") != NULL);
+    CHECK(strstr(stats, "\"link_bytes\": 4") != NULL); /* 4xxx bytes at most */
+    snprintf(command, sizeof(command), "render %s --solution %s -o %s --size 32x32 --spp 1",
+             test_path("room2.obj"), test_path("room.solution"), test_path("again.pfm"));
+    CHECK(test_run_tool(command) == 0);
+    snprintf(command, sizeof(command), "render %s --solver hierarchical --max-memory 3X -o %s",
+             test_path("room2.obj"), test_path("bad.pfm"));
+    CHECK(test_run_tool(command) != 0);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "--max-memory: '3X'") != NULL);
+    CHECK(!test_file_exists(test_path("bad.pfm")));
     return test_finish("test_hierarchical_scaling");
 }
