@@ -898,15 +898,6 @@ rad_status rad_image_compare(const rad_image *a, const rad_image *b,
 /* ------------------------------------------------------------------------------------ */
 /* Output files                                                                          */
 
-/* Writes the view-factor matrix as CSV: header "surface,NAME1,...", then one row per
- * surface. Atomic like rad_image_write. */
-rad_status rad_viewfactors_write_csv(const rad_scene *scene, const double *matrix,
-                                     const char *path, rad_error *error);
-
-/* The same CSV to an open stream (standard output, say). */
-rad_status rad_viewfactors_print_csv(const rad_scene *scene, const double *matrix, FILE *stream,
-                                     rad_error *error);
-
 /* The lit mesh: the solution as geometry other tools read, view-independent. Each mesh
  * vertex carries its linear radiance (rad_reconstruct_vertices: what the renderer
  * interpolates) and a display colour: radiance times an exposure, clamped to [0,1]. The
