@@ -130,20 +130,6 @@ static bool same_rgb(const float *f, rad_rgb c)
     return same_float(f[0], c.r) && same_float(f[1], c.g) && same_float(f[2], c.b);
 }
 
-static uint8_t *read_file(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long length = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    uint8_t *bytes = malloc(length > 0 ? (size_t)length : 1);
-    *size = fread(bytes, 1, (size_t)length, f);
-    fclose(f);
-    return bytes;
-}
-
 static uint32_t get_u32(const uint8_t *p)
 {
     return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
@@ -195,7 +181,7 @@ static const uint8_t *accessor_data(const cJSON *json, int index, const uint8_t 
 static void check_glb(const char *name, const reference *ref)
 {
     size_t size = 0;
-    uint8_t *bytes = read_file(test_path(name), &size);
+    uint8_t *bytes = test_read_bytes(test_path(name), &size);
     CHECK(bytes != NULL && size >= 28);
     if (!bytes || size < 28)
         return;
@@ -349,7 +335,7 @@ static void check_geometry_through_assimp(const char *name, const reference *ref
 static void check_ply(const char *name, const reference *ref, bool furnace)
 {
     size_t size = 0;
-    uint8_t *bytes = read_file(test_path(name), &size);
+    uint8_t *bytes = test_read_bytes(test_path(name), &size);
     CHECK(bytes != NULL);
     if (!bytes)
         return;

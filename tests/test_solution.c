@@ -27,21 +27,6 @@ static int count_lines(const char *text)
     return lines;
 }
 
-static uint8_t *read_file(const char *path, size_t *size)
-{
-    *size = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long length = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    uint8_t *bytes = malloc(length > 0 ? (size_t)length : 1);
-    *size = fread(bytes, 1, (size_t)length, f);
-    fclose(f);
-    return bytes;
-}
-
 static void write_bytes(const char *name, const uint8_t *bytes, size_t size)
 {
     FILE *f = fopen(test_path(name), "wb");
@@ -54,7 +39,7 @@ static void write_bytes(const char *name, const uint8_t *bytes, size_t size)
 static bool same_files(const char *a, const char *b)
 {
     size_t na, nb;
-    uint8_t *x = read_file(test_path(a), &na), *y = read_file(test_path(b), &nb);
+    uint8_t *x = test_read_bytes(test_path(a), &na), *y = test_read_bytes(test_path(b), &nb);
     bool same = x && y && na == nb && memcmp(x, y, na) == 0;
     free(x);
     free(y);
@@ -138,7 +123,7 @@ static void check_library(void)
     /* a flipped bit anywhere (every byte of the header and checksum, every 13th byte of
      * B; the bit turns with the byte) and a cut anywhere are refused */
     size_t size;
-    uint8_t *bytes = read_file(test_path("library.sol"), &size);
+    uint8_t *bytes = test_read_bytes(test_path("library.sol"), &size);
     uint32_t accepted_flips = 0, accepted_cuts = 0, flips = 0, cuts = 0;
     for (size_t k = 0; bytes && k < size; k += (k < 32 || k + 8 >= size) ? 1 : 13) {
         uint8_t bit = (uint8_t)(1u << (k % 8));
@@ -223,7 +208,7 @@ int main(void)
     expect_refusal("solve --solution cornell.sol --emit light=17,12,4.5 -o out.ply",
                    "cornell.sol", "another scene");
     size_t size;
-    uint8_t *bytes = read_file(test_path("cornell.sol"), &size);
+    uint8_t *bytes = test_read_bytes(test_path("cornell.sol"), &size);
     CHECK(bytes && size > 200);
     if (bytes && size > 200) {
         bytes[size / 2] ^= 0x10;

@@ -94,6 +94,23 @@ const char *test_read_text(const char *path)
     return buffer;
 }
 
+uint8_t *test_read_bytes(const char *path, size_t *size)
+{
+    *size = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    uint8_t *bytes = NULL;
+    long length = -1;
+    if (fseek(f, 0, SEEK_END) == 0)
+        length = ftell(f);
+    if (length >= 0 && fseek(f, 0, SEEK_SET) == 0 &&
+        (bytes = malloc(length > 0 ? (size_t)length : 1)) != NULL)
+        *size = fread(bytes, 1, (size_t)length, f);
+    fclose(f);
+    return bytes;
+}
+
 bool test_file_exists(const char *path)
 {
     struct stat st;

@@ -67,6 +67,10 @@ int test_run_tool(const char *arguments);
 /* Reads a whole small file into a static buffer ("" if missing). */
 const char *test_read_text(const char *path);
 
+/* The whole file, malloc'd (the caller frees it), its length in *size; NULL (and *size 0)
+ * when it cannot be read. */
+uint8_t *test_read_bytes(const char *path, size_t *size);
+
 bool test_file_exists(const char *path);
 
 /* A new black image (exits the test on failure), and pixel access. */
