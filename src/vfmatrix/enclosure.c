@@ -17,6 +17,7 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "vfmatrix/matrix_entry.h"
 
 /* Conjugate gradients stop at this residual relative to the right-hand side (double
  * precision's floor for these well-scaled systems). */
@@ -138,19 +139,6 @@ static uint32_t find_singular_group(const rad_viewfactor_matrix *m, const bool *
     return 0;
 }
 
-static uint64_t find_entry(const rad_viewfactor_matrix *m, uint32_t row, uint32_t column)
-{
-    uint64_t lo = m->row_start[row], hi = m->row_start[row + 1];
-    while (lo < hi) {
-        uint64_t mid = lo + (hi - lo) / 2;
-        if (m->column[mid] < column)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < m->row_start[row + 1] && m->column[lo] == column ? lo : UINT64_MAX;
-}
-
 rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *m,
                                                  const rad_scene *scene,
                                                  rad_enclosure_report *report,
@@ -200,7 +188,7 @@ rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *m,
                 fixed += m->area[I] * m->value[k];
                 continue;
             }
-            uint64_t t = find_entry(m, J, I);
+            uint64_t t = vf_matrix_entry(m, J, I);
             if (t == UINT64_MAX) {
                 status = rad_fail(error, RAD_ERR_INVALID,
                                   "F from %s to surface %u is stored without its reciprocal",

@@ -23,6 +23,7 @@
 #include "core/error.h"
 #include "core/random.h"
 #include "core/vec3.h"
+#include "vfmatrix/matrix_entry.h"
 #include "viewfactor/occluder_tree.h"
 #include "viewfactor/pair_transfer.h"
 #include "viewfactor/vf_geometry.h"
@@ -383,14 +384,6 @@ double rad_viewfactor_matrix_get(const rad_viewfactor_matrix *matrix, uint32_t r
 {
     if (row >= matrix->n || column >= matrix->n)
         return 0;
-    uint64_t lo = matrix->row_start[row], hi = matrix->row_start[row + 1];
-    while (lo < hi) {
-        uint64_t mid = lo + (hi - lo) / 2;
-        if (matrix->column[mid] < column)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < matrix->row_start[row + 1] && matrix->column[lo] == column ? matrix->value[lo]
-                                                                            : 0;
+    uint64_t entry = vf_matrix_entry(matrix, row, column);
+    return entry == UINT64_MAX ? 0 : matrix->value[entry];
 }
