@@ -785,7 +785,10 @@ typedef struct rad_render_options {
 } rad_render_options;
 
 /* Radiance at every mesh vertex: the area-weighted average of B/pi over the patches that
- * share the vertex. `vertex_radiance` receives mesh->vertex_count values. */
+ * share the vertex; a T-vertex (a vertex strictly inside an edge of a neighbouring patch of
+ * its region, where two polygons split their shared edge into different counts) takes
+ * instead the linear interpolation along that edge, so the displayed radiance is
+ * continuous across it. `vertex_radiance` receives mesh->vertex_count values. */
 void rad_reconstruct_vertices(const rad_mesh *mesh, const rad_rgb *B,
                               rad_rgb *vertex_radiance);
 
@@ -903,10 +906,11 @@ rad_status rad_image_compare(const rad_image *a, const rad_image *b,
  * interpolates) and a display colour: radiance times an exposure, clamped to [0,1]. The
  * automatic exposure is the PNG one applied to vertices: the 95th percentile of the
  * luminance of the lit vertices (luminance > 0) is scaled to 0.9. Vertices are per smooth
- * region (rad_mesh), so creases and emitters stay sharp; quads are written as the two
- * triangles the renderer uses (0,1,2 and 0,2,3). Coordinates are the scene's own (the
- * built-in Cornell box is in millimetres); radiance is in the unit of the emitters' Ke,
- * the same numbers as a .pfm render. */
+ * region (rad_mesh), so creases and emitters stay sharp; patches are written as the
+ * triangles the renderer uses: a quad as (0,1,2) and (0,2,3), a patch with T-vertices on
+ * its edges split through them, so faces meet corner to corner. Coordinates are the
+ * scene's own (the built-in Cornell box is in millimetres); radiance is in the unit of the
+ * emitters' Ke, the same numbers as a .pfm render. */
 typedef struct rad_lit_mesh_options {
     bool fixed_exposure; /* false = automatic (above), true = use `exposure` */
     double exposure;     /* the display colour is radiance * 2^exposure */

@@ -19,6 +19,7 @@
 #include "core/rgb.h"
 #include "core/vec3.h"
 #include "image/tonemap.h"
+#include "render/display_mesh.h"
 
 typedef enum lit_mesh_format { FORMAT_UNKNOWN, FORMAT_PLY, FORMAT_GLB, FORMAT_OBJ } lit_mesh_format;
 
@@ -60,26 +61,6 @@ static void vertex_normals(const rad_mesh *mesh, rad_vec3 *normal)
         normal[v] = v3_length(normal[v]) > 0 ? v3_normalize(normal[v]) : v3(0, 0, 1);
 }
 
-/* The renderer's triangles: a quad split along its first diagonal (render.c). */
-static uint32_t patch_triangles(const rad_mesh *mesh, uint32_t (*triangles)[3])
-{
-    uint32_t count = 0;
-    for (uint32_t p = 0; p < mesh->patch_count; p++) {
-        const uint32_t *v = mesh->patches[p].vertex;
-        triangles[count][0] = v[0];
-        triangles[count][1] = v[1];
-        triangles[count][2] = v[2];
-        count++;
-        if (mesh->patches[p].vertex_count == 4) {
-            triangles[count][0] = v[0];
-            triangles[count][1] = v[2];
-            triangles[count][2] = v[3];
-            count++;
-        }
-    }
-    return count;
-}
-
 rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char *path,
                               const rad_lit_mesh_options *options, rad_error *error)
 {
@@ -99,12 +80,15 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
     rad_rgb *radiance = rad_alloc_array(n, sizeof(*radiance));
     rad_rgb *display = rad_alloc_array(n, sizeof(*display));
     double *luminance = rad_alloc_array(n, sizeof(*luminance));
-    uint32_t (*triangles)[3] = rad_alloc_array((size_t)mesh->patch_count * 2, sizeof(*triangles));
-    if (!normal || !radiance || !display || !luminance || !triangles) {
+    display_mesh shown = {0};
+    if (!normal || !radiance || !display || !luminance) {
         status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for %u vertices", path, n);
         goto done;
     }
-    rad_reconstruct_vertices(mesh, B, radiance);
+    status = display_mesh_build(mesh, true, &shown, error);
+    if (status != RAD_OK)
+        goto done;
+    display_mesh_radiance(mesh, &shown, B, radiance);
     vertex_normals(mesh, normal);
     lit_mesh lit = {
         .vertex_count = n,
@@ -112,8 +96,8 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
         .normal = normal,
         .radiance = radiance,
         .display = display,
-        .triangles = (const uint32_t(*)[3])triangles,
-        .triangle_count = patch_triangles(mesh, triangles),
+        .triangles = (const uint32_t(*)[3])shown.triangles,
+        .triangle_count = shown.triangle_count,
         .automatic = !options || !options->fixed_exposure,
     };
     if (lit.automatic) {
@@ -148,6 +132,6 @@ done:
     free(radiance);
     free(display);
     free(luminance);
-    free(triangles);
+    display_mesh_free(&shown);
     return status;
 }

@@ -1,13 +1,14 @@
 /*
  * render.c - images of a radiosity solution, and the two-pass method.
  *
- * The patches are split into triangles (quads along their first diagonal) and handed to a
- * tracer; each pixel averages k x k jittered stratified primary rays (box filter). A hit
- * on a front face takes the radiance interpolated from the vertex values with the hit's
- * barycentrics; a back face or a miss is black. Pixels whose first samples disagree
- * (silhouettes, the light's rim) get edge_samples more. With the scene's materials given, a hit
- * on a surface with Ks > 0 also sends a mirror ray, weighted by Ks, whose hit is shaded
- * the same way (the radiosity solution replaces Whitted's ambient term), up to a depth.
+ * The patches are split into triangles (display_mesh.h: quads along their first diagonal,
+ * patches with T-vertices on their edges through those) and handed to a tracer; each
+ * pixel averages k x k jittered stratified primary rays (box filter). A hit on a front
+ * face takes the radiance interpolated from the vertex values with the hit's barycentrics;
+ * a back face or a miss is black. Pixels whose first samples disagree (silhouettes, the
+ * light's rim) get edge_samples more. With the scene's materials given, a hit on a surface
+ * with Ks > 0 also sends a mirror ray, weighted by Ks, whose hit is shaded the same way
+ * (the radiosity solution replaces Whitted's ambient term), up to a depth.
  * Random numbers come from (seed, pixel). With the scene's albedo textures, a textured
  * patch's vertices hold the irradiance (B - E) / (pi rho_avg) instead, and a hit shows
  * L_e + texel albedo x that, so texture detail finer than the patches survives.
@@ -24,6 +25,7 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "render/camera.h"
+#include "render/display_mesh.h"
 #include "scene/texture.h"
 #include "trace/ray.h"
 
@@ -201,35 +203,25 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                         options->threads);
     int threads = options->threads > 0 ? options->threads : omp_get_max_threads();
 
-    /* triangles of the patches, and the radiance at each vertex */
-    size_t triangle_count = 0;
-    for (uint32_t p = 0; p < mesh->patch_count; p++)
-        triangle_count += mesh->patches[p].vertex_count - 2;
-    uint32_t (*triangles)[3] = rad_alloc_array(triangle_count, sizeof(*triangles));
-    uint32_t *patch_of = rad_alloc_array(triangle_count, sizeof(*patch_of));
+    /* the display triangles (patches split through their T-vertices) and the radiance at
+     * each vertex */
+    display_mesh display = {0};
     rad_rgb *radiance = rad_alloc_array(mesh->vertex_count, sizeof(*radiance));
     rad_tracer *tracer = NULL;
     row_work *work = NULL;
     albedo_lookup *lookup = NULL;
     rad_rgb *patch_albedo = NULL, *shaded = NULL;
-    if (!triangles || !patch_of || !radiance || triangle_count > UINT32_MAX)
+    if (!radiance)
         goto nomem;
-    size_t t = 0;
-    for (uint32_t p = 0; p < mesh->patch_count; p++) {
-        const rad_patch *patch = &mesh->patches[p];
-        for (uint32_t s = 0; s + 2 < patch->vertex_count + 0u; s++) {
-            triangles[t][0] = patch->vertex[0];
-            triangles[t][1] = patch->vertex[s + 1];
-            triangles[t][2] = patch->vertex[s + 2];
-            patch_of[t++] = p;
-        }
-    }
+    status = display_mesh_build(mesh, true, &display, error);
+    if (status != RAD_OK)
+        goto done;
     status = textures_begin(options->scene, mesh, B, &lookup, &patch_albedo, &shaded, error);
     if (status != RAD_OK)
         goto done;
-    rad_reconstruct_vertices(mesh, shaded ? shaded : B, radiance);
+    display_mesh_radiance(mesh, &display, shaded ? shaded : B, radiance);
     status = rad_tracer_create(RAD_TRACER_EMBREE, mesh->vertices, mesh->vertex_count,
-                               (const uint32_t(*)[3])triangles, (uint32_t)triangle_count,
+                               (const uint32_t(*)[3])display.triangles, display.triangle_count,
                                &tracer, error);
     if (status != RAD_OK)
         goto done;
@@ -265,7 +257,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         if (!w->rays || !w->hits || !w->weight || !w->sample || !w->sum || !w->edge || !w->level)
             goto nomem;
     }
-    shading shade = {mesh, (const uint32_t(*)[3])triangles, patch_of, radiance, options->materials,
+    shading shade = {mesh, (const uint32_t(*)[3])display.triangles, display.patch_of, radiance,
+                     options->materials,
                      t_near, leave, lookup, options->scene ? options->scene->materials : NULL,
                      patch_albedo};
 
@@ -357,8 +350,7 @@ done:
         }
     free(work);
     rad_tracer_destroy(tracer);
-    free(triangles);
-    free(patch_of);
+    display_mesh_free(&display);
     free(radiance);
     albedo_lookup_destroy(lookup);
     free(patch_albedo);

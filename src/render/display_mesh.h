@@ -1,0 +1,49 @@
+/*
+ * display_mesh.h - what the image renderer and the lit mesh show of a solution (internal).
+ *
+ * Two neighbouring polygons of one smooth region that split their shared edge into
+ * different counts leave T-vertices: mesh vertices strictly inside an edge of a patch on
+ * the other side. display_mesh_build finds them, and gives
+ *   - each T-vertex a constraint: its radiance is the linear interpolation between the
+ *     two nearest vertices along its line that are no T-vertices ("anchors"), which makes
+ *     it the interpolation along the coarse edge it lies in, so both sides of the edge
+ *     show the same values (C0);
+ *   - the display triangles: every patch split into triangles through the T-vertices on
+ *     its edges, so the triangles meet corner to corner (no T-junction a rasteriser could
+ *     crack along); a patch without T-vertices keeps the plain split (0,1,2), (0,2,3).
+ * Detection is a hash of patch edges (an edge used once is a boundary or part of a
+ * T-junction), then the once-used edges joined into straight chains through shared
+ * vertices, each chain sorted along its line: O(n log n) in the patch count.
+ */
+#ifndef RAD_RENDER_DISPLAY_MESH_H
+#define RAD_RENDER_DISPLAY_MESH_H
+
+#include "radiosity.h"
+
+typedef struct display_tvertex {
+    uint32_t vertex;   /* the T-vertex */
+    uint32_t from, to; /* the anchors either side along its line */
+    double t;          /* its place between them: 0 at `from`, 1 at `to` */
+} display_tvertex;
+
+typedef struct display_mesh {
+    uint32_t (*triangles)[3]; /* into mesh vertices, counter-clockwise (front) */
+    uint32_t *patch_of;       /* per triangle: its patch */
+    uint32_t triangle_count;
+    display_tvertex *tvertices; /* in an order where a T-vertex that is another's anchor
+                                   (a rare cross of two lines) comes first */
+    uint32_t tvertex_count;
+} display_mesh;
+
+/* Finds the T-vertices and, when `triangles` is true, makes the display triangles. */
+rad_status display_mesh_build(const rad_mesh *mesh, bool triangles, display_mesh *out,
+                              rad_error *error);
+
+/* The displayed radiance at every vertex: the area-weighted mean of B / pi over the
+ * patches sharing it, then the T-vertex constraints. `display` may be NULL (means only). */
+void display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, const rad_rgb *B,
+                           rad_rgb *vertex_radiance);
+
+void display_mesh_free(display_mesh *display);
+
+#endif
