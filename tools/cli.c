@@ -390,49 +390,130 @@ double cli_now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-/* Progress: one line rewritten in place, at most ~10 times a second. */
-static struct {
-    int enabled; /* -1 unknown, 0 no, 1 yes */
-    bool line_open;
-    double last_time;
-    char phase[64];
-    double phase_start;
-    double last_fraction;
-} progress = {-1, false, 0, "", 0, 0};
+/* Progress. RADIOSITY_PROGRESS picks where it goes: unset (or "auto"), one line rewritten
+ * in place about 10 times a second when stderr is a terminal, nothing otherwise; "lines"
+ * (or "1"), also when stderr is not a terminal, as whole lines, at most one a second per
+ * phase; "0", never.
+ *
+ * A solver may interleave phases (the hierarchical solver refines, gathers, refines
+ * again), so each phase keeps its own clock: the time since the previous report (of any
+ * phase) is the work the current report covers, and is added to the current phase. The
+ * time left is the phase's rate so far carried to 1; a phase whose fraction goes back
+ * down starts that estimate again, and at 99 % or more (a guessed fraction's cap) no
+ * estimate is shown. */
+enum { PROGRESS_UNKNOWN = -1, PROGRESS_OFF, PROGRESS_TERMINAL, PROGRESS_LINES };
+#define PROGRESS_PHASES 8
 
-bool cli_progress_enabled(void)
+typedef struct phase_clock {
+    char name[32];
+    double seconds;       /* all the phase's time so far */
+    double since_restart; /* its time since its fraction last went down */
+    double fraction;
+    double printed;       /* when its line was last printed */
+    bool done;            /* its closing line is out */
+} phase_clock;
+
+static struct {
+    int mode;
+    bool line_open;
+    double last_report; /* 0: no report yet (and no mark) */
+    phase_clock *current;
+    phase_clock phases[PROGRESS_PHASES];
+    unsigned count;
+} progress = {PROGRESS_UNKNOWN, false, 0, NULL, {{"", 0, 0, 0, 0, false}}, 0};
+
+static int progress_mode(void)
 {
-    if (progress.enabled < 0)
-        progress.enabled = isatty(STDERR_FILENO) ? 1 : 0;
-    return progress.enabled == 1;
+    if (progress.mode == PROGRESS_UNKNOWN) {
+        const char *setting = getenv("RADIOSITY_PROGRESS");
+        if (setting && (strcmp(setting, "lines") == 0 || strcmp(setting, "1") == 0))
+            progress.mode = PROGRESS_LINES;
+        else if (setting && strcmp(setting, "0") == 0)
+            progress.mode = PROGRESS_OFF;
+        else
+            progress.mode = isatty(STDERR_FILENO) ? PROGRESS_TERMINAL : PROGRESS_OFF;
+    }
+    return progress.mode;
+}
+
+bool cli_progress_enabled(void) { return progress_mode() != PROGRESS_OFF; }
+
+void cli_progress_mark(void) { progress.last_report = cli_now(); }
+
+static phase_clock *phase_named(const char *name)
+{
+    for (unsigned k = 0; k < progress.count; k++)
+        if (strcmp(progress.phases[k].name, name) == 0)
+            return &progress.phases[k];
+    /* a new phase; past the table's size the last entry is reused */
+    phase_clock *clock = &progress.phases[progress.count < PROGRESS_PHASES
+                                              ? progress.count++
+                                              : PROGRESS_PHASES - 1];
+    memset(clock, 0, sizeof(*clock));
+    snprintf(clock->name, sizeof(clock->name), "%s", name);
+    return clock;
+}
+
+/* "4.2 s", "42 s", "3 min 5 s", "2 h 10 min" */
+static void format_duration(double seconds, char *text, size_t size)
+{
+    if (seconds < 9.95)
+        snprintf(text, size, "%.1f s", seconds);
+    else if (seconds < 99.5)
+        snprintf(text, size, "%.0f s", seconds);
+    else if (seconds < 5999.5)
+        snprintf(text, size, "%.0f min %.0f s", floor(seconds / 60), floor(fmod(seconds, 60)));
+    else
+        snprintf(text, size, "%.0f h %.0f min", floor(seconds / 3600),
+                 fmod(floor(seconds / 60), 60));
 }
 
 void cli_progress(void *user, const char *phase, double fraction)
 {
     (void)user;
-    if (!cli_progress_enabled())
+    int mode = progress_mode();
+    if (mode == PROGRESS_OFF)
         return;
     double now = cli_now();
-    if (strcmp(phase, progress.phase) != 0) {
-        snprintf(progress.phase, sizeof(progress.phase), "%s", phase);
-        progress.phase_start = now;
-        progress.last_time = 0;
-        progress.last_fraction = 0;
-    } else if (progress.last_fraction >= 1) {
-        return; /* this phase's closing line is already out */
+    double work = progress.last_report > 0 ? now - progress.last_report : 0;
+    progress.last_report = now;
+    phase_clock *clock = phase_named(phase);
+    if (clock->done) {
+        if (fraction >= 1)
+            return; /* this phase's closing line is already out */
+        /* the same phase run again (a second render): a new clock */
+        clock->seconds = clock->since_restart = clock->fraction = clock->printed = 0;
+        clock->done = false;
     }
-    if (fraction < 1 && now - progress.last_time < 0.1)
+    clock->seconds += work;
+    if (fraction < clock->fraction)
+        clock->since_restart = 0;
+    clock->since_restart += work;
+    clock->fraction = fraction;
+    bool switched = progress.current != clock;
+    progress.current = clock;
+    double interval = mode == PROGRESS_LINES ? 1.0 : 0.1;
+    if (fraction < 1 && !switched && now - clock->printed < interval)
         return;
-    progress.last_time = now;
-    progress.last_fraction = fraction;
-    double elapsed = now - progress.phase_start;
-    if (fraction >= 1)
-        fprintf(stderr, "\r%-14s done in %.2f s            ", phase, elapsed);
-    else if (fraction > 0.02)
-        fprintf(stderr, "\r%-14s %5.1f%%  %6.1f s left   ", phase, 100 * fraction,
-                elapsed * (1 - fraction) / fraction);
-    else
-        fprintf(stderr, "\r%-14s %5.1f%%                 ", phase, 100 * fraction);
+    clock->printed = now;
+
+    char text[128], elapsed[32], left[32];
+    format_duration(clock->seconds, elapsed, sizeof(elapsed));
+    if (fraction >= 1) {
+        snprintf(text, sizeof(text), "%-14s done in %.2f s", phase, clock->seconds);
+        clock->done = true;
+    } else if (fraction >= 0.02 && fraction < 0.99 && clock->since_restart > 0) {
+        format_duration(clock->since_restart * (1 - fraction) / fraction, left, sizeof(left));
+        snprintf(text, sizeof(text), "%-14s %5.1f%%  %s, about %s left", phase,
+                 100 * fraction, elapsed, left);
+    } else {
+        snprintf(text, sizeof(text), "%-14s %5.1f%%  %s", phase, 100 * fraction, elapsed);
+    }
+    if (mode == PROGRESS_LINES) {
+        fprintf(stderr, "radiosity: progress: %s\n", text);
+        return;
+    }
+    fprintf(stderr, "\r%-60s", text);
     progress.line_open = true;
     if (fraction >= 1)
         cli_progress_end();

@@ -11,7 +11,10 @@
 
 #include "radiosity.h"
 
-enum { EXIT_OK = 0, EXIT_ERROR = 1, EXIT_USAGE = 2 };
+/* EXIT_INTERRUPTED (128 + SIGINT, what a shell reports for a run ended by Ctrl-C): a
+ * hierarchical solve was stopped by Ctrl-C, and the outputs were written, complete, with
+ * the solution so far. */
+enum { EXIT_OK = 0, EXIT_ERROR = 1, EXIT_USAGE = 2, EXIT_INTERRUPTED = 130 };
 
 /* An option the parser accepts: name without dashes, short letter or 0, and whether it
  * takes a value. */
@@ -101,9 +104,12 @@ enum {
 
 /* What Ctrl-C does, for the help of every command that solves. */
 #define CLI_INTERRUPT_HELP                                                                 \
-    "Ctrl-C during a hierarchical solve stops refinement and gathering at the next sweep\n"  \
-    "and the run goes on with the solution so far (written by --save-solution, rendered\n"   \
-    "or written as a lit mesh); a second Ctrl-C ends the run at once.\n"
+    "Ctrl-C during a hierarchical solve stops refinement and gathering at the end of the\n"  \
+    "current pass or sweep and the run goes on with the solution so far (written by\n"      \
+    "--save-solution, rendered or written as a lit mesh, each file complete), then exits\n"  \
+    "with status 130; a second Ctrl-C ends the run at once. Progress (each phase, its time\n" \
+    "and the time left) shows on a terminal; RADIOSITY_PROGRESS=lines prints it as lines\n"  \
+    "elsewhere too, RADIOSITY_PROGRESS=0 never.\n"
 
 #define CLI_SCENE_OPTIONS                                                                  \
     [OPT_EMIT] = {"emit", 0, true}, [OPT_ALBEDO] = {"albedo", 0, true}
@@ -173,10 +179,15 @@ void cli_warn(const char *format, ...) __attribute__((format(printf, 1, 2)));
 /* A rad_log_fn printing "radiosity: warning: message". */
 void cli_log(void *user, const char *message);
 
-/* Progress on stderr when it is a terminal (user: NULL). */
+/* Progress on stderr (user: NULL): on a terminal, or as whole lines with
+ * RADIOSITY_PROGRESS=lines (cli.c). Each phase shows its fraction, its time and the time
+ * left. */
 void cli_progress(void *user, const char *phase, double fraction);
 void cli_progress_end(void);
 bool cli_progress_enabled(void);
+/* The work from now on belongs to the next phase reported (its first report then counts
+ * the time since here). */
+void cli_progress_mark(void);
 
 /* Seconds on a monotonic clock. */
 double cli_now(void);

@@ -161,6 +161,7 @@ static rad_status solve_hierarchical(const cli_solve *solve, cli_solved *out, ra
     interrupt_requested = 0;
     options.stop = &interrupt_requested;
     void (*previous)(int) = signal(SIGINT, on_interrupt);
+    cli_progress_mark();
     status = rad_solve_hierarchical(out->scene, out->mesh, occluders, &options, out->B,
                                     &out->hierarchy, error);
     signal(SIGINT, previous == SIG_ERR ? SIG_DFL : previous);
@@ -196,6 +197,7 @@ static rad_status solve_here(const cli_shared *shared, const cli_solve *solve, c
     double t0 = cli_now();
     rad_status status =
         rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, out->scene, &occluders, error);
+    cli_progress_mark();
     if (status == RAD_OK)
         status = rad_formfactors_compute(out->mesh, occluders, &shared->formfactor, &ff,
                                          &out->formfactors, error);

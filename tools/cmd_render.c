@@ -132,6 +132,7 @@ int command_render(int argc, char **argv)
         s.render.materials = solved.scene->materials;
     s.render.scene = solved.scene;
     status = rad_image_create(s.view.width, s.view.height, &image, &error);
+    cli_progress_mark();
     if (status == RAD_OK)
         status = rad_render(solved.mesh, solved.B, &camera, &s.render, image, &error);
     if (status != RAD_OK)
@@ -172,6 +173,8 @@ int command_render(int argc, char **argv)
         if (!stats_write(&stats, s.stats_path))
             exit_code = EXIT_ERROR;
     }
+    if (exit_code == EXIT_OK && solved.hierarchical && solved.hierarchy.interrupted)
+        exit_code = EXIT_INTERRUPTED; /* the image is complete, of the solution so far */
     goto done;
 fail:
     cli_error("%s", error.message);

@@ -132,6 +132,8 @@ int command_solve(int argc, char **argv)
         if (!stats_write(&stats, shared.stats_path))
             exit_code = EXIT_ERROR;
     }
+    if (exit_code == EXIT_OK && solved.hierarchical && solved.hierarchy.interrupted)
+        exit_code = EXIT_INTERRUPTED; /* the files are complete, of the solution so far */
 done:
     cli_progress_end();
     cli_solved_free(&solved);
