@@ -7,7 +7,9 @@
  *     splits the shared edge x = 1 in 2, the trapezoid in 6 (nested: 4 T-vertices); at 0.4
  *     in 3 and 8 (neither nests: all 9 inner points are T-vertices);
  *   - two triangles (0,0) (1,0) (0,1) and (1,0) (2,2) (0,1) sharing their edge (1,0)-(0,1),
- *     split 3 and 5 times at patch size 0.5 (triangle patches with T-vertices).
+ *     split 3 and 5 times at patch size 0.5 (triangle patches with T-vertices);
+ *   - a unit square framed by four trapezoids (a 3 x 3 square): at patch size 1 the square
+ *     is one patch with T-vertices on all four edges.
  * The radiosity is set directly, linear in x and y at each patch's centroid, so the
  * values vary along the seam. Independent of the library's own T-vertex search, the test
  * finds by brute force every vertex lying strictly inside a patch edge and checks:
@@ -270,8 +272,16 @@ int main(void)
     seam_case crossed = {"crossed", quads, 0.4, 9, 5, true};
     /* triangle 3 against triangle 5: 2 + 4; areas 0.5 and 1.5 */
     seam_case fan = {"triangles", triangles, 0.5, 6, 2, false};
+    /* a unit square framed by four trapezoids out to a 3 x 3 square: at patch size 1 the
+     * square is one patch with 2 T-vertices on each of its 4 edges (1 against 3) */
+    const char *frame = "o floor\n"
+                        "v 1 1 0\nv 2 1 0\nv 2 2 0\nv 1 2 0\n"
+                        "v 0 0 0\nv 3 0 0\nv 3 3 0\nv 0 3 0\n"
+                        "f 1 2 3 4\nf 5 6 2 1\nf 6 7 3 2\nf 7 8 4 3\nf 8 5 1 4\n";
+    seam_case framed = {"frame", frame, 1, 8, 9, false};
     run_case(&nested);
     run_case(&crossed);
     run_case(&fan);
+    run_case(&framed);
     return test_finish("test_seams");
 }

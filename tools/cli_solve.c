@@ -389,10 +389,11 @@ void cli_solved_summary(const cli_solved *s, const cli_solve *solve, char *text,
         const rad_hierarchy_report *h = &s->hierarchy;
         snprintf(text, size,
                  "%u patches, %llu elements, %llu clusters, %llu links, %.1f M rays, %u sweeps "
-                 "(change %.2g)%s, peak %.0f MB",
+                 "(change %.2g)%s%s, refine %.1f s, gather %.1f s, peak %.0f MB",
                  s->mesh->patch_count, (unsigned long long)h->elements,
                  (unsigned long long)h->clusters, (unsigned long long)h->links, h->rays / 1e6,
                  h->sweeps, h->residual, h->memory_capped ? ", memory capped" : "",
+                 h->interrupted ? ", interrupted" : "", h->seconds_refine, h->seconds_gather,
                  rad_peak_memory_bytes() / 1048576.0);
         return;
     }
