@@ -15,7 +15,8 @@
  *   - the lit mesh (.obj) holds for each vertex the radiance rad_reconstruct_vertices
  *     gives from that saved solution (1e-6 relative): both files are the same solution,
  *     complete; no temporary file is left;
- *   - `render --solution` of that file works (exit 0) and the image is lit.
+ *   - `render --solution` of that file works (exit 0) and the image is lit;
+ *   - `render` interrupted the same way exits 130 with its image written, lit.
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -185,6 +186,36 @@ int main(void)
             sum += image->rgb[k];
         printf("render --solution: exit %d, mean value %.4f\n", code,
                sum / ((double)image->width * image->height * 3));
+        CHECK(sum > 0);
+        rad_image_destroy(image);
+    }
+
+    /* `render` the same way: exit 130 and the image of the solution so far, complete */
+    char pfm[4200];
+    snprintf(pfm, sizeof(pfm), "%s", test_path("interrupted.pfm"));
+    const char *render_words[] = {RAD_TOOL, "render", "-o", pfm, "--size", "32x24",
+                                  "--solver", "hierarchical", "--patch-size", PATCH_SIZE};
+    enum { RENDER_WORDS = sizeof(render_words) / sizeof(render_words[0]) };
+    char render_copies[RENDER_WORDS][4200];
+    char *render_argv[RENDER_WORDS + 1];
+    for (size_t k = 0; k < RENDER_WORDS; k++) {
+        snprintf(render_copies[k], sizeof(render_copies[k]), "%s", render_words[k]);
+        render_argv[k] = render_copies[k];
+    }
+    render_argv[RENDER_WORDS] = NULL;
+    status = run_and_interrupt(render_argv, "progress: refine", text, sizeof(text), first,
+                               sizeof(first));
+    printf("render stderr:\n%s", text);
+    CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 130);
+    CHECK(strstr(text, "warning: interrupted") != NULL);
+    CHECK(test_count_files("interrupted.pfm.tmp") == 0);
+    image = NULL;
+    CHECK(rad_image_read(pfm, &image, &error) == RAD_OK);
+    if (image) {
+        CHECK(image->width == 32 && image->height == 24);
+        double sum = 0;
+        for (size_t k = 0; k < (size_t)image->width * image->height * 3; k++)
+            sum += image->rgb[k];
         CHECK(sum > 0);
         rad_image_destroy(image);
     }
