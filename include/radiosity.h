@@ -708,6 +708,7 @@ typedef struct rad_hierarchy_report {
     double seconds_build;    /* element and cluster trees */
     double seconds_refine;   /* link refinement, visibility included */
     double seconds_gather;   /* sweeps and push-pull */
+    double seconds_final;    /* the final gather at the leaves */
     int threads;
 } rad_hierarchy_report;
 

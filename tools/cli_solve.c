@@ -346,6 +346,7 @@ void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *st
         stats_number(stats, "seconds_hierarchy", h->seconds_build);
         stats_number(stats, "seconds_refine", h->seconds_refine);
         stats_number(stats, "seconds_gather", h->seconds_gather);
+        stats_number(stats, "seconds_final_gather", h->seconds_final);
         stats_number(stats, "seconds_solve", s->seconds_solve);
         if (solve->save_solution_path)
             stats_number(stats, "seconds_save_solution", s->seconds_save);
@@ -389,11 +390,13 @@ void cli_solved_summary(const cli_solved *s, const cli_solve *solve, char *text,
         const rad_hierarchy_report *h = &s->hierarchy;
         snprintf(text, size,
                  "%u patches, %llu elements, %llu clusters, %llu links, %.1f M rays, %u sweeps "
-                 "(change %.2g)%s%s, refine %.1f s, gather %.1f s, peak %.0f MB",
+                 "(change %.2g)%s%s; tree %.2f s, refine %.2f s, gather %.2f s, final gather "
+                 "%.2f s; peak %.0f MB",
                  s->mesh->patch_count, (unsigned long long)h->elements,
                  (unsigned long long)h->clusters, (unsigned long long)h->links, h->rays / 1e6,
                  h->sweeps, h->residual, h->memory_capped ? ", memory capped" : "",
-                 h->interrupted ? ", interrupted" : "", h->seconds_refine, h->seconds_gather,
+                 h->interrupted ? ", interrupted" : "", h->seconds_build, h->seconds_refine,
+                 h->seconds_gather, h->seconds_final,
                  rad_peak_memory_bytes() / 1048576.0);
         return;
     }

@@ -155,7 +155,7 @@ int command_render(int argc, char **argv)
         goto fail;
     t_write = cli_now();
     if (cli_progress_enabled()) { /* a summary for a person watching; quiet in scripts */
-        char summary[256];
+        char summary[384];
         cli_solved_summary(&solved, &s.solve, summary, sizeof(summary));
         fprintf(stderr, "radiosity: %s, %.2f s: wrote %s\n", summary, t_write - t0, s.output);
     }

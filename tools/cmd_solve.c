@@ -116,7 +116,7 @@ int command_solve(int argc, char **argv)
         goto done;
     }
     if (cli_progress_enabled()) {
-        char summary[256];
+        char summary[384];
         cli_solved_summary(&solved, &solve, summary, sizeof(summary));
         fprintf(stderr, "radiosity: %s, %.2f s: wrote %s\n", summary, t_write - t0,
                 shared.output ? shared.output : solve.save_solution_path);

@@ -62,6 +62,15 @@ typedef struct link_estimate {
 link_estimate hier_estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
                             uint32_t source);
 
+/* Only the bound on A_receiver F (cheap: no factor), for refinement's decisions. */
+double hier_error_bound(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
+                        uint32_t source);
+
+/* F from the point x (unit normal nx) to the patches below source, unoccluded: the contour
+ * formula for patches, nodes far enough away as disks. */
+double hier_point_factor(const rad_mesh *mesh, const hier_tree *tree, rad_vec3 x, rad_vec3 nx,
+                         uint32_t source);
+
 /* A point uniform in area on the patches below node, lifted off folded quads, and the
  * normal of its patch; u1..u3 in [0,1). */
 rad_vec3 hier_sample_point(const rad_mesh *mesh, const hier_tree *tree, uint32_t node,

@@ -12,6 +12,7 @@
  * spheres as the distance, and never exceeds min(A_p, A_q) (reciprocity with F <= 1).
  */
 #include <math.h>
+#include <stdbool.h>
 
 #include "core/vec3.h"
 #include "formfactor/contour.h"
@@ -20,6 +21,9 @@
 #define CLUSTER_MEAN_COSINE 0.25
 #define NEAR_DISTANCE 3.0     /* patch pairs closer than this x (sum of radii): 2 x 2 points */
 #define TOUCHING_DISTANCE 1.0 /* and closer than this: 4 x 4 points */
+#define OPEN_RATIO 5.0        /* a node seen from this many of its radii or more is a disk */
+#define MAX_RECEIVER_POINTS 16u
+#define MAX_SOURCE_OPENINGS 64
 
 /* Largest signed distance of the box's corners from the plane through c with normal n. */
 static double box_front(rad_vec3 lo, rad_vec3 hi, rad_vec3 c, rad_vec3 n)
@@ -77,8 +81,89 @@ static double patch_to_patch(const rad_mesh *mesh, const hnode *p, const hnode *
     return sum / count;
 }
 
-link_estimate hier_estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
+/* F from a point to one node seen as a disk facing along its normal (a cluster: the mean
+ * cosine). */
+static double disk_factor(rad_vec3 x, rad_vec3 nx, const hnode *q)
+{
+    rad_vec3 d = v3_sub(q->centroid, x);
+    double r2 = v3_dot(d, d), r = sqrt(r2);
+    if (!(r > 0))
+        return 0;
+    double cos_x = fmax(0, v3_dot(nx, d) / r);
+    double cos_q = q->planar ? fmax(0, -v3_dot(q->normal, d) / r) : CLUSTER_MEAN_COSINE;
+    return q->area * cos_x * cos_q / (RAD_PI * r2 + q->area);
+}
+
+/* F from the point x (unit normal nx) to the patches below node q, unoccluded: the contour
+ * formula for patches, a disk for nodes seen from OPEN_RATIO of their radii or more
+ * (Barnes-Hut style), else the sum over the children; at most *budget nodes are opened. */
+static double point_to_node(const rad_mesh *mesh, const hier_tree *tree, rad_vec3 x,
+                            rad_vec3 nx, uint32_t index, int *budget)
+{
+    const hnode *q = &tree->nodes[index];
+    if (box_front(q->lo, q->hi, x, nx) <= tree->plane_epsilon)
+        return 0; /* wholly behind x's plane */
+    if (q->planar && v3_dot(q->normal, v3_sub(x, q->centroid)) <= tree->plane_epsilon)
+        return 0; /* x behind q's plane */
+    if (q->patch != HNODE_NONE) {
+        const rad_patch *rq = &mesh->patches[q->patch];
+        rad_vec3 polygon[4];
+        for (uint32_t k = 0; k < rq->vertex_count; k++)
+            polygon[k] = mesh->vertices[rq->vertex[k]];
+        return contour_point_to_polygon(x, nx, polygon, rq->vertex_count, rq->normal,
+                                        1e-7 * q->radius);
+    }
+    rad_vec3 d = v3_sub(q->centroid, x);
+    if (*budget <= 0 || (q->planar && v3_dot(d, d) >= OPEN_RATIO * OPEN_RATIO * q->radius * q->radius))
+        return disk_factor(x, nx, q);
+    (*budget)--;
+    return point_to_node(mesh, tree, x, nx, q->child[0], budget) +
+           point_to_node(mesh, tree, x, nx, q->child[1], budget);
+}
+
+/* F(p <- q) for a planar receiver node: the area-weighted mean of point_to_node over the
+ * centroids of nodes below p small enough to be seen from q as points (largest first, at
+ * most MAX_RECEIVER_POINTS). */
+static double plane_to_node(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
                             uint32_t source)
+{
+    const hnode *q = &tree->nodes[source];
+    uint32_t points[MAX_RECEIVER_POINTS];
+    unsigned count = 1;
+    points[0] = receiver;
+    for (;;) { /* split the point whose node is largest for its distance to q */
+        unsigned widest = count;
+        double worst = 1.0 / OPEN_RATIO;
+        for (unsigned k = 0; k < count; k++) {
+            const hnode *n = &tree->nodes[points[k]];
+            if (n->child[0] == HNODE_NONE)
+                continue;
+            double gap = v3_length(v3_sub(n->centroid, q->centroid)) - q->radius;
+            double ratio = gap > 0 ? n->radius / gap : INFINITY;
+            if (ratio > worst) {
+                worst = ratio;
+                widest = k;
+            }
+        }
+        if (widest == count || count == MAX_RECEIVER_POINTS)
+            break;
+        const hnode *n = &tree->nodes[points[widest]];
+        points[widest] = n->child[0];
+        points[count++] = n->child[1];
+    }
+    double sum = 0, area = 0;
+    for (unsigned k = 0; k < count; k++) {
+        const hnode *n = &tree->nodes[points[k]];
+        int budget = MAX_SOURCE_OPENINGS;
+        sum += n->area * point_to_node(mesh, tree, n->centroid, n->normal, source, &budget);
+        area += n->area;
+    }
+    return area > 0 ? sum / area : 0;
+}
+
+/* The factor estimate and, when bound is set, the bound on A_p F. */
+static link_estimate estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
+                              uint32_t source, bool factor)
 {
     const hnode *p = &tree->nodes[receiver], *q = &tree->nodes[source];
     link_estimate e = {0, 0};
@@ -88,8 +173,8 @@ link_estimate hier_estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_
     if (q->planar && box_front(p->lo, p->hi, q->centroid, q->normal) <= tree->plane_epsilon)
         return e;
     if (p->patch != HNODE_NONE && q->patch != HNODE_NONE) {
-        e.factor = patch_to_patch(mesh, p, q);
-        e.factor_bound = e.factor * p->area;
+        e.factor = factor ? patch_to_patch(mesh, p, q) : 0;
+        e.factor_bound = factor ? e.factor * p->area : 0; /* leaves never split */
         return e;
     }
     rad_vec3 d = v3_sub(q->centroid, p->centroid);
@@ -106,12 +191,33 @@ link_estimate hier_estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_
         cos_q = fmax(0, -v3_dot(q->normal, d) / r);
         bound_q = fmin(1, cos_q + spread);
     }
-    e.factor = q->area * cos_p * cos_q / (RAD_PI * r2 + q->area);
     double gap = r - p->radius - q->radius;
     e.factor_bound = smaller;
     if (gap > 0)
         e.factor_bound = fmin(smaller, p->area * q->area * bound_p * bound_q / (RAD_PI * gap * gap));
+    if (factor)
+        e.factor = p->planar && q->planar ? plane_to_node(mesh, tree, receiver, source)
+                                          : q->area * cos_p * cos_q / (RAD_PI * r2 + q->area);
     return e;
+}
+
+link_estimate hier_estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
+                            uint32_t source)
+{
+    return estimate(mesh, tree, receiver, source, true);
+}
+
+double hier_error_bound(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
+                        uint32_t source)
+{
+    return estimate(mesh, tree, receiver, source, false).factor_bound;
+}
+
+double hier_point_factor(const rad_mesh *mesh, const hier_tree *tree, rad_vec3 x, rad_vec3 nx,
+                         uint32_t source)
+{
+    int budget = MAX_SOURCE_OPENINGS;
+    return point_to_node(mesh, tree, x, nx, source, &budget);
 }
 
 rad_vec3 hier_sample_point(const rad_mesh *mesh, const hier_tree *tree, uint32_t node,

@@ -46,8 +46,8 @@ static uint8_t decide(const refine_context *c, const hlink *link, float *bound)
         *bound = 0;
         return KEEP;
     }
-    link_estimate e = hier_estimate(c->mesh, c->tree, link->receiver, link->source);
-    double error = brightest(c->node_radiosity[link->source]) * e.factor_bound;
+    double error = brightest(c->node_radiosity[link->source]) *
+                   hier_error_bound(c->mesh, c->tree, link->receiver, link->source);
     bool partial = link->visibility < 1;
     *bound = (float)error;
     if (!(error > c->epsilon * (partial ? PARTIAL_FACTOR : 1)))
@@ -193,9 +193,8 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
             }
             /* two patches: the contour formula times the visible fraction; larger nodes: the
              * kernel sampled at the segments' ends, unbiased whatever the shadows */
-            bool sampled = nodes[child->receiver].patch == HNODE_NONE ||
-                           nodes[child->source].patch == HNODE_NONE;
             bool planes = nodes[child->receiver].planar && nodes[child->source].planar;
+            bool sampled = !planes;
             tb->pend[pending_count] = (pending){(uint32_t)slot, ray_count,
                                                 sampled ? -1.0 : e.factor,
                                                 planes ? e.factor : -1.0};
