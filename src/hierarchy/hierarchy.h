@@ -33,11 +33,21 @@ typedef struct hnode {
     bool planar;
 } hnode;
 
+/* A patch for sampling, compact and in leaf order (a node's patches are contiguous): the
+ * corner a (lifted off a folded quad by twice its bulge), the edges to the other corners
+ * (ad zero for a triangle), the normal, and the share of the area in triangle (a, b, c). */
+typedef struct leaf_shape {
+    float a[3], ab[3], ac[3], ad[3];
+    float normal[3];
+    float first_share;
+} leaf_shape;
+
 typedef struct hier_tree {
     hnode *nodes;
     uint32_t node_count;
     uint32_t *order;      /* patches in leaf order */
     double *cumulative;   /* cumulative[k] = area of order[0..k], for sampling */
+    struct leaf_shape *shapes; /* per leaf, in leaf order: what sampling needs */
     uint32_t planar_count, cluster_count;
     double plane_epsilon; /* scene units: the front-of-plane guard */
 } hier_tree;
@@ -50,6 +60,7 @@ typedef struct hlink {
     uint32_t receiver, source;
     float transfer;   /* F(receiver <- source) x visibility */
     float visibility; /* visible fraction: 1 full, in (0,1) partial */
+    float bound;      /* bound on A_receiver F: B(source) x bound is refinement's error */
 } hlink;
 
 /* What refinement needs to know about a link, computed from geometry alone. */
@@ -62,10 +73,6 @@ typedef struct link_estimate {
 link_estimate hier_estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
                             uint32_t source);
 
-/* Only the bound on A_receiver F (cheap: no factor), for refinement's decisions. */
-double hier_error_bound(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
-                        uint32_t source);
-
 /* F from the point x (unit normal nx) to the patches below source, unoccluded: the contour
  * formula for patches, nodes far enough away as disks. */
 double hier_point_factor(const rad_mesh *mesh, const hier_tree *tree, rad_vec3 x, rad_vec3 nx,
@@ -73,8 +80,8 @@ double hier_point_factor(const rad_mesh *mesh, const hier_tree *tree, rad_vec3 x
 
 /* A point uniform in area on the patches below node, lifted off folded quads, and the
  * normal of its patch; u1..u3 in [0,1). */
-rad_vec3 hier_sample_point(const rad_mesh *mesh, const hier_tree *tree, uint32_t node,
-                           double u1, double u2, double u3, rad_vec3 *normal);
+rad_vec3 hier_sample_point(const hier_tree *tree, uint32_t node, double u1, double u2,
+                           double u3, rad_vec3 *normal);
 
 /* The links, in two buffers of `capacity` (the second is scratch for refinement and for
  * sorting by receiver). */

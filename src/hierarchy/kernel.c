@@ -10,10 +10,14 @@
  * or from four points of it when the two are close. The bound on A_p F used by refinement
  * takes cosines at their largest over the nodes' bounding spheres and the gap between the
  * spheres as the distance, and never exceeds min(A_p, A_q) (reciprocity with F <= 1).
+ *
+ * The final gather needs F from a leaf's centre to a node (hier_point_factor): the contour
+ * formula over the node's patches, with subtrees seen from OPEN_RATIO of their radii or
+ * more taken as one disk each (Barnes and Hut's opening rule).
  */
 #include <math.h>
-#include <stdbool.h>
 
+#include "core/minmax.h"
 #include "core/vec3.h"
 #include "formfactor/contour.h"
 #include "hierarchy/hierarchy.h"
@@ -22,7 +26,6 @@
 #define NEAR_DISTANCE 3.0     /* patch pairs closer than this x (sum of radii): 2 x 2 points */
 #define TOUCHING_DISTANCE 1.0 /* and closer than this: 4 x 4 points */
 #define OPEN_RATIO 5.0        /* a node seen from this many of its radii or more is a disk */
-#define MAX_RECEIVER_POINTS 16u
 #define MAX_SOURCE_OPENINGS 64
 
 /* Largest signed distance of the box's corners from the plane through c with normal n. */
@@ -31,7 +34,7 @@ static double box_front(rad_vec3 lo, rad_vec3 hi, rad_vec3 c, rad_vec3 n)
     double best = -INFINITY;
     for (int k = 0; k < 8; k++) {
         rad_vec3 corner = v3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
-        best = fmax(best, v3_dot(n, v3_sub(corner, c)));
+        best = max_d(best, v3_dot(n, v3_sub(corner, c)));
     }
     return best;
 }
@@ -89,8 +92,8 @@ static double disk_factor(rad_vec3 x, rad_vec3 nx, const hnode *q)
     double r2 = v3_dot(d, d), r = sqrt(r2);
     if (!(r > 0))
         return 0;
-    double cos_x = fmax(0, v3_dot(nx, d) / r);
-    double cos_q = q->planar ? fmax(0, -v3_dot(q->normal, d) / r) : CLUSTER_MEAN_COSINE;
+    double cos_x = max_d(0, v3_dot(nx, d) / r);
+    double cos_q = q->planar ? max_d(0, -v3_dot(q->normal, d) / r) : CLUSTER_MEAN_COSINE;
     return q->area * cos_x * cos_q / (RAD_PI * r2 + q->area);
 }
 
@@ -121,49 +124,8 @@ static double point_to_node(const rad_mesh *mesh, const hier_tree *tree, rad_vec
            point_to_node(mesh, tree, x, nx, q->child[1], budget);
 }
 
-/* F(p <- q) for a planar receiver node: the area-weighted mean of point_to_node over the
- * centroids of nodes below p small enough to be seen from q as points (largest first, at
- * most MAX_RECEIVER_POINTS). */
-static double plane_to_node(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
+link_estimate hier_estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
                             uint32_t source)
-{
-    const hnode *q = &tree->nodes[source];
-    uint32_t points[MAX_RECEIVER_POINTS];
-    unsigned count = 1;
-    points[0] = receiver;
-    for (;;) { /* split the point whose node is largest for its distance to q */
-        unsigned widest = count;
-        double worst = 1.0 / OPEN_RATIO;
-        for (unsigned k = 0; k < count; k++) {
-            const hnode *n = &tree->nodes[points[k]];
-            if (n->child[0] == HNODE_NONE)
-                continue;
-            double gap = v3_length(v3_sub(n->centroid, q->centroid)) - q->radius;
-            double ratio = gap > 0 ? n->radius / gap : INFINITY;
-            if (ratio > worst) {
-                worst = ratio;
-                widest = k;
-            }
-        }
-        if (widest == count || count == MAX_RECEIVER_POINTS)
-            break;
-        const hnode *n = &tree->nodes[points[widest]];
-        points[widest] = n->child[0];
-        points[count++] = n->child[1];
-    }
-    double sum = 0, area = 0;
-    for (unsigned k = 0; k < count; k++) {
-        const hnode *n = &tree->nodes[points[k]];
-        int budget = MAX_SOURCE_OPENINGS;
-        sum += n->area * point_to_node(mesh, tree, n->centroid, n->normal, source, &budget);
-        area += n->area;
-    }
-    return area > 0 ? sum / area : 0;
-}
-
-/* The factor estimate and, when bound is set, the bound on A_p F. */
-static link_estimate estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
-                              uint32_t source, bool factor)
 {
     const hnode *p = &tree->nodes[receiver], *q = &tree->nodes[source];
     link_estimate e = {0, 0};
@@ -173,44 +135,30 @@ static link_estimate estimate(const rad_mesh *mesh, const hier_tree *tree, uint3
     if (q->planar && box_front(p->lo, p->hi, q->centroid, q->normal) <= tree->plane_epsilon)
         return e;
     if (p->patch != HNODE_NONE && q->patch != HNODE_NONE) {
-        e.factor = factor ? patch_to_patch(mesh, p, q) : 0;
-        e.factor_bound = factor ? e.factor * p->area : 0; /* leaves never split */
+        e.factor = patch_to_patch(mesh, p, q);
+        e.factor_bound = e.factor * p->area;
         return e;
     }
     rad_vec3 d = v3_sub(q->centroid, p->centroid);
     double r2 = v3_dot(d, d), r = sqrt(r2);
-    double smaller = fmin(p->area, q->area);
+    double smaller = min_d(p->area, q->area);
     double spread = r > 0 ? (p->radius + q->radius) / r : INFINITY;
     double cos_p = CLUSTER_MEAN_COSINE, cos_q = CLUSTER_MEAN_COSINE;
     double bound_p = 1, bound_q = 1;
     if (r > 0 && p->planar) {
-        cos_p = fmax(0, v3_dot(p->normal, d) / r);
-        bound_p = fmin(1, cos_p + spread);
+        cos_p = max_d(0, v3_dot(p->normal, d) / r);
+        bound_p = min_d(1, cos_p + spread);
     }
     if (r > 0 && q->planar) {
-        cos_q = fmax(0, -v3_dot(q->normal, d) / r);
-        bound_q = fmin(1, cos_q + spread);
+        cos_q = max_d(0, -v3_dot(q->normal, d) / r);
+        bound_q = min_d(1, cos_q + spread);
     }
     double gap = r - p->radius - q->radius;
     e.factor_bound = smaller;
     if (gap > 0)
-        e.factor_bound = fmin(smaller, p->area * q->area * bound_p * bound_q / (RAD_PI * gap * gap));
-    if (factor)
-        e.factor = p->planar && q->planar ? plane_to_node(mesh, tree, receiver, source)
-                                          : q->area * cos_p * cos_q / (RAD_PI * r2 + q->area);
+        e.factor_bound = min_d(smaller, p->area * q->area * bound_p * bound_q / (RAD_PI * gap * gap));
+    e.factor = q->area * cos_p * cos_q / (RAD_PI * r2 + q->area);
     return e;
-}
-
-link_estimate hier_estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
-                            uint32_t source)
-{
-    return estimate(mesh, tree, receiver, source, true);
-}
-
-double hier_error_bound(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
-                        uint32_t source)
-{
-    return estimate(mesh, tree, receiver, source, false).factor_bound;
 }
 
 double hier_point_factor(const rad_mesh *mesh, const hier_tree *tree, rad_vec3 x, rad_vec3 nx,
@@ -220,13 +168,13 @@ double hier_point_factor(const rad_mesh *mesh, const hier_tree *tree, rad_vec3 x
     return point_to_node(mesh, tree, x, nx, source, &budget);
 }
 
-rad_vec3 hier_sample_point(const rad_mesh *mesh, const hier_tree *tree, uint32_t node,
-                           double u1, double u2, double u3, rad_vec3 *normal)
+rad_vec3 hier_sample_point(const hier_tree *tree, uint32_t node, double u1, double u2,
+                           double u3, rad_vec3 *normal)
 {
     const hnode *n = &tree->nodes[node];
-    double base = n->first > 0 ? tree->cumulative[n->first - 1] : 0;
-    double target = base + u1 * n->area;
     uint32_t lo = n->first, hi = n->first + n->count - 1;
+    double before = lo > 0 ? tree->cumulative[lo - 1] : 0;
+    double target = before + u1 * n->area;
     while (lo < hi) { /* first k with cumulative[k] > target */
         uint32_t mid = lo + (hi - lo) / 2;
         if (tree->cumulative[mid] > target)
@@ -234,23 +182,18 @@ rad_vec3 hier_sample_point(const rad_mesh *mesh, const hier_tree *tree, uint32_t
         else
             lo = mid + 1;
     }
-    const rad_patch *p = &mesh->patches[tree->order[lo]];
-    double before = lo > 0 ? tree->cumulative[lo - 1] : 0;
-    double within = p->area > 0 ? (target - before) / p->area : 0; /* in [0, 1) */
-    rad_vec3 a = mesh->vertices[p->vertex[0]], b = mesh->vertices[p->vertex[1]],
-             c = mesh->vertices[p->vertex[2]];
-    if (p->vertex_count == 4) { /* triangle (0,1,2) or (0,2,3) by area */
-        rad_vec3 dd = mesh->vertices[p->vertex[3]];
-        double a0 = v3_length(v3_cross(v3_sub(b, a), v3_sub(c, a)));
-        double a1 = v3_length(v3_cross(v3_sub(c, a), v3_sub(dd, a)));
-        if (within * (a0 + a1) >= a0) {
-            b = c;
-            c = dd;
-        }
+    if (lo > n->first)
+        before = tree->cumulative[lo - 1];
+    const leaf_shape *shape = &tree->shapes[lo];
+    double area = tree->cumulative[lo] - before;
+    double within = area > 0 ? (target - before) / area : 0; /* in [0, 1) */
+    const float *e1 = shape->ab, *e2 = shape->ac;
+    if (within >= shape->first_share) { /* triangle (a, c, d) of a quad */
+        e1 = shape->ac;
+        e2 = shape->ad;
     }
-    *normal = p->normal;
-    double s = sqrt(u2);
-    rad_vec3 point = v3_add(a, v3_add(v3_scale(v3_sub(b, a), s * (1 - u3)),
-                                      v3_scale(v3_sub(c, a), s * u3)));
-    return v3_add(point, v3_scale(p->normal, 2 * p->bulge));
+    *normal = v3(shape->normal[0], shape->normal[1], shape->normal[2]);
+    double s = sqrt(u2), w1 = s * (1 - u3), w2 = s * u3;
+    return v3(shape->a[0] + w1 * e1[0] + w2 * e2[0], shape->a[1] + w1 * e1[1] + w2 * e2[1],
+              shape->a[2] + w1 * e1[2] + w2 * e2[2]);
 }

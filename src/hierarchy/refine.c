@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/minmax.h"
 #include "core/random.h"
 #include "core/tolerance.h"
 #include "core/vec3.h"
@@ -31,7 +32,7 @@ static unsigned children_of(uint8_t action)
     return action == KEEP ? 1 : action == SPLIT_SELF ? 4 : 2;
 }
 
-static double brightest(rad_rgb b) { return fmax(b.r, fmax(b.g, b.b)); }
+static double brightest(rad_rgb b) { return max_d(b.r, max_d(b.g, b.b)); }
 
 static uint8_t decide(const refine_context *c, const hlink *link, float *bound)
 {
@@ -46,8 +47,7 @@ static uint8_t decide(const refine_context *c, const hlink *link, float *bound)
         *bound = 0;
         return KEEP;
     }
-    double error = brightest(c->node_radiosity[link->source]) *
-                   hier_error_bound(c->mesh, c->tree, link->receiver, link->source);
+    double error = brightest(c->node_radiosity[link->source]) * link->bound;
     bool partial = link->visibility < 1;
     *bound = (float)error;
     if (!(error > c->epsilon * (partial ? PARTIAL_FACTOR : 1)))
@@ -114,12 +114,12 @@ static void make_rays(const refine_context *c, uint32_t receiver, uint32_t sourc
         u[0] = (k + u[0]) / count;
         u[3] = ((k * stride + offset) % count + u[3]) / count;
         rad_vec3 na, nb;
-        rad_vec3 a = hier_sample_point(c->mesh, c->tree, receiver, u[0], u[1], u[2], &na);
-        rad_vec3 b = hier_sample_point(c->mesh, c->tree, source, u[3], u[4], u[5], &nb);
+        rad_vec3 a = hier_sample_point(c->tree, receiver, u[0], u[1], u[2], &na);
+        rad_vec3 b = hier_sample_point(c->tree, source, u[3], u[4], u[5], &nb);
         rad_vec3 d = v3_sub(b, a);
         double r2 = v3_dot(d, d), r = sqrt(r2);
-        double cos_a = r > 0 ? fmax(0, v3_dot(na, d) / r) : 0;
-        double cos_b = r > 0 ? fmax(0, -v3_dot(nb, d) / r) : 0;
+        double cos_a = r > 0 ? max_d(0, v3_dot(na, d) / r) : 0;
+        double cos_b = r > 0 ? max_d(0, -v3_dot(nb, d) / r) : 0;
         kernel[k] = area * cos_a * cos_b / (RAD_PI * r2 + 0.25 * area);
         rad_ray *ray = &rays[k];
         ray->origin[0] = (float)a.x;
@@ -179,6 +179,7 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
             child->source = pairs[k][1];
             child->transfer = 0;
             child->visibility = 1;
+            child->bound = 0;
             if (child->receiver == child->source) {
                 if (nodes[child->receiver].planar) /* a plane sends nothing to itself */
                     child->receiver = HNODE_NONE;
@@ -191,6 +192,7 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
                 slot++;
                 continue;
             }
+            child->bound = (float)e.factor_bound;
             /* two patches: the contour formula times the visible fraction; larger nodes: the
              * kernel sampled at the segments' ends, unbiased whatever the shadows */
             bool planes = nodes[child->receiver].planar && nodes[child->source].planar;

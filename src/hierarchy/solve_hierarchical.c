@@ -261,7 +261,7 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
         }
         s.store.capacity = 1;
         s.store.count = 1;
-        s.store.links[0] = (hlink){0, 0, 0, 1};
+        s.store.links[0] = (hlink){0, 0, 0, 1, INFINITY};
         s.store.peak_bytes = 2 * sizeof(hlink);
     }
     refine_context rc = {mesh, &s.tree, occluders, s.node_B,

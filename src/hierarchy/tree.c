@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/minmax.h"
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "hierarchy/hierarchy.h"
@@ -47,8 +48,8 @@ static void median_order(builder *b, uint32_t *ids, uint32_t n, const rad_vec3 *
     rad_vec3 lo = points[ids[0]], hi = lo;
     for (uint32_t k = 1; k < n; k++) {
         rad_vec3 p = points[ids[k]];
-        lo = v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
-        hi = v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
+        lo = v3(min_d(lo.x, p.x), min_d(lo.y, p.y), min_d(lo.z, p.z));
+        hi = v3(max_d(hi.x, p.x), max_d(hi.y, p.y), max_d(hi.z, p.z));
     }
     rad_vec3 e = v3_sub(hi, lo);
     int axis = e.x >= e.y && e.x >= e.z ? 0 : e.y >= e.z ? 1 : 2;
@@ -66,7 +67,7 @@ static void bound_radius(hnode *node)
         rad_vec3 c = v3(k & 1 ? node->hi.x : node->lo.x, k & 2 ? node->hi.y : node->lo.y,
                         k & 4 ? node->hi.z : node->lo.z);
         rad_vec3 d = v3_sub(c, node->centroid);
-        r2 = fmax(r2, v3_dot(d, d));
+        r2 = max_d(r2, v3_dot(d, d));
     }
     node->radius = sqrt(r2);
 }
@@ -83,8 +84,8 @@ static void combine(hier_tree *tree, uint32_t index, bool planar)
     n->normal = v3_add(v3_scale(a->normal, a->area), v3_scale(c->normal, c->area));
     double length = v3_length(n->normal);
     n->normal = length > 0 ? v3_scale(n->normal, 1.0 / length) : a->normal;
-    n->lo = v3(fmin(a->lo.x, c->lo.x), fmin(a->lo.y, c->lo.y), fmin(a->lo.z, c->lo.z));
-    n->hi = v3(fmax(a->hi.x, c->hi.x), fmax(a->hi.y, c->hi.y), fmax(a->hi.z, c->hi.z));
+    n->lo = v3(min_d(a->lo.x, c->lo.x), min_d(a->lo.y, c->lo.y), min_d(a->lo.z, c->lo.z));
+    n->hi = v3(max_d(a->hi.x, c->hi.x), max_d(a->hi.y, c->hi.y), max_d(a->hi.z, c->hi.z));
     n->first = a->first;
     n->count = a->count + c->count;
     n->planar = planar;
@@ -120,8 +121,8 @@ static uint32_t build_plane(builder *b, uint32_t *patches, uint32_t n, uint32_t 
         leaf->lo = leaf->hi = b->mesh->vertices[p->vertex[0]];
         for (uint32_t k = 1; k < p->vertex_count; k++) {
             rad_vec3 v = b->mesh->vertices[p->vertex[k]];
-            leaf->lo = v3(fmin(leaf->lo.x, v.x), fmin(leaf->lo.y, v.y), fmin(leaf->lo.z, v.z));
-            leaf->hi = v3(fmax(leaf->hi.x, v.x), fmax(leaf->hi.y, v.y), fmax(leaf->hi.z, v.z));
+            leaf->lo = v3(min_d(leaf->lo.x, v.x), min_d(leaf->lo.y, v.y), min_d(leaf->lo.z, v.z));
+            leaf->hi = v3(max_d(leaf->hi.x, v.x), max_d(leaf->hi.y, v.y), max_d(leaf->hi.z, v.z));
         }
         leaf->planar = true;
         bound_radius(leaf);
@@ -157,6 +158,33 @@ static uint32_t build_clusters(builder *b, uint32_t *groups, uint32_t n, uint32_
     return index;
 }
 
+static void put3(float out[3], rad_vec3 v)
+{
+    out[0] = (float)v.x;
+    out[1] = (float)v.y;
+    out[2] = (float)v.z;
+}
+
+static void describe_leaf(const rad_mesh *mesh, uint32_t patch, leaf_shape *shape)
+{
+    const rad_patch *p = &mesh->patches[patch];
+    rad_vec3 a = mesh->vertices[p->vertex[0]];
+    rad_vec3 ab = v3_sub(mesh->vertices[p->vertex[1]], a);
+    rad_vec3 ac = v3_sub(mesh->vertices[p->vertex[2]], a);
+    rad_vec3 ad = v3(0, 0, 0);
+    shape->first_share = 1;
+    if (p->vertex_count == 4) {
+        ad = v3_sub(mesh->vertices[p->vertex[3]], a);
+        double a0 = v3_length(v3_cross(ab, ac)), a1 = v3_length(v3_cross(ac, ad));
+        shape->first_share = a0 + a1 > 0 ? (float)(a0 / (a0 + a1)) : 0.5f;
+    }
+    put3(shape->a, v3_add(a, v3_scale(p->normal, 2 * p->bulge)));
+    put3(shape->ab, ab);
+    put3(shape->ac, ac);
+    put3(shape->ad, ad);
+    put3(shape->normal, p->normal);
+}
+
 /* Does patch k continue the plane that patch g starts? */
 static bool same_plane(const rad_mesh *mesh, uint32_t g, uint32_t k, double epsilon)
 {
@@ -179,6 +207,7 @@ int hier_tree_build(const rad_mesh *mesh, hier_tree *tree)
     tree->nodes = rad_alloc_array(2 * (size_t)n - 1, sizeof(hnode));
     tree->order = rad_alloc_array(n, sizeof(uint32_t));
     tree->cumulative = rad_alloc_array(n, sizeof(double));
+    tree->shapes = rad_alloc_array(n, sizeof(leaf_shape));
     uint32_t *patch_ids = rad_alloc_array(n, sizeof(uint32_t));
     rad_vec3 *centroids = rad_alloc_array(n, sizeof(rad_vec3));
     b.group_first = rad_alloc_array(n, sizeof(uint32_t));
@@ -186,7 +215,7 @@ int hier_tree_build(const rad_mesh *mesh, hier_tree *tree)
     b.group_centroid = rad_alloc_array(n, sizeof(rad_vec3));
     uint32_t *groups = rad_alloc_array(n, sizeof(uint32_t));
     b.scratch = rad_alloc_array(n, sizeof(keyed));
-    int ok = tree->nodes && tree->order && tree->cumulative && patch_ids && centroids &&
+    int ok = tree->nodes && tree->order && tree->cumulative && tree->shapes && patch_ids && centroids &&
              b.group_first && b.group_count && b.group_centroid && groups && b.scratch;
     if (ok) {
         rad_vec3 lo, hi;
@@ -216,6 +245,8 @@ int hier_tree_build(const rad_mesh *mesh, hier_tree *tree)
             groups[g] = g;
         }
         build_clusters(&b, groups, group_total, HNODE_NONE, patch_ids, centroids);
+        for (uint32_t k = 0; k < n; k++)
+            describe_leaf(mesh, tree->order[k], &tree->shapes[k]);
         double running = 0;
         for (uint32_t k = 0; k < n; k++) {
             running += mesh->patches[tree->order[k]].area;
@@ -239,5 +270,6 @@ void hier_tree_free(hier_tree *tree)
     free(tree->nodes);
     free(tree->order);
     free(tree->cumulative);
+    free(tree->shapes);
     memset(tree, 0, sizeof(*tree));
 }
