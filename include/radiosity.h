@@ -673,7 +673,7 @@ void rad_system_free_arrays(rad_system *system);
  * count. */
 typedef struct rad_hierarchy_options {
     double refine_threshold;  /* BFA threshold, as a fraction of the scene's emitted power
-                                 per patch; 0 = 0.05. Smaller = more links, more accurate */
+                                 per patch; 0 = 0.25. Smaller = more links, more accurate */
     uint32_t visibility_rays; /* segments per link when the first 4 disagree; 0 = 16 */
     double tolerance;         /* relative change of a sweep (area-weighted); 0 = 1e-4 */
     uint32_t max_sweeps;      /* 0 = 1000 */

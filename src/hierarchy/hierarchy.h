@@ -73,15 +73,33 @@ typedef struct link_estimate {
 link_estimate hier_estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_t receiver,
                             uint32_t source);
 
-/* F from the point x (unit normal nx) to the patches below source, unoccluded: the contour
- * formula for patches, nodes far enough away as disks. */
-double hier_point_factor(const rad_mesh *mesh, const hier_tree *tree, rad_vec3 x, rad_vec3 nx,
-                         uint32_t source);
+/* The irradiance on leaf node `leaf` from the patches below source with radiosity B (per
+ * node), unoccluded: sum of F x B over the leaf's area (the midpoint rule, on 1, 2 x 2 or
+ * 4 x 4 cells by how close the source is), the contour formula for source patches, nodes
+ * far enough away as disks with their mean B. */
+rad_rgb hier_leaf_gather(const rad_mesh *mesh, const hier_tree *tree, const rad_rgb *B,
+                         uint32_t leaf, uint32_t source);
 
 /* A point uniform in area on the patches below node, lifted off folded quads, and the
  * normal of its patch; u1..u3 in [0,1). */
 rad_vec3 hier_sample_point(const hier_tree *tree, uint32_t node, double u1, double u2,
-                           double u3, rad_vec3 *normal);
+                           double u3, rad_vec3 *normal, uint32_t *position);
+
+/* count segments between area-uniform points of receiver and source (stratified along
+ * both nodes' leaf order; random numbers from (seed, receiver, source)); when kernel is
+ * not NULL, the transfer kernel A_source cos cos / (pi r^2 + A_source / 4) at each (their
+ * mean is a Monte Carlo estimate of F(receiver <- source)); when weight is not NULL,
+ * leaf_weight of the source leaf each ends on (by leaf-order position). */
+void hier_segments(const hier_tree *tree, uint64_t seed, uint32_t receiver, uint32_t source,
+                   unsigned count, rad_ray *rays, double *kernel, const float *leaf_weight,
+                   float *weight);
+
+/* The visible share of a link from its segments: the open ones' kernel x weight over all
+ * of it (weight NULL: 1; the plain open fraction when all of it is 0). Weighting by the
+ * kernel and by the source's radiosity where each segment ends keeps F x share unbiased
+ * when the shadowed part of a node is nearer, farther, brighter or darker than the rest. */
+double hier_visible_share(const double *kernel, const float *weight, const uint8_t *occluded,
+                          unsigned count);
 
 /* The links, in two buffers of `capacity` (the second is scratch for refinement and for
  * sorting by receiver). */
@@ -97,6 +115,7 @@ typedef struct refine_context {
     const hier_tree *tree;
     const rad_tracer *occluders;
     const rad_rgb *node_radiosity; /* pulled B of every node */
+    const float *leaf_brightness;  /* B.r + B.g + B.b by leaf-order position */
     double epsilon;                /* absolute BFA threshold (power) */
     unsigned visibility_rays;      /* segments for a link the first 4 found partial */
     uint64_t seed;

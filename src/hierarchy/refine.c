@@ -24,6 +24,8 @@
 #define FIRST_RAYS 4u       /* segments every new link gets */
 #define MAX_RAYS 64u
 #define PARTIAL_FACTOR 0.25 /* partly visible links refine at a quarter of the threshold */
+#define HIDDEN_FACTOR 0.125 /* a pair of nodes all of whose 16 segments were blocked likely
+                               lets through less than 1/8 of its bound */
 
 enum { KEEP = 0, SPLIT_RECEIVER = 1, SPLIT_SOURCE = 2, SPLIT_SELF = 3 };
 
@@ -48,7 +50,9 @@ static uint8_t decide(const refine_context *c, const hlink *link, float *bound)
         return KEEP;
     }
     double error = brightest(c->node_radiosity[link->source]) * link->bound;
-    bool partial = link->visibility < 1;
+    if (!(link->visibility > 0))
+        error *= HIDDEN_FACTOR;
+    bool partial = link->visibility < 1 && link->visibility > 0;
     *bound = (float)error;
     if (!(error > c->epsilon * (partial ? PARTIAL_FACTOR : 1)))
         return KEEP;
@@ -69,8 +73,6 @@ typedef struct pending {
     uint32_t slot;  /* index into the chunk's output */
     uint32_t first; /* its first ray in the batch */
     double factor;  /* the geometric estimate; < 0: sample the kernel (larger nodes) */
-    double planes;  /* two planes' centre estimate (< 0 for clusters): used when every
-                       segment is open, where it has no sampling noise */
 } pending;
 
 typedef struct thread_buffers {
@@ -81,62 +83,8 @@ typedef struct thread_buffers {
     rad_ray *more_rays;
     uint8_t *more_occluded;
     double *more_kernel;
+    float *weight, *more_weight;
 } thread_buffers;
-
-static unsigned greatest_divisor(unsigned a, unsigned b)
-{
-    while (b) {
-        unsigned t = a % b;
-        a = b;
-        b = t;
-    }
-    return a;
-}
-
-/* Segments between area-uniform points of the two nodes, and at each the transfer kernel
- * A_source cos cos / (pi r^2), capped at 1 (a factor never exceeds 1): the mean over the
- * segments is the Monte Carlo form factor, unbiased but for the cap. */
-static void make_rays(const refine_context *c, uint32_t receiver, uint32_t source,
-                      unsigned round, unsigned count, rad_ray *rays, double *kernel)
-{
-    double area = c->tree->nodes[source].area;
-    rad_rng rng = rad_rng_seed(c->seed + round, receiver, source);
-    /* stratified along each node's leaf order (spatially coherent), strata of the source
-     * paired with the receiver's by a random stride prime to their count */
-    unsigned stride = 1 + (unsigned)(rad_rng_next(&rng) % count);
-    while (greatest_divisor(stride, count) != 1)
-        stride--;
-    unsigned offset = (unsigned)(rad_rng_next(&rng) % count);
-    for (unsigned k = 0; k < count; k++) {
-        double u[6];
-        for (int m = 0; m < 6; m++)
-            u[m] = rad_rng_uniform(&rng);
-        u[0] = (k + u[0]) / count;
-        u[3] = ((k * stride + offset) % count + u[3]) / count;
-        rad_vec3 na, nb;
-        rad_vec3 a = hier_sample_point(c->tree, receiver, u[0], u[1], u[2], &na);
-        rad_vec3 b = hier_sample_point(c->tree, source, u[3], u[4], u[5], &nb);
-        rad_vec3 d = v3_sub(b, a);
-        double r2 = v3_dot(d, d), r = sqrt(r2);
-        double cos_a = r > 0 ? max_d(0, v3_dot(na, d) / r) : 0;
-        double cos_b = r > 0 ? max_d(0, -v3_dot(nb, d) / r) : 0;
-        kernel[k] = area * cos_a * cos_b / (RAD_PI * r2 + 0.25 * area);
-        rad_ray *ray = &rays[k];
-        ray->origin[0] = (float)a.x;
-        ray->origin[1] = (float)a.y;
-        ray->origin[2] = (float)a.z;
-        ray->direction[0] = (float)(b.x - a.x);
-        ray->direction[1] = (float)(b.y - a.y);
-        ray->direction[2] = (float)(b.z - a.z);
-        ray->t_near = RAD_SEGMENT_END_EPSILON;
-        ray->t_far = 1.0f - RAD_SEGMENT_END_EPSILON;
-        if (!(ray->direction[0] != 0 || ray->direction[1] != 0 || ray->direction[2] != 0)) {
-            ray->direction[0] = 1; /* coincident points: an empty segment */
-            ray->t_near = 1;
-            ray->t_far = 0;
-        }
-    }
-}
 
 /* Children of one chunk of parent links, written to out; returns how many are live. */
 static size_t refine_chunk(const refine_context *c, const hlink *links, const uint8_t *action,
@@ -193,15 +141,14 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
                 continue;
             }
             child->bound = (float)e.factor_bound;
-            /* two patches: the contour formula times the visible fraction; larger nodes: the
-             * kernel sampled at the segments' ends, unbiased whatever the shadows */
+            /* two planes: the factor estimate times the visible share; a cluster: the
+             * kernel sampled at the segments' ends */
             bool planes = nodes[child->receiver].planar && nodes[child->source].planar;
-            bool sampled = !planes;
             tb->pend[pending_count] = (pending){(uint32_t)slot, ray_count,
-                                                sampled ? -1.0 : e.factor,
                                                 planes ? e.factor : -1.0};
-            make_rays(c, child->receiver, child->source, 0, FIRST_RAYS, &tb->rays[ray_count],
-                      &tb->kernel[ray_count]);
+            hier_segments(c->tree, c->seed, child->receiver, child->source, FIRST_RAYS,
+                          &tb->rays[ray_count], &tb->kernel[ray_count], c->leaf_brightness,
+                          &tb->weight[ray_count]);
             ray_count += FIRST_RAYS;
             pending_count++;
             slot++;
@@ -215,35 +162,47 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
         const pending *pd = &tb->pend[k];
         hlink *child = &out[pd->slot];
         unsigned visible = 0, total = FIRST_RAYS;
-        double kernel_sum = 0;
+        double kernel_open = 0, weighted_open = 0, weighted_all = 0;
         for (unsigned r = 0; r < FIRST_RAYS; r++) {
             bool open = !tb->occluded[pd->first + r];
+            double kernel = tb->kernel[pd->first + r];
+            double weighted = kernel * tb->weight[pd->first + r];
             visible += open;
-            kernel_sum += open ? tb->kernel[pd->first + r] : 0;
+            kernel_open += open ? kernel : 0;
+            weighted_open += open ? weighted : 0;
+            weighted_all += weighted;
         }
-        if (visible < FIRST_RAYS && extra > 0 && (visible > 0 || pd->factor < 0)) {
-            make_rays(c, child->receiver, child->source, 1, extra, tb->more_rays, tb->more_kernel);
+        bool leaves = nodes[child->receiver].patch != HNODE_NONE &&
+                      nodes[child->source].patch != HNODE_NONE;
+        /* partly visible, or hidden between larger nodes (a gap the first few missed) */
+        if (visible < FIRST_RAYS && extra > 0 && (visible > 0 || !leaves)) {
+            hier_segments(c->tree, c->seed + 1, child->receiver, child->source, extra,
+                          tb->more_rays, tb->more_kernel, c->leaf_brightness, tb->more_weight);
             rad_tracer_occluded(c->occluders, tb->more_rays, extra, tb->more_occluded);
             *rays_cast += extra;
             for (unsigned r = 0; r < extra; r++) {
                 bool open = !tb->more_occluded[r];
+                double kernel = tb->more_kernel[r], weighted = kernel * tb->more_weight[r];
                 visible += open;
-                kernel_sum += open ? tb->more_kernel[r] : 0;
+                kernel_open += open ? kernel : 0;
+                weighted_open += open ? weighted : 0;
+                weighted_all += weighted;
             }
             total += extra;
         }
-        bool leaves = nodes[child->receiver].patch != HNODE_NONE &&
-                      nodes[child->source].patch != HNODE_NONE;
         if (visible == 0 && leaves) {
             child->receiver = HNODE_NONE; /* fully hidden */
             continue;
         }
         /* a hidden pair of larger nodes stays (transfer 0) so that refinement can still
-         * find what a few segments missed */
-        double fraction = (double)visible / total;
-        child->visibility = (float)fraction;
-        double sampled = visible == total && pd->planes >= 0 ? pd->planes : kernel_sum / total;
-        child->transfer = (float)(pd->factor >= 0 ? pd->factor * fraction : sampled);
+         * find what a few segments missed. The visible share is weighted by kernel and
+         * radiosity (see hier_visible_share); planes take their factor estimate times it,
+         * clusters the sampled kernel itself */
+        double share = visible == total  ? 1
+                       : weighted_all > 0 ? weighted_open / weighted_all
+                                          : (double)visible / total;
+        child->visibility = (float)share;
+        child->transfer = (float)(pd->factor >= 0 ? pd->factor * share : kernel_open / total);
     }
     size_t live = 0;
     for (size_t k = 0; k < slot; k++)
@@ -376,11 +335,13 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
         tb.occluded = rad_alloc_array(most * FIRST_RAYS, 1);
         tb.kernel = rad_alloc_array(most * FIRST_RAYS, sizeof(double));
         tb.more_kernel = rad_alloc_array(MAX_RAYS, sizeof(double));
+        tb.weight = rad_alloc_array(most * FIRST_RAYS, sizeof(float));
+        tb.more_weight = rad_alloc_array(MAX_RAYS, sizeof(float));
         tb.pend = rad_alloc_array(most, sizeof(pending));
         tb.more_rays = rad_alloc_array(MAX_RAYS, sizeof(rad_ray));
         tb.more_occluded = rad_alloc_array(MAX_RAYS, 1);
         bool have = tb.rays && tb.occluded && tb.kernel && tb.pend && tb.more_rays &&
-                    tb.more_occluded && tb.more_kernel;
+                    tb.more_occluded && tb.more_kernel && tb.weight && tb.more_weight;
         refine_context local = *c;
         local.visibility_rays = extra_rays;
 #pragma omp for schedule(dynamic, 1)
@@ -397,6 +358,8 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
         free(tb.occluded);
         free(tb.kernel);
         free(tb.more_kernel);
+        free(tb.weight);
+        free(tb.more_weight);
         free(tb.pend);
         free(tb.more_rays);
         free(tb.more_occluded);

@@ -20,15 +20,15 @@
 #include "core/memory.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
+#include "hierarchy/final_gather.h"
 #include "hierarchy/hierarchy.h"
 
-#define DEFAULT_THRESHOLD 0.05
+#define DEFAULT_THRESHOLD 0.25
 #define DEFAULT_TOLERANCE 1e-4
 #define DEFAULT_MAX_SWEEPS 1000u
 #define DEFAULT_VISIBILITY_RAYS 16u
 #define SWEEPS_PER_PASS 2u
 #define MAX_PASSES 256u
-#define FINAL_GATHERS 4u /* at most; each is one Jacobi step of the leaf-level kernel */
 
 typedef struct hsolver {
     const rad_scene *scene;
@@ -36,7 +36,10 @@ typedef struct hsolver {
     hier_tree tree;
     rad_rgb *emission, *albedo; /* per patch */
     rad_rgb *node_B, *gathered, *down;
+    rad_rgb *correction, *scale; /* per node (leaves only): the final gather's, or NULL:
+                                    a leaf gathers down x scale + correction */
     rad_rgb *patch_B;           /* per patch */
+    float *brightness;          /* B.r + B.g + B.b by leaf-order position */
     size_t *offsets;            /* links by receiver: node k's are [offsets[k], offsets[k+1]) */
     link_store store;
     double emitted;             /* sum A |E|_1 */
@@ -106,7 +109,10 @@ static double sweep(hsolver *s)
                                              : rgb_add(s->down[n->parent], s->gathered[k]);
         if (n->patch != HNODE_NONE) {
             uint32_t p = n->patch;
-            rad_rgb b = rgb_add(s->emission[p], rgb_mul(s->albedo[p], s->down[k]));
+            rad_rgb h = s->down[k];
+            if (s->correction)
+                h = rgb_add(rgb_mul(h, s->scale[k]), s->correction[k]);
+            rad_rgb b = rgb_add(s->emission[p], rgb_mul(s->albedo[p], h));
             change += n->area * (fabs(b.r - s->patch_B[p].r) + fabs(b.g - s->patch_B[p].g) +
                                  fabs(b.b - s->patch_B[p].b));
             s->patch_B[p] = b;
@@ -116,48 +122,23 @@ static double sweep(hsolver *s)
     return s->emitted > 0 ? change / s->emitted : 0;
 }
 
-/* The final gather: a link at an ancestor of a leaf handed the leaf its receiver's mean
- * irradiance; here every leaf gathers its ancestors' links again with the kernel at its
- * own centre (visible fraction of the link, the converged B), which removes the per-leaf
- * error of coarse links (their variation across the receiver). Its own links stay. One
- * pass, parallel over leaves; returns the relative change. */
-static double final_gather(hsolver *s)
+/* One channel of the final gather's correction c to what comes down d, as a factor where d
+ * is positive (the correction then moves with B), else added. */
+static void as_scale(double d, double *c, double *factor)
 {
-    const hier_tree *t = &s->tree;
-    const hlink *links = s->store.links;
-    int64_t nodes = t->node_count;
-#pragma omp parallel for num_threads(s->threads) schedule(dynamic, 64)
-    for (int64_t k = 0; k < nodes; k++) {
-        const hnode *leaf = &t->nodes[k];
-        if (leaf->patch == HNODE_NONE)
-            continue;
-        rad_rgb sum = {0, 0, 0};
-        for (size_t l = s->offsets[k]; l < s->offsets[k + 1]; l++)
-            rgb_add_to(&sum, rgb_scale(s->node_B[links[l].source], links[l].transfer));
-        const rad_patch *patch = &s->mesh->patches[leaf->patch];
-        rad_vec3 x = v3_add(patch->centroid, v3_scale(patch->normal, 2 * patch->bulge));
-        for (uint32_t a = leaf->parent; a != HNODE_NONE; a = t->nodes[a].parent)
-            for (size_t l = s->offsets[a]; l < s->offsets[a + 1]; l++) {
-                if (!(links[l].visibility > 0))
-                    continue;
-                double f = hier_point_factor(s->mesh, t, x, patch->normal, links[l].source);
-                rgb_add_to(&sum, rgb_scale(s->node_B[links[l].source], links[l].visibility * f));
-            }
-        s->gathered[k] = sum;
+    *factor = 1;
+    if (d > 0 && d + *c >= 0) {
+        *factor = (d + *c) / d;
+        *c = 0;
     }
-    double change = 0;
-    for (uint32_t k = 0; k < t->node_count; k++) {
-        const hnode *n = &t->nodes[k];
-        if (n->patch == HNODE_NONE)
-            continue;
-        uint32_t p = n->patch;
-        rad_rgb b = rgb_add(s->emission[p], rgb_mul(s->albedo[p], s->gathered[k]));
-        change += n->area * (fabs(b.r - s->patch_B[p].r) + fabs(b.g - s->patch_B[p].g) +
-                             fabs(b.b - s->patch_B[p].b));
-        s->patch_B[p] = b;
+}
+
+static void update_brightness(hsolver *s)
+{
+    for (uint32_t k = 0; k < s->mesh->patch_count; k++) {
+        rad_rgb b = s->patch_B[s->tree.order[k]];
+        s->brightness[k] = (float)(b.r + b.g + b.b);
     }
-    pull(s);
-    return s->emitted > 0 ? change / s->emitted : 0;
 }
 
 static void hsolver_free(hsolver *s)
@@ -168,7 +149,10 @@ static void hsolver_free(hsolver *s)
     free(s->node_B);
     free(s->gathered);
     free(s->down);
+    free(s->correction);
+    free(s->scale);
     free(s->patch_B);
+    free(s->brightness);
     free(s->offsets);
     free(s->store.links);
     free(s->store.spare);
@@ -220,12 +204,13 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
     s.emission = rad_alloc_array(n, sizeof(rad_rgb));
     s.albedo = rad_alloc_array(n, sizeof(rad_rgb));
     s.patch_B = rad_alloc_array(n, sizeof(rad_rgb));
+    s.brightness = rad_alloc_array(n, sizeof(float));
     s.node_B = rad_alloc_array(nodes, sizeof(rad_rgb));
     s.gathered = rad_alloc_array(nodes, sizeof(rad_rgb));
     s.down = rad_alloc_array(nodes, sizeof(rad_rgb));
     s.offsets = rad_alloc_array((size_t)nodes + 1, sizeof(size_t));
     if (!s.emission || !s.albedo || !s.patch_B || !s.node_B || !s.gathered || !s.down ||
-        !s.offsets) {
+        !s.offsets || !s.brightness) {
         hsolver_free(&s);
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the hierarchy");
     }
@@ -264,8 +249,15 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
         s.store.links[0] = (hlink){0, 0, 0, 1, INFINITY};
         s.store.peak_bytes = 2 * sizeof(hlink);
     }
-    refine_context rc = {mesh, &s.tree, occluders, s.node_B,
-                         threshold * brightest_total / n, rays, o.seed, s.threads};
+    refine_context rc = {mesh,
+                         &s.tree,
+                         occluders,
+                         s.node_B,
+                         s.brightness,
+                         threshold * brightest_total / n,
+                         rays,
+                         o.seed,
+                         s.threads};
 
     double residual = s.emitted > 0 ? 1 : 0;
     bool refining = s.store.count > 0, converged = false;
@@ -275,6 +267,7 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
         if (refining && !rep.memory_capped && rep.passes < MAX_PASSES) {
             double tr = now_seconds();
             refine_result rr;
+            update_brightness(&s);
             if (!hier_refine_pass(&rc, &s.store, &rr)) {
                 hsolver_free(&s);
                 return rad_fail(error, RAD_ERR_NOMEM, "out of memory refining the links");
@@ -322,9 +315,28 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
         o.progress(o.progress_user, "gather", 1);
     if (!stopped(&o) && s.store.count > 0) {
         double tf = now_seconds();
-        for (unsigned k = 0; k < FINAL_GATHERS && !stopped(&o); k++) {
-            if (final_gather(&s) <= tolerance)
-                break;
+        s.correction = rad_alloc_array(nodes, sizeof(rad_rgb));
+        s.scale = rad_alloc_array(nodes, sizeof(rad_rgb));
+        update_brightness(&s);
+        final_gather_context fg = {mesh,     &s.tree,      occluders, s.store.links, s.offsets,
+                                   s.node_B, s.brightness, rays,      o.seed + 2,    s.threads};
+        bool gathered = s.correction && s.scale &&
+                        hier_final_gather(&fg, s.correction, &rep.rays);
+        if (!gathered) {
+            hsolver_free(&s);
+            return rad_fail(error, RAD_ERR_NOMEM, "out of memory in the final gather");
+        }
+        /* as a factor on what comes down where that is not 0, so that the correction moves
+         * with B */
+        for (uint32_t k = 0; k < nodes; k++) {
+            as_scale(s.down[k].r, &s.correction[k].r, &s.scale[k].r);
+            as_scale(s.down[k].g, &s.correction[k].g, &s.scale[k].g);
+            as_scale(s.down[k].b, &s.correction[k].b, &s.scale[k].b);
+        }
+        residual = 1;
+        while (residual > tolerance && rep.sweeps < max_sweeps && !stopped(&o)) {
+            residual = sweep(&s);
+            rep.sweeps++;
         }
         rep.seconds_final = now_seconds() - tf;
     }
