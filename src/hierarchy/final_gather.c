@@ -142,6 +142,8 @@ bool hier_final_gather(const final_gather_context *c, rad_rgb *correction, uint6
         gather_buffers b = {0};
 #pragma omp for schedule(dynamic, 64)
         for (int64_t k = 0; k < nodes; k++) {
+            if (c->progress && omp_get_thread_num() == 0 && k % 8192 == 0)
+                c->progress(c->progress_user, "final gather", (double)k / (double)nodes);
             if (t->nodes[k].patch == HNODE_NONE || failed)
                 continue;
             if (!gather_leaf(c, (uint32_t)k, &b, &correction[k], &cast))

@@ -22,6 +22,8 @@ typedef struct final_gather_context {
                                visible fraction */
     uint64_t seed;
     int threads;
+    rad_progress_fn progress; /* "final gather", from the calling thread; may be NULL */
+    void *progress_user;
 } final_gather_context;
 
 /* correction[k] for every leaf node k: the irradiance per unit area its ancestors' links

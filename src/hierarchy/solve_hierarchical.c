@@ -318,8 +318,9 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
         s.correction = rad_alloc_array(nodes, sizeof(rad_rgb));
         s.scale = rad_alloc_array(nodes, sizeof(rad_rgb));
         update_brightness(&s);
-        final_gather_context fg = {mesh,     &s.tree,      occluders, s.store.links, s.offsets,
-                                   s.node_B, s.brightness, rays,      o.seed + 2,    s.threads};
+        final_gather_context fg = {mesh,      &s.tree,      occluders,  s.store.links,
+                                   s.offsets, s.node_B,     s.brightness, rays,
+                                   o.seed + 2, s.threads,   o.progress, o.progress_user};
         bool gathered = s.correction && s.scale &&
                         hier_final_gather(&fg, s.correction, &rep.rays);
         if (!gathered) {
@@ -338,6 +339,8 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
             residual = sweep(&s);
             rep.sweeps++;
         }
+        if (o.progress)
+            o.progress(o.progress_user, "final gather", 1);
         rep.seconds_final = now_seconds() - tf;
     }
     rep.interrupted = stopped(&o);
