@@ -904,12 +904,15 @@ rad_status rad_image_compare(const rad_image *a, const rad_image *b,
 
 /* The lit mesh: the solution as geometry other tools read, view-independent. Each mesh
  * vertex carries its linear radiance (rad_reconstruct_vertices: what the renderer
- * interpolates) and a display colour: radiance times an exposure, clamped to [0,1]. The
+ * interpolates) and a display colour: radiance times an exposure, clamped to [0,1]. After
+ * the mesh's vertices come added ones, where a vertex of one region lies strictly inside
+ * a patch edge of another (a crease or two materials side by side whose sides split their
+ * common edge differently): each is its own region's interpolation along that edge. The
  * automatic exposure is the PNG one applied to vertices: the 95th percentile of the
  * luminance of the lit vertices (luminance > 0) is scaled to 0.9. Vertices are per smooth
  * region (rad_mesh), so creases and emitters stay sharp; patches are written as the
- * triangles the renderer uses: a quad as (0,1,2) and (0,2,3), a patch with T-vertices on
- * its edges split through them, so faces meet corner to corner. Coordinates are the
+ * triangles the renderer uses: a quad as (0,1,2) and (0,2,3), a patch with T-vertices or
+ * added vertices on its edges split through them, so faces meet corner to corner. Coordinates are the
  * scene's own (the built-in Cornell box is in millimetres); radiance is in the unit of the
  * emitters' Ke, the same numbers as a .pfm render. */
 typedef struct rad_lit_mesh_options {

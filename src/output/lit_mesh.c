@@ -74,25 +74,36 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
         return rad_fail(error, RAD_ERR_INVALID, "%s: exposure %g is not a finite number", path,
                         options->exposure);
 
-    uint32_t n = mesh->vertex_count;
     rad_status status = RAD_OK;
-    rad_vec3 *normal = rad_alloc_array(n, sizeof(*normal));
-    rad_rgb *radiance = rad_alloc_array(n, sizeof(*radiance));
-    rad_rgb *display = rad_alloc_array(n, sizeof(*display));
-    double *luminance = rad_alloc_array(n, sizeof(*luminance));
+    rad_vec3 *position = NULL, *normal = NULL;
+    rad_rgb *radiance = NULL, *display = NULL;
+    double *luminance = NULL;
     display_mesh shown = {0};
-    if (!normal || !radiance || !display || !luminance) {
-        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for %u vertices", path, n);
-        goto done;
-    }
     status = display_mesh_build(mesh, true, &shown, error);
     if (status != RAD_OK)
         goto done;
+    uint32_t n = shown.vertex_count; /* the mesh's vertices and the added ones */
+    position = rad_alloc_array(n, sizeof(*position));
+    normal = rad_alloc_array(n, sizeof(*normal));
+    radiance = rad_alloc_array(n, sizeof(*radiance));
+    display = rad_alloc_array(n, sizeof(*display));
+    luminance = rad_alloc_array(n, sizeof(*luminance));
+    if (!position || !normal || !radiance || !display || !luminance) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for %u vertices", path, n);
+        goto done;
+    }
+    display_mesh_positions(mesh, &shown, position);
     display_mesh_radiance(mesh, &shown, B, radiance);
     vertex_normals(mesh, normal);
+    for (uint32_t k = 0; k < shown.extra_count; k++) { /* along their edge, as the values */
+        const display_extra *x = &shown.extras[k];
+        rad_vec3 along = v3_add(v3_scale(normal[x->from], 1 - x->t), v3_scale(normal[x->to], x->t));
+        normal[mesh->vertex_count + k] =
+            v3_length(along) > 0 ? v3_normalize(along) : normal[x->from];
+    }
     lit_mesh lit = {
         .vertex_count = n,
-        .position = mesh->vertices,
+        .position = position,
         .normal = normal,
         .radiance = radiance,
         .display = display,
@@ -128,6 +139,7 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
     else
         rad_atomic_abort(&file);
 done:
+    free(position);
     free(normal);
     free(radiance);
     free(display);

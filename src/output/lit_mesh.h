@@ -21,7 +21,7 @@
 
 typedef struct lit_mesh {
     uint32_t vertex_count;
-    const rad_vec3 *position;      /* the mesh's vertices */
+    const rad_vec3 *position;      /* the mesh's vertices, then the display's added ones */
     const rad_vec3 *normal;        /* unit: the area-weighted mean of the patches' normals */
     const rad_rgb *radiance;       /* linear radiance, rad_reconstruct_vertices */
     const rad_rgb *display;        /* radiance * scale clamped to [0,1], still linear */

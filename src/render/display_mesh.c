@@ -16,8 +16,13 @@
  *    (2 against 3), every vertex between two common points is inside an edge of the other
  *    side, and the only values both sides' interpolations agree on are linear between
  *    those points, which is what the anchors give.
- * 4. A patch with T-vertices on its edges is cut into triangles by ear clipping around its
- *    boundary (corners and T-vertices in order). Collinearity is decided exactly from
+ * 4. For the triangles, steps 2 and 3 run again with vertices identified by position
+ *    across regions (a crease, or two materials side by side, whose sides split their
+ *    common edge differently): a point strictly inside a patch edge is its region's own
+ *    vertex there when it has one (a T-vertex of step 3), else an added vertex at that
+ *    position interpolated along the edge, so that region's values stay its own.
+ * 5. A patch with points inside its edges is cut into triangles by ear clipping around its
+ *    boundary (corners and those points in order). Collinearity is decided exactly from
  *    which of the patch's edges each point lies on (a convex patch's three boundary points
  *    are collinear only on one edge), so no ear is ever a sliver of zero area.
  */
@@ -30,6 +35,7 @@
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/vec3.h"
+#include "core/weld.h"
 
 /* Two once-used edges meeting at a vertex are on one line when the sine of their angle is
  * below this: the mesher's points lie on their input edge to rounding (1e-16 relative),
@@ -77,6 +83,11 @@ static uint32_t find_root(uint32_t *parent, uint32_t x)
     return x;
 }
 
+static rad_rgb rgb_lerp(rad_rgb a, rad_rgb b, double t)
+{
+    return (rad_rgb){a.r + t * (b.r - a.r), a.g + t * (b.g - a.g), a.b + t * (b.b - a.b)};
+}
+
 static bool parallel(rad_vec3 d0, rad_vec3 d1)
 {
     rad_vec3 c = v3_cross(d0, d1);
@@ -96,18 +107,22 @@ static int compare_along(const void *a, const void *b)
     return x->vertex < y->vertex ? -1 : x->vertex > y->vertex;
 }
 
-/* Everything step 2 and 3 work with; freed at the end of display_mesh_build. */
+/* Everything steps 1 to 4 work with; freed at the end of display_mesh_build. */
 typedef struct work {
     edge_table table;
     uint32_t unmatched_count;
     uint32_t *from, *to;        /* per once-used edge, in its patch's order */
-    uint32_t *first, *incident; /* per vertex: its once-used edges (CSR) */
+    const rad_vec3 *points;     /* positions of the ids chains are made of */
+    const uint32_t *ends[2];    /* per once-used edge: its ends as chain ids */
+    uint32_t *first, *incident; /* per id: its once-used edges (CSR) */
     uint32_t *parent;           /* union-find over once-used edges */
     uint32_t *chain_start, *chain_edges; /* edges grouped by chain */
-    uint32_t *stamp, *position; /* per vertex: chain it was last seen in (+1), sorted place */
+    uint32_t *stamp, *position; /* per id: chain it was last seen in, its sorted place */
+    uint32_t stamp_next;
     uint32_t *tindex;           /* per vertex: its T-vertex index or UINT32_MAX */
-    uint32_t *insert_start, *insert_count; /* per once-used edge: its T-vertices */
-    uint32_t *inserts;          /* T-vertices in order from each edge's `from` to `to` */
+    uint32_t *insert_start, *insert_count; /* per once-used edge: points inside it */
+    uint32_t *inserts;          /* those points in order from each edge's `from` to `to`:
+                                   vertex ids, or vertex_count + k for added vertex k */
     size_t insert_total, insert_capacity;
     along *line;
     int *diff;
@@ -115,18 +130,33 @@ typedef struct work {
     display_tvertex *tvertices;
     size_t tvertex_capacity;
     uint32_t tvertex_count;
+    /* step 4 */
+    uint32_t *canonical;        /* per vertex: the id of its position across regions */
+    rad_vec3 *canonical_points; /* per position id */
+    uint32_t *copies_first, *copies; /* per position id: the vertices there (CSR) */
+    uint32_t *label;            /* per vertex: its region (a union-find root) */
+    uint32_t *canonical_ends[2];
+    display_extra *extras;
+    size_t extra_capacity;
+    uint32_t extra_count;
 } work;
+
+static void chains_free(work *w)
+{
+    free(w->first);
+    free(w->incident);
+    free(w->parent);
+    free(w->chain_start);
+    free(w->chain_edges);
+    w->first = w->incident = w->parent = w->chain_start = w->chain_edges = NULL;
+}
 
 static void work_free(work *w)
 {
     free(w->table.slots);
     free(w->from);
     free(w->to);
-    free(w->first);
-    free(w->incident);
-    free(w->parent);
-    free(w->chain_start);
-    free(w->chain_edges);
+    chains_free(w);
     free(w->stamp);
     free(w->position);
     free(w->tindex);
@@ -136,6 +166,14 @@ static void work_free(work *w)
     free(w->line);
     free(w->diff);
     free(w->tvertices);
+    free(w->canonical);
+    free(w->canonical_points);
+    free(w->copies_first);
+    free(w->copies);
+    free(w->label);
+    free(w->canonical_ends[0]);
+    free(w->canonical_ends[1]);
+    free(w->extras);
 }
 
 /* Step 1: the edge table and the once-used edges. */
@@ -193,42 +231,44 @@ static bool find_unmatched(const rad_mesh *mesh, work *w)
     return true;
 }
 
-/* Step 2: once-used edges into straight chains, grouped. */
-static bool build_chains(const rad_mesh *mesh, work *w)
+/* Step 2: once-used edges into straight chains, grouped. Chains are made of the ids in
+ * w->ends (vertex ids, or position ids for step 4), `ids` of them, at w->points. */
+static bool build_chains(work *w, uint32_t ids)
 {
-    uint32_t U = w->unmatched_count, V = mesh->vertex_count;
-    w->first = rad_alloc_array((size_t)V + 1, sizeof(*w->first));
+    uint32_t U = w->unmatched_count;
+    const uint32_t *from = w->ends[0], *to = w->ends[1];
+    const rad_vec3 *X = w->points;
+    w->first = rad_alloc_array((size_t)ids + 1, sizeof(*w->first));
     w->incident = rad_alloc_array(2 * (size_t)U, sizeof(*w->incident));
     w->parent = rad_alloc_array(U, sizeof(*w->parent));
     w->chain_start = rad_alloc_array((size_t)U + 1, sizeof(*w->chain_start));
     w->chain_edges = rad_alloc_array(U, sizeof(*w->chain_edges));
-    if (!w->first || !w->incident || !w->parent || !w->chain_start || !w->chain_edges)
+    uint32_t *cursor = rad_alloc_array((size_t)ids + 1, sizeof(*cursor));
+    if (!w->first || !w->incident || !w->parent || !w->chain_start || !w->chain_edges ||
+        !cursor) {
+        free(cursor);
         return false;
+    }
     for (uint32_t u = 0; u < U; u++) {
-        w->first[w->from[u] + 1]++;
-        w->first[w->to[u] + 1]++;
+        w->first[from[u] + 1]++;
+        w->first[to[u] + 1]++;
         w->parent[u] = u;
     }
-    for (uint32_t v = 0; v < V; v++)
+    for (uint32_t v = 0; v < ids; v++)
         w->first[v + 1] += w->first[v];
-    uint32_t *cursor = rad_alloc_array(V, sizeof(*cursor));
-    if (!cursor)
-        return false;
-    memcpy(cursor, w->first, V * sizeof(*cursor));
+    memcpy(cursor, w->first, ids * sizeof(*cursor));
     for (uint32_t u = 0; u < U; u++) {
-        w->incident[cursor[w->from[u]]++] = u;
-        w->incident[cursor[w->to[u]]++] = u;
+        w->incident[cursor[from[u]]++] = u;
+        w->incident[cursor[to[u]]++] = u;
     }
-    free(cursor);
-    for (uint32_t v = 0; v < V; v++) {
-        rad_vec3 p = mesh->vertices[v];
+    for (uint32_t v = 0; v < ids; v++) {
+        rad_vec3 p = X[v];
         for (uint32_t i = w->first[v]; i < w->first[v + 1]; i++) {
             uint32_t ei = w->incident[i];
-            rad_vec3 di = v3_sub(mesh->vertices[w->from[ei] == v ? w->to[ei] : w->from[ei]], p);
+            rad_vec3 di = v3_sub(X[from[ei] == v ? to[ei] : from[ei]], p);
             for (uint32_t j = i + 1; j < w->first[v + 1]; j++) {
                 uint32_t ej = w->incident[j];
-                rad_vec3 dj =
-                    v3_sub(mesh->vertices[w->from[ej] == v ? w->to[ej] : w->from[ej]], p);
+                rad_vec3 dj = v3_sub(X[from[ej] == v ? to[ej] : from[ej]], p);
                 if (!parallel(di, dj))
                     continue;
                 uint32_t ra = find_root(w->parent, ei), rb = find_root(w->parent, ej);
@@ -238,21 +278,72 @@ static bool build_chains(const rad_mesh *mesh, work *w)
         }
     }
     /* group by root (counting sort; roots are edge indices) */
-    memset(w->chain_start, 0, ((size_t)U + 1) * sizeof(*w->chain_start));
     for (uint32_t u = 0; u < U; u++)
         w->chain_start[find_root(w->parent, u) + 1]++;
     for (uint32_t u = 0; u < U; u++)
         w->chain_start[u + 1] += w->chain_start[u];
-    for (uint32_t u = 0; u < U; u++) /* parent[] becomes the cursor: roots are final now */
-        w->parent[u] = find_root(w->parent, u);
+    free(cursor);
     uint32_t *next = rad_alloc_array((size_t)U + 1, sizeof(*next));
     if (!next)
         return false;
     memcpy(next, w->chain_start, ((size_t)U + 1) * sizeof(*next));
     for (uint32_t u = 0; u < U; u++)
-        w->chain_edges[next[w->parent[u]]++] = u;
+        w->chain_edges[next[find_root(w->parent, u)]++] = u;
     free(next);
     return true;
+}
+
+/* Sorts the ids of one chain (its edges chain_edges[begin, end)) along its line into
+ * w->line[0, m) (w->position: each id's place) and marks in w->diff[k] the ids strictly
+ * inside one of its edges. Returns m, or 0 when no id is inside an edge; SIZE_MAX when
+ * out of memory. */
+static size_t sort_chain(work *w, uint32_t begin, uint32_t end)
+{
+    const rad_vec3 *X = w->points;
+    const uint32_t *from = w->ends[0], *to = w->ends[1];
+    uint32_t e0 = w->chain_edges[begin];
+    rad_vec3 origin = X[from[e0]];
+    rad_vec3 direction = v3_normalize(v3_sub(X[to[e0]], origin));
+    size_t m = 0, most = 2 * (size_t)(end - begin);
+    if (!rad_grow_array((void **)&w->line, &w->line_capacity, most, sizeof(*w->line)) ||
+        !rad_grow_array((void **)&w->diff, &w->diff_capacity, most + 1, sizeof(*w->diff)))
+        return SIZE_MAX;
+    uint32_t stamp = ++w->stamp_next;
+    for (uint32_t i = begin; i < end; i++) {
+        uint32_t e = w->chain_edges[i];
+        uint32_t ends[2] = {from[e], to[e]};
+        for (int k = 0; k < 2; k++) {
+            uint32_t v = ends[k];
+            if (w->stamp[v] == stamp)
+                continue;
+            w->stamp[v] = stamp;
+            w->line[m++] = (along){v3_dot(v3_sub(X[v], origin), direction), v};
+        }
+    }
+    qsort(w->line, m, sizeof(*w->line), compare_along);
+    for (size_t k = 0; k < m; k++)
+        w->position[w->line[k].vertex] = (uint32_t)k;
+    memset(w->diff, 0, (m + 1) * sizeof(*w->diff));
+    bool any = false;
+    for (uint32_t i = begin; i < end; i++) {
+        uint32_t e = w->chain_edges[i];
+        uint32_t a = w->position[from[e]], b = w->position[to[e]];
+        uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
+        if (hi > lo + 1) {
+            w->diff[lo + 1]++;
+            w->diff[hi]--;
+            any = true;
+        }
+    }
+    if (!any)
+        return 0;
+    /* covered: diff's running sum; the line's first and last points never are */
+    int covered = 0;
+    for (size_t k = 0; k < m; k++) {
+        covered += w->diff[k];
+        w->diff[k] = covered > 0;
+    }
+    return m;
 }
 
 static bool add_tvertex(work *w, display_tvertex t)
@@ -265,52 +356,12 @@ static bool add_tvertex(work *w, display_tvertex t)
     return true;
 }
 
-/* Step 3 for one chain (its edges chain_edges[begin, end)). */
-static bool chain_tvertices(const rad_mesh *mesh, work *w, uint32_t chain, uint32_t begin,
-                            uint32_t end)
+/* Step 3 for one chain of vertex ids. */
+static bool chain_tvertices(work *w, uint32_t begin, uint32_t end)
 {
-    const rad_vec3 *X = mesh->vertices;
-    uint32_t e0 = w->chain_edges[begin];
-    rad_vec3 origin = X[w->from[e0]];
-    rad_vec3 direction = v3_normalize(v3_sub(X[w->to[e0]], origin));
-    size_t m = 0, most = 2 * (size_t)(end - begin);
-    if (!rad_grow_array((void **)&w->line, &w->line_capacity, most, sizeof(*w->line)) ||
-        !rad_grow_array((void **)&w->diff, &w->diff_capacity, most + 1, sizeof(*w->diff)))
+    size_t m = sort_chain(w, begin, end);
+    if (m == SIZE_MAX)
         return false;
-    for (uint32_t i = begin; i < end; i++) {
-        uint32_t e = w->chain_edges[i];
-        uint32_t ends[2] = {w->from[e], w->to[e]};
-        for (int k = 0; k < 2; k++) {
-            uint32_t v = ends[k];
-            if (w->stamp[v] == chain + 1)
-                continue;
-            w->stamp[v] = chain + 1;
-            w->line[m++] = (along){v3_dot(v3_sub(X[v], origin), direction), v};
-        }
-    }
-    qsort(w->line, m, sizeof(*w->line), compare_along);
-    for (size_t k = 0; k < m; k++)
-        w->position[w->line[k].vertex] = (uint32_t)k;
-    memset(w->diff, 0, (m + 1) * sizeof(*w->diff));
-    bool any = false;
-    for (uint32_t i = begin; i < end; i++) {
-        uint32_t e = w->chain_edges[i];
-        uint32_t a = w->position[w->from[e]], b = w->position[w->to[e]];
-        uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
-        if (hi > lo + 1) {
-            w->diff[lo + 1]++;
-            w->diff[hi]--;
-            any = true;
-        }
-    }
-    if (!any)
-        return true;
-    /* covered: diff's running sum; the line's first and last points never are */
-    int covered = 0;
-    for (size_t k = 0; k < m; k++) {
-        covered += w->diff[k];
-        w->diff[k] = covered > 0;
-    }
     size_t previous = 0;
     for (size_t k = 1; k + 1 < m; k++) {
         if (!w->diff[k]) {
@@ -332,10 +383,37 @@ static bool chain_tvertices(const rad_mesh *mesh, work *w, uint32_t chain, uint3
         }
         k = next - 1;
     }
-    /* each edge's T-vertices, in order from its `from` to its `to` */
+    return true;
+}
+
+/* The vertex of `region` at position id q: its own, or a vertex added on once-used edge e
+ * (UINT32_MAX when out of memory). */
+static uint32_t vertex_at(work *w, uint32_t vertex_count, uint32_t q, uint32_t region,
+                          uint32_t e, double t)
+{
+    for (uint32_t c = w->copies_first[q]; c < w->copies_first[q + 1]; c++)
+        if (w->label[w->copies[c]] == region)
+            return w->copies[c];
+    if (!rad_grow_array((void **)&w->extras, &w->extra_capacity, w->extra_count + 1,
+                        sizeof(*w->extras)))
+        return UINT32_MAX;
+    w->extras[w->extra_count] = (display_extra){w->copies[w->copies_first[q]], w->from[e],
+                                                w->to[e], t};
+    return vertex_count + w->extra_count++;
+}
+
+/* Step 4 for one chain of position ids: each once-used edge's inner points. */
+static bool chain_inserts(work *w, uint32_t vertex_count, uint32_t begin, uint32_t end)
+{
+    size_t m = sort_chain(w, begin, end);
+    if (m == SIZE_MAX)
+        return false;
+    if (m == 0)
+        return true;
+    const uint32_t *from = w->ends[0], *to = w->ends[1];
     for (uint32_t i = begin; i < end; i++) {
         uint32_t e = w->chain_edges[i];
-        uint32_t a = w->position[w->from[e]], b = w->position[w->to[e]];
+        uint32_t a = w->position[from[e]], b = w->position[to[e]];
         uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
         if (hi <= lo + 1)
             continue;
@@ -345,10 +423,76 @@ static bool chain_tvertices(const rad_mesh *mesh, work *w, uint32_t chain, uint3
             return false;
         w->insert_start[e] = (uint32_t)w->insert_total;
         w->insert_count[e] = count;
-        for (uint32_t j = 0; j < count; j++)
-            w->inserts[w->insert_total + j] = w->line[a < b ? lo + 1 + j : hi - 1 - j].vertex;
+        double s_from = w->line[a].s, span = w->line[b].s - s_from;
+        for (uint32_t j = 0; j < count; j++) {
+            const along *point = &w->line[a < b ? lo + 1 + j : hi - 1 - j];
+            double t = span != 0 ? (point->s - s_from) / span : 0.5;
+            uint32_t v = vertex_at(w, vertex_count, point->vertex, w->label[w->from[e]], e, t);
+            if (v == UINT32_MAX)
+                return false;
+            w->inserts[w->insert_total + j] = v;
+        }
         w->insert_total += count;
     }
+    return true;
+}
+
+/* Step 4's ids: positions across regions, the vertices at each, and each vertex's
+ * region. */
+static bool identify_positions(const rad_mesh *mesh, work *w, uint32_t *position_count)
+{
+    uint32_t V = mesh->vertex_count, U = w->unmatched_count;
+    rad_weld weld;
+    w->canonical = rad_alloc_array(V, sizeof(*w->canonical));
+    w->label = rad_alloc_array(V, sizeof(*w->label));
+    if (!w->canonical || !w->label || !rad_weld_init(&weld, V))
+        return false;
+    bool ok = true;
+    for (uint32_t v = 0; v < V && ok; v++) {
+        w->canonical[v] = rad_weld_insert(&weld, 0, mesh->vertices[v]);
+        ok = w->canonical[v] != UINT32_MAX;
+    }
+    uint32_t C = weld.count;
+    w->canonical_points = ok ? rad_weld_take_positions(&weld) : NULL;
+    if (!ok)
+        rad_weld_free(&weld);
+    w->copies_first = rad_alloc_array((size_t)C + 1, sizeof(*w->copies_first));
+    w->copies = rad_alloc_array(V, sizeof(*w->copies));
+    w->canonical_ends[0] = rad_alloc_array(U, sizeof(*w->canonical_ends[0]));
+    w->canonical_ends[1] = rad_alloc_array(U, sizeof(*w->canonical_ends[1]));
+    uint32_t *cursor = rad_alloc_array((size_t)C + 1, sizeof(*cursor));
+    if (!ok || !w->canonical_points || !w->copies_first || !w->copies ||
+        !w->canonical_ends[0] || !w->canonical_ends[1] || !cursor) {
+        free(cursor);
+        return false;
+    }
+    for (uint32_t v = 0; v < V; v++)
+        w->copies_first[w->canonical[v] + 1]++;
+    for (uint32_t q = 0; q < C; q++)
+        w->copies_first[q + 1] += w->copies_first[q];
+    memcpy(cursor, w->copies_first, (size_t)C * sizeof(*cursor));
+    for (uint32_t v = 0; v < V; v++)
+        w->copies[cursor[w->canonical[v]]++] = v;
+    free(cursor);
+    /* regions: vertices joined by the patches that use them */
+    for (uint32_t v = 0; v < V; v++)
+        w->label[v] = v;
+    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        const rad_patch *patch = &mesh->patches[p];
+        for (uint32_t k = 1; k < patch->vertex_count; k++) {
+            uint32_t ra = find_root(w->label, patch->vertex[0]);
+            uint32_t rb = find_root(w->label, patch->vertex[k]);
+            if (ra != rb)
+                w->label[ra < rb ? rb : ra] = ra < rb ? ra : rb;
+        }
+    }
+    for (uint32_t v = 0; v < V; v++)
+        w->label[v] = find_root(w->label, v);
+    for (uint32_t u = 0; u < U; u++) {
+        w->canonical_ends[0][u] = w->canonical[w->from[u]];
+        w->canonical_ends[1][u] = w->canonical[w->to[u]];
+    }
+    *position_count = C;
     return true;
 }
 
@@ -549,30 +693,58 @@ rad_status display_mesh_build(const rad_mesh *mesh, bool triangles, display_mesh
     work w;
     memset(&w, 0, sizeof(w));
     uint32_t V = mesh->vertex_count;
-    bool ok = find_unmatched(mesh, &w) && build_chains(mesh, &w);
+    bool ok = find_unmatched(mesh, &w);
+    uint32_t U = w.unmatched_count;
     if (ok) {
-        uint32_t U = w.unmatched_count;
         w.stamp = rad_alloc_array(V, sizeof(*w.stamp));
         w.position = rad_alloc_array(V, sizeof(*w.position));
         w.tindex = rad_alloc_array(V, sizeof(*w.tindex));
         w.insert_start = rad_alloc_array(U, sizeof(*w.insert_start));
         w.insert_count = rad_alloc_array(U, sizeof(*w.insert_count));
         ok = w.stamp && w.position && w.tindex && w.insert_start && w.insert_count;
-        if (ok)
-            for (uint32_t v = 0; v < V; v++)
-                w.tindex[v] = UINT32_MAX;
+    }
+    if (ok) { /* steps 2 and 3: T-vertices, by vertex id */
+        for (uint32_t v = 0; v < V; v++)
+            w.tindex[v] = UINT32_MAX;
+        w.points = mesh->vertices;
+        w.ends[0] = w.from;
+        w.ends[1] = w.to;
+        ok = build_chains(&w, V);
         for (uint32_t c = 0; ok && c < U; c++) {
             uint32_t begin = w.chain_start[c], end = w.chain_start[c + 1];
             if (end - begin >= 3) /* a T-vertex needs a coarse edge and two fine ones */
-                ok = chain_tvertices(mesh, &w, c, begin, end);
+                ok = chain_tvertices(&w, begin, end);
         }
+        chains_free(&w);
     }
     if (ok)
         ok = order_tvertices(&w, &out->tvertices);
-    if (ok) {
-        out->tvertex_count = w.tvertex_count;
-        ok = !triangles || build_triangles(mesh, &w, out);
+    out->tvertex_count = ok ? w.tvertex_count : 0;
+    uint32_t positions = 0;
+    if (ok && triangles) /* step 4: points inside edges, by position across regions */
+        ok = identify_positions(mesh, &w, &positions);
+    if (ok && triangles) {
+        w.points = w.canonical_points;
+        w.ends[0] = w.canonical_ends[0];
+        w.ends[1] = w.canonical_ends[1];
+        ok = build_chains(&w, positions);
+        for (uint32_t c = 0; ok && c < U; c++) {
+            uint32_t begin = w.chain_start[c], end = w.chain_start[c + 1];
+            if (end - begin >= 3)
+                ok = chain_inserts(&w, V, begin, end);
+        }
+        chains_free(&w);
+        if (ok && (uint64_t)V + w.extra_count > UINT32_MAX - 1)
+            ok = false;
+        if (ok)
+            ok = build_triangles(mesh, &w, out);
     }
+    if (ok) {
+        out->extras = w.extras;
+        out->extra_count = w.extra_count;
+        w.extras = NULL;
+    }
+    out->vertex_count = V + out->extra_count;
     work_free(&w);
     if (!ok) {
         display_mesh_free(out);
@@ -583,11 +755,20 @@ rad_status display_mesh_build(const rad_mesh *mesh, bool triangles, display_mesh
     return RAD_OK;
 }
 
+void display_mesh_positions(const rad_mesh *mesh, const display_mesh *display,
+                            rad_vec3 *positions)
+{
+    memcpy(positions, mesh->vertices, mesh->vertex_count * sizeof(*positions));
+    for (uint32_t k = 0; k < display->extra_count; k++)
+        positions[mesh->vertex_count + k] = mesh->vertices[display->extras[k].at];
+}
+
 void display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, const rad_rgb *B,
                            rad_rgb *vertex_radiance)
 {
     double *weight = calloc(mesh->vertex_count ? mesh->vertex_count : 1, sizeof(*weight));
-    memset(vertex_radiance, 0, mesh->vertex_count * sizeof(*vertex_radiance));
+    memset(vertex_radiance, 0,
+           (display ? display->vertex_count : mesh->vertex_count) * sizeof(*vertex_radiance));
     if (!weight)
         return; /* callers check nothing here: black is the graceful failure */
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
@@ -611,10 +792,13 @@ void display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, co
         return;
     for (uint32_t i = 0; i < display->tvertex_count; i++) {
         const display_tvertex *tv = &display->tvertices[i];
-        const rad_rgb *a = &vertex_radiance[tv->from], *b = &vertex_radiance[tv->to];
-        vertex_radiance[tv->vertex] = (rad_rgb){a->r + tv->t * (b->r - a->r),
-                                                a->g + tv->t * (b->g - a->g),
-                                                a->b + tv->t * (b->b - a->b)};
+        vertex_radiance[tv->vertex] =
+            rgb_lerp(vertex_radiance[tv->from], vertex_radiance[tv->to], tv->t);
+    }
+    for (uint32_t k = 0; k < display->extra_count; k++) {
+        const display_extra *x = &display->extras[k];
+        vertex_radiance[mesh->vertex_count + k] =
+            rgb_lerp(vertex_radiance[x->from], vertex_radiance[x->to], x->t);
     }
 }
 
@@ -623,5 +807,6 @@ void display_mesh_free(display_mesh *display)
     free(display->triangles);
     free(display->patch_of);
     free(display->tvertices);
+    free(display->extras);
     memset(display, 0, sizeof(*display));
 }

@@ -8,9 +8,12 @@
  *     two nearest vertices along its line that are no T-vertices ("anchors"), which makes
  *     it the interpolation along the coarse edge it lies in, so both sides of the edge
  *     show the same values (C0);
- *   - the display triangles: every patch split into triangles through the T-vertices on
- *     its edges, so the triangles meet corner to corner (no T-junction a rasteriser could
- *     crack along); a patch without T-vertices keeps the plain split (0,1,2), (0,2,3).
+ *   - the display triangles: every patch split into triangles through the points that lie
+ *     strictly inside its edges, so the triangles meet corner to corner (no T-junction a
+ *     rasteriser or a ray could slip through); a patch without such points keeps the
+ *     plain split (0,1,2), (0,2,3). Those points include other regions' vertices (a
+ *     crease, or two materials side by side, split differently): the patch's region then
+ *     gets an added vertex there, interpolated along the edge, so values stay per region.
  * Detection is a hash of patch edges (an edge used once is a boundary or part of a
  * T-junction), then the once-used edges joined into straight chains through shared
  * vertices, each chain sorted along its line: O(n log n) in the patch count.
@@ -26,8 +29,18 @@ typedef struct display_tvertex {
     double t;          /* its place between them: 0 at `from`, 1 at `to` */
 } display_tvertex;
 
+/* A vertex added where another region's vertex lies strictly inside a patch edge. */
+typedef struct display_extra {
+    uint32_t at;       /* the other region's vertex: the position */
+    uint32_t from, to; /* the edge it lies in (its own region's vertices) */
+    double t;          /* its place along the edge: 0 at `from`, 1 at `to` */
+} display_extra;
+
 typedef struct display_mesh {
-    uint32_t (*triangles)[3]; /* into mesh vertices, counter-clockwise (front) */
+    uint32_t vertex_count;    /* the mesh's vertices, then the added ones */
+    display_extra *extras;    /* the added vertices: vertex mesh->vertex_count + k */
+    uint32_t extra_count;
+    uint32_t (*triangles)[3]; /* into the vertices above, counter-clockwise (front) */
     uint32_t *patch_of;       /* per triangle: its patch */
     uint32_t triangle_count;
     display_tvertex *tvertices; /* in an order where a T-vertex that is another's anchor
@@ -35,14 +48,21 @@ typedef struct display_mesh {
     uint32_t tvertex_count;
 } display_mesh;
 
-/* Finds the T-vertices and, when `triangles` is true, makes the display triangles. */
+/* Finds the T-vertices and, when `triangles` is true, makes the display triangles and
+ * the added vertices (without: vertex_count is the mesh's). */
 rad_status display_mesh_build(const rad_mesh *mesh, bool triangles, display_mesh *out,
                               rad_error *error);
 
-/* The displayed radiance at every vertex: the area-weighted mean of B / pi over the
- * patches sharing it, then the T-vertex constraints. `display` may be NULL (means only). */
+/* The displayed radiance at every vertex (display->vertex_count of them): the
+ * area-weighted mean of B / pi over the patches sharing it, then the T-vertex
+ * constraints, then the added vertices. `display` may be NULL (the mesh's vertices, means
+ * only). */
 void display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, const rad_rgb *B,
                            rad_rgb *vertex_radiance);
+
+/* The positions of all display->vertex_count vertices. */
+void display_mesh_positions(const rad_mesh *mesh, const display_mesh *display,
+                            rad_vec3 *positions);
 
 void display_mesh_free(display_mesh *display);
 

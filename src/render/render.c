@@ -206,21 +206,25 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     /* the display triangles (patches split through their T-vertices) and the radiance at
      * each vertex */
     display_mesh display = {0};
-    rad_rgb *radiance = rad_alloc_array(mesh->vertex_count, sizeof(*radiance));
+    rad_rgb *radiance = NULL;
+    rad_vec3 *positions = NULL;
     rad_tracer *tracer = NULL;
     row_work *work = NULL;
     albedo_lookup *lookup = NULL;
     rad_rgb *patch_albedo = NULL, *shaded = NULL;
-    if (!radiance)
-        goto nomem;
     status = display_mesh_build(mesh, true, &display, error);
     if (status != RAD_OK)
         goto done;
+    radiance = rad_alloc_array(display.vertex_count, sizeof(*radiance));
+    positions = rad_alloc_array(display.vertex_count, sizeof(*positions));
+    if (!radiance || !positions)
+        goto nomem;
+    display_mesh_positions(mesh, &display, positions);
     status = textures_begin(options->scene, mesh, B, &lookup, &patch_albedo, &shaded, error);
     if (status != RAD_OK)
         goto done;
     display_mesh_radiance(mesh, &display, shaded ? shaded : B, radiance);
-    status = rad_tracer_create(RAD_TRACER_EMBREE, mesh->vertices, mesh->vertex_count,
+    status = rad_tracer_create(RAD_TRACER_EMBREE, positions, display.vertex_count,
                                (const uint32_t(*)[3])display.triangles, display.triangle_count,
                                &tracer, error);
     if (status != RAD_OK)
@@ -352,6 +356,7 @@ done:
     rad_tracer_destroy(tracer);
     display_mesh_free(&display);
     free(radiance);
+    free(positions);
     albedo_lookup_destroy(lookup);
     free(patch_albedo);
     free(shaded);
