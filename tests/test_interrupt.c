@@ -2,8 +2,8 @@
  * test_interrupt.c - Ctrl-C during a hierarchical solve: the run stops cleanly, writes its
  * outputs with the solution so far, and exits with status 130.
  *
- * The tool solves the Cornell box at patch size 10 mm (19633 patches: about 20 s of
- * refinement in a Release build on 2 cores, far more under the sanitizers) with
+ * The tool solves the Cornell box at patch size 5 mm (78225 patches: about 14 s in a
+ * Release build on 2 cores, far more under the sanitizers) with
  * RADIOSITY_PROGRESS=lines, so that progress comes as lines on a pipe. As soon as the
  * first "refine" line arrives (the first refinement pass is done, the Ctrl-C handler is
  * in place) the test sends SIGINT: there is no sleep and no timing, and the solve is far
@@ -12,7 +12,7 @@
  *     "converged": false, and that the first progress line shows the time left;
  *   - the solution file reads back, belongs to the scene and mesh, and holds finite,
  *     non-negative exitances, with the lights' own (pi Ke) at least on their patches;
- *   - the lit mesh (.obj) holds for each vertex the radiance rad_reconstruct_vertices
+ *   - the lit mesh (.obj) holds for each mesh vertex the radiance rad_reconstruct_vertices
  *     gives from that saved solution (1e-6 relative): both files are the same solution,
  *     complete; no temporary file is left;
  *   - `render --solution` of that file works (exit 0) and the image is lit;
@@ -32,7 +32,7 @@
 
 extern char **environ;
 
-#define PATCH_SIZE "10"
+#define PATCH_SIZE "5"
 
 /* Runs the tool with argv, SIGINT as soon as a stderr line contains `trigger`; returns
  * the wait status and the whole stderr in `text`. */
@@ -107,9 +107,10 @@ static void check_obj_against_solution(const char *obj_path, const rad_mesh *mes
     }
     if (f)
         fclose(f);
-    printf("lit mesh: %u vertices' radiance (%u differ from the saved solution's), %u faces\n",
-           count, bad, faces);
-    CHECK(count == mesh->vertex_count);
+    printf("lit mesh: %u vertices' radiance (%u differ from the saved solution's; %u added "
+           "where regions split a common edge differently), %u faces\n",
+           count, bad, count - mesh->vertex_count, faces);
+    CHECK(count >= mesh->vertex_count); /* the mesh's, then the display's added ones */
     CHECK(bad == 0);
     CHECK(faces >= mesh->patch_count);
     free(L);
