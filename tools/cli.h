@@ -90,7 +90,7 @@ enum {
     "                       gather, or hierarchical when the mesh has more than 4096\n"     \
     "                       patches\n"                                                      \
     "  --refine-threshold X hierarchical: split a link while B x F x A exceeds X times\n"   \
-    "                       the emitted power per patch (default 0.05; smaller = finer)\n"  \
+    "                       the emitted power per patch (default 0.25; smaller = finer)\n"  \
     "  --max-memory SIZE    hierarchical: bytes the links may use (K, M, G suffixes;\n"     \
     "                       default half the machine's memory); refinement stops there\n"   \
     "                       and the run says so\n"                                          \

@@ -84,7 +84,7 @@ static bool gather_leaf(const final_gather_context *c, uint32_t k, gather_buffer
     double unoccluded = 0; /* sum over partly visible links, for the share that is traced */
     for (uint32_t a = k; a != HNODE_NONE; a = t->nodes[a].parent)
         for (size_t l = c->offsets[a]; l < c->offsets[a + 1]; l++) {
-            float visibility = links[l].visibility;
+            float visibility = (float)link_visibility(&links[l]);
             uint32_t source = links[l].source;
             if (a == k && t->nodes[source].patch != HNODE_NONE)
                 continue; /* between two patches: already exact for the leaf */

@@ -58,10 +58,33 @@ void hier_tree_free(hier_tree *tree);
 
 typedef struct hlink {
     uint32_t receiver, source;
-    float transfer;   /* F(receiver <- source) x visibility */
-    float visibility; /* visible fraction: 1 full, in (0,1) partial */
-    float bound;      /* bound on A_receiver F: B(source) x bound is refinement's error */
+    float transfer;   /* F(receiver <- source) x visible share */
+    float bound;      /* bound on A_receiver F: B(source) x bound is refinement's error; 0
+                         for two patches (they never split) */
+    uint16_t visible; /* visible share x LINK_VISIBLE: LINK_VISIBLE full, 0 hidden */
+    uint16_t flags;   /* LINK_SETTLED */
 } hlink;
+
+#define LINK_VISIBLE 65535u
+/* Its error was far under the threshold when last looked at: only a full check (every few
+ * passes, and before the solver stops) looks at it again. */
+#define LINK_SETTLED 1u
+
+static inline double link_visibility(const hlink *link)
+{
+    return link->visible * (1.0 / LINK_VISIBLE);
+}
+
+/* The share in [0, 1], with (0, 1) kept strictly partial. */
+static inline uint16_t link_visible_code(double share)
+{
+    if (!(share > 0))
+        return 0;
+    if (share >= 1)
+        return (uint16_t)LINK_VISIBLE;
+    double code = share * LINK_VISIBLE + 0.5;
+    return (uint16_t)(code < 1 ? 1 : code > LINK_VISIBLE - 1 ? LINK_VISIBLE - 1 : code);
+}
 
 /* What refinement needs to know about a link, computed from geometry alone. */
 typedef struct link_estimate {
@@ -117,6 +140,7 @@ typedef struct refine_context {
     const rad_rgb *node_radiosity; /* pulled B of every node */
     const float *leaf_brightness;  /* B.r + B.g + B.b by leaf-order position */
     double epsilon;                /* absolute BFA threshold (power) */
+    bool full_check;               /* look at settled links too */
     unsigned visibility_rays;      /* segments for a link the first 4 found partial */
     uint64_t seed;
     int threads;

@@ -205,15 +205,15 @@ rad_vec3 hier_sample_point(const hier_tree *tree, uint32_t node, double u1, doub
                            double u3, rad_vec3 *normal, uint32_t *position)
 {
     const hnode *n = &tree->nodes[node];
-    uint32_t lo = n->first, hi = n->first + n->count - 1;
+    uint32_t lo = n->first, length = n->count;
     double before = lo > 0 ? tree->cumulative[lo - 1] : 0;
     double target = before + u1 * n->area;
-    while (lo < hi) { /* first k with cumulative[k] > target */
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (tree->cumulative[mid] > target)
-            hi = mid;
-        else
-            lo = mid + 1;
+    /* the first k with cumulative[k] > target lies in [lo, lo + length): halve without
+     * branches (the comparison becomes a conditional move) */
+    while (length > 1) {
+        uint32_t half = length / 2;
+        lo = tree->cumulative[lo + half - 1] <= target ? lo + half : lo;
+        length -= half;
     }
     if (lo > n->first)
         before = tree->cumulative[lo - 1];

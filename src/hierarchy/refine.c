@@ -24,6 +24,8 @@
 #define FIRST_RAYS 4u       /* segments every new link gets */
 #define MAX_RAYS 64u
 #define PARTIAL_FACTOR 0.25 /* partly visible links refine at a quarter of the threshold */
+#define SETTLED_SHARE 0.25  /* a link whose error is under this share of its threshold is
+                               settled until the next full check */
 #define HIDDEN_FACTOR 0.125 /* a pair of nodes all of whose 16 segments were blocked likely
                                lets through less than 1/8 of its bound */
 
@@ -36,26 +38,31 @@ static unsigned children_of(uint8_t action)
 
 static double brightest(rad_rgb b) { return max_d(b.r, max_d(b.g, b.b)); }
 
-static uint8_t decide(const refine_context *c, const hlink *link, float *bound)
+static uint8_t decide(const refine_context *c, hlink *link, float *bound)
 {
-    const hnode *nodes = c->tree->nodes;
-    const hnode *p = &nodes[link->receiver], *q = &nodes[link->source];
+    *bound = 0;
     if (link->receiver == link->source) {
         *bound = INFINITY;
         return SPLIT_SELF; /* only clusters link to themselves */
     }
-    bool p_leaf = p->child[0] == HNODE_NONE, q_leaf = q->child[0] == HNODE_NONE;
-    if (p_leaf && q_leaf) {
-        *bound = 0;
+    /* the common case touches nothing but the link and its source's B */
+    if (!(link->bound > 0) || ((link->flags & LINK_SETTLED) && !c->full_check))
+        return KEEP;
+    double error = brightest(c->node_radiosity[link->source]) * link->bound;
+    if (link->visible == 0)
+        error *= HIDDEN_FACTOR;
+    bool partial = link->visible > 0 && link->visible < LINK_VISIBLE;
+    double threshold = c->epsilon * (partial ? PARTIAL_FACTOR : 1);
+    *bound = (float)error;
+    if (!(error > threshold)) {
+        if (error < SETTLED_SHARE * threshold)
+            link->flags |= LINK_SETTLED;
         return KEEP;
     }
-    double error = brightest(c->node_radiosity[link->source]) * link->bound;
-    if (!(link->visibility > 0))
-        error *= HIDDEN_FACTOR;
-    bool partial = link->visibility < 1 && link->visibility > 0;
-    *bound = (float)error;
-    if (!(error > c->epsilon * (partial ? PARTIAL_FACTOR : 1)))
-        return KEEP;
+    link->flags &= (uint16_t)~LINK_SETTLED;
+    const hnode *nodes = c->tree->nodes;
+    const hnode *p = &nodes[link->receiver], *q = &nodes[link->source];
+    bool p_leaf = p->child[0] == HNODE_NONE, q_leaf = q->child[0] == HNODE_NONE;
     if (p_leaf)
         return SPLIT_SOURCE;
     if (q_leaf)
@@ -126,7 +133,8 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
             child->receiver = pairs[k][0];
             child->source = pairs[k][1];
             child->transfer = 0;
-            child->visibility = 1;
+            child->visible = (uint16_t)LINK_VISIBLE;
+            child->flags = 0;
             child->bound = 0;
             if (child->receiver == child->source) {
                 if (nodes[child->receiver].planar) /* a plane sends nothing to itself */
@@ -140,7 +148,9 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
                 slot++;
                 continue;
             }
-            child->bound = (float)e.factor_bound;
+            bool two_patches = nodes[child->receiver].patch != HNODE_NONE &&
+                               nodes[child->source].patch != HNODE_NONE;
+            child->bound = two_patches ? 0 : (float)e.factor_bound;
             /* two planes: the factor estimate times the visible share; a cluster: the
              * kernel sampled at the segments' ends */
             bool planes = nodes[child->receiver].planar && nodes[child->source].planar;
@@ -201,7 +211,7 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
         double share = visible == total  ? 1
                        : weighted_all > 0 ? weighted_open / weighted_all
                                           : (double)visible / total;
-        child->visibility = (float)share;
+        child->visible = link_visible_code(share);
         child->transfer = (float)(pd->factor >= 0 ? pd->factor * share : kernel_open / total);
     }
     size_t live = 0;
@@ -267,7 +277,7 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
         free(chunk_live);
         return 0;
     }
-    const hlink *links = store->links;
+    hlink *links = store->links;
 #pragma omp parallel for num_threads(c->threads) schedule(static, 4096)
     for (size_t l = 0; l < n; l++)
         action[l] = decide(c, &links[l], &bound[l]);

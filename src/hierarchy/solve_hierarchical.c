@@ -18,6 +18,7 @@
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/memory.h"
+#include "core/minmax.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
 #include "hierarchy/final_gather.h"
@@ -27,7 +28,9 @@
 #define DEFAULT_TOLERANCE 1e-4
 #define DEFAULT_MAX_SWEEPS 1000u
 #define DEFAULT_VISIBILITY_RAYS 16u
-#define SWEEPS_PER_PASS 2u
+#define SWEEPS_PER_PASS 1u
+#define MAX_CORRECTION_FACTOR 1.0
+#define FULL_CHECK_EVERY 8u /* passes; the others look only at links not settled */
 #define MAX_PASSES 256u
 
 typedef struct hsolver {
@@ -122,14 +125,16 @@ static double sweep(hsolver *s)
     return s->emitted > 0 ? change / s->emitted : 0;
 }
 
-/* One channel of the final gather's correction c to what comes down d, as a factor where d
- * is positive (the correction then moves with B), else added. */
+/* One channel of the final gather's correction c to what comes down d: as a factor where d
+ * is positive (the correction then moves with B), at most MAX_CORRECTION_FACTOR = 1 (a
+ * factor above 1 raises the sweeps' operator, which can then diverge in a bright
+ * enclosure); the rest is added, a constant that cannot. */
 static void as_scale(double d, double *c, double *factor)
 {
     *factor = 1;
     if (d > 0 && d + *c >= 0) {
-        *factor = (d + *c) / d;
-        *c = 0;
+        *factor = min_d((d + *c) / d, MAX_CORRECTION_FACTOR);
+        *c = d + *c - *factor * d;
     }
 }
 
@@ -246,7 +251,7 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
         }
         s.store.capacity = 1;
         s.store.count = 1;
-        s.store.links[0] = (hlink){0, 0, 0, 1, INFINITY};
+        s.store.links[0] = (hlink){0, 0, 0, INFINITY, (uint16_t)LINK_VISIBLE, 0};
         s.store.peak_bytes = 2 * sizeof(hlink);
     }
     refine_context rc = {mesh,
@@ -255,6 +260,7 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
                          s.node_B,
                          s.brightness,
                          threshold * brightest_total / n,
+                         true,
                          rays,
                          o.seed,
                          s.threads};
@@ -268,6 +274,7 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
             double tr = now_seconds();
             refine_result rr;
             update_brightness(&s);
+            rc.full_check = quiet_passes > 0 || rep.passes % FULL_CHECK_EVERY == 0;
             if (!hier_refine_pass(&rc, &s.store, &rr)) {
                 hsolver_free(&s);
                 return rad_fail(error, RAD_ERR_NOMEM, "out of memory refining the links");
@@ -348,7 +355,7 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
     rep.residual = residual;
     rep.links = s.store.count;
     for (size_t l = 0; l < s.store.count; l++)
-        rep.links_partial += s.store.links[l].visibility < 1;
+        rep.links_partial += s.store.links[l].visible < LINK_VISIBLE;
     rep.link_bytes = s.store.peak_bytes;
     memcpy(B, s.patch_B, (size_t)n * sizeof(rad_rgb));
     hsolver_free(&s);
