@@ -357,6 +357,11 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
     for (size_t l = 0; l < s.store.count; l++)
         rep.links_partial += s.store.links[l].visible < LINK_VISIBLE;
     rep.link_bytes = s.store.peak_bytes;
+    if (!isfinite(residual)) { /* never hand out a diverged answer as a solution */
+        hsolver_free(&s);
+        return rad_fail(error, RAD_ERR_INTERNAL,
+                        "the hierarchical solution diverged (a bug: please report the scene)");
+    }
     memcpy(B, s.patch_B, (size_t)n * sizeof(rad_rgb));
     hsolver_free(&s);
     if (report)
