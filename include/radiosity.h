@@ -683,8 +683,9 @@ typedef struct rad_hierarchy_options {
     uint64_t seed;
     int threads;              /* 0 = all cores */
     /* When non-NULL and it becomes non-zero (a SIGINT handler, say), refinement and
-     * gathering stop at the next sweep and the current solution is returned (report.
-     * interrupted); B is then a valid, less converged answer. */
+     * gathering stop at the next sweep (the final gather at once, its partial result
+     * dropped) and the current solution is returned (report.interrupted); B is then a
+     * valid, less converged answer. */
     const volatile int *stop;
     rad_progress_fn progress;
     void *progress_user;

@@ -399,8 +399,8 @@ double cli_now(void)
  * again), so each phase keeps its own clock: the time since the previous report (of any
  * phase) is the work the current report covers, and is added to the current phase. The
  * time left is the phase's rate so far carried to 1; a phase whose fraction goes back
- * down starts that estimate again, and at 99 % or more (a guessed fraction's cap) no
- * estimate is shown. */
+ * down starts that estimate again; below 1 % (too little to go on) and at 99 % or more (a
+ * guessed fraction's cap) no estimate is shown. */
 enum { PROGRESS_UNKNOWN = -1, PROGRESS_OFF, PROGRESS_TERMINAL, PROGRESS_LINES };
 #define PROGRESS_PHASES 8
 
@@ -502,7 +502,7 @@ void cli_progress(void *user, const char *phase, double fraction)
     if (fraction >= 1) {
         snprintf(text, sizeof(text), "%-14s done in %.2f s", phase, clock->seconds);
         clock->done = true;
-    } else if (fraction >= 0.02 && fraction < 0.99 && clock->since_restart > 0) {
+    } else if (fraction >= 0.01 && fraction < 0.99 && clock->since_restart > 0) {
         format_duration(clock->since_restart * (1 - fraction) / fraction, left, sizeof(left));
         snprintf(text, sizeof(text), "%-14s %5.1f%%  %s, about %s left", phase,
                  100 * fraction, elapsed, left);

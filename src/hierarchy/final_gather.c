@@ -131,20 +131,22 @@ static bool gather_leaf(const final_gather_context *c, uint32_t k, gather_buffer
     return true;
 }
 
-bool hier_final_gather(const final_gather_context *c, rad_rgb *correction, uint64_t *rays)
+int hier_final_gather(const final_gather_context *c, rad_rgb *correction, uint64_t *rays)
 {
     const hier_tree *t = c->tree;
     int64_t nodes = t->node_count;
     uint64_t cast = 0;
-    int failed = 0;
-#pragma omp parallel num_threads(c->threads) reduction(+ : cast) reduction(| : failed)
+    int failed = 0, stopped = 0;
+#pragma omp parallel num_threads(c->threads) reduction(+ : cast) reduction(| : failed, stopped)
     {
         gather_buffers b = {0};
 #pragma omp for schedule(dynamic, 64)
         for (int64_t k = 0; k < nodes; k++) {
             if (c->progress && omp_get_thread_num() == 0 && k % 8192 == 0)
                 c->progress(c->progress_user, "final gather", (double)k / (double)nodes);
-            if (t->nodes[k].patch == HNODE_NONE || failed)
+            if (c->stop && *c->stop)
+                stopped = 1;
+            if (t->nodes[k].patch == HNODE_NONE || failed || stopped)
                 continue;
             if (!gather_leaf(c, (uint32_t)k, &b, &correction[k], &cast))
                 failed = 1;
@@ -156,5 +158,5 @@ bool hier_final_gather(const final_gather_context *c, rad_rgb *correction, uint6
         free(b.weight);
     }
     *rays += cast;
-    return !failed;
+    return failed ? 0 : stopped ? -1 : 1;
 }

@@ -24,12 +24,14 @@ typedef struct final_gather_context {
     int threads;
     rad_progress_fn progress; /* "final gather", from the calling thread; may be NULL */
     void *progress_user;
+    const volatile int *stop; /* when it becomes non-zero, the gather gives up; may be NULL */
 } final_gather_context;
 
 /* correction[k] for every leaf node k: the irradiance per unit area its ancestors' links
  * give at its own resolution minus what they hand down (their transfer x B). Adds the
- * segments traced to *rays. false when memory ran out. */
-bool hier_final_gather(const final_gather_context *context, rad_rgb *correction,
-                       uint64_t *rays);
+ * segments traced to *rays. Returns 1, or 0 when memory ran out, or -1 when stopped (the
+ * corrections are then incomplete and must not be used). */
+int hier_final_gather(const final_gather_context *context, rad_rgb *correction,
+                      uint64_t *rays);
 
 #endif

@@ -285,9 +285,10 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
             if (rr.capped)
                 rep.memory_capped = true;
             rep.seconds_refine += now_seconds() - tr;
-            if (o.progress)
+            if (o.progress) /* about 4 passes per level of the tree (measured: 87 at 1M
+                                leaves' 21 levels) */
                 o.progress(o.progress_user, "refine",
-                           fmin(0.99, rep.passes / (2.0 * log2((double)nodes + 2) + 4)));
+                           fmin(0.99, rep.passes / (4.0 * log2((double)nodes + 2) + 8)));
         }
         double tg = now_seconds();
         sort_by_receiver(&s);
@@ -325,25 +326,31 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
         s.correction = rad_alloc_array(nodes, sizeof(rad_rgb));
         s.scale = rad_alloc_array(nodes, sizeof(rad_rgb));
         update_brightness(&s);
-        final_gather_context fg = {mesh,      &s.tree,      occluders,  s.store.links,
-                                   s.offsets, s.node_B,     s.brightness, rays,
-                                   o.seed + 2, s.threads,   o.progress, o.progress_user};
-        bool gathered = s.correction && s.scale &&
-                        hier_final_gather(&fg, s.correction, &rep.rays);
-        if (!gathered) {
+        final_gather_context fg = {mesh,       &s.tree,    occluders,  s.store.links,
+                                   s.offsets,  s.node_B,   s.brightness, rays,
+                                   o.seed + 2, s.threads,  o.progress, o.progress_user,
+                                   o.stop};
+        int gathered = s.correction && s.scale ? hier_final_gather(&fg, s.correction, &rep.rays)
+                                               : 0;
+        if (gathered == 0) {
             hsolver_free(&s);
             return rad_fail(error, RAD_ERR_NOMEM, "out of memory in the final gather");
         }
+        if (gathered < 0) { /* stopped: the solution without it stands */
+            free(s.correction);
+            free(s.scale);
+            s.correction = s.scale = NULL;
+        }
         /* as a factor on what comes down where that is not 0, so that the correction moves
          * with B */
-        for (uint32_t k = 0; k < nodes; k++) {
+        for (uint32_t k = 0; s.correction && k < nodes; k++) {
             as_scale(s.down[k].r, &s.correction[k].r, &s.scale[k].r);
             as_scale(s.down[k].g, &s.correction[k].g, &s.scale[k].g);
             as_scale(s.down[k].b, &s.correction[k].b, &s.scale[k].b);
         }
-        residual = 1;
-        while (residual > tolerance && rep.sweeps < max_sweeps && !stopped(&o)) {
-            residual = sweep(&s);
+        double change = s.correction ? 1 : 0;
+        while (change > tolerance && rep.sweeps < max_sweeps && !stopped(&o)) {
+            residual = change = sweep(&s);
             rep.sweeps++;
         }
         if (o.progress)
