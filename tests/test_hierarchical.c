@@ -153,17 +153,24 @@ static void compare_with_dense(const char *label, const rad_scene *scene, const 
     free(mean_hier);
 }
 
+/* About 2000 patches of the scene, and a tracer over it. */
+static void prepare(const rad_scene *scene, rad_mesh **mesh, rad_tracer **tracer)
+{
+    rad_error error;
+    fail_on(rad_mesh_build(scene, rad_mesh_default_patch_size(scene, 2000), mesh, &error),
+            &error, "mesh");
+    fail_on(rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, tracer, &error), &error,
+            "tracer");
+}
+
 static void furnished_room(void)
 {
     rad_error error;
     rad_scene *scene = NULL;
     fail_on(rad_scene_load(write_furnished_room(), NULL, &scene, &error), &error, "room");
     rad_mesh *mesh = NULL;
-    fail_on(rad_mesh_build(scene, rad_mesh_default_patch_size(scene, 2000), &mesh, &error),
-            &error, "room mesh");
     rad_tracer *tracer = NULL;
-    fail_on(rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &tracer, &error), &error,
-            "tracer");
+    prepare(scene, &mesh, &tracer);
     rad_rgb *dense = calloc(mesh->patch_count, sizeof(rad_rgb));
     rad_rgb *hier = calloc(mesh->patch_count, sizeof(rad_rgb));
     rad_camera camera = {{3.6, 1.8, 0.3}, {1.5, 0.6, 3.5}, {0, 1, 0}, 70};
@@ -185,11 +192,8 @@ int main(void)
     rad_scene *scene = NULL;
     fail_on(rad_scene_cornell_box(&scene, &error), &error, "cornell");
     rad_mesh *mesh = NULL;
-    fail_on(rad_mesh_build(scene, rad_mesh_default_patch_size(scene, 2000), &mesh, &error),
-            &error, "mesh");
     rad_tracer *tracer = NULL;
-    fail_on(rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &tracer, &error), &error,
-            "tracer");
+    prepare(scene, &mesh, &tracer);
     rad_rgb *dense = calloc(mesh->patch_count, sizeof(rad_rgb));
     rad_rgb *hier = calloc(mesh->patch_count, sizeof(rad_rgb));
     rad_rgb *hier1 = calloc(mesh->patch_count, sizeof(rad_rgb));

@@ -29,6 +29,7 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "formfactor/contour.h"
+#include "trace/ray.h"
 
 #define DEFAULT_VISIBILITY_RAYS 16u
 #define MAX_QUADRATURE 8u
@@ -203,15 +204,7 @@ static void make_segments(const engine *e, uint32_t i, uint32_t j, unsigned k, u
             rad_vec3 q = v3_add(patch_point(gj, (sj + (double)(b >> 32) * to_unit) * inv_k,
                                             (tj + (double)(b & 0xFFFFFFFFu) * to_unit) * inv_k),
                                 gj->lift);
-            rad_ray *ray = &rays[s];
-            ray->origin[0] = (float)p.x;
-            ray->origin[1] = (float)p.y;
-            ray->origin[2] = (float)p.z;
-            ray->direction[0] = (float)(q.x - p.x);
-            ray->direction[1] = (float)(q.y - p.y);
-            ray->direction[2] = (float)(q.z - p.z);
-            ray->t_near = RAD_SEGMENT_END_EPSILON;
-            ray->t_far = 1.0f - RAD_SEGMENT_END_EPSILON;
+            ray_segment(&rays[s], p, q);
         }
 }
 

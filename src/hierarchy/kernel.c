@@ -24,6 +24,7 @@
 #include "core/vec3.h"
 #include "formfactor/contour.h"
 #include "hierarchy/hierarchy.h"
+#include "trace/ray.h"
 
 #define CLUSTER_MEAN_COSINE 0.25
 #define NEAR_DISTANCE 3.0     /* patch pairs closer than this x (sum of radii): 2 x 2 points */
@@ -272,20 +273,7 @@ void hier_segments(const hier_tree *tree, uint64_t seed, uint32_t receiver, uint
             kernel[k] = area * cos_a * cos_b / (RAD_PI * r2 + 0.25 * area);
         if (weight)
             weight[k] = leaf_weight[at_b];
-        rad_ray *ray = &rays[k];
-        ray->origin[0] = (float)a.x;
-        ray->origin[1] = (float)a.y;
-        ray->origin[2] = (float)a.z;
-        ray->direction[0] = (float)(b.x - a.x);
-        ray->direction[1] = (float)(b.y - a.y);
-        ray->direction[2] = (float)(b.z - a.z);
-        ray->t_near = RAD_SEGMENT_END_EPSILON;
-        ray->t_far = 1.0f - RAD_SEGMENT_END_EPSILON;
-        if (!(ray->direction[0] != 0 || ray->direction[1] != 0 || ray->direction[2] != 0)) {
-            ray->direction[0] = 1; /* coincident points: an empty segment */
-            ray->t_near = 1;
-            ray->t_far = 0;
-        }
+        ray_segment(&rays[k], a, b);
     }
 }
 

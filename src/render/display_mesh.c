@@ -33,6 +33,7 @@
 #include <string.h>
 
 #include "core/alloc.h"
+#include "core/edge_key.h"
 #include "core/error.h"
 #include "core/vec3.h"
 #include "core/weld.h"
@@ -53,22 +54,9 @@ typedef struct edge_table {
     size_t mask;
 } edge_table;
 
-static uint64_t edge_key(uint32_t a, uint32_t b)
-{
-    return a < b ? ((uint64_t)a << 32) | b : ((uint64_t)b << 32) | a;
-}
-
-static uint64_t mix(uint64_t x)
-{
-    x ^= x >> 33;
-    x *= 0xff51afd7ed558ccdull;
-    x ^= x >> 33;
-    return x;
-}
-
 static edge_slot *edge_find(const edge_table *table, uint64_t key)
 {
-    size_t s = mix(key) & table->mask;
+    size_t s = edge_key_hash(key) & table->mask;
     while (table->slots[s].key != 0 && table->slots[s].key != key)
         s = (s + 1) & table->mask;
     return &table->slots[s];
