@@ -1,8 +1,9 @@
 /*
  * refine.c - one level of link refinement (Hanrahan, Salzman and Aupperle 1991).
  *
- * Phase 1 (parallel over links, cheap): each link decides from geometry and the current
- * radiosity whether it splits and into how many children. When the children would not fit
+ * Phase 1 (parallel over links, cheap): each link decides from its stored bound and its
+ * source's current radiosity whether it splits and into how many children (settled links
+ * are skipped but on full checks). When the children would not fit
  * the budget, the links with the largest bounds split first and the rest stay (the run is
  * then "capped"). Phase 2 (parallel over fixed chunks of links): children are estimated and
  * their visibility traced, written at positions fixed by the chunk's place, then chunks are
@@ -79,7 +80,7 @@ static uint8_t decide(const refine_context *c, hlink *link, float *bound)
 typedef struct pending {
     uint32_t slot;  /* index into the chunk's output */
     uint32_t first; /* its first ray in the batch */
-    double factor;  /* the geometric estimate; < 0: sample the kernel (larger nodes) */
+    double factor;  /* two planes' geometric estimate; < 0: a cluster, sample the kernel */
 } pending;
 
 typedef struct thread_buffers {
