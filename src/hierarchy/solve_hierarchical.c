@@ -353,6 +353,7 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
             residual = change = sweep(&s);
             rep.sweeps++;
         }
+        converged = converged && change <= tolerance;
         if (o.progress)
             o.progress(o.progress_user, "final gather", 1);
         rep.seconds_final = now_seconds() - tf;
