@@ -22,6 +22,7 @@
 #include "core/edge_key.h"
 #include "core/error.h"
 #include "core/tolerance.h"
+#include "core/union_find.h"
 #include "core/vec3.h"
 #include "core/weld.h"
 
@@ -46,15 +47,6 @@ static edge_slot *edge_find(edge_table *table, uint64_t key)
     while (table->slots[s].triangle != UINT32_MAX && table->slots[s].key != key)
         s = (s + 1) & table->mask;
     return &table->slots[s];
-}
-
-static uint32_t find_root(uint32_t *parent, uint32_t x)
-{
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
 }
 
 typedef struct mesh_input {
@@ -316,7 +308,8 @@ static rad_status plan_build(const rad_scene *scene, mesh_plan *plan, rad_error 
             if (slot->count++ == 1)
                 slot->other = t;
             if (smooth_neighbours(in, slot->triangle, t)) {
-                uint32_t ra = find_root(parent, slot->triangle), rb = find_root(parent, t);
+                uint32_t ra = union_find_root(parent, slot->triangle);
+                uint32_t rb = union_find_root(parent, t);
                 if (ra != rb)
                     parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
             }
@@ -326,7 +319,7 @@ static rad_status plan_build(const rad_scene *scene, mesh_plan *plan, rad_error 
     for (uint32_t t = 0; t < T; t++)
         region_of_root[t] = UINT32_MAX;
     for (uint32_t t = 0; t < T; t++) {
-        uint32_t root = find_root(parent, t);
+        uint32_t root = union_find_root(parent, t);
         if (region_of_root[root] == UINT32_MAX)
             region_of_root[root] = region_count++;
     }
@@ -345,7 +338,7 @@ static rad_status plan_build(const rad_scene *scene, mesh_plan *plan, rad_error 
         if (slot->count != 2)
             continue;
         uint32_t u = slot->triangle == t ? slot->other : slot->triangle;
-        if (partner[u] != UINT32_MAX || find_root(parent, u) != find_root(parent, t))
+        if (partner[u] != UINT32_MAX || union_find_root(parent, u) != union_find_root(parent, t))
             continue;
         const uint32_t *w = scene->triangles[u].vertex;
         int m = longest_edge(scene, u);
@@ -369,7 +362,7 @@ static rad_status plan_build(const rad_scene *scene, mesh_plan *plan, rad_error 
         polygon *poly = &plan->polygons[plan->polygon_count];
         const uint32_t *v = scene->triangles[t].vertex;
         poly->triangle = t;
-        poly->region = region_of_root[find_root(parent, t)];
+        poly->region = region_of_root[union_find_root(parent, t)];
         poly->bulge = bulge[t];
         if (partner[t] == UINT32_MAX) {
             poly->count = 3;

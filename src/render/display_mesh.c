@@ -35,6 +35,7 @@
 #include "core/alloc.h"
 #include "core/edge_key.h"
 #include "core/error.h"
+#include "core/union_find.h"
 #include "core/vec3.h"
 #include "core/weld.h"
 
@@ -60,15 +61,6 @@ static edge_slot *edge_find(const edge_table *table, uint64_t key)
     while (table->slots[s].key != 0 && table->slots[s].key != key)
         s = (s + 1) & table->mask;
     return &table->slots[s];
-}
-
-static uint32_t find_root(uint32_t *parent, uint32_t x)
-{
-    while (parent[x] != x) {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    return x;
 }
 
 static rad_rgb rgb_lerp(rad_rgb a, rad_rgb b, double t)
@@ -259,7 +251,7 @@ static bool build_chains(work *w, uint32_t ids)
                 rad_vec3 dj = v3_sub(X[from[ej] == v ? to[ej] : from[ej]], p);
                 if (!parallel(di, dj))
                     continue;
-                uint32_t ra = find_root(w->parent, ei), rb = find_root(w->parent, ej);
+                uint32_t ra = union_find_root(w->parent, ei), rb = union_find_root(w->parent, ej);
                 if (ra != rb)
                     w->parent[ra < rb ? rb : ra] = ra < rb ? ra : rb;
             }
@@ -267,7 +259,7 @@ static bool build_chains(work *w, uint32_t ids)
     }
     /* group by root (counting sort; roots are edge indices) */
     for (uint32_t u = 0; u < U; u++)
-        w->chain_start[find_root(w->parent, u) + 1]++;
+        w->chain_start[union_find_root(w->parent, u) + 1]++;
     for (uint32_t u = 0; u < U; u++)
         w->chain_start[u + 1] += w->chain_start[u];
     free(cursor);
@@ -276,7 +268,7 @@ static bool build_chains(work *w, uint32_t ids)
         return false;
     memcpy(next, w->chain_start, ((size_t)U + 1) * sizeof(*next));
     for (uint32_t u = 0; u < U; u++)
-        w->chain_edges[next[find_root(w->parent, u)]++] = u;
+        w->chain_edges[next[union_find_root(w->parent, u)]++] = u;
     free(next);
     return true;
 }
@@ -468,14 +460,14 @@ static bool identify_positions(const rad_mesh *mesh, work *w, uint32_t *position
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
         const rad_patch *patch = &mesh->patches[p];
         for (uint32_t k = 1; k < patch->vertex_count; k++) {
-            uint32_t ra = find_root(w->label, patch->vertex[0]);
-            uint32_t rb = find_root(w->label, patch->vertex[k]);
+            uint32_t ra = union_find_root(w->label, patch->vertex[0]);
+            uint32_t rb = union_find_root(w->label, patch->vertex[k]);
             if (ra != rb)
                 w->label[ra < rb ? rb : ra] = ra < rb ? ra : rb;
         }
     }
     for (uint32_t v = 0; v < V; v++)
-        w->label[v] = find_root(w->label, v);
+        w->label[v] = union_find_root(w->label, v);
     for (uint32_t u = 0; u < U; u++) {
         w->canonical_ends[0][u] = w->canonical[w->from[u]];
         w->canonical_ends[1][u] = w->canonical[w->to[u]];
