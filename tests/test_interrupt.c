@@ -34,11 +34,21 @@ extern char **environ;
 
 #define PATCH_SIZE "5"
 
-/* Runs the tool with argv, SIGINT as soon as a stderr line contains `trigger`; returns
+/* Runs the tool with `words` (NULL-terminated, at most 16), SIGINT as soon as a stderr line contains `trigger`; returns
  * the wait status and the whole stderr in `text`. */
-static int run_and_interrupt(char *const argv[], const char *trigger, char *text, size_t size,
-                             char *first_trigger_line, size_t line_size)
+static int run_and_interrupt(const char *const words[], const char *trigger, char *text,
+                             size_t size, char *first_trigger_line, size_t line_size)
 {
+    /* posix_spawn wants writable strings: copies of the words, NULL-terminated */
+    enum { MOST_WORDS = 16, WORD_SIZE = 4200 };
+    static char copies[MOST_WORDS][WORD_SIZE];
+    char *argv[MOST_WORDS + 1];
+    size_t count = 0;
+    for (; words[count] && count < MOST_WORDS; count++) {
+        snprintf(copies[count], WORD_SIZE, "%s", words[count]);
+        argv[count] = copies[count];
+    }
+    argv[count] = NULL;
     int pipe_fd[2];
     if (pipe(pipe_fd) != 0)
         return -1;
@@ -125,18 +135,10 @@ int main(void)
     snprintf(stats, sizeof(stats), "%s", test_path("interrupted.json"));
     const char *words[] = {RAD_TOOL, "solve", "-o", obj, "--solver", "hierarchical",
                            "--patch-size", PATCH_SIZE, "--save-solution", sol, "--stats",
-                           stats};
-    enum { WORDS = sizeof(words) / sizeof(words[0]) };
-    char copies[WORDS][4200];
-    char *argv[WORDS + 1];
-    for (size_t k = 0; k < WORDS; k++) {
-        snprintf(copies[k], sizeof(copies[k]), "%s", words[k]);
-        argv[k] = copies[k];
-    }
-    argv[WORDS] = NULL;
+                           stats, NULL};
     static char text[65536];
     char first[1024];
-    int status = run_and_interrupt(argv, "progress: refine", text, sizeof(text), first,
+    int status = run_and_interrupt(words, "progress: refine", text, sizeof(text), first,
                                    sizeof(first));
     printf("stderr:\n%s", text);
     CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 130);
@@ -195,16 +197,8 @@ int main(void)
     char pfm[4200];
     snprintf(pfm, sizeof(pfm), "%s", test_path("interrupted.pfm"));
     const char *render_words[] = {RAD_TOOL, "render", "-o", pfm, "--size", "32x24",
-                                  "--solver", "hierarchical", "--patch-size", PATCH_SIZE};
-    enum { RENDER_WORDS = sizeof(render_words) / sizeof(render_words[0]) };
-    char render_copies[RENDER_WORDS][4200];
-    char *render_argv[RENDER_WORDS + 1];
-    for (size_t k = 0; k < RENDER_WORDS; k++) {
-        snprintf(render_copies[k], sizeof(render_copies[k]), "%s", render_words[k]);
-        render_argv[k] = render_copies[k];
-    }
-    render_argv[RENDER_WORDS] = NULL;
-    status = run_and_interrupt(render_argv, "progress: refine", text, sizeof(text), first,
+                                  "--solver", "hierarchical", "--patch-size", PATCH_SIZE, NULL};
+    status = run_and_interrupt(render_words, "progress: refine", text, sizeof(text), first,
                                sizeof(first));
     printf("render stderr:\n%s", text);
     CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 130);

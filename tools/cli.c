@@ -129,6 +129,19 @@ bool cli_parse_double(const char *name, const char *text, double *out)
     return true;
 }
 
+bool cli_parse_positive(const char *name, const char *text, double *out)
+{
+    double value;
+    if (!cli_parse_double(name, text, &value))
+        return false;
+    if (!(value > 0)) {
+        cli_error("--%s: must be positive", name);
+        return false;
+    }
+    *out = value;
+    return true;
+}
+
 bool cli_parse_uint(const char *name, const char *text, unsigned long max, unsigned long *out)
 {
     char *end;
@@ -232,12 +245,8 @@ bool cli_parse_shared(const cli_args *args, cli_shared *shared)
     shared->output = args->value[OPT_OUTPUT];
     shared->stats_path = args->value[OPT_STATS];
     if (args->value[OPT_PATCH_SIZE]) {
-        if (!cli_parse_double("patch-size", args->value[OPT_PATCH_SIZE], &shared->patch_size))
+        if (!cli_parse_positive("patch-size", args->value[OPT_PATCH_SIZE], &shared->patch_size))
             return false;
-        if (!(shared->patch_size > 0)) {
-            cli_error("--patch-size: must be positive");
-            return false;
-        }
     }
     if (args->value[OPT_VISIBILITY_RAYS]) {
         if (!cli_parse_uint("visibility-rays", args->value[OPT_VISIBILITY_RAYS], 256, &value))

@@ -170,6 +170,7 @@ rad_status cli_load_scene_logged(const char *path, rad_log_fn log, void *log_use
 
 /* Value parsers: print "radiosity: --NAME: ..." and return false on a bad value. */
 bool cli_parse_double(const char *name, const char *text, double *out);
+bool cli_parse_positive(const char *name, const char *text, double *out); /* > 0 */
 bool cli_parse_uint(const char *name, const char *text, unsigned long max, unsigned long *out);
 bool cli_parse_vec3(const char *name, const char *text, rad_vec3 *out);
 bool cli_parse_size(const char *name, const char *text, uint32_t *width, uint32_t *height);

@@ -63,14 +63,9 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
     }
     solve->options.ambient = true;
     if (args->value[OPT_TOLERANCE]) {
-        double number;
-        if (!cli_parse_double("tolerance", args->value[OPT_TOLERANCE], &number))
+        if (!cli_parse_positive("tolerance", args->value[OPT_TOLERANCE],
+                                &solve->options.tolerance))
             return false;
-        if (!(number > 0)) {
-            cli_error("--tolerance: must be positive");
-            return false;
-        }
-        solve->options.tolerance = number;
     }
     if (args->value[OPT_MAX_ITERATIONS]) {
         unsigned long value;
@@ -82,14 +77,9 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
     solve->options.threads = shared->threads;
     solve->options.progress = cli_progress;
     if (args->value[OPT_REFINE_THRESHOLD]) {
-        double number;
-        if (!cli_parse_double("refine-threshold", args->value[OPT_REFINE_THRESHOLD], &number))
+        if (!cli_parse_positive("refine-threshold", args->value[OPT_REFINE_THRESHOLD],
+                                &solve->hierarchy.refine_threshold))
             return false;
-        if (!(number > 0)) {
-            cli_error("--refine-threshold: must be positive");
-            return false;
-        }
-        solve->hierarchy.refine_threshold = number;
     }
     if (args->value[OPT_MAX_MEMORY] &&
         !parse_bytes("max-memory", args->value[OPT_MAX_MEMORY], &solve->hierarchy.max_memory))

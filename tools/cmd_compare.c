@@ -67,13 +67,10 @@ static bool parse_compare_options(const cli_args *args, rad_compare_options *com
         compare->block_size = (uint32_t)block;
     }
     if (args->value[OPT_BLOCK_TOLERANCE]) {
-        if (!cli_parse_double("block-tolerance", args->value[OPT_BLOCK_TOLERANCE],
-                              &compare->block_tolerance))
+        /* positive: 0 would mean the library's default */
+        if (!cli_parse_positive("block-tolerance", args->value[OPT_BLOCK_TOLERANCE],
+                                &compare->block_tolerance))
             return false;
-        if (!(compare->block_tolerance > 0)) { /* 0 would mean the library's default */
-            cli_error("--block-tolerance: must be positive");
-            return false;
-        }
     }
     return true;
 }
