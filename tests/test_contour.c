@@ -5,7 +5,7 @@
  */
 #include <math.h>
 
-#include "formfactor/contour.h"
+#include "geometry/contour.h"
 #include "testlib.h"
 
 static const double pi = 3.14159265358979323846;

@@ -1,0 +1,149 @@
+/*
+ * lit_mesh.c - rad_lit_mesh_write: the solution as a mesh with per-vertex radiance and
+ * display colour, in .ply, .glb or .obj (the encoders are lit_mesh_ply.c, lit_mesh_glb.c
+ * and lit_mesh_obj.c; see lit_mesh.h for why they are ours).
+ *
+ * Everything that can fail without touching the disk is settled first; then the file is
+ * written under a temporary name and renamed, so a failed write leaves nothing.
+ */
+#include "lit_mesh/lit_mesh.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "core/alloc.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/rgb.h"
+#include "core/vec3.h"
+#include "image/tonemap.h"
+#include "reconstruct/display_mesh.h"
+
+typedef enum lit_mesh_format { FORMAT_UNKNOWN, FORMAT_PLY, FORMAT_GLB, FORMAT_OBJ } lit_mesh_format;
+
+static lit_mesh_format format_of(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(slash ? slash + 1 : path, '.');
+    if (!dot)
+        return FORMAT_UNKNOWN;
+    if (strcasecmp(dot, ".ply") == 0)
+        return FORMAT_PLY;
+    if (strcasecmp(dot, ".glb") == 0)
+        return FORMAT_GLB;
+    if (strcasecmp(dot, ".obj") == 0)
+        return FORMAT_OBJ;
+    return FORMAT_UNKNOWN;
+}
+
+void lit_mesh_describe_colour(const lit_mesh *mesh, char *text, size_t size)
+{
+    snprintf(text, size, "radiance x %.9g (%s), clamped to [0,1]", mesh->scale,
+             mesh->automatic ? "automatic exposure: the 95th percentile of the lit vertices' "
+                               "luminance at 0.9"
+                             : "fixed exposure");
+}
+
+/* Vertex normals: each vertex lies in one smooth region, whose patches' normals differ by
+ * under a degree, so their area-weighted mean is a sound unit normal. */
+static void vertex_normals(const rad_mesh *mesh, rad_vec3 *normal)
+{
+    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        const rad_patch *patch = &mesh->patches[p];
+        for (uint32_t k = 0; k < patch->vertex_count; k++) {
+            rad_vec3 *n = &normal[patch->vertex[k]];
+            *n = v3_add(*n, v3_scale(patch->normal, patch->area));
+        }
+    }
+    for (uint32_t v = 0; v < mesh->vertex_count; v++)
+        normal[v] = v3_length(normal[v]) > 0 ? v3_normalize(normal[v]) : v3(0, 0, 1);
+}
+
+rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char *path,
+                              const rad_lit_mesh_options *options, rad_error *error)
+{
+    if (!path || !*path)
+        return rad_fail(error, RAD_ERR_INVALID, "rad_lit_mesh_write: no path");
+    lit_mesh_format format = format_of(path);
+    if (format == FORMAT_UNKNOWN)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "%s: unknown mesh format (use .ply, .glb or .obj)", path);
+    if (options && options->fixed_exposure && !isfinite(options->exposure))
+        return rad_fail(error, RAD_ERR_INVALID, "%s: exposure %g is not a finite number", path,
+                        options->exposure);
+
+    rad_status status = RAD_OK;
+    rad_vec3 *position = NULL, *normal = NULL;
+    rad_rgb *radiance = NULL, *display = NULL;
+    double *luminance = NULL;
+    display_mesh shown = {0};
+    status = display_mesh_build(mesh, true, &shown, error);
+    if (status != RAD_OK)
+        goto done;
+    uint32_t n = shown.vertex_count; /* the mesh's vertices and the added ones */
+    position = rad_alloc_array(n, sizeof(*position));
+    normal = rad_alloc_array(n, sizeof(*normal));
+    radiance = rad_alloc_array(n, sizeof(*radiance));
+    display = rad_alloc_array(n, sizeof(*display));
+    luminance = rad_alloc_array(n, sizeof(*luminance));
+    if (!position || !normal || !radiance || !display || !luminance) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for %u vertices", path, n);
+        goto done;
+    }
+    display_mesh_positions(mesh, &shown, position);
+    display_mesh_radiance(mesh, &shown, B, radiance);
+    vertex_normals(mesh, normal);
+    for (uint32_t k = 0; k < shown.extra_count; k++) { /* along their edge, as the values */
+        const display_extra *x = &shown.extras[k];
+        rad_vec3 along = v3_add(v3_scale(normal[x->from], 1 - x->t), v3_scale(normal[x->to], x->t));
+        normal[mesh->vertex_count + k] =
+            v3_length(along) > 0 ? v3_normalize(along) : normal[x->from];
+    }
+    lit_mesh lit = {
+        .vertex_count = n,
+        .position = position,
+        .normal = normal,
+        .radiance = radiance,
+        .display = display,
+        .triangles = (const uint32_t(*)[3])shown.triangles,
+        .triangle_count = shown.triangle_count,
+        .automatic = !options || !options->fixed_exposure,
+    };
+    if (lit.automatic) {
+        for (uint32_t v = 0; v < n; v++)
+            luminance[v] = rgb_luminance(radiance[v]);
+        lit.scale = rad_tonemap_auto_scale(luminance, n);
+    } else {
+        lit.scale = exp2(options->exposure);
+    }
+    for (uint32_t v = 0; v < n; v++) {
+        rad_rgb d = rgb_scale(radiance[v], lit.scale);
+        display[v] = (rad_rgb){fmin(fmax(d.r, 0), 1), fmin(fmax(d.g, 0), 1),
+                               fmin(fmax(d.b, 0), 1)};
+    }
+
+    rad_atomic_file file;
+    status = rad_atomic_open(&file, path, error);
+    if (status != RAD_OK)
+        goto done;
+    switch (format) {
+    case FORMAT_PLY: status = lit_mesh_write_ply(&lit, file.stream, path, error); break;
+    case FORMAT_GLB: status = lit_mesh_write_glb(&lit, file.stream, path, error); break;
+    case FORMAT_OBJ: status = lit_mesh_write_obj(&lit, file.stream, path, error); break;
+    case FORMAT_UNKNOWN: status = rad_fail(error, RAD_ERR_INTERNAL, "%s: no writer", path);
+    }
+    if (status == RAD_OK)
+        status = rad_atomic_commit(&file, error);
+    else
+        rad_atomic_abort(&file);
+done:
+    free(position);
+    free(normal);
+    free(radiance);
+    free(display);
+    free(luminance);
+    display_mesh_free(&shown);
+    return status;
+}

@@ -1,0 +1,126 @@
+/*
+ * formfactors.c - the dense patch-to-patch form-factor matrix, and its invariant checks.
+ *
+ * A sink for the pair engine: each symmetric transfer G_ij becomes F_ij = G / A_i and
+ * F_ji = G / A_j, so reciprocity holds by construction. Each pair is written by one thread
+ * and to two distinct cells, so no locking is needed.
+ */
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/memory.h"
+
+/* The dense matrix may take at most this share of the machine's physical memory. */
+#define MATRIX_MEMORY_SHARE 0.75
+#include "patch_formfactors/pair_engine.h"
+
+typedef struct dense_sink {
+    float *F;
+    const rad_patch *patches;
+    size_t n;
+} dense_sink;
+
+static void store_pair(void *data, int thread, uint32_t i, uint32_t j, double G)
+{
+    (void)thread;
+    dense_sink *sink = data;
+    sink->F[i * sink->n + j] = (float)(G / sink->patches[i].area);
+    sink->F[j * sink->n + i] = (float)(G / sink->patches[j].area);
+}
+
+rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occluders,
+                                   const rad_formfactor_options *options,
+                                   rad_formfactors **out, rad_formfactor_report *report,
+                                   rad_error *error)
+{
+    *out = NULL;
+    size_t n = mesh->patch_count;
+    if (n == 0)
+        return rad_fail(error, RAD_ERR_INVALID, "the mesh has no patches");
+    if (n > SIZE_MAX / n)
+        return rad_fail(error, RAD_ERR_NOMEM, "%zu patches: the matrix size overflows", n);
+    /* calloc may succeed lazily and the kernel kill the process later: refuse up front */
+    uint64_t physical = rad_physical_memory_bytes();
+    double bytes = (double)n * n * sizeof(float);
+    if (physical && bytes > MATRIX_MEMORY_SHARE * (double)physical)
+        return rad_fail(error, RAD_ERR_NOMEM,
+                        "%zu patches need a %.1f GB form-factor matrix and this machine has "
+                        "%.1f GB: use a larger --patch-size",
+                        n, bytes / 1e9, (double)physical / 1e9);
+    rad_formfactors *result = calloc(1, sizeof(*result));
+    float *F = rad_alloc_array(n * n, sizeof(*F));
+    if (!result || !F) {
+        free(result);
+        free(F);
+        return rad_fail(error, RAD_ERR_NOMEM,
+                        "out of memory for the %zu x %zu form-factor matrix (%.1f GB): use a "
+                        "larger --patch-size",
+                        n, n, (double)n * n * sizeof(float) / 1e9);
+    }
+    dense_sink sink = {F, mesh->patches, n};
+    rad_status status = pair_engine_run(mesh, occluders, options, store_pair, &sink, report, error);
+    if (status != RAD_OK) {
+        free(F);
+        free(result);
+        return status;
+    }
+    result->n = (uint32_t)n;
+    result->F = F;
+    *out = result;
+    return RAD_OK;
+}
+
+void rad_formfactors_destroy(rad_formfactors *formfactors)
+{
+    if (!formfactors)
+        return;
+    free(formfactors->F);
+    free(formfactors);
+}
+
+/* Pairs are compared tile by tile so that both F_ij and F_ji are read from cache. */
+#define CHECK_TILE 64u
+
+void rad_formfactors_check(const rad_formfactors *ff, const rad_mesh *mesh,
+                           rad_formfactor_check *check)
+{
+    size_t n = ff->n;
+    const float *F = ff->F;
+    double reciprocity = 0, largest_row = 0, closure = 0, largest = 0;
+    uint32_t empty = 0;
+    long long tiles = (long long)((n + CHECK_TILE - 1) / CHECK_TILE);
+#pragma omp parallel for schedule(dynamic, 1) reduction(max : reciprocity)
+    for (long long ti = 0; ti < tiles; ti++) {
+        size_t i0 = (size_t)ti * CHECK_TILE, i1 = i0 + CHECK_TILE < n ? i0 + CHECK_TILE : n;
+        for (size_t j0 = i0; j0 < n; j0 += CHECK_TILE) {
+            size_t j1 = j0 + CHECK_TILE < n ? j0 + CHECK_TILE : n;
+            for (size_t i = i0; i < i1; i++)
+                for (size_t j = j0 > i + 1 ? j0 : i + 1; j < j1; j++) {
+                    double fij = F[i * n + j], fji = F[j * n + i];
+                    if (fmax(fij, fji) <= 1e-6)
+                        continue;
+                    double a = mesh->patches[i].area * fij, b = mesh->patches[j].area * fji;
+                    reciprocity = fmax(reciprocity, fabs(a - b) / fmax(a, b));
+                }
+        }
+    }
+#pragma omp parallel for reduction(max : largest_row, closure, largest) reduction(+ : empty)
+    for (size_t i = 0; i < n; i++) {
+        double row = 0, row_largest = 0;
+        for (size_t j = 0; j < n; j++) {
+            row += F[i * n + j];
+            row_largest = fmax(row_largest, F[i * n + j]);
+        }
+        largest_row = fmax(largest_row, row);
+        closure = fmax(closure, fabs(row - 1));
+        largest = fmax(largest, row_largest);
+        empty += row == 0;
+    }
+    check->reciprocity = reciprocity;
+    check->largest_row_sum = largest_row;
+    check->closure = closure;
+    check->largest_factor = largest;
+    check->empty_rows = empty;
+}

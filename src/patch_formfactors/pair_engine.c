@@ -1,0 +1,500 @@
+/*
+ * pair_engine.c - the form-factor kernel: analytic transfer times sampled visibility.
+ *
+ * For a pair (i, j), i < j, of patches that face each other:
+ *   - the unoccluded transfer G_ij = A_i Fhat_ij is Lambert's contour formula (contour.c)
+ *     integrated over the smaller patch by the midpoint rule on an m x m split; for pairs
+ *     close to each other the split is finer and the estimates from both sides are
+ *     averaged, weighted towards the smaller patch;
+ *   - visibility is the fraction of segments between jittered stratified points of the
+ *     two patches that no triangle of the scene blocks: 2 x 2 segments first; when they
+ *     disagree (a shadow boundary crosses the pair) the full k x k set decides.
+ * Pairs where either patch is wholly behind the other's plane need no work (G = 0).
+ *
+ * Random numbers come from (seed, i, j), so the result is the same for any thread count.
+ * Rays are batched per thread and traced with rad_tracer_occluded; the hot loop allocates
+ * nothing.
+ */
+#include "patch_formfactors/pair_engine.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/random.h"
+#include "core/tolerance.h"
+#include "core/vec3.h"
+#include "geometry/contour.h"
+#include "trace/ray.h"
+
+#define DEFAULT_VISIBILITY_RAYS 16u
+#define MAX_QUADRATURE 8u
+#define MAX_STRATA 16u             /* at most 16 x 16 = 256 rays per pair */
+#define BATCH_RAYS 4096u           /* rays traced per call */
+#define FIRST_STRATA 2u            /* first pass: 2 x 2 segments per pair */
+/* Pairs closer than NEAR_DISTANCE x (sum of their radii) get NEAR_QUADRATURE^2 points:
+ * the midpoint rule is worst where the kernel varies fastest, next to a shared edge. */
+#define NEAR_DISTANCE 3.0
+#define NEAR_QUADRATURE 4u
+
+/* Everything the kernel needs about one patch, precomputed. */
+typedef struct patch_geometry {
+    rad_vec3 corner[4];
+    unsigned corner_count;
+    rad_vec3 normal;
+    rad_vec3 centroid;
+    double radius; /* largest distance from the centroid to a corner */
+    double area;
+    /* the map from the unit square: quads P = o + s u + t v + s t w (bilinear);
+     * triangles P = o + sqrt(s) (u + t w), which is uniform in area */
+    rad_vec3 o, u, v, w;
+    rad_vec3 lift; /* added to sample points: 2 x bulge along the normal (folded quads) */
+} patch_geometry;
+
+typedef struct pending_pair {
+    uint32_t j;
+    uint32_t first_ray, ray_count;
+    double unoccluded; /* G before visibility */
+} pending_pair;
+
+typedef struct engine {
+    const rad_mesh *mesh;
+    const rad_tracer *occluders;
+    patch_geometry *geometry;
+    rad_vec3 *quadrature_points; /* m*m per patch */
+    double *quadrature_weights;  /* m*m per patch, sum to 1 */
+    unsigned quadrature_count;
+    rad_vec3 *near_points;       /* the same with NEAR_QUADRATURE, for close pairs */
+    double *near_weights;
+    unsigned near_count;
+    unsigned strata;             /* k: at most k*k segments per pair */
+    unsigned first_strata;       /* the first pass casts first_strata^2 segments */
+    uint64_t seed;
+    double plane_epsilon;
+    pair_sink_fn sink;
+    void *sink_data;
+} engine;
+
+int pair_engine_threads(const rad_formfactor_options *options)
+{
+    int threads = options && options->threads > 0 ? options->threads : omp_get_max_threads();
+    return threads < 1 ? 1 : threads;
+}
+
+/* Point of the patch at unit-square coordinates (s, t): bilinear for quads, an
+ * area-preserving warp for triangles. */
+static rad_vec3 patch_point(const patch_geometry *g, double s, double t)
+{
+    if (g->corner_count == 4)
+        return v3(g->o.x + s * g->u.x + t * g->v.x + s * t * g->w.x,
+                  g->o.y + s * g->u.y + t * g->v.y + s * t * g->w.y,
+                  g->o.z + s * g->u.z + t * g->v.z + s * t * g->w.z);
+    double r = sqrt(s);
+    return v3(g->o.x + r * (g->u.x + t * g->w.x), g->o.y + r * (g->u.y + t * g->w.y),
+              g->o.z + r * (g->u.z + t * g->w.z));
+}
+
+static void patch_map(patch_geometry *g)
+{
+    const rad_vec3 *c = g->corner;
+    g->o = c[0];
+    g->u = v3_sub(c[1], c[0]);
+    if (g->corner_count == 4) {
+        g->v = v3_sub(c[3], c[0]);
+        g->w = v3_add(v3_sub(c[2], c[1]), v3_sub(c[0], c[3]));
+    } else {
+        g->v = v3(0, 0, 0);
+        g->w = v3_sub(c[2], c[1]);
+    }
+}
+
+/* Midpoint rule on an m x m split: sub-cell centres (quads) or sub-triangle centroids. */
+static void quadrature_for(const patch_geometry *g, unsigned m, rad_vec3 *points,
+                           double *weights)
+{
+    unsigned q = 0;
+    if (g->corner_count == 4) {
+        double total = 0;
+        for (unsigned j = 0; j < m; j++)
+            for (unsigned i = 0; i < m; i++) {
+                rad_vec3 a = patch_point(g, (double)i / m, (double)j / m);
+                rad_vec3 b = patch_point(g, (double)(i + 1) / m, (double)j / m);
+                rad_vec3 c = patch_point(g, (double)(i + 1) / m, (double)(j + 1) / m);
+                rad_vec3 d = patch_point(g, (double)i / m, (double)(j + 1) / m);
+                double area = 0.5 * v3_length(v3_cross(v3_sub(c, a), v3_sub(d, b)));
+                points[q] = v3_scale(v3_add(v3_add(a, b), v3_add(c, d)), 0.25);
+                weights[q++] = area;
+                total += area;
+            }
+        for (unsigned k = 0; k < q; k++)
+            weights[k] = total > 0 ? weights[k] / total : 1.0 / q;
+        return;
+    }
+    /* triangle: m^2 similar sub-triangles of equal area */
+    rad_vec3 a = g->corner[0], ab = v3_sub(g->corner[1], a), ac = v3_sub(g->corner[2], a);
+    for (unsigned j = 0; j < m; j++)
+        for (unsigned i = 0; i + j < m; i++) {
+            double u = (i + 1.0 / 3.0) / m, v = (j + 1.0 / 3.0) / m;
+            points[q] = v3_add(a, v3_add(v3_scale(ab, u), v3_scale(ac, v)));
+            weights[q++] = 1.0 / ((double)m * m);
+            if (i + j + 1 < m) {
+                u = (i + 2.0 / 3.0) / m;
+                v = (j + 2.0 / 3.0) / m;
+                points[q] = v3_add(a, v3_add(v3_scale(ab, u), v3_scale(ac, v)));
+                weights[q++] = 1.0 / ((double)m * m);
+            }
+        }
+}
+
+/* True when some corner of b lies in front of a's plane. */
+static bool any_in_front(const patch_geometry *a, const patch_geometry *b, double epsilon)
+{
+    for (unsigned k = 0; k < b->corner_count; k++)
+        if (v3_dot(a->normal, v3_sub(b->corner[k], a->corner[0])) > epsilon)
+            return true;
+    return false;
+}
+
+/* Area-weighted unoccluded factor from patch a to patch b: A_a * Fhat_ab. */
+static double transfer(const engine *e, uint32_t a, uint32_t b, bool near)
+{
+    const patch_geometry *ga = &e->geometry[a], *gb = &e->geometry[b];
+    unsigned count = near ? e->near_count : e->quadrature_count;
+    const rad_vec3 *points = (near ? e->near_points : e->quadrature_points) + (size_t)a * count;
+    const double *weights = (near ? e->near_weights : e->quadrature_weights) + (size_t)a * count;
+    double sum = 0;
+    for (unsigned q = 0; q < count; q++)
+        sum += weights[q] * contour_point_to_polygon(points[q], ga->normal, gb->corner,
+                                                     gb->corner_count, gb->normal,
+                                                     e->plane_epsilon);
+    return ga->area * sum;
+}
+
+/* Fills k*k segments from stratified points of i to stratified points of j; `round`
+ * tells the first pass (0) from the refining pass (1) so they draw different points. */
+static void make_segments(const engine *e, uint32_t i, uint32_t j, unsigned k, unsigned round,
+                          rad_ray *rays)
+{
+    unsigned count = k * k;
+    rad_rng rng = rad_rng_seed(e->seed + round, i, j);
+    uint8_t order[MAX_STRATA * MAX_STRATA];
+    for (unsigned s = 0; s < count; s++)
+        order[s] = (uint8_t)s;
+    for (unsigned s = count; s > 1; s--) { /* shuffle which stratum of j pairs with which of i */
+        unsigned r = (unsigned)(((rad_rng_next(&rng) >> 32) * s) >> 32); /* uniform in [0, s) */
+        uint8_t swap = order[s - 1];
+        order[s - 1] = order[r];
+        order[r] = swap;
+    }
+    const patch_geometry *gi = &e->geometry[i], *gj = &e->geometry[j];
+    const double inv_k = 1.0 / k, to_unit = 1.0 / 4294967296.0;
+    unsigned s = 0;
+    for (unsigned ti = 0; ti < k; ti++)
+        for (unsigned si = 0; si < k; si++, s++) {
+            /* four 32-bit jitters from two draws */
+            uint64_t a = rad_rng_next(&rng), b = rad_rng_next(&rng);
+            unsigned sj = order[s] % k, tj = order[s] / k;
+            rad_vec3 p = v3_add(patch_point(gi, (si + (double)(a >> 32) * to_unit) * inv_k,
+                                            (ti + (double)(a & 0xFFFFFFFFu) * to_unit) * inv_k),
+                                gi->lift);
+            rad_vec3 q = v3_add(patch_point(gj, (sj + (double)(b >> 32) * to_unit) * inv_k,
+                                            (tj + (double)(b & 0xFFFFFFFFu) * to_unit) * inv_k),
+                                gj->lift);
+            ray_segment(&rays[s], p, q);
+        }
+}
+
+/* A batch of pairs waiting for their segments to be traced. */
+typedef struct batch {
+    rad_ray *rays;
+    uint8_t *occluded;
+    pending_pair *pending;
+    uint32_t ray_count, pending_count;
+} batch;
+
+typedef struct thread_work {
+    batch first;  /* every facing pair, first_strata^2 segments */
+    batch refine; /* pairs the first pass found partly visible, strata^2 segments */
+    uint64_t rays_cast, pairs_facing, pairs_refined;
+    double tracing_seconds; /* this thread's time inside rad_tracer_occluded */
+} thread_work;
+
+static void batch_add(const engine *e, batch *b, uint32_t i, uint32_t j, double G, unsigned k,
+                      unsigned round)
+{
+    pending_pair *pair = &b->pending[b->pending_count++];
+    pair->j = j;
+    pair->first_ray = b->ray_count;
+    pair->ray_count = k * k;
+    pair->unoccluded = G;
+    make_segments(e, i, j, k, round, &b->rays[b->ray_count]);
+    b->ray_count += k * k;
+}
+
+static uint32_t visible_count(const batch *b, const pending_pair *pair)
+{
+    uint32_t visible = 0;
+    for (uint32_t r = 0; r < pair->ray_count; r++)
+        visible += !b->occluded[pair->first_ray + r];
+    return visible;
+}
+
+/* The visible fraction of a partly occluded pair, each segment weighted by the transfer
+ * kernel cos(theta_i) cos(theta_j) / r^2 at its ends: a shadow over the part of the pair
+ * that exchanges the most light (the near ends of two patches meeting at a corner) counts
+ * for more, so that visibility and the analytic factor are not treated as independent.
+ * r^2 is kept above a quarter of the smaller patch's radius squared so that one segment
+ * next to a shared edge cannot take all the weight. */
+static double weighted_visibility(const engine *e, const batch *b, const pending_pair *pair,
+                                  uint32_t i)
+{
+    const patch_geometry *gi = &e->geometry[i], *gj = &e->geometry[pair->j];
+    double floor_r = 0.5 * fmin(gi->radius, gj->radius);
+    double floor_r2 = floor_r * floor_r;
+    double total = 0, visible = 0;
+    for (uint32_t r = 0; r < pair->ray_count; r++) {
+        const rad_ray *ray = &b->rays[pair->first_ray + r];
+        rad_vec3 d = v3(ray->direction[0], ray->direction[1], ray->direction[2]);
+        double r2 = v3_dot(d, d);
+        double length = sqrt(r2);
+        double ci = v3_dot(gi->normal, d) / length, cj = -v3_dot(gj->normal, d) / length;
+        double kernel = fmax(ci, 0) * fmax(cj, 0) / fmax(r2, floor_r2);
+        total += kernel;
+        if (!b->occluded[pair->first_ray + r])
+            visible += kernel;
+    }
+    return total > 0 ? visible / total : (double)visible_count(b, pair) / pair->ray_count;
+}
+
+static double now_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Traces a batch (4096 segments at most: the two clock reads are noise beside it). */
+static void trace(const engine *e, thread_work *w, batch *b)
+{
+    double start = now_seconds();
+    rad_tracer_occluded(e->occluders, b->rays, b->ray_count, b->occluded);
+    w->tracing_seconds += now_seconds() - start;
+}
+
+static void flush_refine(const engine *e, thread_work *w, int thread, uint32_t i)
+{
+    batch *b = &w->refine;
+    if (b->ray_count)
+        trace(e, w, b);
+    for (uint32_t p = 0; p < b->pending_count; p++) {
+        const pending_pair *pair = &b->pending[p];
+        uint32_t visible = visible_count(b, pair);
+        if (visible == pair->ray_count)
+            e->sink(e->sink_data, thread, i, pair->j, pair->unoccluded);
+        else if (visible)
+            e->sink(e->sink_data, thread, i, pair->j,
+                    pair->unoccluded * weighted_visibility(e, b, pair, i));
+    }
+    w->rays_cast += b->ray_count;
+    b->ray_count = b->pending_count = 0;
+}
+
+/* Traces the first pass; pairs seen wholly visible or wholly hidden are done, the others
+ * go to the refining pass with the full number of segments. */
+static void flush_first(const engine *e, thread_work *w, int thread, uint32_t i)
+{
+    batch *b = &w->first;
+    unsigned full = e->strata * e->strata;
+    if (b->ray_count)
+        trace(e, w, b);
+    for (uint32_t p = 0; p < b->pending_count; p++) {
+        const pending_pair *pair = &b->pending[p];
+        uint32_t visible = visible_count(b, pair);
+        if (visible == pair->ray_count) {
+            e->sink(e->sink_data, thread, i, pair->j, pair->unoccluded);
+        } else if (visible == 0) {
+            continue;
+        } else if (pair->ray_count >= full) {
+            e->sink(e->sink_data, thread, i, pair->j,
+                    pair->unoccluded * weighted_visibility(e, b, pair, i));
+        } else {
+            if (w->refine.ray_count + full > BATCH_RAYS)
+                flush_refine(e, w, thread, i);
+            batch_add(e, &w->refine, i, pair->j, pair->unoccluded, e->strata, 1);
+            w->pairs_refined++;
+        }
+    }
+    w->rays_cast += b->ray_count;
+    b->ray_count = b->pending_count = 0;
+}
+
+static void row(const engine *e, thread_work *w, int thread, uint32_t i)
+{
+    const patch_geometry *gi = &e->geometry[i];
+    uint32_t n = e->mesh->patch_count;
+    unsigned k = e->first_strata;
+    for (uint32_t j = i + 1; j < n; j++) {
+        const patch_geometry *gj = &e->geometry[j];
+        if (!any_in_front(gi, gj, e->plane_epsilon) || !any_in_front(gj, gi, e->plane_epsilon))
+            continue;
+        bool near = v3_length(v3_sub(gi->centroid, gj->centroid)) <
+                    NEAR_DISTANCE * (gi->radius + gj->radius);
+        double G;
+        if (near) {
+            /* both one-sided estimates, the smaller patch's trusted more: its quadrature
+             * points are finer relative to the distance between the two */
+            double wi = 1.0 / (gi->radius * gi->radius), wj = 1.0 / (gj->radius * gj->radius);
+            G = (wi * transfer(e, i, j, true) + wj * transfer(e, j, i, true)) / (wi + wj);
+        } else {
+            /* far apart, the two estimates agree to the midpoint rule's small error: one
+             * suffices, from the smaller patch */
+            G = gi->radius <= gj->radius ? transfer(e, i, j, false) : transfer(e, j, i, false);
+        }
+        if (!(G > 0))
+            continue;
+        w->pairs_facing++;
+        if (w->first.ray_count + k * k > BATCH_RAYS)
+            flush_first(e, w, thread, i);
+        batch_add(e, &w->first, i, j, G, k, 0);
+    }
+    flush_first(e, w, thread, i);
+    flush_refine(e, w, thread, i);
+}
+
+static unsigned strata_for(uint32_t rays)
+{
+    if (rays == 0)
+        rays = DEFAULT_VISIBILITY_RAYS;
+    unsigned k = (unsigned)lround(sqrt((double)rays));
+    return k < 1 ? 1 : k > MAX_STRATA ? MAX_STRATA : k;
+}
+
+rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
+                           const rad_formfactor_options *options, pair_sink_fn sink,
+                           void *sink_data, rad_formfactor_report *report, rad_error *error)
+{
+    rad_formfactor_options defaults = {0};
+    if (!options)
+        options = &defaults;
+    uint32_t n = mesh->patch_count;
+    unsigned m = options->quadrature ? options->quadrature : 1;
+    if (m > MAX_QUADRATURE)
+        return rad_fail(error, RAD_ERR_INVALID, "quadrature %u is above the limit %u", m,
+                        MAX_QUADRATURE);
+    engine e = {0};
+    e.mesh = mesh;
+    e.occluders = occluders;
+    e.quadrature_count = m * m;
+    unsigned m_near = m > NEAR_QUADRATURE ? m : NEAR_QUADRATURE;
+    e.near_count = m_near * m_near;
+    e.strata = strata_for(options->visibility_rays);
+    e.first_strata = e.strata < FIRST_STRATA ? e.strata : FIRST_STRATA;
+    e.seed = options->seed;
+    e.sink = sink;
+    e.sink_data = sink_data;
+    rad_vec3 lo, hi;
+    v3_bounds(mesh->vertices, mesh->vertex_count, &lo, &hi);
+    e.plane_epsilon = RAD_PLANE_EPSILON * v3_length(v3_sub(hi, lo));
+
+    int threads = pair_engine_threads(options);
+    rad_status status = RAD_OK;
+    thread_work *work = rad_alloc_array((size_t)threads, sizeof(*work));
+    e.geometry = rad_alloc_array(n, sizeof(*e.geometry));
+    e.quadrature_points = rad_alloc_array((size_t)n * e.quadrature_count, sizeof(rad_vec3));
+    e.quadrature_weights = rad_alloc_array((size_t)n * e.quadrature_count, sizeof(double));
+    e.near_points = rad_alloc_array((size_t)n * e.near_count, sizeof(rad_vec3));
+    e.near_weights = rad_alloc_array((size_t)n * e.near_count, sizeof(double));
+    if (!work || !e.geometry || !e.quadrature_points || !e.quadrature_weights ||
+        !e.near_points || !e.near_weights)
+        goto nomem;
+    for (int t = 0; t < threads; t++) {
+        batch *b[2] = {&work[t].first, &work[t].refine};
+        for (int k = 0; k < 2; k++) {
+            b[k]->rays = rad_alloc_array(BATCH_RAYS, sizeof(*b[k]->rays));
+            b[k]->occluded = rad_alloc_array(BATCH_RAYS, sizeof(*b[k]->occluded));
+            b[k]->pending = rad_alloc_array(BATCH_RAYS, sizeof(*b[k]->pending));
+            if (!b[k]->rays || !b[k]->occluded || !b[k]->pending)
+                goto nomem;
+        }
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        const rad_patch *patch = &mesh->patches[i];
+        patch_geometry *g = &e.geometry[i];
+        g->corner_count = patch->vertex_count;
+        for (unsigned k = 0; k < patch->vertex_count; k++)
+            g->corner[k] = mesh->vertices[patch->vertex[k]];
+        g->normal = patch->normal;
+        g->area = patch->area;
+        patch_map(g);
+        g->lift = v3_scale(patch->normal, 2 * patch->bulge);
+        g->centroid = patch->centroid;
+        g->radius = 0;
+        for (unsigned k = 0; k < patch->vertex_count; k++)
+            g->radius = fmax(g->radius, v3_length(v3_sub(g->corner[k], g->centroid)));
+        quadrature_for(g, m, &e.quadrature_points[(size_t)i * e.quadrature_count],
+                       &e.quadrature_weights[(size_t)i * e.quadrature_count]);
+        quadrature_for(g, m_near, &e.near_points[(size_t)i * e.near_count],
+                       &e.near_weights[(size_t)i * e.near_count]);
+    }
+
+    struct timespec start, end;
+    clock_gettime(CLOCK_MONOTONIC, &start);
+    double total_pairs = (double)n * (n - 1) / 2;
+    uint64_t rows_done = 0;
+#pragma omp parallel num_threads(threads)
+    {
+        int thread = omp_get_thread_num();
+#pragma omp for schedule(dynamic, 1)
+        for (uint32_t i = 0; i < n; i++) {
+            row(&e, &work[thread], thread, i);
+            uint64_t done;
+#pragma omp atomic capture
+            done = ++rows_done;
+            if (thread == 0 && options->progress) {
+                /* pairs done when the first `done` rows are finished (rows go in order) */
+                double pairs_done = (double)done * n - (double)done * (done + 1) / 2;
+                options->progress(options->progress_user, "form factors",
+                                  total_pairs > 0 ? pairs_done / total_pairs : 1);
+            }
+        }
+    }
+    clock_gettime(CLOCK_MONOTONIC, &end);
+    if (report) {
+        memset(report, 0, sizeof(*report));
+        report->pairs = (uint64_t)total_pairs;
+        report->threads = threads;
+        for (int t = 0; t < threads; t++) {
+            report->rays += work[t].rays_cast;
+            report->pairs_facing += work[t].pairs_facing;
+            report->pairs_refined += work[t].pairs_refined;
+            report->tracing_seconds += work[t].tracing_seconds;
+        }
+        report->seconds = (double)(end.tv_sec - start.tv_sec) + 1e-9 * (double)(end.tv_nsec - start.tv_nsec);
+    }
+    if (options->progress)
+        options->progress(options->progress_user, "form factors", 1);
+    goto done;
+nomem:
+    status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for form factors of %u patches", n);
+done:
+    if (work)
+        for (int t = 0; t < threads; t++) {
+            batch *b[2] = {&work[t].first, &work[t].refine};
+            for (int k = 0; k < 2; k++) {
+                free(b[k]->rays);
+                free(b[k]->occluded);
+                free(b[k]->pending);
+            }
+        }
+    free(work);
+    free(e.geometry);
+    free(e.quadrature_points);
+    free(e.quadrature_weights);
+    free(e.near_points);
+    free(e.near_weights);
+    return status;
+}

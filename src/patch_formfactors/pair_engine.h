@@ -1,0 +1,25 @@
+/*
+ * pair_engine.h - computing the symmetric transfer G_ij = A_i F_ij = A_j F_ji of every
+ * patch pair, in parallel, and handing each to a sink.
+ *
+ * What a sink does with G decides the product: the dense patch matrix (formfactors.c) or
+ * the surface-to-surface view factors (viewfactors.c). Storing G once per pair is what
+ * makes reciprocity exact by construction.
+ */
+#ifndef RAD_FORMFACTOR_PAIR_ENGINE_H
+#define RAD_FORMFACTOR_PAIR_ENGINE_H
+
+#include "radiosity.h"
+
+/* Called once for every pair i < j with G > 0, from thread `thread` (0 .. threads-1). Calls
+ * for the same i come from one thread; calls for different pairs may run at once. */
+typedef void (*pair_sink_fn)(void *sink, int thread, uint32_t i, uint32_t j, double G);
+
+/* The number of threads pair_engine_run will use for these options. */
+int pair_engine_threads(const rad_formfactor_options *options);
+
+rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
+                           const rad_formfactor_options *options, pair_sink_fn sink,
+                           void *sink_data, rad_formfactor_report *report, rad_error *error);
+
+#endif

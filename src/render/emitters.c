@@ -1,0 +1,90 @@
+/*
+ * emitters.c - power-proportional sampling of emitting triangles, see emitters.h.
+ */
+#include "render/emitters.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/rgb.h"
+#include "core/vec3.h"
+
+static double triangle_area(const rad_scene *scene, uint32_t t)
+{
+    const uint32_t *v = scene->triangles[t].vertex;
+    return 0.5 * v3_length(v3_cross(v3_sub(scene->positions[v[1]], scene->positions[v[0]]),
+                                    v3_sub(scene->positions[v[2]], scene->positions[v[0]])));
+}
+
+rad_status emitters_build(const rad_scene *scene, emitter_set *set, rad_error *error)
+{
+    memset(set, 0, sizeof(*set));
+    uint32_t count = 0;
+    for (uint32_t t = 0; t < scene->triangle_count; t++)
+        count += rgb_luminance(scene->materials[scene->triangles[t].material].emission) > 0;
+    set->triangle = rad_alloc_array(count, sizeof(*set->triangle));
+    set->cdf = rad_alloc_array(count, sizeof(*set->cdf));
+    set->pdf_area_of = rad_alloc_array(scene->triangle_count, sizeof(*set->pdf_area_of));
+    if (!set->triangle || !set->cdf || !set->pdf_area_of) {
+        emitters_free(set);
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u emitters", count);
+    }
+    double total = 0;
+    for (uint32_t t = 0; t < scene->triangle_count; t++) {
+        double power = rgb_luminance(scene->materials[scene->triangles[t].material].emission) *
+                       triangle_area(scene, t);
+        if (!(power > 0))
+            continue;
+        set->triangle[set->count] = t;
+        total += power;
+        set->cdf[set->count++] = total;
+    }
+    for (uint32_t k = 0; k < set->count; k++) {
+        uint32_t t = set->triangle[k];
+        double probability = (set->cdf[k] - (k ? set->cdf[k - 1] : 0)) / total;
+        set->pdf_area_of[t] = probability / triangle_area(scene, t);
+    }
+    for (uint32_t k = 0; k < set->count; k++)
+        set->cdf[k] /= total;
+    if (set->count)
+        set->cdf[set->count - 1] = 1;
+    set->total_power = total;
+    return RAD_OK;
+}
+
+void emitters_free(emitter_set *set)
+{
+    free(set->triangle);
+    free(set->cdf);
+    free(set->pdf_area_of);
+    memset(set, 0, sizeof(*set));
+}
+
+void emitters_sample(const emitter_set *set, const rad_scene *scene, double u0, double u1,
+                     double u2, emitter_sample *sample)
+{
+    /* the first k with cdf[k] > u0 */
+    uint32_t lo = 0, hi = set->count - 1;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (set->cdf[mid] > u0)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    uint32_t t = set->triangle[lo];
+    const rad_triangle *tri = &scene->triangles[t];
+    rad_vec3 a = scene->positions[tri->vertex[0]], b = scene->positions[tri->vertex[1]],
+             c = scene->positions[tri->vertex[2]];
+    double r = sqrt(u1); /* uniform in area */
+    double wa = 1 - r, wb = r * (1 - u2), wc = r * u2;
+    sample->point = v3(wa * a.x + wb * b.x + wc * c.x, wa * a.y + wb * b.y + wc * c.y,
+                       wa * a.z + wb * b.z + wc * c.z);
+    sample->normal = v3_normalize(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+    sample->triangle = t;
+    sample->pdf_area = set->pdf_area_of[t];
+    sample->radiance = scene->materials[tri->material].emission;
+}

@@ -1,0 +1,364 @@
+/*
+ * radiosity_render.c - images of a radiosity solution, and the two-pass method.
+ *
+ * The patches are split into triangles (display_mesh.h: quads along their first diagonal,
+ * patches with T-vertices on their edges through those) and handed to a tracer; each
+ * pixel averages k x k jittered stratified primary rays (box filter). A hit on a front
+ * face takes the radiance interpolated from the vertex values with the hit's barycentrics;
+ * a back face or a miss is black. Pixels whose first samples disagree (silhouettes, the
+ * light's rim) get edge_samples more. With the scene's materials given, a hit on a surface
+ * with Ks > 0 also sends a mirror ray, weighted by Ks, whose hit is shaded the same way
+ * (the radiosity solution replaces Whitted's ambient term), up to a depth.
+ * Random numbers come from (seed, pixel). With the scene's albedo textures, a textured
+ * patch's vertices hold the irradiance (B - E) / (pi rho_avg) instead, and a hit shows
+ * L_e + texel albedo x that, so texture detail finer than the patches survives.
+ */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/random.h"
+#include "core/rgb.h"
+#include "core/tolerance.h"
+#include "core/vec3.h"
+#include "render/camera.h"
+#include "reconstruct/display_mesh.h"
+#include "scene/texture.h"
+#include "trace/ray.h"
+
+#define MAX_STRATA 16u
+#define DEFAULT_MAX_DEPTH 5u
+#define DEFAULT_EDGE_SAMPLES 64u /* extra samples for an edge pixel */
+#define EDGE_CONTRAST 0.1        /* relative luminance spread that makes an edge */
+#define EDGE_STREAM 0x5EED0EDCEull /* keeps edge samples' random numbers apart */
+
+/* One thread's rays of one image row, compacted bounce by bounce. */
+typedef struct row_work {
+    rad_ray *rays;
+    rad_hit *hits;
+    rad_rgb *weight;  /* product of the Ks met so far */
+    uint32_t *sample; /* the sample (pixel x, stratum) a ray belongs to */
+    rad_rgb *sum;     /* radiance gathered per sample: first samples, then edge samples */
+    uint8_t *edge;    /* per pixel of the row: gets edge samples */
+    double *level;    /* per pixel of the row: mean luminance of its first samples */
+} row_work;
+
+typedef struct shading {
+    const rad_mesh *mesh;
+    const uint32_t (*triangles)[3]; /* render triangles, into mesh vertices */
+    const uint32_t *patch_of;       /* render triangle -> patch */
+    const rad_rgb *radiance;        /* per mesh vertex */
+    const rad_material *materials;  /* NULL: no mirror rays */
+    float t_near;
+    double leave;                   /* how far mirror rays start off a surface (scene units) */
+    const albedo_lookup *textures;  /* NULL: no textured surface */
+    const rad_material *scene_materials; /* for textured hits: L_e */
+    const rad_rgb *patch_albedo;    /* per patch: the average the solve used */
+} shading;
+
+static double mean_luminance(const rad_rgb *samples, unsigned count)
+{
+    double mean = 0;
+    for (unsigned s = 0; s < count; s++)
+        mean += rgb_luminance(samples[s]);
+    return mean / count;
+}
+
+/* Two neighbouring pixels' luminances differ by more than EDGE_CONTRAST of the larger. */
+static bool is_step(double a, double b) { return fabs(a - b) > EDGE_CONTRAST * fmax(a, b); }
+
+/* A pixel is an edge when the luminance of its first samples spreads by more than
+ * EDGE_CONTRAST of their mean. */
+static bool is_edge(const rad_rgb *samples, unsigned count, double mean)
+{
+    double lo = INFINITY, hi = 0;
+    for (unsigned s = 0; s < count; s++) {
+        double y = rgb_luminance(samples[s]);
+        lo = fmin(lo, y);
+        hi = fmax(hi, y);
+    }
+    return hi - lo > EDGE_CONTRAST * mean;
+}
+
+/* A textured patch's radiance at a hit: L_e + texel albedo x interpolated irradiance. */
+static rad_rgb textured_radiance(const shading *sh, const rad_ray *ray, const rad_hit *hit,
+                                 uint32_t patch_index, rad_rgb irradiance)
+{
+    const rad_patch *patch = &sh->mesh->patches[patch_index];
+    rad_vec3 point = v3(ray->origin[0] + (double)hit->t * ray->direction[0],
+                        ray->origin[1] + (double)hit->t * ray->direction[1],
+                        ray->origin[2] + (double)hit->t * ray->direction[2]);
+    rad_rgb albedo = sh->patch_albedo[patch_index];
+    albedo_lookup_at(sh->textures, point, patch->normal, 2 * patch->bulge, &albedo);
+    return rgb_add(sh->scene_materials[patch->material].emission, rgb_mul(albedo, irradiance));
+}
+
+/* Adds each hit's interpolated radiance (times the ray's weight) to its sample and, when
+ * mirrors are allowed, writes the mirror rays of specular hits to the front of the arrays.
+ * Returns how many rays are left for the next bounce. */
+static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool mirrors)
+{
+    uint32_t next = 0;
+    for (uint32_t r = 0; r < count; r++) {
+        const rad_hit *hit = &w->hits[r];
+        if (hit->triangle == RAD_NO_HIT || !hit->front)
+            continue;
+        const uint32_t *v = sh->triangles[hit->triangle];
+        const rad_rgb *L = sh->radiance;
+        rad_rgb weight = w->weight[r];
+        rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit->u - hit->v),
+                                       rgb_add(rgb_scale(L[v[1]], hit->u), rgb_scale(L[v[2]], hit->v)));
+        uint32_t patch_index = sh->patch_of[hit->triangle];
+        if (sh->textures &&
+            albedo_lookup_textured(sh->textures, sh->mesh->patches[patch_index].material))
+            interpolated = textured_radiance(sh, &w->rays[r], hit, patch_index, interpolated);
+        rgb_add_to(&w->sum[w->sample[r]], rgb_mul(weight, interpolated));
+        if (!mirrors || !sh->materials)
+            continue;
+        const rad_patch *patch = &sh->mesh->patches[sh->patch_of[hit->triangle]];
+        rad_rgb ks = sh->materials[patch->material].specular;
+        if (!(ks.r > 0 || ks.g > 0 || ks.b > 0))
+            continue;
+        const rad_ray *ray = &w->rays[r];
+        rad_vec3 d = v3(ray->direction[0], ray->direction[1], ray->direction[2]);
+        rad_vec3 p = v3(ray->origin[0] + hit->t * d.x, ray->origin[1] + hit->t * d.y,
+                        ray->origin[2] + hit->t * d.z);
+        rad_vec3 n = patch->normal;
+        rad_vec3 mirror = v3_normalize(v3_sub(d, v3_scale(n, 2 * v3_dot(d, n))));
+        /* leave the surface on its front side: nudged along the normal, past the float
+         * rounding of the hit point */
+        rad_vec3 origin = v3_add(p, v3_scale(n, sh->leave));
+        w->weight[next] = rgb_mul(weight, ks);
+        w->sample[next] = w->sample[r];
+        ray_set(&w->rays[next], origin, mirror, sh->t_near, INFINITY);
+        next++;
+    }
+    return next;
+}
+
+static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work *w,
+                          uint32_t count, unsigned max_depth)
+{
+    for (unsigned depth = 0; count > 0; depth++) {
+        rad_tracer_intersect(tracer, w->rays, count, w->hits);
+        count = shade_hits(sh, w, count, depth < max_depth);
+    }
+}
+
+/* With textures: the lookup, each patch's average albedo, and the per-patch values to
+ * reconstruct: (B - E) / rho_avg on textured patches (0 where rho_avg is 0), B elsewhere.
+ * All NULL when the scene has no textured triangle. */
+static rad_status textures_begin(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
+                                 albedo_lookup **lookup, rad_rgb **patch_albedo,
+                                 rad_rgb **shaded, rad_error *error)
+{
+    *lookup = NULL;
+    *patch_albedo = *shaded = NULL;
+    if (!scene || scene->texture_count == 0)
+        return RAD_OK;
+    rad_status status = albedo_lookup_create(scene, lookup, error);
+    if (status != RAD_OK || !*lookup)
+        return status;
+    *patch_albedo = rad_alloc_array(mesh->patch_count, sizeof(**patch_albedo));
+    *shaded = rad_alloc_array(mesh->patch_count, sizeof(**shaded));
+    if (!*patch_albedo || !*shaded)
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for textures");
+    status = rad_patch_albedo(scene, mesh, *patch_albedo, error);
+    if (status != RAD_OK)
+        return status;
+    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        uint32_t m = mesh->patches[p].material;
+        if (!albedo_lookup_textured(*lookup, m)) {
+            (*shaded)[p] = B[p];
+            continue;
+        }
+        const double *b = &B[p].r, *e = &scene->materials[m].emission.r;
+        const double *rho = &(*patch_albedo)[p].r;
+        double *out = &(*shaded)[p].r;
+        for (int c = 0; c < 3; c++)
+            out[c] = rho[c] > 0 ? (b[c] - RAD_PI * e[c]) / rho[c] : 0;
+    }
+    return RAD_OK;
+}
+
+rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
+                      const rad_render_options *options, rad_image *image, rad_error *error)
+{
+    rad_render_options defaults = {0};
+    if (!options)
+        options = &defaults;
+    uint32_t W = image->width, H = image->height;
+    camera_frame frame;
+    rad_status status = camera_frame_make(camera, W, H, &frame, error);
+    if (status != RAD_OK)
+        return status;
+    unsigned spp = options->samples_per_pixel ? options->samples_per_pixel : 16;
+    unsigned k = (unsigned)lround(sqrt((double)spp));
+    k = k < 1 ? 1 : k > MAX_STRATA ? MAX_STRATA : k;
+    if (options->threads < 0)
+        return rad_fail(error, RAD_ERR_INVALID, "render: thread count %d is negative",
+                        options->threads);
+    int threads = options->threads > 0 ? options->threads : omp_get_max_threads();
+
+    /* the display triangles (patches split through their T-vertices) and the radiance at
+     * each vertex */
+    display_mesh display = {0};
+    rad_rgb *radiance = NULL;
+    rad_vec3 *positions = NULL;
+    rad_tracer *tracer = NULL;
+    row_work *work = NULL;
+    albedo_lookup *lookup = NULL;
+    rad_rgb *patch_albedo = NULL, *shaded = NULL;
+    status = display_mesh_build(mesh, true, &display, error);
+    if (status != RAD_OK)
+        goto done;
+    radiance = rad_alloc_array(display.vertex_count, sizeof(*radiance));
+    positions = rad_alloc_array(display.vertex_count, sizeof(*positions));
+    if (!radiance || !positions)
+        goto nomem;
+    display_mesh_positions(mesh, &display, positions);
+    status = textures_begin(options->scene, mesh, B, &lookup, &patch_albedo, &shaded, error);
+    if (status != RAD_OK)
+        goto done;
+    display_mesh_radiance(mesh, &display, shaded ? shaded : B, radiance);
+    status = rad_tracer_create(RAD_TRACER_EMBREE, positions, display.vertex_count,
+                               (const uint32_t(*)[3])display.triangles, display.triangle_count,
+                               &tracer, error);
+    if (status != RAD_OK)
+        goto done;
+
+    rad_vec3 lo, hi;
+    v3_bounds(mesh->vertices, mesh->vertex_count, &lo, &hi);
+    double diagonal = mesh->vertex_count ? v3_length(v3_sub(hi, lo)) : 1;
+    float t_near = (float)(RAD_CAMERA_NEAR * diagonal);
+    double largest = fmax(fmax(fmax(fabs(lo.x), fabs(hi.x)), fmax(fabs(lo.y), fabs(hi.y))),
+                          fmax(fabs(lo.z), fabs(hi.z)));
+    /* hit points are float: their error grows with the distance from the origin */
+    double leave = RAD_SURFACE_LEAVE_DIAGONAL * diagonal + RAD_SURFACE_LEAVE_COORDINATE * largest;
+
+    size_t per_row = (size_t)W * k * k;
+    unsigned edge_k = (unsigned)lround(sqrt((double)(options->edge_samples ? options->edge_samples
+                                                                          : DEFAULT_EDGE_SAMPLES)));
+    edge_k = edge_k < 1 ? 1 : edge_k > MAX_STRATA ? MAX_STRATA : edge_k;
+    size_t per_row_edges = (size_t)W * edge_k * edge_k;
+    size_t ray_capacity = per_row > per_row_edges ? per_row : per_row_edges;
+    unsigned max_depth = options->max_depth ? options->max_depth : DEFAULT_MAX_DEPTH;
+    work = rad_alloc_array((size_t)threads, sizeof(*work));
+    if (!work)
+        goto nomem;
+    for (int th = 0; th < threads; th++) {
+        row_work *w = &work[th];
+        w->rays = rad_alloc_array(ray_capacity, sizeof(*w->rays));
+        w->hits = rad_alloc_array(ray_capacity, sizeof(*w->hits));
+        w->weight = rad_alloc_array(ray_capacity, sizeof(*w->weight));
+        w->sample = rad_alloc_array(ray_capacity, sizeof(*w->sample));
+        w->sum = rad_alloc_array(per_row + per_row_edges, sizeof(*w->sum));
+        w->edge = rad_alloc_array(W, sizeof(*w->edge));
+        w->level = rad_alloc_array(W, sizeof(*w->level));
+        if (!w->rays || !w->hits || !w->weight || !w->sample || !w->sum || !w->edge || !w->level)
+            goto nomem;
+    }
+    shading shade = {mesh, (const uint32_t(*)[3])display.triangles, display.patch_of, radiance,
+                     options->materials,
+                     t_near, leave, lookup, options->scene ? options->scene->materials : NULL,
+                     patch_albedo};
+
+    uint32_t rows_done = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (uint32_t y = 0; y < H; y++) {
+        int thread = omp_get_thread_num();
+        row_work *w = &work[thread];
+        for (uint32_t x = 0; x < W; x++) {
+            rad_rng rng = rad_rng_seed(options->seed, y, x);
+            for (unsigned s = 0; s < k * k; s++) {
+                double px = x + ((s % k) + rad_rng_uniform(&rng)) / k;
+                double py = y + ((s / k) + rad_rng_uniform(&rng)) / k;
+                rad_vec3 d = v3_normalize(camera_direction(&frame, px, py, W, H));
+                size_t index = (size_t)x * k * k + s;
+                ray_set(&w->rays[index], frame.eye, d, t_near, INFINITY);
+                w->weight[index] = (rad_rgb){1, 1, 1};
+                w->sample[index] = (uint32_t)index;
+                w->sum[index] = (rad_rgb){0, 0, 0};
+            }
+        }
+        trace_samples(&shade, tracer, w, (uint32_t)per_row, max_depth);
+
+        /* edges: pixels whose first samples disagree (a silhouette, the light's rim) get
+         * edge_k x edge_k more, so that high-contrast edges are antialiased */
+        uint32_t extra = 0;
+        for (uint32_t x = 0; x < W; x++)
+            w->level[x] = mean_luminance(&w->sum[(size_t)x * k * k], k * k);
+        for (uint32_t x = 0; x < W; x++) {
+            /* an edge shows inside the pixel's samples, or as a step to a row neighbour
+             * (samples that all fell on one side of an edge crossing the pixel) */
+            w->edge[x] = is_edge(&w->sum[(size_t)x * k * k], k * k, w->level[x]) ||
+                         (x > 0 && is_step(w->level[x], w->level[x - 1])) ||
+                         (x + 1 < W && is_step(w->level[x], w->level[x + 1]));
+            if (!w->edge[x])
+                continue;
+            rad_rng rng = rad_rng_seed(options->seed ^ EDGE_STREAM, y, x);
+            for (unsigned s = 0; s < edge_k * edge_k; s++) {
+                double px = x + ((s % edge_k) + rad_rng_uniform(&rng)) / edge_k;
+                double py = y + ((s / edge_k) + rad_rng_uniform(&rng)) / edge_k;
+                rad_vec3 d = v3_normalize(camera_direction(&frame, px, py, W, H));
+                size_t index = per_row + extra++;
+                ray_set(&w->rays[index - per_row], frame.eye, d, t_near, INFINITY);
+                w->weight[index - per_row] = (rad_rgb){1, 1, 1};
+                w->sample[index - per_row] = (uint32_t)index;
+                w->sum[index] = (rad_rgb){0, 0, 0};
+            }
+        }
+        if (extra)
+            trace_samples(&shade, tracer, w, extra, max_depth);
+
+        uint32_t next_extra = 0;
+        for (uint32_t x = 0; x < W; x++) {
+            rad_rgb sum = {0, 0, 0};
+            unsigned count = k * k;
+            for (unsigned s = 0; s < k * k; s++)
+                rgb_add_to(&sum, w->sum[(size_t)x * k * k + s]);
+            if (w->edge[x]) {
+                for (unsigned s = 0; s < edge_k * edge_k; s++)
+                    rgb_add_to(&sum, w->sum[per_row + next_extra++]);
+                count += edge_k * edge_k;
+            }
+            float *pixel = &image->rgb[((size_t)y * W + x) * 3];
+            pixel[0] = (float)(sum.r / count);
+            pixel[1] = (float)(sum.g / count);
+            pixel[2] = (float)(sum.b / count);
+        }
+        uint32_t done;
+#pragma omp atomic capture
+        done = ++rows_done;
+        if (thread == 0 && options->progress)
+            options->progress(options->progress_user, "render", (double)done / H);
+    }
+    if (options->progress)
+        options->progress(options->progress_user, "render", 1);
+    goto done;
+nomem:
+    status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for rendering");
+done:
+    if (work)
+        for (int th = 0; th < threads; th++) {
+            free(work[th].rays);
+            free(work[th].hits);
+            free(work[th].weight);
+            free(work[th].sample);
+            free(work[th].sum);
+            free(work[th].edge);
+            free(work[th].level);
+        }
+    free(work);
+    rad_tracer_destroy(tracer);
+    display_mesh_free(&display);
+    free(radiance);
+    free(positions);
+    albedo_lookup_destroy(lookup);
+    free(patch_albedo);
+    free(shaded);
+    return status;
+}

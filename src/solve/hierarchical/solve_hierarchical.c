@@ -1,0 +1,378 @@
+/*
+ * solve_hierarchical.c - rad_solve_hierarchical: refinement alternating with Jacobi
+ * gathering over links and push-pull between levels.
+ *
+ * A sweep: every node gathers H = sum over its links of transfer x B(source) (parallel over
+ * nodes, links sorted by receiver); push adds each node's H to everything below it
+ * (preorder: one forward loop); every patch takes B = E + rho H; pull makes every node's B
+ * the area-weighted mean of its children's (one backward loop). The outer loop refines the
+ * links one level with the newest B and sweeps twice, until nothing splits; then it sweeps
+ * to the tolerance and checks refinement once more with the converged B.
+ */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/memory.h"
+#include "core/minmax.h"
+#include "core/rgb.h"
+#include "core/vec3.h"
+#include "solve/hierarchical/final_gather.h"
+#include "solve/hierarchical/hierarchy.h"
+
+#define DEFAULT_THRESHOLD 0.25
+#define DEFAULT_TOLERANCE 1e-4
+#define DEFAULT_MAX_SWEEPS 1000u
+#define DEFAULT_VISIBILITY_RAYS 16u
+#define SWEEPS_PER_PASS 1u
+#define MAX_CORRECTION_FACTOR 1.0
+#define FULL_CHECK_EVERY 8u /* passes; the others look only at links not settled */
+#define MAX_PASSES 256u
+
+typedef struct hsolver {
+    const rad_scene *scene;
+    const rad_mesh *mesh;
+    hier_tree tree;
+    rad_rgb *emission, *albedo; /* per patch */
+    rad_rgb *node_B, *gathered, *down;
+    rad_rgb *correction, *scale; /* per node (leaves only): the final gather's, or NULL:
+                                    a leaf gathers down x scale + correction */
+    rad_rgb *patch_B;           /* per patch */
+    float *brightness;          /* B.r + B.g + B.b by leaf-order position */
+    size_t *offsets;            /* links by receiver: node k's are [offsets[k], offsets[k+1]) */
+    link_store store;
+    double emitted;             /* sum A |E|_1 */
+    int threads;
+} hsolver;
+
+static double now_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void pull(hsolver *s)
+{
+    const hier_tree *t = &s->tree;
+    for (uint32_t k = t->node_count; k-- > 0;) {
+        const hnode *n = &t->nodes[k];
+        if (n->patch != HNODE_NONE) {
+            s->node_B[k] = s->patch_B[n->patch];
+            continue;
+        }
+        const hnode *a = &t->nodes[n->child[0]], *b = &t->nodes[n->child[1]];
+        double wa = n->area > 0 ? a->area / n->area : 0.5, wb = n->area > 0 ? b->area / n->area : 0.5;
+        s->node_B[k] = rgb_add(rgb_scale(s->node_B[n->child[0]], wa),
+                               rgb_scale(s->node_B[n->child[1]], wb));
+    }
+}
+
+/* Stable counting sort of the links by receiver into the spare buffer, then swap. */
+static void sort_by_receiver(hsolver *s)
+{
+    link_store *st = &s->store;
+    uint32_t nodes = s->tree.node_count;
+    memset(s->offsets, 0, ((size_t)nodes + 1) * sizeof(size_t));
+    for (size_t l = 0; l < st->count; l++)
+        s->offsets[st->links[l].receiver + 1]++;
+    for (uint32_t k = 0; k < nodes; k++)
+        s->offsets[k + 1] += s->offsets[k];
+    for (size_t l = 0; l < st->count; l++)
+        st->spare[s->offsets[st->links[l].receiver]++] = st->links[l];
+    for (uint32_t k = nodes; k > 0; k--)
+        s->offsets[k] = s->offsets[k - 1];
+    s->offsets[0] = 0;
+    hlink *swap = st->links;
+    st->links = st->spare;
+    st->spare = swap;
+}
+
+/* One Jacobi sweep with push-pull; returns the relative change. */
+static double sweep(hsolver *s)
+{
+    const hier_tree *t = &s->tree;
+    const hlink *links = s->store.links;
+    int64_t nodes = t->node_count;
+#pragma omp parallel for num_threads(s->threads) schedule(dynamic, 256)
+    for (int64_t k = 0; k < nodes; k++) {
+        rad_rgb sum = {0, 0, 0};
+        for (size_t l = s->offsets[k]; l < s->offsets[k + 1]; l++)
+            rgb_add_to(&sum, rgb_scale(s->node_B[links[l].source], links[l].transfer));
+        s->gathered[k] = sum;
+    }
+    double change = 0;
+    for (uint32_t k = 0; k < t->node_count; k++) {
+        const hnode *n = &t->nodes[k];
+        s->down[k] = n->parent == HNODE_NONE ? s->gathered[k]
+                                             : rgb_add(s->down[n->parent], s->gathered[k]);
+        if (n->patch != HNODE_NONE) {
+            uint32_t p = n->patch;
+            rad_rgb h = s->down[k];
+            if (s->correction)
+                h = rgb_add(rgb_mul(h, s->scale[k]), s->correction[k]);
+            rad_rgb b = rgb_add(s->emission[p], rgb_mul(s->albedo[p], h));
+            change += n->area * (fabs(b.r - s->patch_B[p].r) + fabs(b.g - s->patch_B[p].g) +
+                                 fabs(b.b - s->patch_B[p].b));
+            s->patch_B[p] = b;
+        }
+    }
+    pull(s);
+    return s->emitted > 0 ? change / s->emitted : 0;
+}
+
+/* One channel of the final gather's correction c to what comes down d: as a factor where d
+ * is positive (the correction then moves with B), at most MAX_CORRECTION_FACTOR = 1 (a
+ * factor above 1 raises the sweeps' operator, which can then diverge in a bright
+ * enclosure); the rest is added, a constant that cannot. */
+static void as_scale(double d, double *c, double *factor)
+{
+    *factor = 1;
+    if (d > 0 && d + *c >= 0) {
+        *factor = min_d((d + *c) / d, MAX_CORRECTION_FACTOR);
+        *c = d + *c - *factor * d;
+    }
+}
+
+static void update_brightness(hsolver *s)
+{
+    for (uint32_t k = 0; k < s->mesh->patch_count; k++) {
+        rad_rgb b = s->patch_B[s->tree.order[k]];
+        s->brightness[k] = (float)(b.r + b.g + b.b);
+    }
+}
+
+static void hsolver_free(hsolver *s)
+{
+    hier_tree_free(&s->tree);
+    free(s->emission);
+    free(s->albedo);
+    free(s->node_B);
+    free(s->gathered);
+    free(s->down);
+    free(s->correction);
+    free(s->scale);
+    free(s->patch_B);
+    free(s->brightness);
+    free(s->offsets);
+    free(s->store.links);
+    free(s->store.spare);
+}
+
+static bool stopped(const rad_hierarchy_options *o) { return o->stop && *o->stop; }
+
+rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
+                                  const rad_tracer *occluders,
+                                  const rad_hierarchy_options *options, rad_rgb *B,
+                                  rad_hierarchy_report *report, rad_error *error)
+{
+    rad_hierarchy_options o = {0};
+    if (options)
+        o = *options;
+    rad_hierarchy_report rep = {0};
+    if (o.threads < 0)
+        return rad_fail(error, RAD_ERR_INVALID, "threads must be 0 (all cores) or positive");
+    if (!(o.refine_threshold >= 0) || !isfinite(o.refine_threshold))
+        return rad_fail(error, RAD_ERR_INVALID, "the refinement threshold must be >= 0");
+    if (!(o.tolerance >= 0))
+        return rad_fail(error, RAD_ERR_INVALID, "the tolerance must be >= 0");
+    double threshold = o.refine_threshold > 0 ? o.refine_threshold : DEFAULT_THRESHOLD;
+    double tolerance = o.tolerance > 0 ? o.tolerance : DEFAULT_TOLERANCE;
+    uint32_t max_sweeps = o.max_sweeps ? o.max_sweeps : DEFAULT_MAX_SWEEPS;
+    unsigned rays = o.visibility_rays ? o.visibility_rays : DEFAULT_VISIBILITY_RAYS;
+    uint64_t budget = o.max_memory;
+    if (budget == 0)
+        budget = rad_physical_memory_bytes() / 2;
+    if (budget == 0)
+        budget = UINT64_MAX;
+
+    hsolver s;
+    memset(&s, 0, sizeof(s));
+    s.scene = scene;
+    s.mesh = mesh;
+    s.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+    rep.threads = s.threads;
+    uint32_t n = mesh->patch_count;
+    double t0 = now_seconds();
+    if (n == 0) {
+        if (report)
+            *report = rep;
+        return RAD_OK;
+    }
+    if (!hier_tree_build(mesh, &s.tree))
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory building the element tree");
+    uint32_t nodes = s.tree.node_count;
+    s.emission = rad_alloc_array(n, sizeof(rad_rgb));
+    s.albedo = rad_alloc_array(n, sizeof(rad_rgb));
+    s.patch_B = rad_alloc_array(n, sizeof(rad_rgb));
+    s.brightness = rad_alloc_array(n, sizeof(float));
+    s.node_B = rad_alloc_array(nodes, sizeof(rad_rgb));
+    s.gathered = rad_alloc_array(nodes, sizeof(rad_rgb));
+    s.down = rad_alloc_array(nodes, sizeof(rad_rgb));
+    s.offsets = rad_alloc_array((size_t)nodes + 1, sizeof(size_t));
+    if (!s.emission || !s.albedo || !s.patch_B || !s.node_B || !s.gathered || !s.down ||
+        !s.offsets || !s.brightness) {
+        hsolver_free(&s);
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the hierarchy");
+    }
+    double brightest_total = 0;
+    for (uint32_t p = 0; p < n; p++) {
+        const rad_material *m = &scene->materials[mesh->patches[p].material];
+        s.emission[p] = rgb_scale(m->emission, 3.14159265358979323846);
+        s.albedo[p] = m->albedo;
+        s.patch_B[p] = s.emission[p];
+        double a = mesh->patches[p].area;
+        s.emitted += a * (s.emission[p].r + s.emission[p].g + s.emission[p].b);
+        brightest_total += a * fmax(s.emission[p].r, fmax(s.emission[p].g, s.emission[p].b));
+    }
+    pull(&s);
+    rep.leaves = n;
+    rep.elements = s.tree.planar_count;
+    rep.clusters = s.tree.cluster_count;
+    rep.seconds_build = now_seconds() - t0;
+
+    s.store.max_bytes = budget;
+    bool root_cluster = !s.tree.nodes[0].planar;
+    if (root_cluster && s.emitted > 0) {
+        if (2 * sizeof(hlink) > budget) {
+            hsolver_free(&s);
+            return rad_fail(error, RAD_ERR_NOMEM, "--max-memory: %llu bytes cannot hold a link",
+                            (unsigned long long)budget);
+        }
+        s.store.links = malloc(sizeof(hlink));
+        s.store.spare = malloc(sizeof(hlink));
+        if (!s.store.links || !s.store.spare) {
+            hsolver_free(&s);
+            return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the links");
+        }
+        s.store.capacity = 1;
+        s.store.count = 1;
+        s.store.links[0] = (hlink){0, 0, 0, INFINITY, (uint16_t)LINK_VISIBLE, 0};
+        s.store.peak_bytes = 2 * sizeof(hlink);
+    }
+    refine_context rc = {mesh,
+                         &s.tree,
+                         occluders,
+                         s.node_B,
+                         s.brightness,
+                         threshold * brightest_total / n,
+                         true,
+                         rays,
+                         o.seed,
+                         s.threads};
+
+    double residual = s.emitted > 0 ? 1 : 0;
+    bool refining = s.store.count > 0, converged = false;
+    uint32_t quiet_passes = 0;
+    while (!stopped(&o) && rep.sweeps < max_sweeps) {
+        size_t split = 0;
+        if (refining && !rep.memory_capped && rep.passes < MAX_PASSES) {
+            double tr = now_seconds();
+            refine_result rr;
+            update_brightness(&s);
+            rc.full_check = quiet_passes > 0 || rep.passes % FULL_CHECK_EVERY == 0;
+            if (!hier_refine_pass(&rc, &s.store, &rr)) {
+                hsolver_free(&s);
+                return rad_fail(error, RAD_ERR_NOMEM, "out of memory refining the links");
+            }
+            rep.passes++;
+            rep.rays += rr.rays;
+            split = rr.split;
+            if (rr.capped)
+                rep.memory_capped = true;
+            rep.seconds_refine += now_seconds() - tr;
+            if (o.progress) /* about 4 passes per level of the tree (measured: 87 at 1M
+                                leaves' 21 levels) */
+                o.progress(o.progress_user, "refine",
+                           fmin(0.99, rep.passes / (4.0 * log2((double)nodes + 2) + 8)));
+        }
+        double tg = now_seconds();
+        sort_by_receiver(&s);
+        if (split > 0) {
+            quiet_passes = 0;
+            for (unsigned k = 0; k < SWEEPS_PER_PASS && rep.sweeps < max_sweeps; k++) {
+                residual = sweep(&s);
+                rep.sweeps++;
+            }
+            rep.seconds_gather += now_seconds() - tg;
+            continue;
+        }
+        /* nothing split: sweep to the tolerance, then look once more */
+        double first = residual;
+        while (residual > tolerance && rep.sweeps < max_sweeps && !stopped(&o)) {
+            residual = sweep(&s);
+            rep.sweeps++;
+            if (o.progress && first > tolerance && residual > 0)
+                o.progress(o.progress_user, "gather",
+                           fmin(0.99, fmax(0, log(first / residual) / log(first / tolerance))));
+        }
+        rep.seconds_gather += now_seconds() - tg;
+        if (residual <= tolerance && (quiet_passes > 0 || !refining || rep.memory_capped ||
+                                      rep.passes >= MAX_PASSES)) {
+            converged = true;
+            break;
+        }
+        quiet_passes++;
+        refining = s.store.count > 0;
+    }
+    if (o.progress)
+        o.progress(o.progress_user, "gather", 1);
+    if (!stopped(&o) && s.store.count > 0) {
+        double tf = now_seconds();
+        s.correction = rad_alloc_array(nodes, sizeof(rad_rgb));
+        s.scale = rad_alloc_array(nodes, sizeof(rad_rgb));
+        update_brightness(&s);
+        final_gather_context fg = {mesh,       &s.tree,    occluders,  s.store.links,
+                                   s.offsets,  s.node_B,   s.brightness, rays,
+                                   o.seed + 2, s.threads,  o.progress, o.progress_user,
+                                   o.stop};
+        int gathered = s.correction && s.scale ? hier_final_gather(&fg, s.correction, &rep.rays)
+                                               : 0;
+        if (gathered == 0) {
+            hsolver_free(&s);
+            return rad_fail(error, RAD_ERR_NOMEM, "out of memory in the final gather");
+        }
+        if (gathered < 0) { /* stopped: the solution without it stands */
+            free(s.correction);
+            free(s.scale);
+            s.correction = s.scale = NULL;
+        }
+        /* as a factor on what comes down where that is not 0, so that the correction moves
+         * with B */
+        for (uint32_t k = 0; s.correction && k < nodes; k++) {
+            as_scale(s.down[k].r, &s.correction[k].r, &s.scale[k].r);
+            as_scale(s.down[k].g, &s.correction[k].g, &s.scale[k].g);
+            as_scale(s.down[k].b, &s.correction[k].b, &s.scale[k].b);
+        }
+        double change = s.correction ? 1 : 0;
+        while (change > tolerance && rep.sweeps < max_sweeps && !stopped(&o)) {
+            residual = change = sweep(&s);
+            rep.sweeps++;
+        }
+        converged = converged && change <= tolerance;
+        if (o.progress)
+            o.progress(o.progress_user, "final gather", 1);
+        rep.seconds_final = now_seconds() - tf;
+    }
+    rep.interrupted = stopped(&o);
+    rep.converged = converged && !rep.interrupted;
+    rep.residual = residual;
+    rep.links = s.store.count;
+    for (size_t l = 0; l < s.store.count; l++)
+        rep.links_partial += s.store.links[l].visible < LINK_VISIBLE;
+    rep.link_bytes = s.store.peak_bytes;
+    if (!isfinite(residual)) { /* never hand out a diverged answer as a solution */
+        hsolver_free(&s);
+        return rad_fail(error, RAD_ERR_INTERNAL,
+                        "the hierarchical solution diverged (a bug: please report the scene)");
+    }
+    memcpy(B, s.patch_B, (size_t)n * sizeof(rad_rgb));
+    hsolver_free(&s);
+    if (report)
+        *report = rep;
+    return RAD_OK;
+}

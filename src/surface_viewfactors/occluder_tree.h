@@ -1,0 +1,32 @@
+/*
+ * occluder_tree.h - "could anything block the view between these two polygons?"
+ *
+ * A bounding-volume tree over every scene triangle (obstructions included), queried with
+ * the convex hull of two polygons: every segment between them lies inside that hull, so a
+ * triangle that is separated from the hull cannot block any of them. The answer is
+ * conservative: `false` means provably unobstructed (the analytic value is exact), `true`
+ * means some triangle may block and visibility must be sampled.
+ */
+#ifndef RAD_VIEWFACTOR_OCCLUDER_TREE_H
+#define RAD_VIEWFACTOR_OCCLUDER_TREE_H
+
+#include "radiosity.h"
+#include "surface_viewfactors/shadow_clip.h"
+#include "surface_viewfactors/vf_geometry.h"
+
+typedef struct occluder_tree occluder_tree;
+
+/* triangle_source: per scene triangle, the radiating polygon covering it (its own
+ * triangles never block a polygon's view), or UINT32_MAX (vf_geometry.triangle_source). */
+rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_source,
+                               occluder_tree **out, rad_error *error);
+void occluder_tree_destroy(occluder_tree *tree);
+
+/* The triangles other than the polygons' own that may cut the hull of p and q (touching
+ * the hull's boundary within epsilon, scene units, does not count): their corners go to
+ * `out` (room for `max`); returns how many, or max + 1 when there are more. */
+uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
+                               const vf_polygon *q, double epsilon, shadow_occluder *out,
+                               uint32_t max);
+
+#endif

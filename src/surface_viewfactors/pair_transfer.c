@@ -1,0 +1,267 @@
+/*
+ * pair_transfer.c - polygon-to-polygon transfer, see pair_transfer.h.
+ */
+#include "surface_viewfactors/pair_transfer.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/alloc.h"
+#include "core/random.h"
+#include "core/tolerance.h"
+#include "core/vec3.h"
+#include "geometry/contour.h"
+#include "trace/ray.h"
+
+/* Deepest subdivision of the outer triangle: 4^12 cells would be far past any need. */
+#define MAX_DEPTH 12
+
+/* The same behind occluders, where the integrand has kinks along penumbra edges and each
+ * point costs more: what is left at this depth is reported in the error bound. */
+#define OBSTRUCTED_MAX_DEPTH 8
+
+/* Exact shadow clipping may spend this many (point, occluder) clippings on one pair, about
+ * a millisecond; a pair that needs more is sampled instead, so the run time stays
+ * predictable. */
+#define EXACT_WORK_BUDGET 4096u
+
+/* Largest k of a round's k x k stratified segments per replicate. */
+#define MAX_STRATA 32u
+
+/* The 7-point degree-5 rule on a triangle (Radon; Strang and Fix): barycentric points. */
+static const double rule_a1 = 0.059715871789769820, rule_b1 = 0.470142064105115090;
+static const double rule_a2 = 0.797426985353087322, rule_b2 = 0.101286507323456338;
+static const double rule_w0 = 0.225, rule_w1 = 0.132394152788506181,
+                    rule_w2 = 0.125939180544827153;
+
+typedef struct outer_context {
+    rad_vec3 normal;         /* of the outer polygon */
+    const vf_polygon *inner;
+    double plane_epsilon;
+    const shadow_occluder *occluders; /* what may stand in between (none: unobstructed) */
+    uint32_t occluder_count;
+    int max_depth;
+    uint64_t work_left;      /* occluder clippings this pair may still spend */
+    bool failed;             /* too many pieces somewhere, or the work budget ran out */
+} outer_context;
+
+static inline double point_factor(outer_context *c, rad_vec3 x)
+{
+    if (c->occluder_count == 0)
+        return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
+                                        c->inner->normal, c->plane_epsilon);
+    if (c->failed || c->work_left < c->occluder_count) {
+        c->failed = true;
+        return 0;
+    }
+    c->work_left -= c->occluder_count;
+    double factor = shadow_visible_factor(x, c->normal, c->inner, c->occluders,
+                                          c->occluder_count, c->plane_epsilon);
+    if (factor < 0) {
+        c->failed = true;
+        return 0;
+    }
+    return factor;
+}
+
+static inline rad_vec3 barycentric(rad_vec3 a, rad_vec3 b, rad_vec3 c, double u, double v,
+                                   double w)
+{
+    return v3(u * a.x + v * b.x + w * c.x, u * a.y + v * b.y + w * c.y,
+              u * a.z + v * b.z + w * c.z);
+}
+
+/* The 7-point rule times the area; *centre receives the 1-point (centroid) rule. */
+static double rule7(outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d, double area,
+                    double *centre)
+{
+    double f0 = point_factor(c, barycentric(a, b, d, 1.0 / 3, 1.0 / 3, 1.0 / 3));
+    double s1 = point_factor(c, barycentric(a, b, d, rule_a1, rule_b1, rule_b1)) +
+                point_factor(c, barycentric(a, b, d, rule_b1, rule_a1, rule_b1)) +
+                point_factor(c, barycentric(a, b, d, rule_b1, rule_b1, rule_a1));
+    double s2 = point_factor(c, barycentric(a, b, d, rule_a2, rule_b2, rule_b2)) +
+                point_factor(c, barycentric(a, b, d, rule_b2, rule_a2, rule_b2)) +
+                point_factor(c, barycentric(a, b, d, rule_b2, rule_b2, rule_a2));
+    *centre = f0 * area;
+    return (rule_w0 * f0 + rule_w1 * s1 + rule_w2 * s2) * area;
+}
+
+/* Integral over triangle (a, b, d) whose rule7 value is `whole`; *error accumulates the
+ * estimated error of what is returned. */
+static double adapt(outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d, double area,
+                    double whole, double tolerance, int depth, double *error)
+{
+    rad_vec3 ab = v3_scale(v3_add(a, b), 0.5), bd = v3_scale(v3_add(b, d), 0.5),
+             da = v3_scale(v3_add(d, a), 0.5);
+    double quarter = 0.25 * area, unused;
+    double part[4] = {rule7(c, a, ab, da, quarter, &unused), rule7(c, ab, b, bd, quarter, &unused),
+                      rule7(c, da, bd, d, quarter, &unused), rule7(c, ab, bd, da, quarter, &unused)};
+    double sum = part[0] + part[1] + part[2] + part[3];
+    double difference = fabs(sum - whole);
+    if (difference <= tolerance || depth >= c->max_depth || c->failed) {
+        *error += difference;
+        return sum;
+    }
+    double t = 0.5 * tolerance;
+    return adapt(c, a, ab, da, quarter, part[0], t, depth + 1, error) +
+           adapt(c, ab, b, bd, quarter, part[1], t, depth + 1, error) +
+           adapt(c, da, bd, d, quarter, part[2], t, depth + 1, error) +
+           adapt(c, ab, bd, da, quarter, part[3], t, depth + 1, error);
+}
+
+static double integrate_triangle(outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d,
+                                 double accuracy, double *error)
+{
+    double area = 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(d, a)));
+    double centre;
+    double whole = rule7(c, a, b, d, area, &centre);
+    /* the floor keeps a pair that transfers (almost) nothing from refining forever */
+    double tolerance = fmax(accuracy * fabs(whole), 1e-15 * area);
+    if (fabs(whole - centre) <= tolerance) {
+        /* the 1-point rule already agrees: the degree-5 value is far better than that */
+        *error += fabs(whole - centre);
+        return whole;
+    }
+    return adapt(c, a, b, d, area, whole, tolerance, 1, error);
+}
+
+/* G = int over the smaller polygon of F(x -> the other, as far as it is visible). */
+static double integrate_outer(outer_context *c, const vf_polygon *outer, double accuracy,
+                              double *bound)
+{
+    double error = 0, sum = 0;
+    /* each fan triangle to the relative accuracy: so is their sum */
+    for (unsigned k = 1; k + 1 < outer->count; k++)
+        sum += integrate_triangle(c, outer->vertex[0], outer->vertex[k], outer->vertex[k + 1],
+                                  accuracy, &error);
+    *bound = error;
+    return sum;
+}
+
+double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accuracy,
+                         double plane_epsilon, double *bound)
+{
+    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
+    outer_context c = {outer->normal, inner, plane_epsilon, NULL, 0, MAX_DEPTH, 0, false};
+    return integrate_outer(&c, outer, accuracy, bound);
+}
+
+bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
+                           const shadow_occluder *occluders, uint32_t occluder_count,
+                           double accuracy, double plane_epsilon, double *value, double *bound)
+{
+    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
+    outer_context c = {outer->normal,       inner, plane_epsilon, occluders, occluder_count,
+                       OBSTRUCTED_MAX_DEPTH, EXACT_WORK_BUDGET, false};
+    *value = integrate_outer(&c, outer, accuracy, bound);
+    return !c.failed;
+}
+
+bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)
+{
+    workspace->capacity = max_rays;
+    workspace->rays = rad_alloc_array(max_rays, sizeof(rad_ray));
+    workspace->occluded = rad_alloc_array(max_rays, 1);
+    workspace->weight = rad_alloc_array(max_rays, sizeof(double));
+    return workspace->rays && workspace->occluded && workspace->weight;
+}
+
+void pair_workspace_free(pair_workspace *workspace)
+{
+    free(workspace->rays);
+    free(workspace->occluded);
+    free(workspace->weight);
+}
+
+/* A point of the polygon from (s, t) in the unit square, uniform in area: a quad picks
+ * one of its two triangles by area with s. */
+static rad_vec3 polygon_point(const vf_polygon *polygon, double s, double t)
+{
+    /* the fan triangle (0, k, k + 1) by area with s, then s rescaled within it */
+    unsigned k = 0;
+    while (k + 3 < polygon->count && s >= polygon->fan[k])
+        k++;
+    double low = k ? polygon->fan[k - 1] : 0, high = polygon->fan[k];
+    s = high > low ? (s - low) / (high - low) : 0;
+    double r = sqrt(fmin(fmax(s, 0), 1));
+    return barycentric(polygon->vertex[0], polygon->vertex[k + 1], polygon->vertex[k + 2], 1 - r,
+                       r * (1 - t), r * t);
+}
+
+/* One round: PAIR_REPLICATES independent stratified sets of k x k segments. */
+static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
+                           uint64_t stream, unsigned round, pair_workspace *w)
+{
+    uint32_t n = 0;
+    unsigned cells = k * k;
+    for (unsigned r = 0; r < PAIR_REPLICATES; r++) {
+        rad_rng rng = rad_rng_seed(stream, round, r);
+        /* the cells of q are visited in a shuffled order, paired with p's in order */
+        unsigned order[MAX_STRATA * MAX_STRATA];
+        for (unsigned m = 0; m < cells; m++)
+            order[m] = m;
+        for (unsigned m = cells; m > 1; m--) {
+            unsigned swap = (unsigned)(rad_rng_uniform(&rng) * m);
+            unsigned keep = order[m - 1];
+            order[m - 1] = order[swap];
+            order[swap] = keep;
+        }
+        for (unsigned m = 0; m < cells; m++) {
+            double s0 = ((m % k) + rad_rng_uniform(&rng)) / k;
+            double t0 = ((m / k) + rad_rng_uniform(&rng)) / k;
+            double s1 = ((order[m] % k) + rad_rng_uniform(&rng)) / k;
+            double t1 = ((order[m] / k) + rad_rng_uniform(&rng)) / k;
+            rad_vec3 x = polygon_point(p, s0, t0), y = polygon_point(q, s1, t1);
+            rad_vec3 d = v3_sub(y, x);
+            double r2 = v3_dot(d, d);
+            double cx = v3_dot(p->normal, d), cy = -v3_dot(q->normal, d);
+            w->weight[n] = cx > 0 && cy > 0 && r2 > 0 ? cx * cy / (r2 * r2) : 0;
+            ray_set(&w->rays[n++], x, d, RAD_SEGMENT_END_EPSILON, 1 - RAD_SEGMENT_END_EPSILON);
+        }
+    }
+    return n;
+}
+
+void pair_sample_visibility(const vf_polygon *p, const vf_polygon *q,
+                            const rad_tracer *occluders, double accuracy, uint32_t max_rays,
+                            uint64_t stream, pair_workspace *w, pair_visibility *out)
+{
+    out->rays = 0;
+    out->capped = false;
+    unsigned round = 0;
+    for (unsigned k = 1;; k *= 2, round++) {
+        uint32_t n = fill_round(p, q, k, stream, round, w);
+        rad_tracer_occluded(occluders, w->rays, n, w->occluded);
+        out->rays += n;
+        double estimate[PAIR_REPLICATES], mean = 0;
+        unsigned cells = k * k;
+        bool all_same = true;
+        for (unsigned r = 0; r < PAIR_REPLICATES; r++) {
+            double seen = 0, total = 0;
+            for (unsigned m = r * cells; m < (r + 1) * cells; m++) {
+                total += w->weight[m];
+                seen += w->occluded[m] ? 0 : w->weight[m];
+                all_same = all_same && w->occluded[m] == w->occluded[0];
+            }
+            estimate[r] = total > 0 ? seen / total : (w->occluded[r * cells] ? 0 : 1);
+            mean += estimate[r];
+        }
+        mean /= PAIR_REPLICATES;
+        double spread = 0;
+        for (unsigned r = 0; r < PAIR_REPLICATES; r++)
+            spread += (estimate[r] - mean) * (estimate[r] - mean);
+        double standard_error = sqrt(spread / (PAIR_REPLICATES - 1) / PAIR_REPLICATES);
+        out->fraction = fmin(fmax(mean, 0), 1);
+        /* all segments agreeing says nothing about features smaller than a cell: the
+         * bound is then one cell's share */
+        out->bound = all_same ? 1.0 / (double)n : PAIR_STUDENT_T * standard_error;
+        uint32_t next = PAIR_REPLICATES * (2 * k) * (2 * k);
+        bool settled = all_same ? k >= 2 : out->bound <= accuracy;
+        if (settled)
+            return;
+        if (out->rays + next > max_rays || next > w->capacity || 2 * k > MAX_STRATA) {
+            out->capped = !all_same;
+            return;
+        }
+    }
+}

@@ -1,0 +1,70 @@
+/*
+ * pair_transfer.h - the transfer G_pq = A_p F_pq between two convex polygons.
+ *
+ * Unobstructed: the outer integral of Lambert's contour formula (exact point-to-polygon
+ * factor) over the smaller polygon by adaptive quadrature: a 7-point degree-5 rule on each
+ * triangle, compared with its 4 children, split further where they disagree, to a
+ * relative tolerance. Obstructed by a few triangles: the same integral of the exact factor
+ * to the part left visible by their shadows (shadow_clip.h). Obstructed by many, or when
+ * the visible part breaks into too many pieces: the unobstructed value times the visible
+ * fraction, estimated from
+ * replicated stratified segments between the polygons, weighted by the kernel
+ * cos cos / r^2; rounds of 4x more segments until the estimate's error bound meets the
+ * target or the ray budget is spent. The result never exceeds the unobstructed value.
+ */
+#ifndef RAD_VIEWFACTOR_PAIR_TRANSFER_H
+#define RAD_VIEWFACTOR_PAIR_TRANSFER_H
+
+#include "radiosity.h"
+#include "surface_viewfactors/shadow_clip.h"
+#include "surface_viewfactors/vf_geometry.h"
+
+/* Replicates of the visibility estimate; its spread gives the error bound. */
+#define PAIR_REPLICATES 8u
+
+/* Two-sided 95 % Student t for PAIR_REPLICATES - 1 = 7 degrees of freedom. */
+#define PAIR_STUDENT_T 2.365
+
+/* The unobstructed transfer, to relative tolerance `accuracy` (and *bound receives the
+ * estimated absolute error). plane_epsilon as in vf_geometry. */
+double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accuracy,
+                         double plane_epsilon, double *bound);
+
+/* The obstructed transfer by exact shadow clipping at every quadrature point
+ * (shadow_clip.h), to relative tolerance `accuracy`; false when the visible part broke into
+ * too many pieces (sample instead). */
+bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
+                           const shadow_occluder *occluders, uint32_t occluder_count,
+                           double accuracy, double plane_epsilon, double *value, double *bound);
+
+/* Scratch space for the sampled visibility of one thread. */
+/* Pairs with at most this many triangles in between get exact shadow clipping; pairs with
+ * more are sampled. */
+#define PAIR_EXACT_MAX_OCCLUDERS 4u
+
+typedef struct pair_workspace {
+    shadow_occluder occluders[PAIR_EXACT_MAX_OCCLUDERS];
+    rad_ray *rays;
+    uint8_t *occluded;
+    double *weight;
+    uint32_t capacity; /* rays */
+} pair_workspace;
+
+bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays);
+void pair_workspace_free(pair_workspace *workspace);
+
+typedef struct pair_visibility {
+    double fraction; /* visible fraction in [0, 1] */
+    double bound;    /* its error bound (about 95 %), absolute, as a fraction */
+    uint32_t rays;
+    bool capped;     /* the ray budget ran out before the bound met the target */
+} pair_visibility;
+
+/* Samples visibility between p and q through `occluders` until bound <= accuracy or
+ * max_rays; `stream` seeds the random numbers (the same for any thread). */
+void pair_sample_visibility(const vf_polygon *p, const vf_polygon *q,
+                            const rad_tracer *occluders, double accuracy, uint32_t max_rays,
+                            uint64_t stream, pair_workspace *workspace,
+                            pair_visibility *out);
+
+#endif

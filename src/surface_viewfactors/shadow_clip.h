@@ -1,0 +1,29 @@
+/*
+ * shadow_clip.h - the exact view factor from a point to a polygon behind occluders.
+ *
+ * Each occluding triangle is cut to the slab between the point and the receiving polygon's
+ * plane and projected from the point onto that plane; its shadow is subtracted from the
+ * visible part of the receiver, kept as a list of convex pieces. The factor is Lambert's
+ * contour formula summed over the pieces that remain: exact, with no sampling.
+ */
+#ifndef RAD_VIEWFACTOR_SHADOW_CLIP_H
+#define RAD_VIEWFACTOR_SHADOW_CLIP_H
+
+#include "radiosity.h"
+#include "surface_viewfactors/vf_geometry.h"
+
+/* Most convex pieces the visible part may break into before the caller falls back to
+ * sampling. */
+#define SHADOW_MAX_PIECES 48
+
+typedef struct shadow_occluder {
+    rad_vec3 corner[3];
+} shadow_occluder;
+
+/* F from the point x (unit normal n) to what of `receiver` the occluders leave visible.
+ * Returns -1 when the visible part breaks into more than SHADOW_MAX_PIECES pieces. */
+double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
+                             const shadow_occluder *occluders, uint32_t occluder_count,
+                             double plane_epsilon);
+
+#endif

@@ -1,0 +1,389 @@
+/*
+ * viewfactor_matrix.c - surface-to-surface view factors for engineers, see radiosity.h.
+ *
+ * Surface pairs (I, J), J >= I, are visited once, in parallel over rows I. A pair is
+ * skipped at once when either surface is planar and the other lies wholly behind (or on)
+ * its plane. Otherwise every facing polygon pair (p of I, q of J) adds its transfer
+ * G_pq = A_p F_pq (pair_transfer.c): the analytic value when the occluder tree proves
+ * nothing can stand between them; with a few triangles in between, the same integral of
+ * the exactly clipped visible part; with many, that value times a sampled visible fraction.
+ * G_IJ = sum G_pq is symmetric, so F_IJ = G_IJ / A_I and F_JI = G_IJ / A_J hold
+ * reciprocity exactly. A curved surface sees itself: F_II = 2 sum_{p<q} G_pq / A_I.
+ *
+ * Memory: each row keeps only its non-zero G_IJ (J >= I) while it is computed; the rows
+ * are then assembled into compressed sparse rows. Random numbers come from (seed, p, q),
+ * so the result is bitwise the same for any thread count.
+ */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/random.h"
+#include "core/vec3.h"
+#include "surface_viewfactors/matrix_entry.h"
+#include "surface_viewfactors/occluder_tree.h"
+#include "surface_viewfactors/pair_transfer.h"
+#include "surface_viewfactors/vf_geometry.h"
+
+#define DEFAULT_ACCURACY 1e-4
+#define DEFAULT_MAX_RAYS 1024u
+
+typedef struct row_entry {
+    uint32_t column;
+    double transfer; /* G_IJ */
+    double bound;    /* its estimated absolute error */
+} row_entry;
+
+typedef struct pending_row {
+    row_entry *entries;
+    uint32_t count, capacity;
+} pending_row;
+
+typedef struct pair_counts {
+    uint64_t surface_pairs, polygon_pairs, hidden_pairs, obstructed_pairs, sampled_pairs,
+        capped_pairs, rays;
+} pair_counts;
+
+typedef struct engine {
+    const vf_geometry *geometry;
+    const occluder_tree *tree;
+    const rad_tracer *occluders;
+    double accuracy;
+    uint32_t max_rays;
+    uint64_t seed;
+} engine;
+
+static double now_seconds(void) { return omp_get_wtime(); }
+
+/* `plane` is flat and `other` lies wholly behind or on its plane. */
+static bool behind_plane(const vf_geometry *g, const vf_surface *plane, const vf_surface *other)
+{
+    double e = g->plane_epsilon;
+    if (!plane->planar)
+        return false;
+    if (v3_dot(plane->normal, other->center) - plane->offset + other->radius <= e)
+        return true;
+    for (uint32_t k = 0; k < other->polygon_count; k++)
+        if (vf_polygon_in_front(&g->polygons[other->first_polygon + k], plane->normal,
+                                plane->offset, e))
+            return false;
+    return true;
+}
+
+/* Either surface flat with the other wholly behind or on its plane: nothing passes. */
+static bool surfaces_face_away(const vf_geometry *g, const vf_surface *a, const vf_surface *b)
+{
+    return behind_plane(g, a, b) || behind_plane(g, b, a);
+}
+
+/* G_pq and its error bound; 0 when they do not face each other. */
+static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_workspace *w,
+                           pair_counts *counts, double *bound)
+{
+    const vf_polygon *p = &e->geometry->polygons[pi], *q = &e->geometry->polygons[qi];
+    double eps = e->geometry->plane_epsilon;
+    *bound = 0;
+    if (!vf_polygon_in_front(q, p->normal, v3_dot(p->normal, p->vertex[0]), eps) ||
+        !vf_polygon_in_front(p, q->normal, v3_dot(q->normal, q->vertex[0]), eps))
+        return 0;
+    counts->polygon_pairs++;
+    double quadrature_error, unobstructed;
+    uint64_t stream = rad_mix64(e->seed ^ rad_mix64(((uint64_t)pi << 32) | qi));
+    pair_visibility visibility;
+    /* a first look with a few dozen segments: most pairs of a large scene are wholly
+     * hidden, and need no more work than that */
+    pair_sample_visibility(p, q, e->occluders, INFINITY, e->max_rays, stream, w, &visibility);
+    counts->rays += visibility.rays;
+    if (visibility.fraction == 0) {
+        counts->hidden_pairs++;
+        return 0;
+    }
+    uint32_t occluders = occluder_tree_collect(e->tree, p, q, eps, w->occluders,
+                                               PAIR_EXACT_MAX_OCCLUDERS);
+    if (occluders == 0) {
+        unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
+        *bound = quadrature_error;
+        return fmax(unobstructed, 0);
+    }
+    counts->obstructed_pairs++;
+    if (occluders <= PAIR_EXACT_MAX_OCCLUDERS) {
+        double visible, error;
+        if (pair_obstructed_exact(p, q, w->occluders, occluders, 0.25 * e->accuracy, eps,
+                                  &visible, &error)) {
+            unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
+            *bound = error;
+            return fmax(fmin(visible, unobstructed), 0);
+        }
+    }
+    counts->sampled_pairs++;
+    unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
+    if (!(unobstructed > 0))
+        return 0;
+    /* The target: the absolute error of F (seen from the smaller polygon, F0 unobstructed)
+     * at most accuracy * sqrt(F0), so that a row's errors, added in quadrature, stay
+     * within accuracy (the F0 of a row sum to at most 1) while small factors take few
+     * rays. */
+    double f0 = fmin(unobstructed / fmin(p->area, q->area), 1);
+    pair_sample_visibility(p, q, e->occluders, e->accuracy / sqrt(f0), e->max_rays, stream, w,
+                           &visibility);
+    counts->rays += visibility.rays;
+    counts->capped_pairs += visibility.capped;
+    *bound = quadrature_error + visibility.bound * unobstructed;
+    return unobstructed * visibility.fraction;
+}
+
+static bool row_push(pending_row *r, uint32_t column, double transfer, double bound)
+{
+    if (r->count == r->capacity) {
+        uint32_t capacity = r->capacity ? 2 * r->capacity : 8;
+        row_entry *grown = realloc(r->entries, capacity * sizeof(*grown));
+        if (!grown)
+            return false;
+        r->entries = grown;
+        r->capacity = capacity;
+    }
+    r->entries[r->count++] = (row_entry){column, transfer, bound};
+    return true;
+}
+
+/* Row I: every J >= I. False when out of memory. */
+static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_workspace *w,
+                        pair_counts *counts)
+{
+    const vf_geometry *g = e->geometry;
+    const vf_surface *a = &g->surfaces[I];
+    if (a->polygon_count == 0)
+        return true;
+    for (uint32_t J = I; J < g->surface_count; J++) {
+        const vf_surface *b = &g->surfaces[J];
+        if (b->polygon_count == 0 || (J == I && a->planar))
+            continue;
+        counts->surface_pairs++;
+        if (J != I && surfaces_face_away(g, a, b))
+            continue;
+        double transfer = 0, variance = 0;
+        for (uint32_t pk = 0; pk < a->polygon_count; pk++) {
+            uint32_t pi = a->first_polygon + pk;
+            uint32_t q_first = J == I ? pi + 1 : b->first_polygon;
+            for (uint32_t qi = q_first; qi < b->first_polygon + b->polygon_count; qi++) {
+                double bound;
+                double G = polygon_pair(e, pi, qi, w, counts, &bound);
+                transfer += G;
+                /* sampled parts are independent: their bounds add in quadrature */
+                variance += bound * bound;
+                
+            }
+        }
+        if (J == I)
+            transfer *= 2, variance *= 4;
+        if (transfer > 0 && !row_push(out, J, transfer, sqrt(variance)))
+            return false;
+    }
+    return true;
+}
+
+static rad_viewfactor_matrix *assemble(const vf_geometry *g, pending_row *rows, uint32_t n)
+{
+    rad_viewfactor_matrix *m = calloc(1, sizeof(*m));
+    if (!m)
+        return NULL;
+    m->n = n;
+    m->area = rad_alloc_array(n ? n : 1, sizeof(double));
+    m->row_start = rad_alloc_array((size_t)n + 1, sizeof(uint64_t));
+    uint64_t *cursor = rad_alloc_array((size_t)n + 1, sizeof(uint64_t));
+    if (!m->area || !m->row_start || !cursor) {
+        free(cursor);
+        rad_viewfactor_matrix_destroy(m);
+        return NULL;
+    }
+    for (uint32_t I = 0; I < n; I++) {
+        m->area[I] = g->surfaces[I].area;
+        for (uint32_t k = 0; k < rows[I].count; k++) {
+            m->row_start[I + 1]++;
+            if (rows[I].entries[k].column != I)
+                m->row_start[rows[I].entries[k].column + 1]++;
+        }
+    }
+    for (uint32_t I = 0; I < n; I++)
+        m->row_start[I + 1] += m->row_start[I];
+    uint64_t total = m->row_start[n];
+    m->column = rad_alloc_array(total ? total : 1, sizeof(uint32_t));
+    m->value = rad_alloc_array(total ? total : 1, sizeof(double));
+    m->error_bound = rad_alloc_array(total ? total : 1, sizeof(double));
+    if (!m->column || !m->value || !m->error_bound) {
+        free(cursor);
+        rad_viewfactor_matrix_destroy(m);
+        return NULL;
+    }
+    memcpy(cursor, m->row_start, ((size_t)n + 1) * sizeof(uint64_t));
+    /* row I's own entries (columns >= I) arrive after every transposed entry of column
+     * < I, so each row comes out sorted */
+    for (uint32_t I = 0; I < n; I++) {
+        for (uint32_t k = 0; k < rows[I].count; k++) {
+            const row_entry *entry = &rows[I].entries[k];
+            uint32_t J = entry->column;
+            uint64_t at = cursor[I]++;
+            m->column[at] = J;
+            m->value[at] = fmin(entry->transfer / m->area[I], 1.0);
+            m->error_bound[at] = entry->bound / m->area[I];
+            if (J != I) {
+                at = cursor[J]++;
+                m->column[at] = I;
+                m->value[at] = fmin(entry->transfer / m->area[J], 1.0);
+                m->error_bound[at] = entry->bound / m->area[J];
+            }
+        }
+        free(rows[I].entries);
+        rows[I].entries = NULL;
+    }
+    free(cursor);
+    return m;
+}
+
+rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
+                                         const rad_viewfactor_options *options,
+                                         rad_viewfactor_matrix **out,
+                                         rad_viewfactor_report *report, rad_error *error)
+{
+    *out = NULL;
+    rad_viewfactor_options defaults = {0};
+    if (!options)
+        options = &defaults;
+    if (options->threads < 0 || !(options->accuracy >= 0) || options->accuracy >= 1)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "view factors: threads must be >= 0 and accuracy in [0, 1)");
+    double start = now_seconds();
+    int threads = options->threads > 0 ? options->threads : omp_get_max_threads();
+    engine e = {.accuracy = options->accuracy > 0 ? options->accuracy : DEFAULT_ACCURACY,
+                .max_rays = options->max_rays ? options->max_rays : DEFAULT_MAX_RAYS,
+                .seed = options->seed};
+    if (e.max_rays < 64)
+        e.max_rays = 64;
+    vf_geometry geometry;
+    occluder_tree *tree = NULL;
+    rad_tracer *occluders = NULL;
+    pending_row *rows = NULL;
+    rad_status status = vf_geometry_build(scene, &geometry, error);
+    if (status != RAD_OK)
+        return status;
+    status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
+    if (status == RAD_OK)
+        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
+    uint32_t n = scene->surface_count;
+    if (status == RAD_OK) {
+        rows = calloc(n ? n : 1, sizeof(pending_row));
+        if (!rows)
+            status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u rows", n);
+    }
+    if (status != RAD_OK) {
+        rad_tracer_destroy(occluders);
+        occluder_tree_destroy(tree);
+        vf_geometry_free(&geometry);
+        return status;
+    }
+    e.geometry = &geometry;
+    e.tree = tree;
+    e.occluders = occluders;
+
+    /* progress counts surface pairs: row I has n - I of them */
+    double total_pairs = 0.5 * (double)n * ((double)n + 1);
+    double done_pairs = 0;
+    pair_counts totals = {0};
+    bool out_of_memory = false;
+#pragma omp parallel num_threads(threads)
+    {
+        pair_workspace w;
+        pair_counts counts = {0};
+        bool ready = pair_workspace_init(&w, e.max_rays);
+        if (!ready) {
+#pragma omp atomic write
+            out_of_memory = true;
+        }
+#pragma omp for schedule(dynamic, 1)
+        for (uint32_t I = 0; I < n; I++) {
+            bool failed;
+#pragma omp atomic read
+            failed = out_of_memory;
+            if (failed || !ready)
+                continue;
+            if (!compute_row(&e, I, &rows[I], &w, &counts)) {
+#pragma omp atomic write
+                out_of_memory = true;
+            }
+            double done;
+#pragma omp atomic capture
+            {
+                done_pairs += (double)(n - I);
+                done = done_pairs;
+            }
+            if (options->progress && omp_get_thread_num() == 0)
+                options->progress(options->progress_user, "view factors",
+                                  fmin(done / fmax(total_pairs, 1), 0.999));
+        }
+        pair_workspace_free(&w);
+#pragma omp critical
+        {
+            totals.surface_pairs += counts.surface_pairs;
+            totals.polygon_pairs += counts.polygon_pairs;
+            totals.hidden_pairs += counts.hidden_pairs;
+            totals.obstructed_pairs += counts.obstructed_pairs;
+            totals.sampled_pairs += counts.sampled_pairs;
+            totals.capped_pairs += counts.capped_pairs;
+            totals.rays += counts.rays;
+        }
+    }
+    rad_viewfactor_matrix *matrix = out_of_memory ? NULL : assemble(&geometry, rows, n);
+    for (uint32_t I = 0; I < n; I++)
+        free(rows[I].entries);
+    free(rows);
+    rad_tracer_destroy(occluders);
+    occluder_tree_destroy(tree);
+    vf_geometry_free(&geometry);
+    if (!matrix)
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the view factors of %u surfaces",
+                        n);
+    if (options->progress)
+        options->progress(options->progress_user, "view factors", 1.0);
+    if (report) {
+        memset(report, 0, sizeof(*report));
+        report->surface_pairs = totals.surface_pairs;
+        report->polygon_pairs = totals.polygon_pairs;
+        report->hidden_pairs = totals.hidden_pairs;
+        report->obstructed_pairs = totals.obstructed_pairs;
+        report->sampled_pairs = totals.sampled_pairs;
+        report->capped_pairs = totals.capped_pairs;
+        report->rays = totals.rays;
+        report->nonzeros = matrix->row_start[n];
+        for (uint64_t k = 0; k < matrix->row_start[n]; k++)
+            report->largest_error_bound =
+                fmax(report->largest_error_bound, matrix->error_bound[k]);
+        report->seconds = now_seconds() - start;
+        report->threads = threads;
+    }
+    *out = matrix;
+    return RAD_OK;
+}
+
+void rad_viewfactor_matrix_destroy(rad_viewfactor_matrix *matrix)
+{
+    if (!matrix)
+        return;
+    free(matrix->area);
+    free(matrix->row_start);
+    free(matrix->column);
+    free(matrix->value);
+    free(matrix->error_bound);
+    free(matrix);
+}
+
+double rad_viewfactor_matrix_get(const rad_viewfactor_matrix *matrix, uint32_t row,
+                                 uint32_t column)
+{
+    if (row >= matrix->n || column >= matrix->n)
+        return 0;
+    uint64_t entry = vf_matrix_entry(matrix, row, column);
+    return entry == UINT64_MAX ? 0 : matrix->value[entry];
+}
