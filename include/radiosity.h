@@ -95,8 +95,9 @@ typedef struct rad_camera {
 /* ------------------------------------------------------------------------------------ */
 /* Scene: triangles with materials, grouped into named surfaces                          */
 
-/* An albedo texture: linear RGB texels (decoded from 8-bit sRGB PNG or JPEG), row 0 at
- * the top. */
+/* A texture: linear RGB texels (decoded from 8-bit sRGB PNG or JPEG, the encoding of MTL
+ * maps and of glTF's baseColorTexture and emissiveTexture), row 0 at the top. Looked up
+ * bilinearly, repeating outside [0,1]. */
 typedef struct rad_texture {
     char source[512]; /* the image file, or "FILE#N" for an image a glb embeds */
     uint32_t width, height;
@@ -113,6 +114,10 @@ typedef struct rad_material {
     uint32_t albedo_texture; /* 1 + index into rad_scene.textures (MTL map_Kd, glTF
                                 baseColorTexture): the albedo is then `albedo` times the
                                 texel; 0 = none */
+    uint32_t emission_texture; /* 1 + index into rad_scene.textures (MTL map_Ke, glTF
+                                  emissiveTexture): the emitted radiance is then `emission`
+                                  times the texel (linear RGB); 0 = none. Either texture is
+                                  read at the triangle's texture coordinates (rad_scene.uv) */
 } rad_material;
 
 /* A surface is what the user named: an OBJ object (o) or group (g). Its triangles are the
@@ -278,7 +283,9 @@ void rad_scene_destroy(rad_scene *scene);
 double rad_scene_area(const rad_scene *scene);
 void rad_scene_bounds(const rad_scene *scene, rad_vec3 *lo, rad_vec3 *hi);
 
-/* True when some material with triangles has non-zero emission. */
+/* True when some material with triangles has non-zero emission: an emission factor > 0
+ * and, with an emission texture, a texel that is not black in a channel where the factor
+ * is > 0. */
 bool rad_scene_has_emitter(const rad_scene *scene);
 
 /* A camera that frames the whole scene from the front: for a y-up scene from the -z side

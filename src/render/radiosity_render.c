@@ -25,6 +25,7 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "render/camera.h"
+#include "render/progress.h"
 #include "reconstruct/display_mesh.h"
 #include "scene/texture.h"
 #include "trace/ray.h"
@@ -266,7 +267,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                      t_near, leave, lookup, options->scene ? options->scene->materials : NULL,
                      patch_albedo};
 
-    uint32_t rows_done = 0;
+    render_progress progress =
+        render_progress_start(options->progress, options->progress_user, "render", H);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (uint32_t y = 0; y < H; y++) {
         int thread = omp_get_thread_num();
@@ -330,14 +332,9 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
             pixel[1] = (float)(sum.g / count);
             pixel[2] = (float)(sum.b / count);
         }
-        uint32_t done;
-#pragma omp atomic capture
-        done = ++rows_done;
-        if (thread == 0 && options->progress)
-            options->progress(options->progress_user, "render", (double)done / H);
+        render_progress_step(&progress);
     }
-    if (options->progress)
-        options->progress(options->progress_user, "render", 1);
+    render_progress_finish(&progress);
     goto done;
 nomem:
     status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for rendering");
