@@ -382,6 +382,25 @@ static void next_event_with_emission_texture(void)
            measured, standard_error, expected, (measured - expected) / standard_error, both);
     CHECK(fabs(measured - expected) <= 4 * standard_error);
     CHECK(standard_error < 0.005 * expected);
+
+    /* the radiosity pipeline on the same scene: the light's patches carry their mean
+     * emission (the black rectangle's 0), the floor's B interpolated at patch resolution */
+    rad_mesh *mesh = NULL;
+    rad_rgb *B = NULL;
+    if (rad_mesh_build(scene, 0.125, &mesh, &error) == RAD_OK &&
+        (B = calloc(mesh->patch_count, sizeof(*B))) != NULL) {
+        rad_scene_solve_options so = {.solver = RAD_SOLVER_JACOBI, .seed = 1};
+        CHECK(rad_solve_scene(scene, mesh, &so, B, NULL, &error) == RAD_OK);
+        rad_render_options ro = {.samples_per_pixel = 4, .seed = 1, .scene = scene};
+        CHECK(rad_render(mesh, B, &camera, &ro, image, &error) == RAD_OK);
+        double radiosity = mean_green(image);
+        printf("the same floor by radiosity (%u patches): %.5f, %.2f %% from the closed form\n",
+               mesh->patch_count, radiosity, 100 * (radiosity / expected - 1));
+        CHECK_NEAR(radiosity, expected, 0.01); /* discretisation: -2.35 % at 0.25, second order */
+    } else
+        test_fail(__FILE__, __LINE__, "%s", error.message);
+    free(B);
+    rad_mesh_destroy(mesh);
     rad_image_destroy(image);
     rad_image_destroy(se);
     rad_scene_destroy(scene);
@@ -435,6 +454,97 @@ done:
     rad_scene_destroy(scene);
 }
 
+/* ---------------------------------------------------------------------------------- */
+
+static void log_to_buffer(void *user, const char *message)
+{
+    char *buffer = user;
+    size_t n = strlen(buffer);
+    snprintf(buffer + n, 4096 - n, "%s\n", message);
+}
+
+/* Importing: a glTF emissiveTexture (sRGB like baseColor) times emissiveFactor times
+ * KHR_materials_emissive_strength; an MTL map_Ke whose file is missing is a warning and
+ * the emission stays Ke; a map_Ke without Ke is a warning (it emits nothing). */
+static void import_emission_textures(void)
+{
+    const unsigned value = 188;
+    write_stripes("grey188.png", 4, 4, value, value);
+    float data[4 * 3 + 4 * 2] = {0, 0, 0, 0, 0, 2, 2, 0, 2, 2, 0, 0, 0, 1, 0, 0, 1, 0, 1, 1};
+    uint16_t indices[6] = {0, 1, 2, 0, 2, 3};
+    FILE *file = fopen(test_path("quad.bin"), "wb");
+    if (file) {
+        fwrite(data, sizeof(data), 1, file);
+        fwrite(indices, sizeof(indices), 1, file);
+        fclose(file);
+    }
+    test_write_file(
+        "glow.gltf",
+        "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_materials_emissive_strength\"],"
+        "\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+        "\"meshes\":[{\"name\":\"light\",\"primitives\":[{\"attributes\":{\"POSITION\":0,"
+        "\"TEXCOORD_0\":1},\"indices\":2,\"material\":0}]}],"
+        "\"materials\":[{\"name\":\"glow\",\"emissiveFactor\":[1,0.5,0.25],"
+        "\"emissiveTexture\":{\"index\":0},"
+        "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":4}},"
+        "\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1]}}],"
+        "\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"grey188.png\"}],"
+        "\"buffers\":[{\"byteLength\":92,\"uri\":\"quad.bin\"}],"
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,"
+        "\"byteLength\":32},{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+        "\"min\":[0,0,0],\"max\":[2,0,2]},{\"bufferView\":1,\"componentType\":5126,\"count\":4,"
+        "\"type\":\"VEC2\"},{\"bufferView\":2,\"componentType\":5123,\"count\":6,"
+        "\"type\":\"SCALAR\"}]}");
+    rad_scene *scene = load("glow.gltf");
+    rad_mesh *mesh = NULL;
+    rad_patch_inputs *inputs = NULL;
+    rad_error error;
+    if (scene && rad_mesh_build(scene, 10, &mesh, &error) == RAD_OK &&
+        rad_patch_inputs_build(scene, mesh, &inputs, &error) == RAD_OK) {
+        CHECK(scene->materials[scene->triangles[0].material].emission_texture == 1);
+        double t = srgb_to_linear(value);
+        printf("glTF emissiveTexture (sRGB %u = linear %.5f) x factor (1, 0.5, 0.25) x "
+               "strength 4: E = (%.5f, %.5f, %.5f), pi x 4 t x factor = (%.5f, %.5f, %.5f)\n",
+               value, t, inputs->exitance[0].r, inputs->exitance[0].g, inputs->exitance[0].b,
+               RAD_PI * 4 * t, RAD_PI * 2 * t, RAD_PI * t);
+        CHECK_NEAR(inputs->exitance[0].r, RAD_PI * 4 * t, 1e-6);
+        CHECK_NEAR(inputs->exitance[0].g, RAD_PI * 2 * t, 1e-6);
+        CHECK_NEAR(inputs->exitance[0].b, RAD_PI * t, 1e-6);
+    } else
+        test_fail(__FILE__, __LINE__, "glow.gltf: %s", error.message);
+    rad_patch_inputs_destroy(inputs);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+
+    static char warnings[4096];
+    warnings[0] = 0;
+    rad_load_options options = {log_to_buffer, warnings};
+    test_write_file("missing.mtl", "newmtl lost\nKd 0 0 0\nKe 1 1 1\nmap_Ke nowhere.png\n"
+                                   "newmtl dark\nKd 0 0 0\nmap_Ke grey188.png\n");
+    test_write_file("missing.obj", "mtllib missing.mtl\n"
+                                   "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\n"
+                                   "vt 0 0\nvt 1 0\nvt 1 1\n"
+                                   "o a\nusemtl lost\nf 1/1 2/2 3/3\n"
+                                   "o b\nusemtl dark\nf 4/1 5/2 6/3\n");
+    scene = NULL;
+    CHECK(rad_scene_load(test_path("missing.obj"), &options, &scene, &error) == RAD_OK);
+    CHECK(strstr(warnings, "material 'lost': texture 'nowhere.png' not found; its emission is "
+                           "the material's colour") != NULL);
+    CHECK(strstr(warnings, "material 'dark': an emission texture but an emission factor of 0") !=
+          NULL);
+    if (scene) {
+        for (uint32_t m = 0; m < scene->material_count; m++)
+            if (strcmp(scene->materials[m].name, "lost") == 0) {
+                CHECK(scene->materials[m].emission_texture == 0);
+                CHECK_NEAR(scene->materials[m].emission.g, 1, 1e-12);
+            }
+        CHECK(rad_scene_has_emitter(scene));
+    }
+    rad_scene_destroy(scene);
+    printf("import warnings:\n%s", warnings);
+}
+
 int main(void)
 {
     test_tmpdir();
@@ -443,5 +553,6 @@ int main(void)
     emission_seen_directly();
     next_event_with_emission_texture();
     solve_exitance();
+    import_emission_textures();
     return test_finish("test_texture_renderers");
 }
