@@ -298,7 +298,8 @@ rad_camera rad_scene_default_camera(const rad_scene *scene);
 
 /* Sets the albedo and/or the emitted radiance (either may be NULL) of what `name` names:
  * a surface by that name, else the one material by that name. A surface keeps its other
- * material values; when its material is shared with triangles of other surfaces, it gets
+ * material values, its textures included (a value set is the factor its texture then
+ * multiplies); when its material is shared with triangles of other surfaces, it gets
  * its own copy first, so nothing else changes. RAD_ERR_INVALID, naming `name`, when
  * nothing or several materials have that name (and no surface does), or when a value is
  * out of its domain (albedo in [0,1], emission >= 0, both finite). */

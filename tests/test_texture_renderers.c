@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "core/vec3.h" /* RAD_PI */
+#include "render/emitters.h"
 #include "testlib.h"
 
 static double srgb_to_linear(unsigned value)
@@ -346,6 +347,21 @@ static void next_event_with_emission_texture(void)
     rad_scene *scene = load("nee.obj");
     if (!scene)
         return;
+    /* the emitter set: the black rectangle's triangles (mean texel 0) keep the power floor,
+     * EMITTER_POWER_FLOOR of the white ones' (same area, mean texel 1) */
+    emitter_set emitters;
+    rad_error error;
+    CHECK(emitters_build(scene, &emitters, &error) == RAD_OK);
+    CHECK(emitters.count == 4);
+    for (uint32_t k = 0; k < emitters.count && emitters.count == 4; k++) {
+        uint32_t t = emitters.triangle[k];
+        bool black = scene->surfaces[scene->triangles[t].surface].name[0] == 'b';
+        double expected = (black ? EMITTER_POWER_FLOOR : 1) / (2 + 2 * EMITTER_POWER_FLOOR);
+        printf("emitter triangle %u (%s): pdf_area %.6g, expected %.6g\n", t,
+               black ? "black" : "white", emitters.pdf_area_of[t], expected);
+        CHECK_NEAR(emitters.pdf_area_of[t], expected, 1e-9);
+    }
+    emitters_free(&emitters);
     /* looking down from below the light at the floor under the edge between the halves */
     const double height = 0.5, half = 0.1;
     rad_camera camera = {{1, height, 1}, {1, 0, 1}, {0, 0, 1},
@@ -353,8 +369,14 @@ static void next_event_with_emission_texture(void)
     const uint32_t size = 32;
     rad_image *image = test_new_image(size, size), *se = test_new_image(size, size);
     rad_pathtrace_options options = {.samples_per_pixel = 64, .seed = 11};
-    rad_error error;
     CHECK(rad_pathtrace(scene, &camera, &options, image, se, NULL, &error) == RAD_OK);
+    /* the same image for any thread count */
+    rad_image *one_thread = test_new_image(size, size);
+    rad_pathtrace_options single = options;
+    single.threads = 1;
+    CHECK(rad_pathtrace(scene, &camera, &single, one_thread, NULL, NULL, &error) == RAD_OK);
+    CHECK(memcmp(one_thread->rgb, image->rgb, (size_t)size * size * 3 * sizeof(float)) == 0);
+    rad_image_destroy(one_thread);
     /* the closed form, box-filtered over each pixel by a 4 x 4 midpoint rule */
     double measured = 0, expected = 0, both = 0, variance = 0;
     for (uint32_t y = 0; y < size; y++)
