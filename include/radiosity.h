@@ -906,7 +906,7 @@ typedef struct rad_render_options {
     /* The patch inputs the solve used (rad_patch_inputs_build of scene and mesh; n must be
      * mesh->patch_count, else RAD_ERR_INVALID): E_i and rho_i above. NULL = rad_render
      * builds them from `scene` itself when it has a textured material (the same values:
-     * the build is deterministic). Unused without `scene`. */
+     * the build is deterministic). Read only for textured surfaces of `scene`. */
     const rad_patch_inputs *inputs;
 } rad_render_options;
 
