@@ -37,8 +37,8 @@ static double srgb_to_linear(unsigned value)
 static void write_stripes(const char *name, uint32_t width, uint32_t split, unsigned left,
                           unsigned right)
 {
-    unsigned char rgb[3 * 64];
-    for (uint32_t x = 0; x < width && x < 64; x++)
+    unsigned char rgb[3 * 256];
+    for (uint32_t x = 0; x < width && x < 256; x++)
         memset(&rgb[3 * x], (int)(x < split ? left : right), 3);
     png_image image;
     memset(&image, 0, sizeof(image));
@@ -322,46 +322,69 @@ static void emission_seen_directly(void)
 
 /* ---------------------------------------------------------------------------------- */
 
-/* A floor (Kd 0.8) under a light at height 1 made of two rectangles of one material
- * (Kd 0, Ke 3 x texel): [0,1] x [0,2] reads the texture's black texels only, [1,2] x [0,2]
- * its white ones. The floor is lit by the white rectangle alone, through next-event
- * samples on both (the black one is sampled by its power floor only) and through
- * cosine-sampled rays, combined by MIS. */
-static void next_event_with_emission_texture(void)
+/* A floor (Kd 0.8) under a light [0,2] x [0,2] at height 1 (Kd 0, Ke 3 x texel) whose
+ * texture is black on [0,1] and white on [1,2], so the floor is lit by the white half
+ * alone: L = 0.8 x 3 x F(point -> [1,2] x [0,2]), by next-event samples and cosine-sampled
+ * rays combined by MIS. Two ways to texture it:
+ *   - two_rectangles: the halves are separate rectangles of one material, each reading
+ *     only black or only white texels of an 8-texel stripe: the black one's mean is 0, so
+ *     it is sampled by its power floor alone;
+ *   - one quad whose two triangles span both halves (mean texel 1/2 each), with a texture
+ *     of 128 black | 128 white texels over u in [1/256, 255/256]: half of the light samples
+ *     land on black texels and must bring nothing (the bilinear ramp at the middle is 1/128
+ *     of the light wide and antisymmetric: it changes F by about 1e-5 relative). */
+static void floor_under_half_light(bool two_rectangles)
 {
-    write_stripes("black_white.png", 8, 4, 0, 255);
+    const char *obj;
+    if (two_rectangles) {
+        write_stripes("black_white.png", 8, 4, 0, 255);
+        obj = "mtllib nee.mtl\n"
+              "o floor\nusemtl floor\n"
+              "v -3 0 -3\nv -3 0 3\nv 3 0 3\nv 3 0 -3\n"
+              "f 1 2 3\nf 1 3 4\n"
+              "o black\nusemtl glow\n"
+              "v 0 1 0\nv 1 1 0\nv 1 1 2\nv 0 1 2\n"
+              "vt 0.1 0\nvt 0.4 0\nvt 0.4 1\nvt 0.1 1\n"
+              "f 5/1 6/2 7/3\nf 5/1 7/3 8/4\n"
+              "o white\nusemtl glow\n"
+              "v 1 1 0\nv 2 1 0\nv 2 1 2\nv 1 1 2\n"
+              "vt 0.6 0\nvt 0.9 0\nvt 0.9 1\nvt 0.6 1\n"
+              "f 9/5 10/6 11/7\nf 9/5 11/7 12/8\n";
+    } else {
+        write_stripes("black_white.png", 256, 128, 0, 255);
+        obj = "mtllib nee.mtl\n"
+              "o floor\nusemtl floor\n"
+              "v -3 0 -3\nv -3 0 3\nv 3 0 3\nv 3 0 -3\n"
+              "f 1 2 3\nf 1 3 4\n"
+              "o light\nusemtl glow\n"
+              "v 0 1 0\nv 2 1 0\nv 2 1 2\nv 0 1 2\n"
+              "vt 0.00390625 0\nvt 0.99609375 0\nvt 0.99609375 1\nvt 0.00390625 1\n"
+              "f 5/1 6/2 7/3\nf 5/1 7/3 8/4\n";
+    }
+    const char *variant = two_rectangles ? "two rectangles" : "one quad";
     test_write_file("nee.mtl", "newmtl floor\nKd 0.8 0.8 0.8\n"
                                "newmtl glow\nKd 0 0 0\nKe 3 3 3\nmap_Ke black_white.png\n");
-    test_write_file("nee.obj", "mtllib nee.mtl\n"
-                               "o floor\nusemtl floor\n"
-                               "v -3 0 -3\nv -3 0 3\nv 3 0 3\nv 3 0 -3\n"
-                               "f 1 2 3\nf 1 3 4\n"
-                               "o black\nusemtl glow\n"
-                               "v 0 1 0\nv 1 1 0\nv 1 1 2\nv 0 1 2\n"
-                               "vt 0.1 0\nvt 0.4 0\nvt 0.4 1\nvt 0.1 1\n"
-                               "f 5/1 6/2 7/3\nf 5/1 7/3 8/4\n"
-                               "o white\nusemtl glow\n"
-                               "v 1 1 0\nv 2 1 0\nv 2 1 2\nv 1 1 2\n"
-                               "vt 0.6 0\nvt 0.9 0\nvt 0.9 1\nvt 0.6 1\n"
-                               "f 9/5 10/6 11/7\nf 9/5 11/7 12/8\n");
+    test_write_file("nee.obj", obj);
     rad_scene *scene = load("nee.obj");
     if (!scene)
         return;
-    /* the emitter set: the black rectangle's triangles (mean texel 0) keep the power floor,
-     * EMITTER_POWER_FLOOR of the white ones' (same area, mean texel 1) */
-    emitter_set emitters;
     rad_error error;
-    CHECK(emitters_build(scene, &emitters, &error) == RAD_OK);
-    CHECK(emitters.count == 4);
-    for (uint32_t k = 0; k < emitters.count && emitters.count == 4; k++) {
-        uint32_t t = emitters.triangle[k];
-        bool black = scene->surfaces[scene->triangles[t].surface].name[0] == 'b';
-        double expected = (black ? EMITTER_POWER_FLOOR : 1) / (2 + 2 * EMITTER_POWER_FLOOR);
-        printf("emitter triangle %u (%s): pdf_area %.6g, expected %.6g\n", t,
-               black ? "black" : "white", emitters.pdf_area_of[t], expected);
-        CHECK_NEAR(emitters.pdf_area_of[t], expected, 1e-9);
+    if (two_rectangles) {
+        /* the emitter set: the black rectangle's triangles (mean texel 0) keep the power
+         * floor, EMITTER_POWER_FLOOR of the white ones' (same area, mean texel 1) */
+        emitter_set emitters;
+        CHECK(emitters_build(scene, &emitters, &error) == RAD_OK);
+        CHECK(emitters.count == 4);
+        for (uint32_t k = 0; k < emitters.count && emitters.count == 4; k++) {
+            uint32_t t = emitters.triangle[k];
+            bool black = scene->surfaces[scene->triangles[t].surface].name[0] == 'b';
+            double expected = (black ? EMITTER_POWER_FLOOR : 1) / (2 + 2 * EMITTER_POWER_FLOOR);
+            printf("emitter triangle %u (%s): pdf_area %.6g, expected %.6g\n", t,
+                   black ? "black" : "white", emitters.pdf_area_of[t], expected);
+            CHECK_NEAR(emitters.pdf_area_of[t], expected, 1e-9);
+        }
+        emitters_free(&emitters);
     }
-    emitters_free(&emitters);
     /* looking down from below the light at the floor under the edge between the halves */
     const double height = 0.5, half = 0.1;
     rad_camera camera = {{1, height, 1}, {1, 0, 1}, {0, 0, 1},
@@ -398,15 +421,25 @@ static void next_event_with_emission_texture(void)
     expected /= n;
     both /= n;
     double standard_error = sqrt(variance) / n;
-    printf("next-event estimation, emission texture: floor radiance %.5f +- %.5f (1 s.e.), "
-           "closed form rho Le F(white half) = %.5f (%.2f s.e. off); with the black half "
-           "lit it would be %.5f\n",
-           measured, standard_error, expected, (measured - expected) / standard_error, both);
+    printf("next-event estimation, emission texture (%s): floor radiance %.5f +- %.5f "
+           "(1 s.e.), closed form rho Le F(white half) = %.5f (%.2f s.e. off); with the "
+           "black half lit it would be %.5f\n",
+           variant, measured, standard_error, expected, (measured - expected) / standard_error,
+           both);
     CHECK(fabs(measured - expected) <= 4 * standard_error);
     CHECK(standard_error < 0.005 * expected);
 
+    /* Whitted's area-light samples: the same direct light, quasi-random (no error bar) */
+    rad_raytrace_options rt = {.light_samples = 256, .samples_per_pixel = 4, .seed = 5};
+    CHECK(rad_raytrace(scene, &camera, &rt, image, &error) == RAD_OK);
+    double whitted = mean_green(image);
+    printf("the same floor by Whitted (%s): %.5f, %.3f %% from the closed form\n", variant,
+           whitted, 100 * (whitted / expected - 1));
+    CHECK_NEAR(whitted, expected, 0.01);
+
     /* the radiosity pipeline on the same scene: the light's patches carry their mean
-     * emission (the black rectangle's 0), the floor's B interpolated at patch resolution */
+     * emission (0 or 1 x Ke: the patch edges meet at x = 1), the floor's B interpolated at
+     * patch resolution */
     rad_mesh *mesh = NULL;
     rad_rgb *B = NULL;
     if (rad_mesh_build(scene, 0.125, &mesh, &error) == RAD_OK &&
@@ -416,8 +449,9 @@ static void next_event_with_emission_texture(void)
         rad_render_options ro = {.samples_per_pixel = 4, .seed = 1, .scene = scene};
         CHECK(rad_render(mesh, B, &camera, &ro, image, &error) == RAD_OK);
         double radiosity = mean_green(image);
-        printf("the same floor by radiosity (%u patches): %.5f, %.2f %% from the closed form\n",
-               mesh->patch_count, radiosity, 100 * (radiosity / expected - 1));
+        printf("the same floor by radiosity (%s, %u patches): %.5f, %.2f %% from the closed "
+               "form\n",
+               variant, mesh->patch_count, radiosity, 100 * (radiosity / expected - 1));
         CHECK_NEAR(radiosity, expected, 0.01); /* discretisation: -2.35 % at 0.25, second order */
     } else
         test_fail(__FILE__, __LINE__, "%s", error.message);
@@ -578,7 +612,8 @@ int main(void)
     textured_furnace();
     whitted_texel_ratio();
     emission_seen_directly();
-    next_event_with_emission_texture();
+    floor_under_half_light(true);
+    floor_under_half_light(false);
     solve_exitance();
     import_emission_textures();
     return test_finish("test_texture_renderers");
