@@ -10,10 +10,14 @@
  *   - next-event estimation with an emission texture: a floor under a light whose texture
  *     is black on one of its halves, lit by the white half alone: rho L_e F with F the
  *     point-to-rectangle factor of that half (VALIDATION.md section 2), within the path
- *     tracer's own standard error;
+ *     tracer's own standard error, and by Whitted and radiosity within 1 %; the halves as
+ *     two rectangles (the black one sampled by its power floor, measured) and as one quad
+ *     whose triangles straddle both (half the light samples land on black texels);
  *   - the solves: the patch exitance of an emission-textured patch is pi Ke x the texture's
  *     mean (black | white: 0.5), in the patch inputs, the dense solve and the hierarchical
- *     solve (Kd 0: B = E).
+ *     solve (Kd 0: B = E);
+ *   - importing: glTF emissiveTexture x emissiveFactor x emissive strength, sRGB-decoded;
+ *     warnings for a missing map_Ke, a map_Ke without Ke, a second texture-coordinate set.
  * Textures are PNGs written here; 8-bit sRGB values are decoded to linear with the sRGB
  * curve, computed here too.
  */
