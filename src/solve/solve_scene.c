@@ -67,6 +67,11 @@ static rad_status solve_dense(const rad_mesh *mesh, const rad_patch_inputs *inpu
                               rad_solver solver, rad_rgb *B, rad_scene_solve_report *r,
                               rad_error *error)
 {
+    if (solver == RAD_SOLVER_DIRECT && mesh->patch_count > RAD_DIRECT_MAX_PATCHES)
+        return rad_fail(error, RAD_ERR_UNSUPPORTED,
+                        "the direct solver is for small scenes: %u patches (limit %u): use a "
+                        "larger --patch-size or another solver",
+                        mesh->patch_count, RAD_DIRECT_MAX_PATCHES);
     rad_formfactor_options ff_options = {o->quadrature, o->visibility_rays, o->seed,
                                          o->threads, o->progress, o->progress_user};
     rad_formfactors *ff = NULL;
