@@ -11,9 +11,22 @@
 int main(void)
 {
     /* every status has a name, and unknown ones do not crash */
-    for (int s = RAD_OK; s <= RAD_ERR_INTERNAL; s++)
+    for (int s = RAD_OK; s <= RAD_ERR_INTERNAL; s++) {
         CHECK(strlen(rad_status_name((rad_status)s)) > 0);
+        /* each known status has its own name, not the fallback for unknown ones */
+        for (int t = RAD_OK; t < s; t++)
+            CHECK(strcmp(rad_status_name((rad_status)s), rad_status_name((rad_status)t)) != 0);
+    }
     CHECK(strcmp(rad_status_name(RAD_OK), "success") == 0);
+    /* values outside the enum (a status from a newer library, memory garbage): a name,
+     * never NULL, never one of the real statuses' names */
+    const int unknown[] = {RAD_ERR_INTERNAL + 1, 999, -1};
+    for (size_t k = 0; k < sizeof(unknown) / sizeof(unknown[0]); k++) {
+        const char *name = rad_status_name((rad_status)unknown[k]);
+        CHECK(name != NULL && strlen(name) > 0);
+        for (int t = RAD_OK; name && t <= RAD_ERR_INTERNAL; t++)
+            CHECK(strcmp(name, rad_status_name((rad_status)t)) != 0);
+    }
     /* destroying NULL is harmless for every object */
     rad_scene_destroy(NULL);
     rad_mesh_destroy(NULL);
