@@ -95,8 +95,9 @@ typedef struct rad_camera {
 /* ------------------------------------------------------------------------------------ */
 /* Scene: triangles with materials, grouped into named surfaces                          */
 
-/* An albedo texture: linear RGB texels (decoded from 8-bit sRGB PNG or JPEG), row 0 at
- * the top. */
+/* A texture: linear RGB texels (decoded from 8-bit sRGB PNG or JPEG, the encoding of MTL
+ * maps and of glTF's baseColorTexture and emissiveTexture), row 0 at the top. Looked up
+ * bilinearly, repeating outside [0,1]. */
 typedef struct rad_texture {
     char source[512]; /* the image file, or "FILE#N" for an image a glb embeds */
     uint32_t width, height;
@@ -113,6 +114,10 @@ typedef struct rad_material {
     uint32_t albedo_texture; /* 1 + index into rad_scene.textures (MTL map_Kd, glTF
                                 baseColorTexture): the albedo is then `albedo` times the
                                 texel; 0 = none */
+    uint32_t emission_texture; /* 1 + index into rad_scene.textures (MTL map_Ke, glTF
+                                  emissiveTexture): the emitted radiance is then `emission`
+                                  times the texel (linear RGB); 0 = none. Either texture is
+                                  read at the triangle's texture coordinates (rad_scene.uv) */
 } rad_material;
 
 /* A surface is what the user named: an OBJ object (o) or group (g). Its triangles are the
@@ -278,7 +283,9 @@ void rad_scene_destroy(rad_scene *scene);
 double rad_scene_area(const rad_scene *scene);
 void rad_scene_bounds(const rad_scene *scene, rad_vec3 *lo, rad_vec3 *hi);
 
-/* True when some material with triangles has non-zero emission. */
+/* True when some material with triangles has non-zero emission: an emission factor > 0
+ * and, with an emission texture, a texel that is not black in a channel where the factor
+ * is > 0. */
 bool rad_scene_has_emitter(const rad_scene *scene);
 
 /* A camera that frames the whole scene from the front: for a y-up scene from the -z side
@@ -334,11 +341,13 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
 
 void rad_mesh_destroy(rad_mesh *mesh);
 
-/* Each patch's albedo: its material's, or for a textured material the average of albedo
- * times texel over the patch (8 x 8 points). `albedo` receives mesh->patch_count values.
- * rad_system_from_mesh uses it. */
-rad_status rad_patch_albedo(const rad_scene *scene, const rad_mesh *mesh, rad_rgb *albedo,
-                            rad_error *error);
+/* Each patch's average albedo and average emitted radiance L_e (not the exitance: that is
+ * pi times it): its material's values, or for a textured material the mean over 8 x 8
+ * points of the patch of albedo x albedo texel and of emission x emission texel, each
+ * point's texel read at the scene triangle under it. `albedo` and `emission` (either may
+ * be NULL) receive mesh->patch_count values. rad_patch_inputs_build uses it. */
+rad_status rad_patch_materials(const rad_scene *scene, const rad_mesh *mesh, rad_rgb *albedo,
+                               rad_rgb *emission, rad_error *error);
 
 /* ------------------------------------------------------------------------------------ */
 /* Tracer: ray queries against a triangle set                                            */
@@ -865,8 +874,8 @@ rad_status rad_image_read(const char *path, rad_image **out, rad_error *error);
 /* ------------------------------------------------------------------------------------ */
 /* Rendering                                                                             */
 
+/* The image's size is the rad_image's (rad_render fills the image it is given). */
 typedef struct rad_render_options {
-    uint32_t width, height;     /* 0 = 512 */
     uint32_t samples_per_pixel; /* rounded to a square, stratified, box filter; 0 = 16 */
     uint32_t edge_samples;      /* more samples (rounded to a square) for a pixel whose first
                                    ones disagree by over 10 % in luminance, or that differs
@@ -882,11 +891,18 @@ typedef struct rad_render_options {
     int threads;
     rad_progress_fn progress;
     void *progress_user;
-    /* The scene the mesh was built from, for its albedo textures: a hit on a textured
-     * surface shows its emission plus the texel's albedo times the irradiance
-     * reconstructed from (B - E) / (the patch's average albedo), so texture detail finer
-     * than the patches survives. NULL (or no textures): the solution alone. */
+    /* The scene the mesh was built from, for its textures (albedo and emission): a hit on
+     * a textured surface shows the emitted radiance at the point (emission x its texel)
+     * plus the albedo at the point (albedo x its texel) times the irradiance reconstructed
+     * at the vertices from (B_i - E_i) / rho_i (the patch's mean exitance and albedo, as
+     * the solve used them; 0 where rho_i is 0), so texture detail finer than the patches
+     * survives. NULL (or no textured material): the solution alone, B interpolated. */
     const rad_scene *scene;
+    /* The patch inputs the solve used (rad_patch_inputs_build of scene and mesh; n must be
+     * mesh->patch_count, else RAD_ERR_INVALID): E_i and rho_i above. NULL = rad_render
+     * builds them from `scene` itself when it has a textured material (the same values:
+     * the build is deterministic). Unused without `scene`. */
+    const rad_patch_inputs *inputs;
 } rad_render_options;
 
 /* Radiance at every mesh vertex: the area-weighted average of B/pi over the patches that
@@ -898,9 +914,10 @@ void rad_reconstruct_vertices(const rad_mesh *mesh, const rad_rgb *B,
                               rad_rgb *vertex_radiance);
 
 /* Renders the mesh lit by the solution B (per patch exitance) through the camera: primary
- * rays hit the patches, radiance is interpolated from vertex values; back faces and misses
- * are black; mirror reflections are added when options->materials is given (above).
- * Fills `image` (its size decides the resolution). */
+ * rays hit the patches, radiance is interpolated from vertex values (textured surfaces:
+ * options->scene above); back faces and misses are black; mirror reflections are added
+ * when options->materials is given (above). Fills `image` (its size decides the
+ * resolution). */
 rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
                       const rad_render_options *options, rad_image *image,
                       rad_error *error);

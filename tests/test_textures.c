@@ -101,7 +101,7 @@ static uint32_t floor_albedo(const char *name, double patch_size, rad_rgb *albed
     } else {
         CHECK(scene->texture_count == 1);
         rad_rgb *all = calloc(mesh->patch_count, sizeof(*all));
-        CHECK(all && rad_patch_albedo(scene, mesh, all, &error) == RAD_OK);
+        CHECK(all && rad_patch_materials(scene, mesh, all, NULL, &error) == RAD_OK);
         for (uint32_t p = 0; all && p < mesh->patch_count && count < capacity; p++)
             if (mesh->patches[p].normal.y > 0.5) {
                 albedo[count] = all[p];

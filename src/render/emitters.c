@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
+#include "scene/material_at.h"
 
 static double triangle_area(const rad_scene *scene, uint32_t t)
 {
@@ -19,29 +20,46 @@ static double triangle_area(const rad_scene *scene, uint32_t t)
                                     v3_sub(scene->positions[v[2]], scene->positions[v[0]])));
 }
 
+/* The power the triangle is sampled by (see emitters.h); 0 for a non-emitter. */
+static double triangle_power(const rad_scene *scene, const uint8_t *emits, uint32_t t)
+{
+    uint32_t m = scene->triangles[t].material;
+    if (!emits[m])
+        return 0;
+    double least = EMITTER_POWER_FLOOR * rgb_luminance(scene->materials[m].emission);
+    double mean = rgb_luminance(material_mean_emission(scene, t));
+    return (mean > least ? mean : least) * triangle_area(scene, t);
+}
+
 rad_status emitters_build(const rad_scene *scene, emitter_set *set, rad_error *error)
 {
     memset(set, 0, sizeof(*set));
+    uint8_t *emits = rad_alloc_array(scene->material_count ? scene->material_count : 1, 1);
+    if (!emits)
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for emitters");
+    for (uint32_t m = 0; m < scene->material_count; m++)
+        emits[m] = material_emits(scene, m);
     uint32_t count = 0;
     for (uint32_t t = 0; t < scene->triangle_count; t++)
-        count += rgb_luminance(scene->materials[scene->triangles[t].material].emission) > 0;
+        count += emits[scene->triangles[t].material];
     set->triangle = rad_alloc_array(count, sizeof(*set->triangle));
     set->cdf = rad_alloc_array(count, sizeof(*set->cdf));
     set->pdf_area_of = rad_alloc_array(scene->triangle_count, sizeof(*set->pdf_area_of));
     if (!set->triangle || !set->cdf || !set->pdf_area_of) {
+        free(emits);
         emitters_free(set);
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u emitters", count);
     }
     double total = 0;
     for (uint32_t t = 0; t < scene->triangle_count; t++) {
-        double power = rgb_luminance(scene->materials[scene->triangles[t].material].emission) *
-                       triangle_area(scene, t);
+        double power = triangle_power(scene, emits, t);
         if (!(power > 0))
             continue;
         set->triangle[set->count] = t;
         total += power;
         set->cdf[set->count++] = total;
     }
+    free(emits);
     for (uint32_t k = 0; k < set->count; k++) {
         uint32_t t = set->triangle[k];
         double probability = (set->cdf[k] - (k ? set->cdf[k - 1] : 0)) / total;
@@ -85,6 +103,8 @@ void emitters_sample(const emitter_set *set, const rad_scene *scene, double u0, 
                        wa * a.z + wb * b.z + wc * c.z);
     sample->normal = v3_normalize(v3_cross(v3_sub(b, a), v3_sub(c, a)));
     sample->triangle = t;
+    sample->u = wb;
+    sample->v = wc;
     sample->pdf_area = set->pdf_area_of[t];
-    sample->radiance = scene->materials[tri->material].emission;
+    sample->radiance = material_emission_at(scene, t, wb, wc);
 }

@@ -2,21 +2,33 @@
  * emitters.h - sampling points on the scene's emitting triangles (internal).
  *
  * For next-event estimation (path tracer) and area lights (ray tracer): a triangle is
- * chosen with probability proportional to its power (area x luminance of L_e), then a
- * point uniformly on it. pdf_area is the density of the chosen point per unit area, over
- * the whole set: p(t) / A_t. Built once per scene; read-only afterwards (thread safe).
+ * chosen with probability proportional to its power (area x luminance of its MEAN emitted
+ * radiance: with an emission texture, the texel's mean over the triangle, see
+ * material_mean_emission), then a point uniformly on it, whose radiance is the emitted
+ * radiance AT that point (the texel there). pdf_area is the density of the chosen point
+ * per unit area, over the whole set: P(t) / A_t, so the estimators stay unbiased for any
+ * choice of P as long as every triangle that may emit somewhere has P > 0: a triangle of
+ * an emitting material whose estimated mean is (near) 0 keeps a floor of power,
+ * EMITTER_POWER_FLOOR of its emission factor's. Built once per scene; read-only
+ * afterwards (thread safe).
  */
 #ifndef RAD_SCENE_EMITTERS_H
 #define RAD_SCENE_EMITTERS_H
 
 #include "radiosity.h"
 
+/* The least power per unit area of an emitting triangle, as a fraction of the luminance of
+ * its material's emission factor (dimensionless): a textured triangle whose 16 x 16
+ * estimate of the mean texel is 0 (its bright texels lie between the estimate's points)
+ * is still sampled, rarely, so no emission goes unsampled. */
+#define EMITTER_POWER_FLOOR 1e-3
+
 typedef struct emitter_set {
     uint32_t count;       /* emitting triangles */
     uint32_t *triangle;   /* their scene indices */
     double *cdf;          /* cumulative probability, cdf[count - 1] = 1 */
     double *pdf_area_of;  /* per SCENE triangle: density per unit area, 0 for non-emitters */
-    double total_power;   /* sum of area x luminance(L_e) */
+    double total_power;   /* sum of area x luminance(mean L_e), floors included */
 } emitter_set;
 
 rad_status emitters_build(const rad_scene *scene, emitter_set *set, rad_error *error);
@@ -26,8 +38,10 @@ typedef struct emitter_sample {
     rad_vec3 point;
     rad_vec3 normal;    /* unit front normal of the triangle */
     uint32_t triangle;  /* scene index */
+    double u, v;        /* the point's barycentrics on the triangle (as rad_hit) */
     double pdf_area;    /* density of this point per unit area */
-    rad_rgb radiance;   /* L_e of the triangle's material (one-sided: front only) */
+    rad_rgb radiance;   /* L_e at the point: the material's, times its emission texel
+                           (one-sided: front only) */
 } emitter_sample;
 
 /* u0 picks the triangle, (u1, u2) the point; all in [0,1). The set must not be empty. */

@@ -2,8 +2,10 @@
  * pathtrace.c - the Monte-Carlo reference: unbiased path tracing of Lambertian scenes.
  *
  * What it estimates: the radiance L seen through each pixel (box filter), for one-sided
- * surfaces with albedo Kd and emitted radiance Ke, the same model radiosity solves. What it
- * is not: a general renderer (no specular, no textures, no environment light).
+ * surfaces with albedo Kd and emitted radiance Ke, the same model radiosity solves, each
+ * times its texture's texel at the point (scene/material_at.h: albedo at every path vertex,
+ * emission seen by every ray and at every light sample). What it is not: a general
+ * renderer (no specular, no environment light).
  *
  * The one idea needed to read it: the image is cut into TILE x TILE tiles, and each tile is
  * traced as a sequence of WAVES. A wave holds SAMPLES_PER_WAVE samples of every pixel of
@@ -16,8 +18,8 @@
  * Per path vertex: a back face or a miss ends the path (one-sided surfaces); emission is
  * added with weight 1 on the camera ray and with the power-heuristic MIS weight against
  * light sampling on BSDF-sampled rays; next-event estimation samples a point on the
- * emitters (power-proportional, src/render/emitters.h) and weights it by the same
- * heuristic; the bounce is cosine-weighted around the front normal (throughput *= Kd);
+ * emitters (power-proportional by their mean emission, the sample's radiance the texel
+ * at its point, src/render/emitters.h) and weights it by the same heuristic; the bounce is cosine-weighted around the front normal (throughput *= Kd);
  * Russian roulette starts after RR_START_BOUNCES bounces.
  */
 #include <float.h>
@@ -34,6 +36,8 @@
 #include "core/vec3.h"
 #include "render/camera.h"
 #include "render/emitters.h"
+#include "render/progress.h"
+#include "scene/material_at.h"
 #include "trace/ray.h"
 
 /* Tiles are TILE x TILE pixels: the unit of parallel work (dynamic schedule). */
@@ -225,10 +229,9 @@ static uint32_t extend_paths(const pt_context *c, pt_workspace *w, uint32_t live
             continue; /* escaped, or met a surface's back: one-sided, nothing comes back */
         rad_vec3 d = v3((double)w->rays[k].direction[0], (double)w->rays[k].direction[1],
                         (double)w->rays[k].direction[2]);
-        const rad_material *material = &scene->materials[scene->triangles[hit.triangle].material];
         rad_vec3 n = c->normals[hit.triangle];
 
-        rad_rgb emitted = material->emission;
+        rad_rgb emitted = material_emission_at(scene, hit.triangle, hit.u, hit.v);
         if (max3(emitted) > 0) {
             double weight = 1.0; /* camera rays see emitters whole */
             double pdf_area = c->emitters->pdf_area_of[hit.triangle];
@@ -244,7 +247,7 @@ static uint32_t extend_paths(const pt_context *c, pt_workspace *w, uint32_t live
 
         if (c->max_depth && path->bounces >= c->max_depth)
             continue;
-        rad_rgb albedo = material->albedo;
+        rad_rgb albedo = material_albedo_at(scene, hit.triangle, hit.u, hit.v);
         if (!(max3(albedo) > 0))
             continue;
         rad_vec3 x = hit_point(scene, &hit);
@@ -453,20 +456,15 @@ rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
 
     uint64_t tiles_x = (c.width - 1) / TILE + 1, tiles_y = (c.height - 1) / TILE + 1;
     uint64_t tiles = tiles_x * tiles_y;
-    uint64_t tiles_done = 0;
+    render_progress progress =
+        render_progress_start(options->progress, options->progress_user, "pathtrace", tiles);
     uint64_t rays = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : rays)
     for (uint64_t tile = 0; tile < tiles; tile++) {
-        int thread = omp_get_thread_num();
-        trace_tile(&c, &workspaces[thread], tile, image, standard_error, &rays);
-        uint64_t done;
-#pragma omp atomic capture
-        done = ++tiles_done;
-        if (thread == 0 && options->progress)
-            options->progress(options->progress_user, "pathtrace", (double)done / tiles);
+        trace_tile(&c, &workspaces[omp_get_thread_num()], tile, image, standard_error, &rays);
+        render_progress_step(&progress);
     }
-    if (options->progress)
-        options->progress(options->progress_user, "pathtrace", 1);
+    render_progress_finish(&progress);
     if (report) {
         report->rays = rays;
         report->seconds = omp_get_wtime() - start;

@@ -9,9 +9,12 @@
  * light's rim) get edge_samples more. With the scene's materials given, a hit on a surface
  * with Ks > 0 also sends a mirror ray, weighted by Ks, whose hit is shaded the same way
  * (the radiosity solution replaces Whitted's ambient term), up to a depth.
- * Random numbers come from (seed, pixel). With the scene's albedo textures, a textured
- * patch's vertices hold the irradiance (B - E) / (pi rho_avg) instead, and a hit shows
- * L_e + texel albedo x that, so texture detail finer than the patches survives.
+ * Random numbers come from (seed, pixel). With the scene's textures (albedo or emission),
+ * a textured patch's vertices hold the irradiance (B_i - E_i) / (pi rho_i) instead, E_i and
+ * rho_i the patch inputs the solve used (passed in, or built once here), and a hit shows
+ * L_e(point) + albedo(point) x that, both read from the textures at the hit
+ * (scene/patch_materials.h), so texture detail finer than the patches survives and an
+ * emission texture shows its own texels.
  */
 #include <math.h>
 #include <omp.h>
@@ -25,8 +28,9 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "render/camera.h"
+#include "render/progress.h"
 #include "reconstruct/display_mesh.h"
-#include "scene/texture.h"
+#include "scene/patch_materials.h"
 #include "trace/ray.h"
 
 #define MAX_STRATA 16u
@@ -54,9 +58,8 @@ typedef struct shading {
     const rad_material *materials;  /* NULL: no mirror rays */
     float t_near;
     double leave;                   /* how far mirror rays start off a surface (scene units) */
-    const albedo_lookup *textures;  /* NULL: no textured surface */
-    const rad_material *scene_materials; /* for textured hits: L_e */
-    const rad_rgb *patch_albedo;    /* per patch: the average the solve used */
+    const patch_material_lookup *textures; /* NULL: no textured surface */
+    const rad_patch_inputs *inputs; /* per patch: the means the solve used (with textures) */
 } shading;
 
 static double mean_luminance(const rad_rgb *samples, unsigned count)
@@ -83,7 +86,9 @@ static bool is_edge(const rad_rgb *samples, unsigned count, double mean)
     return hi - lo > EDGE_CONTRAST * mean;
 }
 
-/* A textured patch's radiance at a hit: L_e + texel albedo x interpolated irradiance. */
+/* A textured patch's radiance at a hit: the emitted radiance at the point plus the albedo
+ * at the point times the interpolated irradiance (/ pi). Where the probe finds no scene
+ * triangle, the patch's means stand in: E_i / pi and rho_i. */
 static rad_rgb textured_radiance(const shading *sh, const rad_ray *ray, const rad_hit *hit,
                                  uint32_t patch_index, rad_rgb irradiance)
 {
@@ -91,9 +96,10 @@ static rad_rgb textured_radiance(const shading *sh, const rad_ray *ray, const ra
     rad_vec3 point = v3(ray->origin[0] + (double)hit->t * ray->direction[0],
                         ray->origin[1] + (double)hit->t * ray->direction[1],
                         ray->origin[2] + (double)hit->t * ray->direction[2]);
-    rad_rgb albedo = sh->patch_albedo[patch_index];
-    albedo_lookup_at(sh->textures, point, patch->normal, 2 * patch->bulge, &albedo);
-    return rgb_add(sh->scene_materials[patch->material].emission, rgb_mul(albedo, irradiance));
+    rad_rgb albedo = sh->inputs->albedo[patch_index];
+    rad_rgb emission = rgb_scale(sh->inputs->exitance[patch_index], 1.0 / RAD_PI);
+    patch_material_at(sh->textures, point, patch->normal, 2 * patch->bulge, &albedo, &emission);
+    return rgb_add(emission, rgb_mul(albedo, irradiance));
 }
 
 /* Adds each hit's interpolated radiance (times the ray's weight) to its sample and, when
@@ -112,8 +118,7 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
         rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit->u - hit->v),
                                        rgb_add(rgb_scale(L[v[1]], hit->u), rgb_scale(L[v[2]], hit->v)));
         uint32_t patch_index = sh->patch_of[hit->triangle];
-        if (sh->textures &&
-            albedo_lookup_textured(sh->textures, sh->mesh->patches[patch_index].material))
+        if (patch_material_textured(sh->textures, sh->mesh->patches[patch_index].material))
             interpolated = textured_radiance(sh, &w->rays[r], hit, patch_index, interpolated);
         rgb_add_to(&w->sum[w->sample[r]], rgb_mul(weight, interpolated));
         if (!mirrors || !sh->materials)
@@ -148,38 +153,47 @@ static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work 
     }
 }
 
-/* With textures: the lookup, each patch's average albedo, and the per-patch values to
- * reconstruct: (B - E) / rho_avg on textured patches (0 where rho_avg is 0), B elsewhere.
- * All NULL when the scene has no textured triangle. */
-static rad_status textures_begin(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
-                                 albedo_lookup **lookup, rad_rgb **patch_albedo,
+/* With textures: the lookup, the patch inputs (the caller's, else built here into *built)
+ * and the per-patch values to reconstruct: (B - E) / rho on textured patches (0 where rho
+ * is 0), B elsewhere. All NULL when there is no scene or no textured triangle. */
+static rad_status textures_begin(const rad_render_options *options, const rad_mesh *mesh,
+                                 const rad_rgb *B, patch_material_lookup **lookup,
+                                 const rad_patch_inputs **inputs, rad_patch_inputs **built,
                                  rad_rgb **shaded, rad_error *error)
 {
     *lookup = NULL;
-    *patch_albedo = *shaded = NULL;
+    *inputs = NULL;
+    *built = NULL;
+    *shaded = NULL;
+    const rad_scene *scene = options->scene;
     if (!scene || scene->texture_count == 0)
         return RAD_OK;
-    rad_status status = albedo_lookup_create(scene, lookup, error);
+    if (options->inputs && options->inputs->n != mesh->patch_count)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "render: the patch inputs are for %u patches, the mesh has %u",
+                        options->inputs->n, mesh->patch_count);
+    rad_status status = patch_material_lookup_create(scene, lookup, error);
     if (status != RAD_OK || !*lookup)
         return status;
-    *patch_albedo = rad_alloc_array(mesh->patch_count, sizeof(**patch_albedo));
+    if (!options->inputs) {
+        status = rad_patch_inputs_build(scene, mesh, built, error);
+        if (status != RAD_OK)
+            return status;
+    }
+    *inputs = options->inputs ? options->inputs : *built;
     *shaded = rad_alloc_array(mesh->patch_count, sizeof(**shaded));
-    if (!*patch_albedo || !*shaded)
+    if (!*shaded)
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for textures");
-    status = rad_patch_albedo(scene, mesh, *patch_albedo, error);
-    if (status != RAD_OK)
-        return status;
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
-        uint32_t m = mesh->patches[p].material;
-        if (!albedo_lookup_textured(*lookup, m)) {
+        if (!patch_material_textured(*lookup, mesh->patches[p].material)) {
             (*shaded)[p] = B[p];
             continue;
         }
-        const double *b = &B[p].r, *e = &scene->materials[m].emission.r;
-        const double *rho = &(*patch_albedo)[p].r;
+        const double *b = &B[p].r, *e = &(*inputs)->exitance[p].r;
+        const double *rho = &(*inputs)->albedo[p].r;
         double *out = &(*shaded)[p].r;
         for (int c = 0; c < 3; c++)
-            out[c] = rho[c] > 0 ? (b[c] - RAD_PI * e[c]) / rho[c] : 0;
+            out[c] = rho[c] > 0 ? (b[c] - e[c]) / rho[c] : 0;
     }
     return RAD_OK;
 }
@@ -210,8 +224,10 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     rad_vec3 *positions = NULL;
     rad_tracer *tracer = NULL;
     row_work *work = NULL;
-    albedo_lookup *lookup = NULL;
-    rad_rgb *patch_albedo = NULL, *shaded = NULL;
+    patch_material_lookup *lookup = NULL;
+    const rad_patch_inputs *inputs = NULL;
+    rad_patch_inputs *built_inputs = NULL;
+    rad_rgb *shaded = NULL;
     status = display_mesh_build(mesh, true, &display, error);
     if (status != RAD_OK)
         goto done;
@@ -220,7 +236,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     if (!radiance || !positions)
         goto nomem;
     display_mesh_positions(mesh, &display, positions);
-    status = textures_begin(options->scene, mesh, B, &lookup, &patch_albedo, &shaded, error);
+    status = textures_begin(options, mesh, B, &lookup, &inputs, &built_inputs, &shaded, error);
     if (status != RAD_OK)
         goto done;
     display_mesh_radiance(mesh, &display, shaded ? shaded : B, radiance);
@@ -263,10 +279,10 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     }
     shading shade = {mesh, (const uint32_t(*)[3])display.triangles, display.patch_of, radiance,
                      options->materials,
-                     t_near, leave, lookup, options->scene ? options->scene->materials : NULL,
-                     patch_albedo};
+                     t_near, leave, lookup, inputs};
 
-    uint32_t rows_done = 0;
+    render_progress progress =
+        render_progress_start(options->progress, options->progress_user, "render", H);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (uint32_t y = 0; y < H; y++) {
         int thread = omp_get_thread_num();
@@ -330,14 +346,9 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
             pixel[1] = (float)(sum.g / count);
             pixel[2] = (float)(sum.b / count);
         }
-        uint32_t done;
-#pragma omp atomic capture
-        done = ++rows_done;
-        if (thread == 0 && options->progress)
-            options->progress(options->progress_user, "render", (double)done / H);
+        render_progress_step(&progress);
     }
-    if (options->progress)
-        options->progress(options->progress_user, "render", 1);
+    render_progress_finish(&progress);
     goto done;
 nomem:
     status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for rendering");
@@ -357,8 +368,8 @@ done:
     display_mesh_free(&display);
     free(radiance);
     free(positions);
-    albedo_lookup_destroy(lookup);
-    free(patch_albedo);
+    patch_material_lookup_destroy(lookup);
+    rad_patch_inputs_destroy(built_inputs);
     free(shaded);
     return status;
 }

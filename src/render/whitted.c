@@ -6,11 +6,12 @@
  *   I = I_E + K_A I_A + sum over point lights (K_D <N,L> + K_S <V,R>^n) I_L S_L
  *       + direct light of the emitting surfaces (area lights, below) + K_S I_R
  *
- * with K_A = K_D = the albedo Kd, I_E = the emitted radiance Ke, N the front normal of the
- * triangle hit, L and V unit vectors to the light and to the viewer, R = 2 <N,L> N - L,
- * n = the shininess Ns, S_L = 1 when a shadow ray reaches the light, and I_R the radiance
- * along the mirror direction of the incoming ray, followed while K_S > 0 and fewer than
- * max_depth reflections were made. The lobe <V,R>^n counts only where <V,R> > 0 (so n = 0
+ * with K_A = K_D = the albedo Kd, I_E = the emitted radiance Ke (each times its texture's
+ * texel at the point, scene/material_at.h), N the front normal of the triangle hit, L and
+ * V unit vectors to the light and to the viewer, R = 2 <N,L> N - L, n = the shininess Ns,
+ * S_L = 1 when a shadow ray reaches the light, and I_R the radiance along the mirror
+ * direction of the incoming ray, followed while K_S > 0 and fewer than max_depth
+ * reflections were made. The lobe <V,R>^n counts only where <V,R> > 0 (so n = 0
  * does not light surfaces facing away from the mirror direction).
  *
  * What it is not: a physically based renderer. Point lights have no distance falloff (the
@@ -19,7 +20,7 @@
  *
  * Area lights. Every emitting triangle is part of one area light, sampled `light_samples`
  * times per shading point (emitters_sample: triangle by power, then a point uniformly on
- * it; the triangle choice is stratified, and the points each triangle gets are a shifted
+ * it, whose L_e is the emission texel there; the triangle choice is stratified, and the points each triangle gets are a shifted
  * Halton sequence, see shade_direct). There the Phong model is read as the BRDF
  *     f = (K_D + K_S <V,R>^n) / pi
  * integrated against the emitters: each sample q adds
@@ -54,6 +55,8 @@
 #include "core/vec3.h"
 #include "render/camera.h"
 #include "render/emitters.h"
+#include "render/progress.h"
+#include "scene/material_at.h"
 #include "trace/ray.h"
 
 /* Secondary rays leave a surface from a point nudged this far along its normal and ignore
@@ -179,9 +182,10 @@ static double radical_inverse(uint32_t j, uint32_t b)
 static double wrap(double u) { return u < 1 ? u : u - 1; }
 
 /* Queues the direct light at point p (front normal N, viewer direction V) of the surface
- * with material m, for packet sample `sample` seen with `weight`. */
+ * with material m and, there, albedo `albedo` (K_D, textured), for packet sample `sample`
+ * seen with `weight`. */
 static void shade_direct(const rt_context *ctx, rt_workspace *ws, const rad_material *m,
-                         uint32_t triangle, rad_vec3 p, rad_vec3 N, rad_vec3 V,
+                         rad_rgb albedo, uint32_t triangle, rad_vec3 p, rad_vec3 N, rad_vec3 V,
                          rad_rgb weight, uint32_t sample, uint64_t pixel, uint32_t depth)
 {
     bool specular = !rgb_is_zero(m->specular);
@@ -198,7 +202,7 @@ static void shade_direct(const rt_context *ctx, rt_workspace *ws, const rad_mate
         if (NL <= 0)
             continue;
         double lobe = specular ? phong_lobe(N, L, NL, V, m->shininess) : 0;
-        rad_rgb bracket = rgb_add(rgb_scale(m->albedo, NL), rgb_scale(m->specular, lobe));
+        rad_rgb bracket = rgb_add(rgb_scale(albedo, NL), rgb_scale(m->specular, lobe));
         rad_rgb add = rgb_mul(rgb_mul(weight, bracket), light->intensity);
         if (!rgb_is_zero(add))
             queue_shadow(ctx, ws, from, light->position, 0, sample, add);
@@ -237,7 +241,7 @@ static void shade_direct(const rt_context *ctx, rt_workspace *ws, const rad_mate
             continue;
         double g = cos_surface * cos_light / (RAD_PI * r2 * es.pdf_area * n);
         double lobe = specular ? phong_lobe(N, L, cos_surface, V, m->shininess) : 0;
-        rad_rgb brdf = rgb_add(m->albedo, rgb_scale(m->specular, lobe)); /* times pi */
+        rad_rgb brdf = rgb_add(albedo, rgb_scale(m->specular, lobe)); /* times pi */
         rad_rgb add = rgb_mul(rgb_mul(weight, brdf), rgb_scale(es.radiance, g));
         if (rgb_is_zero(add))
             continue;
@@ -274,12 +278,16 @@ static void trace_packet(const rt_context *ctx, rt_workspace *ws, uint32_t count
             rad_vec3 p = v3_add(path.origin, v3_scale(d, t));
             rad_vec3 V = v3_scale(d, -1);
 
-            rad_rgb local = rgb_add(m->emission, rgb_mul(m->albedo, ctx->ambient));
+            /* K_A = K_D = the albedo at the point, I_E its emitted radiance (textures
+             * applied) */
+            rad_rgb albedo = material_albedo_at(scene, hit->triangle, hit->u, hit->v);
+            rad_rgb emitted = material_emission_at(scene, hit->triangle, hit->u, hit->v);
+            rad_rgb local = rgb_add(emitted, rgb_mul(albedo, ctx->ambient));
             ws->radiance[path.sample] =
                 rgb_add(ws->radiance[path.sample], rgb_mul(path.weight, local));
             uint64_t pixel = (uint64_t)y * ctx->width + (ws->packet_first + path.sample) / spp;
-            shade_direct(ctx, ws, m, hit->triangle, p, N, V, path.weight, path.sample, pixel,
-                         depth);
+            shade_direct(ctx, ws, m, albedo, hit->triangle, p, N, V, path.weight, path.sample,
+                         pixel, depth);
 
             if (depth < ctx->max_depth && !rgb_is_zero(m->specular)) {
                 rt_path next = path; /* alive <= i: overwrites only finished paths */
@@ -461,19 +469,15 @@ rad_status rad_raytrace(const rad_scene *scene, const rad_camera *camera,
     ctx.emitters = &emitters;
     ctx.normal = normal;
 
-    uint32_t rows_done = 0;
+    render_progress progress =
+        render_progress_start(options->progress, options->progress_user, "raytrace", ctx.height);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (uint32_t y = 0; y < ctx.height; y++) {
-        int thread = omp_get_thread_num();
-        trace_row(&ctx, &workspaces[thread], y, &image->rgb[(size_t)y * ctx.width * 3]);
-        uint32_t done;
-#pragma omp atomic capture
-        done = ++rows_done;
-        if (thread == 0 && options->progress)
-            options->progress(options->progress_user, "raytrace", (double)done / ctx.height);
+        trace_row(&ctx, &workspaces[omp_get_thread_num()], y,
+                  &image->rgb[(size_t)y * ctx.width * 3]);
+        render_progress_step(&progress);
     }
-    if (options->progress)
-        options->progress(options->progress_user, "raytrace", 1);
+    render_progress_finish(&progress);
     goto done;
 nomem:
     status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for ray tracing");

@@ -11,8 +11,8 @@
  * Kd / glTF baseColorFactor = albedo, Ke / glTF emissiveFactor x emissiveStrength =
  * emitted radiance; a format's "no material" (STL, PLY without a material element, OBJ
  * faces before any usemtl, glTF primitives without one) gets RAD_DEFAULT_ALBEDO; albedo
- * textures are decoded once each and triangles of textured materials keep their texture
- * coordinates; (4) takes the first glTF camera, and the up axis and unit from the file's
+ * and emission textures are decoded once each and triangles of textured materials keep
+ * their texture coordinates; (4) takes the first glTF camera, and the up axis and unit from the file's
  * metadata.
  * View3D input files are recognised here and handed to import_vs3.c.
  */
@@ -42,7 +42,7 @@ enum { TEXTURE_CACHE = 256 };
 
 typedef struct texture_key {
     char key[1600];         /* the texture's file, or "*N" for an embedded one */
-    uint32_t index;         /* rad_material.albedo_texture */
+    uint32_t index;         /* 1 + index into the scene's textures */
 } texture_key;
 
 static bool has_extension(const char *path, const char *extension)
@@ -223,7 +223,7 @@ typedef struct import_state {
     bool ply_without_materials;
     char stem[128];         /* the file's name without folder and extension */
     const rad_load_options *options;
-    uint8_t *textured;      /* Assimp material index -> its albedo has a texture */
+    uint8_t *textured;      /* Assimp material index -> it has a texture (albedo or emission) */
     texture_key *cache;     /* textures already read (TEXTURE_CACHE at most) */
     unsigned cache_count;
 } import_state;
@@ -283,18 +283,27 @@ static const gltf_material *gltf_material_of(const import_state *state, unsigned
     return found;
 }
 
-/* The albedo texture (MTL map_Kd, glTF baseColorTexture: Assimp's diffuse texture 0) of
- * material m: a file beside the scene, or an image a glb embeds ("*N"). A texture that is
- * missing or cannot be decoded is a warning: the albedo is then the material's colour. */
-static void take_texture(import_state *state, const struct aiMaterial *m, rad_material *material)
+/* Texture 0 of Assimp type `type` of material m, for `role`: a file beside the scene, or
+ * an image a glb embeds ("*N"). Returns 1 + its index into the scene's textures, or 0 when
+ * there is none. A texture that is missing or cannot be decoded is a warning: the value is
+ * then the material's colour. Images already read are shared (one decode per file, the
+ * same sRGB decoding for every role). */
+static uint32_t take_texture(import_state *state, const struct aiMaterial *m,
+                             enum aiTextureType type, const rad_material *material,
+                             const char *role)
 {
     struct aiString texture;
-    if (aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &texture, NULL, NULL, NULL, NULL, NULL,
-                             NULL) != aiReturn_SUCCESS ||
+    unsigned uv_set = 0;
+    if (aiGetMaterialTexture(m, type, 0, &texture, NULL, &uv_set, NULL, NULL, NULL, NULL) !=
+            aiReturn_SUCCESS ||
         texture.length == 0)
-        return;
+        return 0;
     rad_log_fn log = state->options ? state->options->log : NULL;
     void *user = state->options ? state->options->log_user : NULL;
+    if (uv_set != 0)
+        rad_warn(log, user, "%s: material '%s': %s texture '%s' uses texture coordinates %u; "
+                 "only set 0 is read, so it is looked up there",
+                 state->path, material->name, role, texture.data, uv_set);
     char key[sizeof(state->cache[0].key)];
     if (texture.data[0] == '*' || texture.data[0] == '/')
         snprintf(key, sizeof(key), "%s", texture.data);
@@ -304,10 +313,8 @@ static void take_texture(import_state *state, const struct aiMaterial *m, rad_ma
         snprintf(key, sizeof(key), "%s%s", folder, texture.data);
     }
     for (unsigned k = 0; k < state->cache_count; k++)
-        if (strcmp(state->cache[k].key, key) == 0) {
-            material->albedo_texture = state->cache[k].index;
-            return;
-        }
+        if (strcmp(state->cache[k].key, key) == 0)
+            return state->cache[k].index;
     rad_texture decoded;
     rad_error why = {0};
     rad_status status = RAD_ERR_IO;
@@ -329,26 +336,46 @@ static void take_texture(import_state *state, const struct aiMaterial *m, rad_ma
     } else {
         struct stat st;
         if (stat(key, &st) != 0 || !S_ISREG(st.st_mode)) {
-            rad_warn(log, user, "%s: material '%s': texture '%s' not found; its albedo is the "
+            rad_warn(log, user, "%s: material '%s': texture '%s' not found; its %s is the "
                      "material's colour",
-                     state->path, material->name, texture.data);
-            return;
+                     state->path, material->name, texture.data, role);
+            return 0;
         }
         status = texture_load_file(key, &decoded, &why);
     }
     if (status != RAD_OK) {
-        rad_warn(log, user, "%s: material '%s': texture '%s': %s; its albedo is the material's "
+        rad_warn(log, user, "%s: material '%s': texture '%s': %s; its %s is the material's "
                  "colour",
-                 state->path, material->name, texture.data, why.message);
-        return;
+                 state->path, material->name, texture.data, why.message, role);
+        return 0;
     }
-    material->albedo_texture = scene_builder_texture(state->builder, &decoded);
+    uint32_t index = scene_builder_texture(state->builder, &decoded);
     if (!state->cache)
         state->cache = rad_alloc_array(TEXTURE_CACHE, sizeof(*state->cache));
-    if (material->albedo_texture && state->cache && state->cache_count < TEXTURE_CACHE) {
+    if (index && state->cache && state->cache_count < TEXTURE_CACHE) {
         snprintf(state->cache[state->cache_count].key, sizeof(state->cache[0].key), "%s", key);
-        state->cache[state->cache_count++].index = material->albedo_texture;
+        state->cache[state->cache_count++].index = index;
     }
+    return index;
+}
+
+/* The material's textures: albedo (MTL map_Kd, glTF baseColorTexture: Assimp's diffuse
+ * texture 0) and emission (MTL map_Ke, glTF emissiveTexture: Assimp's emissive texture 0,
+ * verified with Assimp 5.2 for both formats). An emission texture multiplies the emission
+ * factor, so with a zero factor (MTL Ke missing, glTF emissiveFactor missing) it shows
+ * nothing: a warning says so. */
+static void take_textures(import_state *state, const struct aiMaterial *m, rad_material *material)
+{
+    material->albedo_texture = take_texture(state, m, aiTextureType_DIFFUSE, material, "albedo");
+    material->emission_texture =
+        take_texture(state, m, aiTextureType_EMISSIVE, material, "emission");
+    const rad_rgb *e = &material->emission;
+    if (material->emission_texture && !(e->r > 0 || e->g > 0 || e->b > 0))
+        rad_warn(state->options ? state->options->log : NULL,
+                 state->options ? state->options->log_user : NULL,
+                 "%s: material '%s': an emission texture but an emission factor of 0 (MTL Ke, "
+                 "glTF emissiveFactor): it emits nothing",
+                 state->path, material->name);
 }
 
 static rad_status map_material(import_state *state, unsigned index, uint32_t *out,
@@ -415,8 +442,8 @@ static rad_status map_material(import_state *state, unsigned index, uint32_t *ou
             }
         }
         if (!is_default)
-            take_texture(state, m, &material);
-        state->textured[index] = material.albedo_texture != 0;
+            take_textures(state, m, &material);
+        state->textured[index] = material.albedo_texture != 0 || material.emission_texture != 0;
         state->material_map[index] = scene_builder_material(state->builder, &material);
         if (state->material_map[index] == UINT32_MAX)
             return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", state->path);

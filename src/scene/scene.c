@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/vec3.h"
 #include "radiosity.h"
+#include "scene/material_at.h"
 
 void rad_scene_destroy(rad_scene *scene)
 {
@@ -45,10 +46,13 @@ void rad_scene_bounds(const rad_scene *scene, rad_vec3 *lo, rad_vec3 *hi)
 
 bool rad_scene_has_emitter(const rad_scene *scene)
 {
-    for (uint32_t t = 0; t < scene->triangle_count; t++) {
-        rad_rgb e = scene->materials[scene->triangles[t].material].emission;
-        if (e.r > 0 || e.g > 0 || e.b > 0)
-            return true;
+    /* each emitting material once (an emission texture is scanned whole), then its use */
+    for (uint32_t m = 0; m < scene->material_count; m++) {
+        if (!material_emits(scene, m))
+            continue;
+        for (uint32_t t = 0; t < scene->triangle_count; t++)
+            if (scene->triangles[t].material == m)
+                return true;
     }
     return false;
 }

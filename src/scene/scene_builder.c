@@ -356,9 +356,12 @@ rad_status scene_builder_finish(scene_builder *b, rad_scene **out, rad_error *er
             memcpy(scene->uv[t], b->triangles[t].uv, sizeof(scene->uv[t]));
     }
     /* a texture index out of range (a bug of a source) becomes no texture */
-    for (size_t m = 0; m < b->material_count; m++)
+    for (size_t m = 0; m < b->material_count; m++) {
         if (b->materials[m].albedo_texture > b->texture_count)
             b->materials[m].albedo_texture = 0;
+        if (b->materials[m].emission_texture > b->texture_count)
+            b->materials[m].emission_texture = 0;
+    }
 
     /* surfaces that kept triangles, renumbered in order of first appearance */
     uint32_t *surface_map = skipped; /* reuse after warning */

@@ -43,7 +43,8 @@ rad_status scene_builder_triangle_uv(scene_builder *builder, uint32_t surface,
                                      const float uv[3][2], rad_error *error);
 
 /* Takes the texture (its texels now belong to the scene); returns 1 + its index, for
- * rad_material.albedo_texture, or 0 when out of memory (the texture is then freed). */
+ * rad_material.albedo_texture or emission_texture, or 0 when out of memory (the texture
+ * is then freed). */
 uint32_t scene_builder_texture(scene_builder *builder, rad_texture *texture);
 
 void scene_builder_set_camera(scene_builder *builder, const rad_camera *camera);

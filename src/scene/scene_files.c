@@ -68,6 +68,7 @@ static rad_status append_file(scene_builder *builder, const rad_scene_file *file
     for (uint32_t m = 0; m < part->material_count && status == RAD_OK; m++) {
         rad_material material = part->materials[m];
         material.albedo_texture = 0; /* textures are not carried over (see radiosity.h) */
+        material.emission_texture = 0;
         uint32_t index = scene_builder_material(builder, &material);
         if (m == 0)
             first_material = index;

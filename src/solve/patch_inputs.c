@@ -3,7 +3,8 @@
  * every solver and renderer (rad_patch_inputs_build), and the dense system made of them.
  *
  * Exitance E_i = pi * L_e (the material's emitted radiance, METHOD.md section 3); albedo
- * rho_i the material's, or its average over the patch for a textured one.
+ * rho_i the material's; for a textured material both are averages over the patch
+ * (rad_patch_materials).
  */
 #include <stdint.h>
 #include <stdlib.h>
@@ -38,20 +39,17 @@ rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
         rad_patch_inputs_destroy(in);
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u patches", n);
     }
-    for (uint32_t i = 0; i < n; i++) {
-        const rad_material *m = &scene->materials[mesh->patches[i].material];
+    for (uint32_t i = 0; i < n; i++)
         in->area[i] = mesh->patches[i].area;
-        in->albedo[i] = m->albedo;
-        in->exitance[i] = (rad_rgb){RAD_PI * m->emission.r, RAD_PI * m->emission.g,
-                                    RAD_PI * m->emission.b};
+    /* the patch means of albedo and emitted radiance (textures applied); E_i = pi L_e */
+    rad_status status = rad_patch_materials(scene, mesh, in->albedo, in->exitance, error);
+    if (status != RAD_OK) {
+        rad_patch_inputs_destroy(in);
+        return status;
     }
-    if (scene->texture_count > 0) {
-        rad_status status = rad_patch_albedo(scene, mesh, in->albedo, error);
-        if (status != RAD_OK) {
-            rad_patch_inputs_destroy(in);
-            return status;
-        }
-    }
+    for (uint32_t i = 0; i < n; i++)
+        in->exitance[i] = (rad_rgb){RAD_PI * in->exitance[i].r, RAD_PI * in->exitance[i].g,
+                                    RAD_PI * in->exitance[i].b};
     *out = in;
     return RAD_OK;
 }
