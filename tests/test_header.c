@@ -33,6 +33,19 @@ int main(void)
     rad_tracer_destroy(NULL);
     rad_formfactors_destroy(NULL);
     rad_image_destroy(NULL);
+    rad_solution_destroy(NULL);
+    rad_viewfactor_matrix_destroy(NULL);
+    rad_patch_inputs_destroy(NULL);
+    /* every solver's name reads back as that solver; an unknown value still has a name */
+    for (int k = RAD_SOLVER_AUTO; k <= RAD_SOLVER_HIERARCHICAL; k++) {
+        rad_solver back = (rad_solver)-1;
+        const char *name = rad_solver_name((rad_solver)k);
+        CHECK(name != NULL && rad_solver_from_name(name, &back) && back == (rad_solver)k);
+    }
+    rad_solver jacobi = RAD_SOLVER_AUTO;
+    CHECK(rad_solver_from_name("jacobi", &jacobi) && jacobi == RAD_SOLVER_JACOBI);
+    CHECK(!rad_solver_from_name("nonsense", &jacobi));
+    CHECK(rad_solver_name((rad_solver)999) != NULL);
     CHECK(rad_peak_memory_bytes() > 0);
     return test_finish("test_header");
 }
