@@ -183,7 +183,11 @@ typedef struct rad_load_options {
  * Collada, 3DS and the other formats Assimp reads. Materials map onto METHOD.md's units:
  * MTL Kd and glTF baseColorFactor are the albedo; MTL Ke, and glTF emissiveFactor times
  * KHR_materials_emissive_strength (read from the file's JSON: Assimp 5.2 drops it), the
- * emitted radiance. A surface is a mesh's name (OBJ o/g, glTF mesh, STL solid), else its
+ * emitted radiance; MTL map_Kd / glTF baseColorTexture and MTL map_Ke / glTF
+ * emissiveTexture (PNG or JPEG, sRGB, in a file or inside a .glb) are decoded into
+ * rad_scene.textures and multiply them (rad_material). A texture that is missing or
+ * unreadable is a warning (the value is then the factor alone), and so is an emission
+ * texture under an emission factor of 0 (it shows nothing). A surface is a mesh's name (OBJ o/g, glTF mesh, STL solid), else its
  * node's, else the file's name without extension. The first glTF camera becomes the
  * scene's camera. Degenerate triangles are skipped with a warning; non-finite
  * coordinates, a missing material library or glTF buffer, a truncated .glb, an index out
@@ -261,8 +265,8 @@ typedef struct rad_scene_file {
  * is "north"), with `flags` (RAD_SURFACE_OBSTRUCTION for meshes that only block) and the
  * area-weighted mean emissivity of the file's own surfaces; or, with keep_surfaces, the
  * file's own surfaces with their names, flags and emissivities. A surface name that two
- * files give is RAD_ERR_INVALID. Materials are kept without their albedo textures (view
- * factors do not depend on them). */
+ * files give is RAD_ERR_INVALID. Materials are kept without their textures, albedo and
+ * emission (view factors do not depend on them). */
 rad_status rad_scene_load_files(const rad_scene_file *files, uint32_t count,
                                 const rad_load_options *options, rad_scene **out,
                                 rad_error *error);
@@ -294,7 +298,8 @@ rad_camera rad_scene_default_camera(const rad_scene *scene);
 
 /* Sets the albedo and/or the emitted radiance (either may be NULL) of what `name` names:
  * a surface by that name, else the one material by that name. A surface keeps its other
- * material values; when its material is shared with triangles of other surfaces, it gets
+ * material values, its textures included (a value set is the factor its texture then
+ * multiplies); when its material is shared with triangles of other surfaces, it gets
  * its own copy first, so nothing else changes. RAD_ERR_INVALID, naming `name`, when
  * nothing or several materials have that name (and no surface does), or when a value is
  * out of its domain (albedo in [0,1], emission >= 0, both finite). */
@@ -901,7 +906,7 @@ typedef struct rad_render_options {
     /* The patch inputs the solve used (rad_patch_inputs_build of scene and mesh; n must be
      * mesh->patch_count, else RAD_ERR_INVALID): E_i and rho_i above. NULL = rad_render
      * builds them from `scene` itself when it has a textured material (the same values:
-     * the build is deterministic). Unused without `scene`. */
+     * the build is deterministic). Read only for textured surfaces of `scene`. */
     const rad_patch_inputs *inputs;
 } rad_render_options;
 
@@ -947,9 +952,11 @@ typedef struct rad_raytrace_options {
 
 /* Whitted ray tracing with the Phong model of METHOD.md section 1:
  *   I = I_E + K_A I_A + sum over lights (K_D <N,L> + K_S <V,R>^n) I_L S_L + K_S I_R
- * with I_E the emitted radiance, S_L the shadow-ray visibility and I_R the radiance along
- * the mirror direction. Point lights follow the classic model (no distance falloff).
- * Emissive surfaces act as area lights, sampled for soft shadows: each sample adds
+ * with I_E the emitted radiance, K_A = K_D the albedo (each times its texture's texel at
+ * the point hit), S_L the shadow-ray visibility and I_R the radiance along the mirror
+ * direction. Point lights follow the classic model (no distance falloff).
+ * Emissive surfaces act as area lights, sampled for soft shadows (a triangle by its mean
+ * emitted power, L_e the emission texel at the sampled point): each sample adds
  * (K_D + K_S <V,R>^n) / pi * L_e cos(surface) cos(light) / r^2 / pdf, the Phong model read as
  * a reflectance function, so their diffuse part is exactly radiosity's direct light. Back
  * faces show black (one-sided surfaces). One sample per pixel goes through the pixel's
@@ -976,7 +983,7 @@ typedef struct rad_pathtrace_report {
 } rad_pathtrace_report;
 
 /* An unbiased path tracer for the same Lambertian scenes radiosity solves (albedo Kd,
- * emitted radiance Ke, one-sided): cosine-weighted importance sampling, next-event
+ * emitted radiance Ke, each times its texture's texel at the point; one-sided): cosine-weighted importance sampling, next-event
  * estimation on emitters combined with BSDF sampling by multiple importance sampling,
  * Russian roulette. Deterministic per seed for any thread count; parallel over tiles. The
  * reference for checking radiosity images. `standard_error` (NULL, or an image of the

@@ -9,7 +9,9 @@
  * per unit area, over the whole set: P(t) / A_t, so the estimators stay unbiased for any
  * choice of P as long as every triangle that may emit somewhere has P > 0: a triangle of
  * an emitting material whose estimated mean is (near) 0 keeps a floor of power,
- * EMITTER_POWER_FLOOR of its emission factor's. Built once per scene; read-only
+ * EMITTER_POWER_FLOOR of its emission factor's. A material whose emission texture is
+ * black everywhere (in the channels where its factor is > 0) emits nowhere: it is not an
+ * emitter (material_emits), and nothing is lost. Built once per scene; read-only
  * afterwards (thread safe).
  */
 #ifndef RAD_SCENE_EMITTERS_H

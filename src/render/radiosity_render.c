@@ -166,12 +166,12 @@ static rad_status textures_begin(const rad_render_options *options, const rad_me
     *built = NULL;
     *shaded = NULL;
     const rad_scene *scene = options->scene;
-    if (!scene || scene->texture_count == 0)
-        return RAD_OK;
     if (options->inputs && options->inputs->n != mesh->patch_count)
         return rad_fail(error, RAD_ERR_INVALID,
                         "render: the patch inputs are for %u patches, the mesh has %u",
                         options->inputs->n, mesh->patch_count);
+    if (!scene || scene->texture_count == 0)
+        return RAD_OK;
     rad_status status = patch_material_lookup_create(scene, lookup, error);
     if (status != RAD_OK || !*lookup)
         return status;
