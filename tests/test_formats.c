@@ -622,6 +622,15 @@ static void emissive_strength(void)
  * Ke (its light's power sits in Ka), so it is dark until --emit names the light. */
 static void cornell_files(void)
 {
+    /* the reference files are part of the project (../shared): missing is a failure */
+    const char *references[] = {RAD_SHARED_DIR "/scenes/cornell-box.obj",
+                                RAD_SHARED_DIR "/scenes/cornell-box.mtl",
+                                RAD_SHARED_DIR "/scenes/wild/cornell_box.obj"};
+    for (size_t k = 0; k < sizeof(references) / sizeof(references[0]); k++)
+        if (!test_file_exists(references[k])) {
+            test_fail(__FILE__, __LINE__, "reference scene %s is missing", references[k]);
+            return;
+        }
     int code = test_run_tool("render " RAD_SHARED_DIR "/scenes/cornell-box.obj -o std.pfm "
                              "--size 24x24 --patch-size 100");
     CHECK(code == 0);

@@ -234,12 +234,17 @@ int main(void)
     volatile int stop = 1;
     options.max_memory = 0;
     options.stop = &stop;
+    /* poison B: a solver that returned without writing it must not pass as "usable" on
+     * the previous call's answer */
+    for (uint32_t p = 0; p < mesh->patch_count; p++)
+        hier1[p] = (rad_rgb){NAN, NAN, NAN};
     fail_on(test_solve_hierarchical(scene, mesh, tracer, &options, hier1, &report1, &error),
             &error, "hierarchical stopped");
     CHECK(report1.interrupted && !report1.converged);
     bool usable = true;
     for (uint32_t p = 0; p < mesh->patch_count; p++)
-        usable = usable && isfinite(hier1[p].r) && hier1[p].r >= 0;
+        usable = usable && isfinite(hier1[p].r) && isfinite(hier1[p].g) &&
+                 isfinite(hier1[p].b) && hier1[p].r >= 0 && hier1[p].g >= 0 && hier1[p].b >= 0;
     CHECK(usable);
 
     free(mean_dense);
