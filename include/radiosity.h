@@ -796,6 +796,9 @@ typedef struct rad_scene_solve_options {
     uint64_t seed;
     int threads;               /* 0 = all cores */
     const volatile int *stop;  /* hierarchical: stops at the next sweep (report.interrupted) */
+    const rad_patch_inputs *inputs; /* the patch inputs when the caller has built them
+                                  (rad_patch_inputs_build of this scene and mesh), to use
+                                  them again in rad_render; NULL: built here */
     rad_log_fn log;            /* warnings: no emitter, iteration limit, memory cap, ... */
     void *log_user;
     rad_progress_fn progress;  /* "form factors", "solve", "refine", "gather", ... */
@@ -816,7 +819,7 @@ typedef struct rad_scene_solve_report {
     rad_formfactor_check check;        /* dense solvers */
     rad_solve_report solve;            /* dense solvers */
     rad_hierarchy_report hierarchy;    /* hierarchical */
-    double seconds_inputs;       /* rad_patch_inputs_build */
+    double seconds_inputs;       /* rad_patch_inputs_build (0 when options->inputs given) */
     double seconds_form_factors; /* dense: the matrix, with its check */
     double seconds_solve;        /* the solve itself */
     double seconds;              /* all of it */

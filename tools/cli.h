@@ -244,9 +244,10 @@ typedef struct cli_solved {
     rad_scene *scene;
     rad_mesh *mesh;
     rad_rgb *B;     /* mesh->patch_count exitances */
+    rad_patch_inputs *inputs; /* built once: the solve's and the render's */
     bool from_file; /* B came from --solution: nothing solved, `report` is empty */
     rad_scene_solve_report report; /* rad_solve_scene's: the solver it chose, and all */
-    double seconds_load, seconds_mesh, seconds_save;
+    double seconds_load, seconds_mesh, seconds_inputs, seconds_save;
 } cli_solved;
 
 /* The part `render` and `solve` share: loads SCENE (NULL = the built-in Cornell box),

@@ -111,6 +111,7 @@ int command_render(int argc, char **argv)
     if (s.specular)
         s.render.materials = solved.scene->materials;
     s.render.scene = solved.scene;
+    s.render.inputs = solved.inputs;
     status = rad_image_create(s.view.width, s.view.height, &image, &error);
     cli_progress_mark();
     if (status == RAD_OK)

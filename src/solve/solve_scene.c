@@ -168,10 +168,20 @@ rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
                  "will be black (--emit NAME=R,G,B makes a surface a light)",
                  scene->source);
 
-    rad_patch_inputs *inputs = NULL;
+    rad_patch_inputs *built = NULL;
+    const rad_patch_inputs *inputs = o.inputs;
     rad_tracer *occluders = NULL;
-    rad_status status = rad_patch_inputs_build(scene, mesh, &inputs, error);
-    r.seconds_inputs = seconds_now() - t0;
+    rad_status status = RAD_OK;
+    if (!inputs) {
+        status = rad_patch_inputs_build(scene, mesh, &built, error);
+        inputs = built;
+        r.seconds_inputs = seconds_now() - t0;
+    } else if (inputs->n != mesh->patch_count) {
+        status = rad_fail(error, RAD_ERR_INVALID,
+                          "rad_solve_scene: the patch inputs are for %u patches, the mesh has "
+                          "%u",
+                          inputs->n, mesh->patch_count);
+    }
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
     if (status == RAD_OK)
@@ -192,7 +202,7 @@ rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
         b->g = fmax(b->g, e->g);
         b->b = fmax(b->b, e->b);
     }
-    rad_patch_inputs_destroy(inputs);
+    rad_patch_inputs_destroy(built);
     r.seconds = seconds_now() - t0;
     if (report)
         *report = r;
