@@ -10,7 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <time.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -116,6 +115,22 @@ bool cli_parse(const char *command, int argc, char **argv, const cli_option *opt
     return true;
 }
 
+const char *cli_next_value(const cli_args *args, int option, int *cursor)
+{
+    for (; *cursor < args->given_count; (*cursor)++)
+        if (args->given_option[*cursor] == option)
+            return args->given_value[(*cursor)++];
+    return NULL;
+}
+
+int cli_value_count(const cli_args *args, int option)
+{
+    int count = 0, cursor = 0;
+    while (cli_next_value(args, option, &cursor))
+        count++;
+    return count;
+}
+
 bool cli_parse_double(const char *name, const char *text, double *out)
 {
     char *end;
@@ -203,6 +218,9 @@ typedef struct material_override {
 static material_override overrides[CLI_MAX_GIVEN];
 static int override_count;
 
+/* --quiet, for cli_summary. */
+static bool quiet;
+
 /* NAME=R,G,B; NAME may itself hold '=' (the last one splits). */
 static bool parse_override(const char *option, const char *text, material_override *out)
 {
@@ -229,6 +247,7 @@ static bool parse_override(const char *option, const char *text, material_overri
 
 bool cli_parse_shared(const cli_args *args, cli_shared *shared)
 {
+    /* --emit and --albedo apply in command-line order, mixed */
     override_count = 0;
     for (int k = 0; k < args->given_count; k++) {
         int option = args->given_option[k];
@@ -239,9 +258,10 @@ bool cli_parse_shared(const cli_args *args, cli_shared *shared)
             return false;
         override_count++;
     }
+    quiet = args->value[OPT_QUIET] != NULL;
     unsigned long value;
     memset(shared, 0, sizeof(*shared));
-    shared->seed = 1;
+    shared->seed = CLI_DEFAULT_SEED;
     shared->output = args->value[OPT_OUTPUT];
     shared->stats_path = args->value[OPT_STATS];
     if (args->value[OPT_PATCH_SIZE]) {
@@ -276,7 +296,8 @@ bool cli_parse_view(const cli_args *args, cli_view *view)
 {
     unsigned long value;
     memset(view, 0, sizeof(*view));
-    view->width = view->height = 512;
+    view->width = CLI_DEFAULT_WIDTH;
+    view->height = CLI_DEFAULT_HEIGHT;
     if ((args->value[OPT_EYE] && !cli_parse_vec3("eye", args->value[OPT_EYE], &view->camera.eye)) ||
         (args->value[OPT_TARGET] &&
          !cli_parse_vec3("target", args->value[OPT_TARGET], &view->camera.target)) ||
@@ -336,10 +357,9 @@ bool cli_image_output_ok(const char *path)
     return false;
 }
 
-bool cli_parse_image_command(const char *command, const char *usage, int argc, char **argv,
-                             const cli_option *options, int option_count, cli_args *args,
-                             cli_shared *shared, cli_view *view, const char **scene_path,
-                             int *exit_code)
+bool cli_begin(const char *command, const char *usage, int argc, char **argv,
+               const cli_option *options, int option_count, cli_args *args,
+               cli_shared *shared, int *exit_code)
 {
     *exit_code = EXIT_USAGE;
     if (!cli_parse(command, argc, argv, options, option_count, args))
@@ -349,13 +369,33 @@ bool cli_parse_image_command(const char *command, const char *usage, int argc, c
         *exit_code = EXIT_OK;
         return false;
     }
-    if (!cli_parse_shared(args, shared) || !cli_parse_view(args, view))
+    if (!cli_parse_shared(args, shared))
         return false;
+    *exit_code = EXIT_OK;
+    return true;
+}
+
+bool cli_scene_argument(const char *command, const cli_args *args, const char **scene_path)
+{
     if (args->positional_count > 1) {
         cli_error("%s: one scene at most (see 'radiosity %s --help')", command, command);
         return false;
     }
     *scene_path = args->positional_count ? args->positional[0] : NULL;
+    return true;
+}
+
+bool cli_parse_image_command(const char *command, const char *usage, int argc, char **argv,
+                             const cli_option *options, int option_count, cli_args *args,
+                             cli_shared *shared, cli_view *view, const char **scene_path,
+                             int *exit_code)
+{
+    if (!cli_begin(command, usage, argc, argv, options, option_count, args, shared,
+                   exit_code))
+        return false;
+    *exit_code = EXIT_USAGE; /* until the command has read its own options */
+    if (!cli_parse_view(args, view) || !cli_scene_argument(command, args, scene_path))
+        return false;
     if (!shared->output) {
         cli_error("%s: no output file: give -o OUT.png, .hdr, .pfm or .exr", command);
         return false;
@@ -390,13 +430,6 @@ rad_status cli_load_scene_logged(const char *path, rad_log_fn log, void *log_use
         }
     }
     return status;
-}
-
-double cli_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
 /* Progress. RADIOSITY_PROGRESS picks where it goes: unset (or "auto"), one line rewritten
@@ -445,9 +478,7 @@ static int progress_mode(void)
     return progress.mode;
 }
 
-bool cli_progress_enabled(void) { return progress_mode() != PROGRESS_OFF; }
-
-void cli_progress_mark(void) { progress.last_report = cli_now(); }
+void cli_progress_mark(void) { progress.last_report = rad_clock_seconds(); }
 
 static phase_clock *phase_named(const char *name)
 {
@@ -483,7 +514,7 @@ void cli_progress(void *user, const char *phase, double fraction)
     int mode = progress_mode();
     if (mode == PROGRESS_OFF)
         return;
-    double now = cli_now();
+    double now = rad_clock_seconds();
     double work = progress.last_report > 0 ? now - progress.last_report : 0;
     progress.last_report = now;
     phase_clock *clock = phase_named(phase);
@@ -600,6 +631,43 @@ void stats_string(cli_stats *stats, const char *key, const char *value)
     stats_append(stats, "\"");
 }
 
+bool cli_summary_wanted(void) { return !quiet; }
+
+static void vsummary(const char *format, va_list args) __attribute__((format(printf, 1, 0)));
+static void vsummary(const char *format, va_list args)
+{
+    if (quiet)
+        return;
+    cli_progress_end();
+    fputs("radiosity: ", stderr);
+    vfprintf(stderr, format, args);
+    fputc('\n', stderr);
+}
+
+void cli_summary(const char *format, ...)
+{
+    va_list args;
+    va_start(args, format);
+    vsummary(format, args);
+    va_end(args);
+}
+
+bool cli_finish(cli_stats *stats, const char *stats_path, const char *summary_format, ...)
+{
+    if (stats_path) {
+        stats_integer(stats, "peak_memory_bytes", rad_peak_memory_bytes());
+        if (!stats_write(stats, stats_path))
+            return false;
+    }
+    if (summary_format) {
+        va_list args;
+        va_start(args, summary_format);
+        vsummary(summary_format, args);
+        va_end(args);
+    }
+    return true;
+}
+
 bool stats_write(cli_stats *stats, const char *path)
 {
     stats_append(stats, "\n}\n");
@@ -637,5 +705,13 @@ bool cli_output_writable(const char *path)
                   folder);
         return false;
     }
+    return true;
+}
+
+bool cli_outputs_writable(const char *const *paths, int count)
+{
+    for (int k = 0; k < count; k++)
+        if (paths[k] && !cli_output_writable(paths[k]))
+            return false;
     return true;
 }

@@ -24,11 +24,11 @@ typedef struct cli_option {
     bool takes_value;
 } cli_option;
 
-enum { CLI_MAX_GIVEN = 128 };
+enum { CLI_MAX_GIVEN = 1024 };
 
 /* A parsed command line: the values by option index (the last one given), every option
- * value in command-line order (for options that may repeat: --emit, --albedo), and
- * positional arguments. */
+ * value in command-line order (for options that may repeat: read them with
+ * cli_next_value), and positional arguments. */
 typedef struct cli_args {
     const char *value[64]; /* NULL = not given; "" for a flag given */
     const char *positional[256]; /* viewfactors takes a list of mesh files */
@@ -43,13 +43,20 @@ typedef struct cli_args {
 bool cli_parse(const char *command, int argc, char **argv, const cli_option *options,
                int option_count, cli_args *args);
 
+/* A repeatable option's values, in command-line order: start with *cursor = 0; each call
+ * returns the next value of `option`, NULL after the last. */
+const char *cli_next_value(const cli_args *args, int option, int *cursor);
+
+/* How many times `option` was given. */
+int cli_value_count(const cli_args *args, int option);
+
 /* Option groups shared by several commands, at fixed indices in every command's table:
  * BASE (every command), FORMFACTOR (render, solve, viewfactors), VIEW (commands that make
  * an image), SOLVE (render, solve), SCENE (every command that loads a scene: --emit and
  * --albedo, applied by cli_load_scene). A command's own options start at OPT_OWN. Entries
  * of a group a command does not include stay empty (NULL name) and are never matched. */
 enum {
-    OPT_OUTPUT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_HELP,            /* BASE */
+    OPT_OUTPUT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_QUIET, OPT_HELP, /* BASE */
     OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS, OPT_QUADRATURE,                /* FORMFACTOR */
     OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE, /* VIEW */
     OPT_EXR_FLOAT,
@@ -62,7 +69,29 @@ enum {
 #define CLI_BASE_OPTIONS                                                                   \
     [OPT_OUTPUT] = {"output", 'o', true}, [OPT_THREADS] = {"threads", 0, true},            \
     [OPT_SEED] = {"seed", 0, true}, [OPT_STATS] = {"stats", 0, true},                      \
-    [OPT_HELP] = {"help", 'h', false}
+    [OPT_QUIET] = {"quiet", 0, false}, [OPT_HELP] = {"help", 'h', false}
+
+/* The help lines of the BASE group; `stats` says what the --stats file holds. */
+#define CLI_BASE_HELP(stats)                                                               \
+    "  --threads N          worker threads (default: all cores)\n"                           \
+    "  --seed N             seed of every random choice (default " CLI_STR(CLI_DEFAULT_SEED) ")\n" \
+    "  --stats FILE.json    write " stats "\n" CLI_QUIET_HELP
+
+/* The help lines of --quiet and --help (every command). */
+#define CLI_QUIET_HELP                                                                     \
+    "  --quiet              no summary line at the end of the run (warnings still show)\n"   \
+    "  -h, --help           this text\n"
+
+/* A constant's value as text, for help texts: CLI_STR(RAD_DEFAULT_MAX_DEPTH) is "5". */
+#define CLI_STR(x) CLI_STR_(x)
+#define CLI_STR_(x) #x
+
+/* The seed when --seed is not given. */
+#define CLI_DEFAULT_SEED 1
+
+/* The image size when --size is not given. */
+#define CLI_DEFAULT_WIDTH 512
+#define CLI_DEFAULT_HEIGHT 512
 
 #define CLI_FORMFACTOR_OPTIONS                                                             \
     [OPT_PATCH_SIZE] = {"patch-size", 0, true},                                            \
@@ -109,7 +138,8 @@ enum {
     "--save-solution, rendered or written as a lit mesh, each file complete), then exits\n"  \
     "with status 130; a second Ctrl-C ends the run at once. Progress (each phase, its time\n" \
     "and the time left) shows on a terminal; RADIOSITY_PROGRESS=lines prints it as lines\n"  \
-    "elsewhere too, RADIOSITY_PROGRESS=0 never.\n"
+    "elsewhere too, RADIOSITY_PROGRESS=0 never. The run ends with a summary line on stderr\n" \
+    "(patches, time, residual, what was written); --quiet leaves it out, warnings stay.\n"
 
 #define CLI_SCENE_OPTIONS                                                                  \
     [OPT_EMIT] = {"emit", 0, true}, [OPT_ALBEDO] = {"albedo", 0, true}
@@ -130,15 +160,37 @@ typedef struct cli_shared {
 } cli_shared;
 
 /* Parses the BASE, FORMFACTOR and SCENE options (after cli_parse); false (after printing)
- * on a bad value. The SCENE options are kept for cli_load_scene. */
+ * on a bad value. The SCENE options are kept for cli_load_scene, --quiet for cli_summary. */
 bool cli_parse_shared(const cli_args *args, cli_shared *shared);
+
+/* The opening every command shares: parses argv against its option table, prints `usage`
+ * for --help, and reads the BASE, FORMFACTOR and SCENE groups (cli_parse_shared). Returns
+ * false with *exit_code set (EXIT_OK after --help, EXIT_USAGE on a usage error) when the
+ * command should stop. */
+bool cli_begin(const char *command, const char *usage, int argc, char **argv,
+               const cli_option *options, int option_count, cli_args *args,
+               cli_shared *shared, int *exit_code);
+
+/* The optional SCENE argument: *scene_path is it, or NULL when none is given; false after
+ * a usage error when there are more. */
+bool cli_scene_argument(const char *command, const cli_args *args, const char **scene_path);
+
+/* The help lines of the VIEW group: the camera (a heading and one line), and the
+ * image file's options. */
+#define CLI_CAMERA_HELP                                                                    \
+    "Camera (default: the scene's camera, or a view of the whole scene from -z):\n"         \
+    "  --eye X,Y,Z  --target X,Y,Z  --up X,Y,Z  --fov DEG (vertical)   --size WxH ("          \
+    CLI_STR(CLI_DEFAULT_WIDTH) "x" CLI_STR(CLI_DEFAULT_HEIGHT) ")\n"
+#define CLI_IMAGE_FILE_HELP                                                                \
+    "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"              \
+    "  --exr-float          .exr: 32-bit float channels instead of half\n"
 
 /* What the VIEW options say. */
 typedef struct cli_view {
     rad_camera camera;                 /* fields given on the command line */
     bool has_eye, has_target, has_up, has_fov;
-    uint32_t width, height;            /* 512 x 512 by default */
-    uint32_t samples_per_pixel;        /* 0 = the command's default */
+    uint32_t width, height;            /* CLI_DEFAULT_WIDTH x CLI_DEFAULT_HEIGHT by default */
+    uint32_t samples_per_pixel;        /* 0 = the library's default */
     rad_image_write_options write;     /* exposure, --exr-float */
 } cli_view;
 
@@ -150,10 +202,9 @@ rad_camera cli_view_camera(const cli_view *view, const rad_scene *scene);
 /* True for .png, .hdr and .pfm; prints the usage error otherwise. */
 bool cli_image_output_ok(const char *path);
 
-/* The opening every image command shares: parses argv against its option table, prints
- * `usage` for --help, reads the BASE and VIEW groups, the optional SCENE and the required
- * -o OUT image. Returns false with *exit_code set (0 after --help, 2 on a usage error)
- * when the command should stop. */
+/* cli_begin for the image commands: also reads the VIEW group, the optional SCENE and the
+ * required -o OUT image. On success *exit_code is EXIT_USAGE, for the command's own
+ * checks that follow (it sets EXIT_OK when they pass). */
 bool cli_parse_image_command(const char *command, const char *usage, int argc, char **argv,
                              const cli_option *options, int option_count, cli_args *args,
                              cli_shared *shared, cli_view *view, const char **scene_path,
@@ -185,13 +236,23 @@ void cli_log(void *user, const char *message);
  * left. */
 void cli_progress(void *user, const char *phase, double fraction);
 void cli_progress_end(void);
-bool cli_progress_enabled(void);
 /* The work from now on belongs to the next phase reported (its first report then counts
  * the time since here). */
 void cli_progress_mark(void);
 
-/* Seconds on a monotonic clock. */
-double cli_now(void);
+/* The run's last line on stderr, "radiosity: " + the formatted text, printed on every run
+ * (terminal or not) unless --quiet was given: what was computed (patches, elements,
+ * samples), the time, the residual, what was written. */
+void cli_summary(const char *format, ...) __attribute__((format(printf, 1, 2)));
+/* False after --quiet. */
+bool cli_summary_wanted(void);
+
+/* Old names kept for cli_solve.c, cmd_render.c and cmd_solve.c until they call
+ * rad_clock_seconds and cli_finish: cli_now is the library's clock, and
+ * cli_progress_enabled (which only ever guarded their summary lines) now says whether a
+ * summary is wanted. */
+static inline double cli_now(void) { return rad_clock_seconds(); }
+static inline bool cli_progress_enabled(void) { return cli_summary_wanted(); }
 
 /* The --stats report: a flat JSON object built up field by field. */
 typedef struct cli_stats {
@@ -206,6 +267,12 @@ void stats_string(cli_stats *stats, const char *key, const char *value);
 void stats_bool(cli_stats *stats, const char *key, bool value);
 /* Closes the object and writes it atomically; false (after printing) on failure. */
 bool stats_write(cli_stats *stats, const char *path);
+
+/* How every command ends: with stats_path, adds peak_memory_bytes and writes the --stats
+ * file (stats_write); then, unless that failed, the summary line (cli_summary; none when
+ * summary_format is NULL). False (after printing) when the stats file failed. */
+bool cli_finish(cli_stats *stats, const char *stats_path, const char *summary_format, ...)
+    __attribute__((format(printf, 3, 4)));
 
 /* What the SOLVE options say (cli_solve.c). */
 typedef struct cli_solve {
@@ -256,6 +323,10 @@ void cli_solved_summary(const cli_solved *solved, const cli_solve *solve, char *
 
 /* Prints an error and returns false when path is a folder or its folder is not writable. */
 bool cli_output_writable(const char *path);
+
+/* cli_output_writable for each of the `count` paths that is not NULL, checked before any
+ * work; false at the first that fails. */
+bool cli_outputs_writable(const char *const *paths, int count);
 
 /* The subcommands, one file each (cmd_NAME.c); argv holds the arguments after the
  * subcommand's name. Each returns the process exit code. */

@@ -22,22 +22,17 @@ static const char usage[] =
     "tone map, sRGB 8-bit), .hdr (Radiance RGBE), .pfm (portable float map) or .exr\n"
     "(OpenEXR, half float); .hdr, .pfm and .exr hold linear radiance.\n"
     "\n"
-    "Camera (default: the scene's camera, or a view of the whole scene from -z):\n"
-    "  --eye X,Y,Z  --target X,Y,Z  --up X,Y,Z  --fov DEG (vertical)   --size WxH (512x512)\n"
-    "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"
-    "  --exr-float          .exr: 32-bit float channels instead of half\n"
+    CLI_CAMERA_HELP
+    CLI_IMAGE_FILE_HELP
     "Sampling:\n"
     "  --spp N              paths per pixel, stratified over the pixel, box filter\n"
-    "                       (default 64); the noise falls as 1/sqrt(N)\n"
+    "                       (default " CLI_STR(RAD_DEFAULT_PATHTRACE_SPP) "); the noise falls as 1/sqrt(N)\n"
     "  --max-depth N        most bounces per path (default 0: no limit, Russian roulette\n"
     "                       ends paths without bias)\n"
     "  --standard-error FILE  also write each pixel's standard error of the mean, per\n"
     "                       channel (.hdr, .pfm or .exr)\n"
     CLI_SCENE_HELP
-    "  --threads N          worker threads (default: all cores)\n"
-    "  --seed N             seed of every random choice (default 1)\n"
-    "  --stats FILE.json    write rays, times, mean radiance and peak memory\n"
-    "  -h, --help           this text\n";
+    CLI_BASE_HELP("rays, times, mean radiance and peak memory");
 
 enum { OPT_MAX_DEPTH = OPT_OWN, OPT_STANDARD_ERROR, OPT_COUNT };
 
@@ -87,7 +82,7 @@ static bool parse_settings(int argc, char **argv, pathtrace_settings *s, int *ex
             return false;
         s->trace.max_depth = (uint32_t)value;
     }
-    s->trace.samples_per_pixel = s->view.samples_per_pixel; /* 0 = the library's 64 */
+    s->trace.samples_per_pixel = s->view.samples_per_pixel; /* 0 = the library's default */
     s->trace.seed = s->shared.seed;
     s->trace.threads = s->shared.threads;
     s->trace.progress = cli_progress;
@@ -122,8 +117,7 @@ int command_pathtrace(int argc, char **argv)
     int exit_code;
     if (!parse_settings(argc, argv, &s, &exit_code))
         return exit_code;
-    if (!cli_output_writable(s.output) || (s.stats_path && !cli_output_writable(s.stats_path)) ||
-        (s.error_path && !cli_output_writable(s.error_path)))
+    if (!cli_outputs_writable((const char *[]){s.output, s.stats_path, s.error_path}, 3))
         return EXIT_ERROR;
 
     rad_error error = {0};
@@ -131,12 +125,12 @@ int command_pathtrace(int argc, char **argv)
     rad_scene *scene = NULL;
     rad_image *image = NULL, *standard_error = NULL;
     rad_pathtrace_report report = {0};
-    double t0 = cli_now(), t_load, t_trace, t_write;
+    double t0 = rad_clock_seconds(), t_load, t_trace, t_write;
 
     status = cli_load_scene(s.scene_path, &scene, &error);
     if (status != RAD_OK)
         goto fail;
-    t_load = cli_now();
+    t_load = rad_clock_seconds();
     if (!rad_scene_has_emitter(scene))
         cli_warn("%s: no surface emits light (no material with non-zero Ke): the image will "
                  "be black (--emit NAME=R,G,B makes a surface a light)",
@@ -151,7 +145,7 @@ int command_pathtrace(int argc, char **argv)
     if (status != RAD_OK)
         goto fail;
     cli_progress_end();
-    t_trace = cli_now();
+    t_trace = rad_clock_seconds();
     status = rad_image_write(image, s.output, &s.view.write, &error);
     if (status == RAD_OK && s.error_path)
         status = rad_image_write(standard_error, s.error_path,
@@ -159,40 +153,38 @@ int command_pathtrace(int argc, char **argv)
                                  &error);
     if (status != RAD_OK)
         goto fail;
-    t_write = cli_now();
-    uint32_t spp = s.trace.samples_per_pixel ? s.trace.samples_per_pixel : 64;
-    if (cli_progress_enabled()) /* a summary for a person watching; quiet in scripts */
-        fprintf(stderr, "radiosity: %u samples per pixel, %.1f M rays (%.1f M/s), %.2f s: wrote %s\n",
-                spp, report.rays / 1e6,
-                report.seconds > 0 ? report.rays / report.seconds / 1e6 : 0, t_write - t0,
-                s.output);
+    t_write = rad_clock_seconds();
+    uint32_t spp = s.trace.samples_per_pixel ? s.trace.samples_per_pixel
+                                             : RAD_DEFAULT_PATHTRACE_SPP;
+    double rays_per_second = report.seconds > 0 ? report.rays / report.seconds : 0;
 
-    if (s.stats_path) {
-        rad_rgb mean = image_mean(image);
-        cli_stats stats;
-        stats_begin(&stats);
-        stats_string(&stats, "scene", scene->source);
-        stats_integer(&stats, "triangles", scene->triangle_count);
-        stats_integer(&stats, "width", s.view.width);
-        stats_integer(&stats, "height", s.view.height);
-        stats_integer(&stats, "samples_per_pixel", spp);
-        stats_integer(&stats, "max_depth", s.trace.max_depth);
-        stats_integer(&stats, "seed", s.trace.seed);
-        stats_integer(&stats, "threads_requested", (unsigned long long)s.trace.threads); /* 0 = all */
-        stats_integer(&stats, "rays_cast", report.rays);
-        stats_number(&stats, "rays_per_second", report.seconds > 0 ? report.rays / report.seconds : 0);
-        stats_number(&stats, "mean_radiance_r", mean.r);
-        stats_number(&stats, "mean_radiance_g", mean.g);
-        stats_number(&stats, "mean_radiance_b", mean.b);
+    rad_rgb mean = image_mean(image);
+    cli_stats stats;
+    stats_begin(&stats);
+    stats_string(&stats, "scene", scene->source);
+    stats_integer(&stats, "triangles", scene->triangle_count);
+    stats_integer(&stats, "width", s.view.width);
+    stats_integer(&stats, "height", s.view.height);
+    stats_integer(&stats, "samples_per_pixel", spp);
+    stats_integer(&stats, "max_depth", s.trace.max_depth);
+    stats_integer(&stats, "seed", s.trace.seed);
+    stats_integer(&stats, "threads_requested", (unsigned long long)s.trace.threads); /* 0 = all */
+    stats_integer(&stats, "rays_cast", report.rays);
+    stats_number(&stats, "rays_per_second", rays_per_second);
+    stats_number(&stats, "mean_radiance_r", mean.r);
+    stats_number(&stats, "mean_radiance_g", mean.g);
+    stats_number(&stats, "mean_radiance_b", mean.b);
+    if (standard_error)
         stats_number(&stats, "rms_standard_error", rms_standard_error(standard_error));
-        stats_number(&stats, "seconds_load", t_load - t0);
-        stats_number(&stats, "seconds_trace", t_trace - t_load);
-        stats_number(&stats, "seconds_write", t_write - t_trace);
-        stats_number(&stats, "seconds_total", t_write - t0);
-        stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
-        if (!stats_write(&stats, s.stats_path))
-            exit_code = EXIT_ERROR;
-    }
+    stats_number(&stats, "seconds_load", t_load - t0);
+    stats_number(&stats, "seconds_trace", t_trace - t_load);
+    stats_number(&stats, "seconds_write", t_write - t_trace);
+    stats_number(&stats, "seconds_total", t_write - t0);
+    if (!cli_finish(&stats, s.stats_path,
+                    "%u samples per pixel, %.1f M rays (%.1f M/s), %.2f s: wrote %s%s%s", spp,
+                    report.rays / 1e6, rays_per_second / 1e6, t_write - t0, s.output,
+                    s.error_path ? " and " : "", s.error_path ? s.error_path : ""))
+        exit_code = EXIT_ERROR;
     goto done;
 fail:
     cli_error("%s", error.message);
