@@ -185,6 +185,12 @@ bool cli_scene_argument(const char *command, const cli_args *args, const char **
     "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"              \
     "  --exr-float          .exr: 32-bit float channels instead of half\n"
 
+/* Sets the seed, threads and progress fields every library options struct has from the
+ * BASE options. */
+#define CLI_SET_RUN_OPTIONS(options, shared)                                               \
+    ((options).seed = (shared).seed, (options).threads = (shared).threads,                  \
+     (options).progress = cli_progress)
+
 /* What the VIEW options say. */
 typedef struct cli_view {
     rad_camera camera;                 /* fields given on the command line */
@@ -223,6 +229,9 @@ rad_status cli_load_scene_logged(const char *path, rad_log_fn log, void *log_use
 bool cli_parse_double(const char *name, const char *text, double *out);
 bool cli_parse_positive(const char *name, const char *text, double *out); /* > 0 */
 bool cli_parse_uint(const char *name, const char *text, unsigned long max, unsigned long *out);
+/* A count from min to max into *out; text NULL (the option not given) leaves *out as it is. */
+bool cli_parse_count(const char *name, const char *text, uint32_t min, uint32_t max,
+                     uint32_t *out);
 bool cli_parse_vec3(const char *name, const char *text, rad_vec3 *out);
 bool cli_parse_size(const char *name, const char *text, uint32_t *width, uint32_t *height);
 
@@ -270,9 +279,38 @@ bool stats_write(cli_stats *stats, const char *path);
 
 /* How every command ends: with stats_path, adds peak_memory_bytes and writes the --stats
  * file (stats_write); then, unless that failed, the summary line (cli_summary; none when
- * summary_format is NULL). False (after printing) when the stats file failed. */
-bool cli_finish(cli_stats *stats, const char *stats_path, const char *summary_format, ...)
+ * summary_format is NULL). Returns the exit code: EXIT_OK, or EXIT_ERROR (after printing)
+ * when the stats file failed. */
+int cli_finish(cli_stats *stats, const char *stats_path, const char *summary_format, ...)
     __attribute__((format(printf, 3, 4)));
+
+/* Prints error's message (a run that failed) and returns EXIT_ERROR. */
+int cli_failed(const rad_error *error);
+
+/* What the image commands (raytrace, pathtrace) do around their one library call: load
+ * the scene, frame it, make the image, write it, and report. */
+typedef struct cli_image_run {
+    rad_scene *scene;
+    rad_camera camera; /* cli_view_camera */
+    rad_image *image;  /* view->width x view->height */
+    double t0, t_load, t_trace, t_write; /* rad_clock_seconds at the start and after each */
+} cli_image_run;
+
+/* Loads SCENE (cli_load_scene; NULL = the built-in Cornell box), sets the camera and
+ * creates the image. The run is always freeable by cli_image_run_free. */
+rad_status cli_image_run_begin(cli_image_run *run, const char *scene_path,
+                               const cli_view *view, rad_error *error);
+/* Writes the image to `output` with the view's write options, after the trace (whose
+ * progress line it closes). */
+rad_status cli_image_run_write(cli_image_run *run, const char *output, const cli_view *view,
+                               rad_error *error);
+/* Starts the --stats report: scene, triangles, width, height, samples_per_pixel, seed,
+ * threads_requested (0 = all). */
+void cli_image_run_stats(const cli_image_run *run, const cli_shared *shared,
+                         uint32_t samples_per_pixel, cli_stats *stats);
+/* Its times: seconds_load, seconds_trace, seconds_write, seconds_total. */
+void cli_image_run_times(const cli_image_run *run, cli_stats *stats);
+void cli_image_run_free(cli_image_run *run);
 
 /* What the SOLVE options say (cli_solve.c). */
 typedef struct cli_solve {

@@ -55,16 +55,8 @@ static const rad_image_write_options false_colour_write = {.fixed_exposure = tru
 
 static bool parse_compare_options(const cli_args *args, rad_compare_options *compare)
 {
-    unsigned long block;
-    if (args->value[OPT_BLOCK]) {
-        if (!cli_parse_uint("block", args->value[OPT_BLOCK], MAX_BLOCK, &block))
-            return false;
-        if (block == 0) {
-            cli_error("--block: must be at least 1");
-            return false;
-        }
-        compare->block_size = (uint32_t)block;
-    }
+    if (!cli_parse_count("block", args->value[OPT_BLOCK], 1, MAX_BLOCK, &compare->block_size))
+        return false;
     if (args->value[OPT_BLOCK_TOLERANCE]) {
         /* positive: 0 would mean the library's default */
         if (!cli_parse_positive("block-tolerance", args->value[OPT_BLOCK_TOLERANCE],
@@ -168,12 +160,10 @@ int command_compare(int argc, char **argv)
     stats_number(&stats, "block_tolerance", compare.block_tolerance > 0
                                                 ? compare.block_tolerance
                                                 : RAD_DEFAULT_BLOCK_TOLERANCE);
-    if (!cli_finish(&stats, stats_path, NULL)) /* the report on stdout is the summary */
-        exit_code = EXIT_ERROR;
+    exit_code = cli_finish(&stats, stats_path, NULL); /* the report on stdout is the summary */
     goto done;
 fail:
-    cli_error("%s", error.message);
-    exit_code = EXIT_ERROR;
+    exit_code = cli_failed(&error);
 done:
     rad_image_destroy(false_colour);
     rad_image_destroy(b);

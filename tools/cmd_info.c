@@ -221,8 +221,7 @@ int command_info(int argc, char **argv)
         /* the warnings that led up to the error still help */
         if (w.lines.text)
             fputs(w.lines.text, stderr);
-        cli_error("%s", error.message);
-        exit_code = EXIT_ERROR;
+        exit_code = cli_failed(&error);
         goto done;
     }
     describe(&r, scene);
@@ -234,8 +233,7 @@ int command_info(int argc, char **argv)
     }
     if (shared.output) {
         if (rad_write_file_atomic(shared.output, r.text, r.length, &error) != RAD_OK) {
-            cli_error("%s", error.message);
-            exit_code = EXIT_ERROR;
+            exit_code = cli_failed(&error);
             goto done;
         }
     } else {
@@ -250,11 +248,10 @@ int command_info(int argc, char **argv)
     stats_integer(&stats, "materials", scene->material_count);
     stats_integer(&stats, "warnings", w.count);
     stats_number(&stats, "seconds_load", t_load);
-    if (!cli_finish(&stats, shared.stats_path,
-                    "%u triangles, %u surfaces, %u materials, %u warnings, %.2f s: wrote %s",
-                    scene->triangle_count, scene->surface_count, scene->material_count, w.count,
-                    t_load, shared.output ? shared.output : "standard output"))
-        exit_code = EXIT_ERROR;
+    exit_code = cli_finish(&stats, shared.stats_path,
+                           "%u triangles, %u surfaces, %u materials, %u warnings, %.2f s: wrote %s",
+                           scene->triangle_count, scene->surface_count, scene->material_count,
+                           w.count, t_load, shared.output ? shared.output : "standard output");
 done:
     free(r.text);
     free(w.lines.text);

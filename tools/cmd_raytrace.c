@@ -56,7 +56,7 @@ static const cli_option options[OPT_COUNT] = {
 #define MAX_DEPTH (1ul << 20)
 
 typedef struct raytrace_settings {
-    const char *scene_path, *output, *stats_path;
+    const char *scene_path;
     cli_shared shared;
     cli_view view;
     rad_point_light *lights; /* owned */
@@ -139,36 +139,17 @@ static bool parse_settings(int argc, char **argv, raytrace_settings *s, int *exi
     if (!cli_parse_image_command("raytrace", usage, argc, argv, options, OPT_COUNT, &args,
                                  &s->shared, &s->view, &s->scene_path, exit_code))
         return false;
-    s->output = s->shared.output;
-    s->stats_path = s->shared.stats_path;
     if (!collect_lights(&args, s))
         return false;
     if (args.value[OPT_AMBIENT] && !parse_rgb("ambient", args.value[OPT_AMBIENT], &s->trace.ambient))
         return false;
-    unsigned long value;
-    if (args.value[OPT_LIGHT_SAMPLES]) {
-        if (!cli_parse_uint("light-samples", args.value[OPT_LIGHT_SAMPLES], MAX_LIGHT_SAMPLES,
-                            &value))
-            return false;
-        if (value == 0) {
-            cli_error("--light-samples: must be at least 1");
-            return false;
-        }
-        s->trace.light_samples = (uint32_t)value;
-    }
-    if (args.value[OPT_MAX_DEPTH]) {
-        if (!cli_parse_uint("max-depth", args.value[OPT_MAX_DEPTH], MAX_DEPTH, &value))
-            return false;
-        if (value == 0) {
-            cli_error("--max-depth: must be at least 1");
-            return false;
-        }
-        s->trace.max_depth = (uint32_t)value;
-    }
+    if (!cli_parse_count("light-samples", args.value[OPT_LIGHT_SAMPLES], 1, MAX_LIGHT_SAMPLES,
+                         &s->trace.light_samples) ||
+        !cli_parse_count("max-depth", args.value[OPT_MAX_DEPTH], 1, MAX_DEPTH,
+                         &s->trace.max_depth))
+        return false;
     s->trace.samples_per_pixel = s->view.samples_per_pixel; /* 0 = the library's default */
-    s->trace.seed = s->shared.seed;
-    s->trace.threads = s->shared.threads;
-    s->trace.progress = cli_progress;
+    CLI_SET_RUN_OPTIONS(s->trace, s->shared);
     *exit_code = EXIT_OK;
     return true;
 }
@@ -176,77 +157,53 @@ static bool parse_settings(int argc, char **argv, raytrace_settings *s, int *exi
 int command_raytrace(int argc, char **argv)
 {
     raytrace_settings s;
-    memset(&s, 0, sizeof(s));
     int exit_code;
-    rad_error error = {0};
-    rad_status status;
-    rad_scene *scene = NULL;
-    rad_image *image = NULL;
-    double t0 = rad_clock_seconds(), t_load, t_trace, t_write;
-
-    if (!parse_settings(argc, argv, &s, &exit_code))
-        goto done;
-    if (!cli_outputs_writable((const char *[]){s.output, s.stats_path}, 2)) {
-        exit_code = EXIT_ERROR;
-        goto done;
+    if (!parse_settings(argc, argv, &s, &exit_code)) {
+        free(s.lights);
+        return exit_code;
+    }
+    if (!cli_outputs_writable((const char *[]){s.shared.output, s.shared.stats_path}, 2)) {
+        free(s.lights);
+        return EXIT_ERROR;
     }
 
-    status = cli_load_scene(s.scene_path, &scene, &error);
-    if (status != RAD_OK)
-        goto fail;
-    t_load = rad_clock_seconds();
-    bool emitters = rad_scene_has_emitter(scene);
+    rad_error error = {0};
+    cli_image_run run;
+    rad_status status = cli_image_run_begin(&run, s.scene_path, &s.view, &error);
+    bool emitters = status == RAD_OK && rad_scene_has_emitter(run.scene);
     bool ambient = s.trace.ambient.r > 0 || s.trace.ambient.g > 0 || s.trace.ambient.b > 0;
-    if (!emitters && s.trace.light_count == 0)
-        cli_warn("%s: no light: no --light given and no surface emits (Ke)%s", scene->source,
+    if (status == RAD_OK && !emitters && s.trace.light_count == 0)
+        cli_warn("%s: no light: no --light given and no surface emits (Ke)%s", run.scene->source,
                  ambient ? ": only the ambient term lights the image" : ": the image will be black");
-    rad_camera camera = cli_view_camera(&s.view, scene);
-
-    status = rad_image_create(s.view.width, s.view.height, &image, &error);
     if (status == RAD_OK)
-        status = rad_raytrace(scene, &camera, &s.trace, image, &error);
+        status = rad_raytrace(run.scene, &run.camera, &s.trace, run.image, &error);
+    if (status == RAD_OK)
+        status = cli_image_run_write(&run, s.shared.output, &s.view, &error);
     if (status != RAD_OK)
         goto fail;
-    cli_progress_end();
-    t_trace = rad_clock_seconds();
-    status = rad_image_write(image, s.output, &s.view.write, &error);
-    if (status != RAD_OK)
-        goto fail;
-    t_write = rad_clock_seconds();
     uint32_t strata = (uint32_t)lround(sqrt((double)(
         s.trace.samples_per_pixel ? s.trace.samples_per_pixel : RAD_DEFAULT_RAYTRACE_SPP)));
     uint32_t spp = strata * strata; /* rounded to a square as the library does */
 
     cli_stats stats;
-    stats_begin(&stats);
-    stats_string(&stats, "scene", scene->source);
-    stats_integer(&stats, "triangles", scene->triangle_count);
-    stats_integer(&stats, "width", s.view.width);
-    stats_integer(&stats, "height", s.view.height);
-    stats_integer(&stats, "samples_per_pixel", spp);
+    cli_image_run_stats(&run, &s.shared, spp, &stats);
     stats_integer(&stats, "point_lights", s.trace.light_count);
     stats_bool(&stats, "area_lights", emitters);
     stats_integer(&stats, "light_samples",
                   s.trace.light_samples ? s.trace.light_samples : RAD_DEFAULT_LIGHT_SAMPLES);
-    stats_integer(&stats, "max_depth", s.trace.max_depth ? s.trace.max_depth : RAD_DEFAULT_MAX_DEPTH);
-    stats_integer(&stats, "seed", s.trace.seed);
-    stats_integer(&stats, "threads_requested", (unsigned long long)s.trace.threads);
-    stats_number(&stats, "seconds_load", t_load - t0);
-    stats_number(&stats, "seconds_trace", t_trace - t_load);
-    stats_number(&stats, "seconds_write", t_write - t_trace);
-    stats_number(&stats, "seconds_total", t_write - t0);
-    if (!cli_finish(&stats, s.stats_path, "%u point lights%s, %u samples per pixel, %.2f s: wrote %s",
-                    s.trace.light_count, emitters ? " and the emitting surfaces" : "", spp,
-                    t_write - t0, s.output))
-        exit_code = EXIT_ERROR;
+    stats_integer(&stats, "max_depth",
+                  s.trace.max_depth ? s.trace.max_depth : RAD_DEFAULT_MAX_DEPTH);
+    cli_image_run_times(&run, &stats);
+    exit_code = cli_finish(&stats, s.shared.stats_path,
+                           "%u point lights%s, %u samples per pixel, %.2f s: wrote %s",
+                           s.trace.light_count, emitters ? " and the emitting surfaces" : "",
+                           spp, run.t_write - run.t0, s.shared.output);
     goto done;
 fail:
-    cli_error("%s", error.message);
-    exit_code = EXIT_ERROR;
+    exit_code = cli_failed(&error);
 done:
     cli_progress_end();
-    rad_image_destroy(image);
-    rad_scene_destroy(scene);
+    cli_image_run_free(&run);
     free(s.lights);
     return exit_code;
 }

@@ -107,8 +107,8 @@ int command_viewfactors(int argc, char **argv)
                   "only; they do not change view factors");
         return EXIT_USAGE;
     }
-    rad_viewfactor_options vf = {.seed = shared.seed, .threads = shared.threads,
-                                 .progress = cli_progress};
+    rad_viewfactor_options vf = {0};
+    CLI_SET_RUN_OPTIONS(vf, shared);
     if (args.value[OPT_ACCURACY]) {
         if (!cli_parse_double("accuracy", args.value[OPT_ACCURACY], &vf.accuracy))
             return EXIT_USAGE;
@@ -117,16 +117,8 @@ int command_viewfactors(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if (args.value[OPT_MAX_RAYS]) {
-        unsigned long value;
-        if (!cli_parse_uint("max-rays", args.value[OPT_MAX_RAYS], 1u << 24, &value))
-            return EXIT_USAGE;
-        if (value < 64) {
-            cli_error("--max-rays: must be at least 64");
-            return EXIT_USAGE;
-        }
-        vf.max_rays = (uint32_t)value;
-    }
+    if (!cli_parse_count("max-rays", args.value[OPT_MAX_RAYS], 64, 1u << 24, &vf.max_rays))
+        return EXIT_USAGE;
     const char *output = shared.output, *stats_path = shared.stats_path;
     rad_viewfactor_write_options write = {RAD_VIEWFACTOR_CSV, false, false};
     if (output)
@@ -172,6 +164,7 @@ int command_viewfactors(int argc, char **argv)
                  scene->source, RAD_SCRIPT_F_MAX_SURFACES, scene->surface_count);
         status = RAD_ERR_UNSUPPORTED;
     }
+    cli_progress_mark();
     if (status == RAD_OK)
         status = rad_viewfactor_matrix_compute(scene, &vf, &matrix, &report, &error);
     if (status != RAD_OK)
@@ -270,20 +263,19 @@ int command_viewfactors(int argc, char **argv)
                      enclosure.row_deviation_after);
     }
     stats_bool(&stats, "script_f", write.script_f);
-    if (!cli_finish(&stats, stats_path,
-                    "%zu surfaces, %llu polygon pairs (%llu hidden, %llu obstructed, %llu of "
-                    "them sampled), %llu rays, %llu non-zero factors, %.2f s: wrote %s",
-                    S, (unsigned long long)report.polygon_pairs,
-                    (unsigned long long)report.hidden_pairs,
-                    (unsigned long long)report.obstructed_pairs,
-                    (unsigned long long)report.sampled_pairs, (unsigned long long)report.rays,
-                    (unsigned long long)report.nonzeros, seconds,
-                    output ? output : "standard output"))
-        exit_code = EXIT_ERROR;
+    exit_code = cli_finish(&stats, stats_path,
+                           "%zu surfaces, %llu polygon pairs (%llu hidden, %llu obstructed, "
+                           "%llu of them sampled), %llu rays, %llu non-zero factors, %.2f s: "
+                           "wrote %s",
+                           S, (unsigned long long)report.polygon_pairs,
+                           (unsigned long long)report.hidden_pairs,
+                           (unsigned long long)report.obstructed_pairs,
+                           (unsigned long long)report.sampled_pairs,
+                           (unsigned long long)report.rays, (unsigned long long)report.nonzeros,
+                           seconds, output ? output : "standard output");
     goto done;
 fail:
-    cli_error("%s", error.message);
-    exit_code = EXIT_ERROR;
+    exit_code = cli_failed(&error);
 done:
     free(emissivity);
     rad_viewfactor_matrix_destroy(matrix);
