@@ -35,10 +35,12 @@
  * image of rad_render, ...) stay the caller's.
  *
  * Options and reports: a NULL options pointer means every default, and a zero field of an
- * options struct means that field's default (each struct says which; the numbers are the
- * RAD_DEFAULT_* constants below). A NULL report pointer (rad_*_report, the vs3 control,
- * the path tracer's standard-error image) means it is not wanted. Every function that
- * takes options or a report accepts NULL for it.
+ * options struct means that field's default (each field says which; the RAD_DEFAULT_*
+ * constants below name them for callers that show them, as the CLI's help does). A NULL
+ * report pointer (rad_*_report, the vs3 control, the path tracer's standard-error image)
+ * means it is not wanted. Every function that takes options or a report accepts NULL for
+ * it; what a function exists to compute (rad_image_compare's difference, an `out`
+ * pointer, B) is not optional.
  *
  * Words: `tolerance` is always when an iteration stops (its stopping value, residual or
  * change of a sweep, is at most the tolerance); `accuracy` is always the error target of a
@@ -96,7 +98,8 @@ typedef void (*rad_log_fn)(void *user, const char *message);
 typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 
 /* ------------------------------------------------------------------------------------ */
-/* Defaults: what a NULL options pointer, or a zero field of one, stands for              */
+/* Defaults: what a zero options field (or NULL options) stands for, and what a file     */
+/* leaves out                                                                            */
 
 #define RAD_DEFAULT_QUADRATURE 1        /* rad_formfactor_options.quadrature: 1 x 1 */
 #define RAD_DEFAULT_VISIBILITY_RAYS 16  /* rad_formfactor_options.visibility_rays */
