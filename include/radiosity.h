@@ -642,13 +642,39 @@ rad_status rad_viewfactor_matrix_apply_vs3_masks(const char *path, rad_scene *sc
 /* Solvers for (I - diag(rho) F) B = E                                                   */
 
 typedef enum rad_solver {
-    RAD_SOLVER_JACOBI = 0,   /* gathering: every patch from the previous iterate */
+    RAD_SOLVER_AUTO = 0,     /* rad_solve_scene decides (see there); rad_solve: Jacobi */
+    RAD_SOLVER_JACOBI,       /* gathering ("gather"): every patch from the previous iterate */
     RAD_SOLVER_GAUSS_SEIDEL, /* gathering with the newest values */
     RAD_SOLVER_SHOOT,        /* progressive refinement: most unshot power first */
-    RAD_SOLVER_DIRECT        /* LU factorisation, O(n^3): small scenes and tests only */
+    RAD_SOLVER_DIRECT,       /* LU factorisation, O(n^3): small scenes and tests only */
+    RAD_SOLVER_HIERARCHICAL  /* links between element and cluster trees, no n x n matrix */
 } rad_solver;
 
-/* The linear system. Exitance E_i = pi * L_e of patch i's material. */
+/* The solver's command-line name: "auto", "gather", "gauss-seidel", "shoot", "direct",
+ * "hierarchical". Never NULL. */
+const char *rad_solver_name(rad_solver solver);
+
+/* The solver named `name` (as rad_solver_name gives it; "jacobi" is "gather"); false when
+ * no solver has that name. */
+bool rad_solver_from_name(const char *name, rad_solver *solver);
+
+/* The per-patch inputs of the radiosity equation, the same for every solver and renderer,
+ * built in one place (rad_patch_inputs_build): area A_i; albedo rho_i, the material's, or
+ * for a textured material the mean of albedo x texel over the patch; exitance
+ * E_i = pi L_e, the material's emitted radiance (times the mean of its emissive texture
+ * over the patch). */
+typedef struct rad_patch_inputs {
+    uint32_t n;        /* mesh->patch_count */
+    double *area;      /* A_i */
+    rad_rgb *albedo;   /* rho_i, in [0,1] */
+    rad_rgb *exitance; /* E_i, >= 0 */
+} rad_patch_inputs;
+
+rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
+                                  rad_patch_inputs **out, rad_error *error);
+void rad_patch_inputs_destroy(rad_patch_inputs *inputs);
+
+/* The linear system of the dense solvers: the patch inputs and the form factors. */
 typedef struct rad_system {
     uint32_t n;
     const float *F;          /* n x n row-major, F_ij */
@@ -657,12 +683,16 @@ typedef struct rad_system {
     const rad_rgb *exitance; /* E_i */
 } rad_system;
 
+/* The system of `inputs` and `formfactors` (NULL: F = NULL), pointing into both: nothing
+ * is copied or allocated. */
+rad_system rad_system_of(const rad_patch_inputs *inputs, const rad_formfactors *formfactors);
+
 typedef struct rad_solve_options {
-    rad_solver solver;
-    double tolerance;        /* relative residual (gathering) or unshot fraction (shooting);
-                                0 = 1e-4 */
-    uint32_t max_iterations; /* sweeps (gathering) or shots (shooting); 0 = 10000 sweeps
-                                or 1000 n shots */
+    rad_solver solver;       /* JACOBI, GAUSS_SEIDEL, SHOOT or DIRECT; AUTO = JACOBI */
+    double tolerance;        /* Jacobi: relative residual; Gauss-Seidel: relative change of
+                                a sweep; shooting: unshot fraction; 0 = 1e-4 */
+    uint32_t max_iterations; /* sweeps, or shots for shooting; 0 = 10000 sweeps or 1000 n
+                                shots */
     bool ambient;            /* shooting: add the ambient term for the unshot energy */
     int threads;
     rad_progress_fn progress;
@@ -677,23 +707,21 @@ typedef struct rad_solve_report {
     double seconds;
 } rad_solve_report;
 
-/* Fills B (n values, exitance). options NULL = all defaults. RAD_ERR_INVALID for a
- * negative thread count, a non-positive area, an albedo outside [0,1] or a negative
- * exitance; the direct solver refuses more than 4096 patches (RAD_ERR_UNSUPPORTED) and a
- * singular system (RAD_ERR_INVALID), and reports iterations 0. Shooting derives F_ji from
- * F_ij by reciprocity, so its residual levels off near float precision (about 1e-7). With
- * the ambient term on, `residual` measures B including it. */
+/* Fills B (n values, exitance). RAD_ERR_INVALID for a negative thread count, a
+ * non-positive area, an albedo outside [0,1], a negative exitance or the hierarchical
+ * solver (it needs the mesh: rad_solve_hierarchical); the direct solver refuses more than
+ * RAD_DIRECT_MAX_PATCHES patches (RAD_ERR_UNSUPPORTED) and a singular system
+ * (RAD_ERR_INVALID), and reports iterations 0. Shooting derives F_ji from F_ij by
+ * reciprocity, so its residual levels off near float precision (about 1e-7). With the
+ * ambient term on, `residual` measures B including it. */
 rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
                      rad_rgb *B, rad_solve_report *report, rad_error *error);
 
+/* Largest system the direct solver takes. */
+#define RAD_DIRECT_MAX_PATCHES 4096u
+
 /* The relative residual used by every solver's report. */
 double rad_system_residual(const rad_system *system, const rad_rgb *B);
-
-/* Fills the system's per-patch arrays from a mesh and its scene (caller owns them). */
-rad_status rad_system_from_mesh(const rad_scene *scene, const rad_mesh *mesh,
-                                const rad_formfactors *formfactors, rad_system *system,
-                                rad_error *error);
-void rad_system_free_arrays(rad_system *system);
 
 /* ------------------------------------------------------------------------------------ */
 /* Hierarchical radiosity (Hanrahan, Salzman and Aupperle 1991, with clusters)          */
@@ -708,16 +736,16 @@ void rad_system_free_arrays(rad_system *system);
  * few segments traced between the two nodes (4 first, 16 when they disagree; links
  * found fully hidden are dropped). Jacobi gathering over the links with push-pull between
  * levels alternates with refinement until nothing refines and the change is below the
- * tolerance. The result is one B per mesh patch, so rad_reconstruct_vertices and
- * rad_render display it smoothly. Deterministic: every random number comes from (seed,
- * receiver, source), every sum has a fixed order, so B is bitwise the same for any thread
- * count. */
+ * tolerance; then a final gather at the leaves. The result is one B per mesh patch, so
+ * rad_reconstruct_vertices and rad_render display it smoothly. Deterministic: every random
+ * number comes from (seed, receiver, source), every sum has a fixed order, so B is bitwise
+ * the same for any thread count. */
 typedef struct rad_hierarchy_options {
     double refine_threshold;  /* BFA threshold, as a fraction of the scene's emitted power
                                  per patch; 0 = 0.25. Smaller = more links, more accurate */
     uint32_t visibility_rays; /* segments per link when the first 4 disagree; 0 = 16 */
     double tolerance;         /* relative change of a sweep (area-weighted); 0 = 1e-4 */
-    uint32_t max_sweeps;      /* 0 = 1000 */
+    uint32_t max_iterations;  /* sweeps; 0 = 1000 */
     uint64_t max_memory;      /* bytes the link store may use (both of its buffers); 0 =
                                  half the machine's memory. Refinement stops where it is
                                  when the next step would exceed it (report.memory_capped) */
@@ -741,10 +769,13 @@ typedef struct rad_hierarchy_report {
     uint64_t rays;           /* visibility segments traced */
     uint64_t link_bytes;     /* the most the link store held, bytes */
     uint32_t passes;         /* refinement passes (each splits links one level) */
-    uint32_t sweeps;         /* Jacobi sweeps with push-pull */
-    double residual;         /* relative change of the last sweep: sum A |B_new - B|_1 /
-                                sum A |E|_1 over the patches */
-    bool converged;          /* residual <= tolerance and nothing left to refine */
+    uint32_t iterations;     /* Jacobi sweeps with push-pull */
+    double change;           /* relative change of the last sweep: sum A |B_new - B|_1 /
+                                sum A |E|_1 over the patches (the stopping value) */
+    double residual;         /* the residual of the B returned, sum A |B - E - rho H B|_1 /
+                                sum A |E|_1 with H the links' (and the final gather's)
+                                transport: one more sweep, measured, not applied */
+    bool converged;          /* change <= tolerance and nothing left to refine */
     bool memory_capped;      /* refinement stopped at max_memory */
     bool interrupted;        /* options.stop was raised */
     double seconds_build;    /* element and cluster trees */
@@ -754,14 +785,86 @@ typedef struct rad_hierarchy_report {
     int threads;
 } rad_hierarchy_report;
 
-/* Solves the mesh's radiosity hierarchically: B receives mesh->patch_count exitances.
- * `occluders` is a tracer over the scene's triangles (RAD_TRACER_EMBREE_FAST is the
- * intended one). RAD_ERR_INVALID for a negative thread count or bad threshold,
+/* Solves the mesh's radiosity hierarchically with the patch inputs of rad_patch_inputs_build:
+ * B receives mesh->patch_count exitances, each at least the patch's own E. `occluders` is
+ * a tracer over the scene's triangles (RAD_TRACER_EMBREE_FAST is the intended one).
+ * RAD_ERR_INVALID for a negative thread count, a bad threshold or inputs of another mesh,
  * RAD_ERR_NOMEM when even the first links do not fit max_memory. */
-rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
+rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *inputs,
                                   const rad_tracer *occluders,
                                   const rad_hierarchy_options *options, rad_rgb *B,
                                   rad_hierarchy_report *report, rad_error *error);
+
+/* ------------------------------------------------------------------------------------ */
+/* From a scene to its solution: the one entry point                                     */
+
+/* Leaf patches the default patch size aims at: RAD_DEFAULT_PATCHES for the dense solvers
+ * (and RAD_SOLVER_AUTO), RAD_HIERARCHICAL_DEFAULT_PATCHES for the hierarchical one. */
+#define RAD_DEFAULT_PATCHES 3000u
+#define RAD_HIERARCHICAL_DEFAULT_PATCHES 30000u
+/* RAD_SOLVER_AUTO picks the dense gather up to this many patches, else hierarchical. */
+#define RAD_DENSE_MAX_PATCHES 4096u
+
+/* The patch size for `solver` on this scene (rad_mesh_default_patch_size of the targets
+ * above). */
+double rad_default_patch_size(const rad_scene *scene, rad_solver solver);
+
+typedef struct rad_scene_solve_options {
+    rad_solver solver;         /* AUTO (0): dense Jacobi gathering up to
+                                  RAD_DENSE_MAX_PATCHES patches when the matrix fits in
+                                  memory, else hierarchical; the report says which ran */
+    double tolerance;          /* when the iteration stops (each solver's criterion, as in
+                                  rad_solve_options and rad_hierarchy_options); 0 = 1e-4 */
+    uint32_t max_iterations;   /* sweeps, or shots for shooting; 0 = the solver's default */
+    uint32_t quadrature;       /* dense form factors: m x m split per patch; 0 = 1 */
+    uint32_t visibility_rays;  /* most visibility segments per patch pair or link; 0 = 16 */
+    double refine_threshold;   /* hierarchical: 0 = 0.25 */
+    uint64_t max_memory;       /* hierarchical: link store bytes; 0 = half the memory */
+    uint64_t seed;
+    int threads;               /* 0 = all cores */
+    const volatile int *stop;  /* hierarchical: stops at the next sweep (report.interrupted) */
+    rad_log_fn log;            /* warnings: no emitter, iteration limit, memory cap, ... */
+    void *log_user;
+    rad_progress_fn progress;  /* "form factors", "solve", "refine", "gather", ... */
+    void *progress_user;
+} rad_scene_solve_options;
+
+typedef struct rad_scene_solve_report {
+    rad_solver solver;         /* the solver that ran (never AUTO) */
+    bool solver_chosen;        /* AUTO was asked: the library chose it */
+    char reason[160];          /* one line on why this solver, e.g. "5000 patches > 4096" */
+    uint32_t patches;
+    uint32_t iterations;       /* sweeps, or shots */
+    double residual;           /* relative residual of the B returned, every solver (see
+                                  rad_solve_report, rad_hierarchy_report) */
+    bool converged;
+    bool interrupted;          /* options.stop was raised: B is the solution so far */
+    rad_formfactor_report formfactors; /* dense solvers */
+    rad_formfactor_check check;        /* dense solvers */
+    rad_solve_report solve;            /* dense solvers */
+    rad_hierarchy_report hierarchy;    /* hierarchical */
+    double seconds_inputs;       /* rad_patch_inputs_build */
+    double seconds_form_factors; /* dense: the matrix, with its check */
+    double seconds_solve;        /* the solve itself */
+    double seconds;              /* all of it */
+} rad_scene_solve_report;
+
+/* The radiosity of every patch of `mesh` (built from `scene`): builds the patch inputs
+ * once, chooses the solver (options->solver, or the automatic choice above), computes the
+ * form factors for the dense solvers or runs the hierarchical solver, and fills B
+ * (mesh->patch_count exitances, every value finite and >= 0). A solver that stops at its
+ * iteration limit is not an error: the report says converged = false and a warning goes
+ * to options->log. RAD_ERR_UNSUPPORTED when a dense solver is asked for a matrix that
+ * does not fit in memory. */
+rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
+                           const rad_scene_solve_options *options, rad_rgb *B,
+                           rad_scene_solve_report *report, rad_error *error);
+
+/* The solver rad_solve_scene runs for this mesh and these options (RAD_SOLVER_AUTO
+ * resolved), with one line on why in `reason` (NULL: not wanted). A caller that handles
+ * Ctrl-C can tell from it whether options->stop will be honoured (hierarchical only). */
+rad_solver rad_solve_scene_choice(const rad_mesh *mesh, const rad_scene_solve_options *options,
+                                  char *reason, size_t size);
 
 /* ------------------------------------------------------------------------------------ */
 /* Images                                                                                */

@@ -236,21 +236,12 @@ static bool solve_faces(const char *name, const rad_scene *scene, rad_rgb mean[6
 {
     rad_error error;
     rad_mesh *mesh = NULL;
-    rad_tracer *tracer = NULL;
-    rad_formfactors *ff = NULL;
-    rad_system system = {0};
     rad_rgb *B = NULL;
-    bool ok = rad_mesh_build(scene, 0.25, &mesh, &error) == RAD_OK &&
-              rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &tracer, &error) == RAD_OK;
-    rad_formfactor_options options = {0};
-    options.seed = 7;
-    ok = ok && rad_formfactors_compute(mesh, tracer, &options, &ff, NULL, &error) == RAD_OK &&
-         rad_system_from_mesh(scene, mesh, ff, &system, &error) == RAD_OK;
+    bool ok = rad_mesh_build(scene, 0.25, &mesh, &error) == RAD_OK;
     if (ok) {
         B = calloc(mesh->patch_count, sizeof(*B));
-        rad_solve_options solve = {0};
-        solve.solver = RAD_SOLVER_DIRECT;
-        ok = B && rad_solve(&system, &solve, B, NULL, &error) == RAD_OK;
+        rad_scene_solve_options solve = {.solver = RAD_SOLVER_DIRECT, .seed = 7};
+        ok = B && rad_solve_scene(scene, mesh, &solve, B, NULL, &error) == RAD_OK;
     }
     if (!ok)
         test_fail(__FILE__, __LINE__, "%s: %s", name, error.message);
@@ -273,9 +264,6 @@ static bool solve_faces(const char *name, const rad_scene *scene, rad_rgb mean[6
         if (area[k] > 0)
             mean[k] = (rad_rgb){mean[k].r / area[k], mean[k].g / area[k], mean[k].b / area[k]};
     free(B);
-    rad_system_free_arrays(&system);
-    rad_formfactors_destroy(ff);
-    rad_tracer_destroy(tracer);
     rad_mesh_destroy(mesh);
     return ok;
 }

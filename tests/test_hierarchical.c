@@ -117,21 +117,23 @@ static void compare_with_dense(const char *label, const rad_scene *scene, const 
     rad_formfactor_options ff_options = {.seed = 1};
     rad_formfactors *ff = NULL;
     fail_on(rad_formfactors_compute(mesh, tracer, &ff_options, &ff, NULL, &error), &error, "ff");
-    rad_system system;
-    fail_on(rad_system_from_mesh(scene, mesh, ff, &system, &error), &error, "system");
+    rad_patch_inputs *inputs = NULL;
+    fail_on(rad_patch_inputs_build(scene, mesh, &inputs, &error), &error, "inputs");
+    rad_system system = rad_system_of(inputs, ff);
     rad_solve_options solve = {.solver = RAD_SOLVER_GAUSS_SEIDEL, .tolerance = 1e-7};
     fail_on(rad_solve(&system, &solve, dense, NULL, &error), &error, "solve");
-    rad_system_free_arrays(&system);
     rad_formfactors_destroy(ff);
 
     rad_hierarchy_options options = {.seed = 1, .threads = 2};
-    fail_on(rad_solve_hierarchical(scene, mesh, tracer, &options, hier, report, &error), &error,
+    fail_on(rad_solve_hierarchical(mesh, inputs, tracer, &options, hier, report, &error), &error,
             "hierarchical");
+    rad_patch_inputs_destroy(inputs);
     printf("elements %llu clusters %llu links %llu partial %llu rays %llu passes %u sweeps %u "
-           "residual %.3g\n",
+           "change %.3g residual %.3g\n",
            (unsigned long long)report->elements, (unsigned long long)report->clusters,
            (unsigned long long)report->links, (unsigned long long)report->links_partial,
-           (unsigned long long)report->rays, report->passes, report->sweeps, report->residual);
+           (unsigned long long)report->rays, report->passes, report->iterations, report->change,
+           report->residual);
     CHECK(report->converged);
     CHECK(!report->memory_capped);
     CHECK(report->leaves == mesh->patch_count);
@@ -207,7 +209,7 @@ int main(void)
     /* the same bits for one thread */
     options.threads = 1;
     rad_hierarchy_report report1;
-    fail_on(rad_solve_hierarchical(scene, mesh, tracer, &options, hier1, &report1, &error),
+    fail_on(test_solve_hierarchical(scene, mesh, tracer, &options, hier1, &report1, &error),
             &error, "hierarchical 1 thread");
     CHECK(memcmp(hier, hier1, mesh->patch_count * sizeof(rad_rgb)) == 0);
     CHECK(report1.links == report.links && report1.rays == report.rays);
@@ -215,7 +217,7 @@ int main(void)
     /* a budget a third of what the links want: capped, reported, still within 5 % */
     options.threads = 2;
     options.max_memory = report.link_bytes / 3;
-    fail_on(rad_solve_hierarchical(scene, mesh, tracer, &options, hier1, &report1, &error),
+    fail_on(test_solve_hierarchical(scene, mesh, tracer, &options, hier1, &report1, &error),
             &error, "hierarchical capped");
     printf("capped: links %llu, link bytes %llu of %llu\n", (unsigned long long)report1.links,
            (unsigned long long)report1.link_bytes, (unsigned long long)options.max_memory);
@@ -232,7 +234,7 @@ int main(void)
     volatile int stop = 1;
     options.max_memory = 0;
     options.stop = &stop;
-    fail_on(rad_solve_hierarchical(scene, mesh, tracer, &options, hier1, &report1, &error),
+    fail_on(test_solve_hierarchical(scene, mesh, tracer, &options, hier1, &report1, &error),
             &error, "hierarchical stopped");
     CHECK(report1.interrupted && !report1.converged);
     bool usable = true;

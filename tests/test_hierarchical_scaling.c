@@ -100,7 +100,7 @@ int main(void)
     rad_rgb *B = calloc(mesh->patch_count, sizeof(rad_rgb));
     rad_hierarchy_options options = {.seed = 1, .threads = 2};
     rad_hierarchy_report report;
-    fail_on(rad_solve_hierarchical(scene, mesh, tracer, &options, B, &report, &error), &error,
+    fail_on(test_solve_hierarchical(scene, mesh, tracer, &options, B, &report, &error), &error,
             "furnace");
     double worst = 0, mean = 0, area = 0;
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
@@ -131,7 +131,7 @@ int main(void)
         fail_on(rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &tracer, &error),
                 &error, "tracer");
         B = calloc(mesh->patch_count, sizeof(rad_rgb));
-        fail_on(rad_solve_hierarchical(scene, mesh, tracer, &options, B, &report, &error), &error,
+        fail_on(test_solve_hierarchical(scene, mesh, tracer, &options, B, &report, &error), &error,
                 "room");
         per_triangle[level] = (double)report.links / scene->triangle_count;
         printf("room x%d: %u triangles, %u patches, %llu links, %.1f links per triangle, "

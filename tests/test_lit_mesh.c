@@ -59,22 +59,12 @@ static void compute_reference(const char *scene_path, double patch_size, referen
     memset(ref, 0, sizeof(*ref));
     rad_status status = scene_path ? rad_scene_load(scene_path, NULL, &ref->scene, &error)
                                    : rad_scene_cornell_box(&ref->scene, &error);
-    rad_tracer *tracer = NULL;
-    rad_formfactors *ff = NULL;
-    rad_system system = {0};
     if (status == RAD_OK)
         status = rad_mesh_build(ref->scene, patch_size, &ref->mesh, &error);
-    if (status == RAD_OK)
-        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, ref->scene, &tracer, &error);
-    rad_formfactor_options ff_options = {.seed = 1};
-    if (status == RAD_OK)
-        status = rad_formfactors_compute(ref->mesh, tracer, &ff_options, &ff, NULL, &error);
-    if (status == RAD_OK)
-        status = rad_system_from_mesh(ref->scene, ref->mesh, ff, &system, &error);
     rad_rgb *B = calloc(ref->mesh ? ref->mesh->patch_count : 1, sizeof(*B));
-    rad_solve_options solve = {.solver = RAD_SOLVER_JACOBI, .ambient = true};
+    rad_scene_solve_options solve = {.solver = RAD_SOLVER_JACOBI, .seed = 1};
     if (status == RAD_OK)
-        status = rad_solve(&system, &solve, B, NULL, &error);
+        status = rad_solve_scene(ref->scene, ref->mesh, &solve, B, NULL, &error);
     if (status != RAD_OK) {
         fprintf(stderr, "reference: %s\n", error.message);
         exit(1);
@@ -106,9 +96,6 @@ static void compute_reference(const char *scene_path, double patch_size, referen
     ref->scale = 0.9 / quantile;
     free(lit);
     free(B);
-    rad_system_free_arrays(&system);
-    rad_formfactors_destroy(ff);
-    rad_tracer_destroy(tracer);
 }
 
 static void free_reference(reference *ref)

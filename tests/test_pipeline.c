@@ -138,9 +138,10 @@ static void check_formfactors(const rad_mesh *mesh, const rad_formfactors *ff)
 
 static void check_solvers(const rad_scene *scene, const rad_mesh *mesh, const rad_formfactors *ff)
 {
-    rad_system system;
     rad_error error;
-    CHECK(rad_system_from_mesh(scene, mesh, ff, &system, &error) == RAD_OK);
+    rad_patch_inputs *inputs = NULL;
+    CHECK(rad_patch_inputs_build(scene, mesh, &inputs, &error) == RAD_OK);
+    rad_system system = rad_system_of(inputs, ff);
     uint32_t n = system.n;
     rad_rgb *reference = calloc(n, sizeof(*reference));
     rad_rgb *B = calloc(n, sizeof(*B));
@@ -170,7 +171,7 @@ static void check_solvers(const rad_scene *scene, const rad_mesh *mesh, const ra
     }
     free(reference);
     free(B);
-    rad_system_free_arrays(&system);
+    rad_patch_inputs_destroy(inputs);
 }
 
 int main(void)

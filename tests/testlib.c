@@ -167,3 +167,16 @@ void test_set_pixel(rad_image *image, uint32_t x, uint32_t y, double r, double g
     p[1] = (float)g;
     p[2] = (float)b;
 }
+
+rad_status test_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
+                                   const rad_tracer *occluders,
+                                   const rad_hierarchy_options *options, rad_rgb *B,
+                                   rad_hierarchy_report *report, rad_error *error)
+{
+    rad_patch_inputs *inputs = NULL;
+    rad_status status = rad_patch_inputs_build(scene, mesh, &inputs, error);
+    if (status == RAD_OK)
+        status = rad_solve_hierarchical(mesh, inputs, occluders, options, B, report, error);
+    rad_patch_inputs_destroy(inputs);
+    return status;
+}

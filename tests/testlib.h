@@ -86,4 +86,10 @@ void test_write_furnace(const char *name);
 /* Counts the files in the scratch folder whose name starts with prefix. */
 int test_count_files(const char *prefix);
 
+/* rad_solve_hierarchical with the scene's patch inputs (rad_patch_inputs_build). */
+rad_status test_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
+                                   const rad_tracer *occluders,
+                                   const rad_hierarchy_options *options, rad_rgb *B,
+                                   rad_hierarchy_report *report, rad_error *error);
+
 #endif

@@ -111,13 +111,19 @@ enum {
     [OPT_REFINE_THRESHOLD] = {"refine-threshold", 0, true},                                \
     [OPT_MAX_MEMORY] = {"max-memory", 0, true}
 
-/* The SOLVE options' help, the same for every command that solves. */
-#define CLI_SOLVER_HELP                                                                    \
+/* The help of the options `render` and `solve` share (SOLVE, FORMFACTOR, SCENE, BASE but
+ * -o), the same for both: a solution file of one is a solution file of the other. */
+#define CLI_SOLVE_HELP                                                                     \
+    "Solution:\n"                                                                          \
+    "  --solution FILE      take the solution saved in FILE (by --save-solution) instead\n" \
+    "                       of solving; refused if FILE belongs to another scene (--emit,\n" \
+    "                       --albedo) or meshing; the solver options are then ignored\n"   \
+    "  --save-solution FILE also write the solution to FILE, for later --solution runs\n"  \
     "  --solver NAME        gather (Jacobi), gauss-seidel, shoot, direct (LU, small\n"       \
     "                       scenes only), or hierarchical (links between element and\n"     \
-    "                       cluster trees, no n x n matrix: large scenes). Default:\n"      \
-    "                       gather, or hierarchical when the mesh has more than 4096\n"     \
-    "                       patches\n"                                                      \
+    "                       cluster trees, no n x n matrix: large scenes). Default: the\n"  \
+    "                       library's choice: gather up to 4096 patches, else\n"           \
+    "                       hierarchical (the summary and --stats say which ran)\n"         \
     "  --refine-threshold X hierarchical: split a link while B x F x A exceeds X times\n"   \
     "                       the emitted power per patch (default 0.25; smaller = finer)\n"  \
     "  --max-memory SIZE    hierarchical: bytes the links may use (K, M, G suffixes;\n"     \
@@ -126,10 +132,20 @@ enum {
     "  --tolerance X        relative residual, or unshot fraction for shoot, or change of\n" \
     "                       a sweep for hierarchical (default 1e-4)\n"                     \
     "  --max-iterations N   sweeps, or shots for shoot (default 10000 sweeps, 1000 n\n"     \
-    "                       shots for n patches)\n"                                         \
+    "                       shots for n patches, 1000 sweeps for hierarchical)\n"          \
     "  --patch-size L       longest patch edge in scene units (default: about 3000\n"       \
     "                       patches, 30000 with --solver hierarchical, or the one\n"        \
-    "                       --solution's file was solved with)\n"
+    "                       --solution's file was solved with)\n"                           \
+    "  --visibility-rays N  most occlusion rays per patch pair or link (default 16; 4\n"    \
+    "                       first, all N only where those 4 disagree)\n"                   \
+    "  --quadrature M       M x M points per patch for the analytic form factor (default 1)\n" \
+    CLI_SCENE_HELP                                                                         \
+    "  --threads N          worker threads (default: all cores)\n"                          \
+    "  --seed N             seed of every random choice (default 1)\n"                      \
+    "  --stats FILE.json    write counts, times, residuals and peak memory\n"               \
+    "  --quiet              no summary line at the end (warnings and errors still show)\n"  \
+    "  -h, --help           this text\n"                                                    \
+    "\n" CLI_INTERRUPT_HELP
 
 /* What Ctrl-C does, for the help of every command that solves. */
 #define CLI_INTERRUPT_HELP                                                                 \
@@ -314,41 +330,37 @@ void cli_image_run_free(cli_image_run *run);
 
 /* What the SOLVE options say (cli_solve.c). */
 typedef struct cli_solve {
-    rad_solve_options options;      /* solver, tolerance, iterations, threads, progress */
-    bool hierarchical;              /* --solver hierarchical */
-    bool solver_given;              /* --solver was given (else: hierarchical when large) */
-    rad_hierarchy_options hierarchy; /* threshold, memory, tolerance, sweeps, rays, seed */
+    rad_scene_solve_options options; /* solver (AUTO unless --solver), tolerance, limits,
+                                        threshold, memory, rays, seed, threads, log,
+                                        progress */
     const char *solution_path;      /* --solution: read B from this file instead of solving */
     const char *save_solution_path; /* --save-solution: write B to this file */
 } cli_solve;
 
-/* Parses the SOLVE options (after cli_parse_shared, whose threads it takes); false (after
- * printing) on a bad value. */
+/* Parses the SOLVE options (after cli_parse_shared, whose threads, seed, quadrature and
+ * visibility rays it takes); false (after printing) on a bad value. */
 bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *solve);
+
+/* -o, --stats and --save-solution can be written (cli_output_writable each). */
+bool cli_solve_outputs_writable(const cli_shared *shared, const cli_solve *solve);
 
 /* A scene, its mesh and its solution, and what getting them cost. */
 typedef struct cli_solved {
     rad_scene *scene;
     rad_mesh *mesh;
     rad_rgb *B;     /* mesh->patch_count exitances */
-    bool from_file; /* B came from --solution: no form factors, no solve */
-    bool hierarchical; /* solved by rad_solve_hierarchical (report in `hierarchy`) */
-    rad_hierarchy_report hierarchy;
-    rad_formfactor_report formfactors;
-    rad_solve_report report;
-    rad_formfactor_check check;
-    double seconds_load, seconds_mesh, seconds_form_factors, seconds_check, seconds_solve,
-        seconds_save;
+    bool from_file; /* B came from --solution: nothing solved, `report` is empty */
+    rad_scene_solve_report report; /* rad_solve_scene's: the solver it chose, and all */
+    double seconds_load, seconds_mesh, seconds_save;
 } cli_solved;
 
 /* The part `render` and `solve` share: loads SCENE (NULL = the built-in Cornell box),
- * meshes it (--patch-size, else the solution file's, else about target_patches patches),
- * then reads B from --solution (refused unless it belongs to this scene and mesh) or
- * computes the form factors and solves, warning when the solver stops at its limit;
+ * meshes it (--patch-size, else the solution file's, else rad_default_patch_size), then
+ * reads B from --solution (refused unless it belongs to this scene and mesh) or solves
+ * with rad_solve_scene (Ctrl-C stops a hierarchical solve with the solution so far);
  * writes --save-solution. On failure, fills error and frees what it made. */
 rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
-                           const cli_solve *solve, uint32_t target_patches, cli_solved *out,
-                           rad_error *error);
+                           const cli_solve *solve, cli_solved *out, rad_error *error);
 void cli_solved_free(cli_solved *solved);
 
 /* The --stats fields of the solution: scene, patches, rays, phase times, solver,

@@ -1,6 +1,7 @@
 /*
  * cli_solve.c - what `render` and `solve` share: the SOLVE options, and scene -> mesh ->
- * form factors -> solution (or a solution file read back), with its --stats fields.
+ * solution (rad_solve_scene, or a solution file read back), with its --stats fields. The
+ * library decides the solver and runs every phase; this file only parses and reports.
  * See cli.h.
  */
 #include <signal.h>
@@ -8,12 +9,6 @@
 #include <string.h>
 
 #include "cli.h"
-
-/* Above this many patches the dense n x n matrix (64 MB of factors and 8 M patch pairs at
- * 4096) stops paying: without --solver, the hierarchical solver takes over. */
-#define DENSE_MAX_PATCHES 4096u
-/* Leaf patches the hierarchical solver's default patch size aims at. */
-#define HIERARCHICAL_TARGET_PATCHES 30000u
 
 /* Parses a byte count with an optional K, M or G suffix (powers of 1024). */
 static bool parse_bytes(const char *name, const char *text, uint64_t *out)
@@ -44,52 +39,36 @@ static bool parse_bytes(const char *name, const char *text, uint64_t *out)
 bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *solve)
 {
     memset(solve, 0, sizeof(*solve));
-    const char *solver = args->value[OPT_SOLVER] ? args->value[OPT_SOLVER] : "gather";
-    solve->solver_given = args->value[OPT_SOLVER] != NULL;
-    if (strcmp(solver, "hierarchical") == 0)
-        solve->hierarchical = true;
-    else if (strcmp(solver, "gather") == 0 || strcmp(solver, "jacobi") == 0)
-        solve->options.solver = RAD_SOLVER_JACOBI;
-    else if (strcmp(solver, "gauss-seidel") == 0)
-        solve->options.solver = RAD_SOLVER_GAUSS_SEIDEL;
-    else if (strcmp(solver, "shoot") == 0)
-        solve->options.solver = RAD_SOLVER_SHOOT;
-    else if (strcmp(solver, "direct") == 0)
-        solve->options.solver = RAD_SOLVER_DIRECT;
-    else {
+    rad_scene_solve_options *o = &solve->options;
+    if (args->value[OPT_SOLVER] && (!rad_solver_from_name(args->value[OPT_SOLVER], &o->solver) ||
+                                    o->solver == RAD_SOLVER_AUTO)) {
         cli_error("--solver: '%s' is not gather, gauss-seidel, shoot, direct or hierarchical",
-                  solver);
+                  args->value[OPT_SOLVER]);
         return false;
     }
-    solve->options.ambient = true;
-    if (args->value[OPT_TOLERANCE]) {
-        if (!cli_parse_positive("tolerance", args->value[OPT_TOLERANCE],
-                                &solve->options.tolerance))
-            return false;
-    }
+    if (args->value[OPT_TOLERANCE] &&
+        !cli_parse_positive("tolerance", args->value[OPT_TOLERANCE], &o->tolerance))
+        return false;
     if (args->value[OPT_MAX_ITERATIONS]) {
         unsigned long value;
         if (!cli_parse_uint("max-iterations", args->value[OPT_MAX_ITERATIONS], UINT32_MAX,
                             &value))
             return false;
-        solve->options.max_iterations = (uint32_t)value;
+        o->max_iterations = (uint32_t)value;
     }
-    solve->options.threads = shared->threads;
-    solve->options.progress = cli_progress;
-    if (args->value[OPT_REFINE_THRESHOLD]) {
-        if (!cli_parse_positive("refine-threshold", args->value[OPT_REFINE_THRESHOLD],
-                                &solve->hierarchy.refine_threshold))
-            return false;
-    }
-    if (args->value[OPT_MAX_MEMORY] &&
-        !parse_bytes("max-memory", args->value[OPT_MAX_MEMORY], &solve->hierarchy.max_memory))
+    if (args->value[OPT_REFINE_THRESHOLD] &&
+        !cli_parse_positive("refine-threshold", args->value[OPT_REFINE_THRESHOLD],
+                            &o->refine_threshold))
         return false;
-    solve->hierarchy.tolerance = solve->options.tolerance;
-    solve->hierarchy.max_sweeps = solve->options.max_iterations;
-    solve->hierarchy.visibility_rays = shared->formfactor.visibility_rays;
-    solve->hierarchy.seed = shared->seed;
-    solve->hierarchy.threads = shared->threads;
-    solve->hierarchy.progress = cli_progress;
+    if (args->value[OPT_MAX_MEMORY] &&
+        !parse_bytes("max-memory", args->value[OPT_MAX_MEMORY], &o->max_memory))
+        return false;
+    o->quadrature = shared->formfactor.quadrature;
+    o->visibility_rays = shared->formfactor.visibility_rays;
+    o->seed = shared->seed;
+    o->threads = shared->threads;
+    o->log = cli_log;
+    o->progress = cli_progress;
     solve->solution_path = args->value[OPT_SOLUTION];
     solve->save_solution_path = args->value[OPT_SAVE_SOLUTION];
     if (solve->solution_path && solve->save_solution_path) {
@@ -99,11 +78,14 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
     }
     if (solve->solution_path) {
         /* nothing is solved: options of the form factors and the solver have no effect */
-        static const int unused[] = {OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS,
-                                     OPT_VISIBILITY_RAYS, OPT_QUADRATURE};
-        static const char *const names[] = {"--solver", "--tolerance", "--max-iterations",
-                                            "--visibility-rays", "--quadrature"};
-        char given[128] = "";
+        static const int unused[] = {OPT_SOLVER,          OPT_TOLERANCE,  OPT_MAX_ITERATIONS,
+                                     OPT_VISIBILITY_RAYS, OPT_QUADRATURE, OPT_REFINE_THRESHOLD,
+                                     OPT_MAX_MEMORY};
+        static const char *const names[] = {"--solver",          "--tolerance",
+                                            "--max-iterations",  "--visibility-rays",
+                                            "--quadrature",      "--refine-threshold",
+                                            "--max-memory"};
+        char given[192] = "";
         for (size_t k = 0; k < sizeof(unused) / sizeof(unused[0]); k++)
             if (args->value[unused[k]]) {
                 size_t length = strlen(given);
@@ -118,15 +100,11 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
     return true;
 }
 
-static const char *solver_name(rad_solver solver)
+bool cli_solve_outputs_writable(const cli_shared *shared, const cli_solve *solve)
 {
-    switch (solver) {
-    case RAD_SOLVER_JACOBI: return "gather";
-    case RAD_SOLVER_GAUSS_SEIDEL: return "gauss-seidel";
-    case RAD_SOLVER_SHOOT: return "shoot";
-    case RAD_SOLVER_DIRECT: return "direct";
-    }
-    return "unknown";
+    return (!shared->output || cli_output_writable(shared->output)) &&
+           (!shared->stats_path || cli_output_writable(shared->stats_path)) &&
+           (!solve->save_solution_path || cli_output_writable(solve->save_solution_path));
 }
 
 static volatile sig_atomic_t interrupt_requested;
@@ -138,87 +116,27 @@ static void on_interrupt(int signal_number)
     signal(SIGINT, SIG_DFL); /* a second Ctrl-C ends the run at once */
 }
 
-/* B from the hierarchical solver; Ctrl-C stops it cleanly with the solution so far. */
-static rad_status solve_hierarchical(const cli_solve *solve, cli_solved *out, rad_error *error)
+/* The refusal of a solution file solved with another patch size than the one given. */
+static rad_status patch_size_mismatch(const rad_solution *solution, double given_size,
+                                      rad_error *error)
 {
-    rad_tracer *occluders = NULL;
-    double t0 = cli_now();
-    rad_status status =
-        rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, out->scene, &occluders, error);
-    if (status != RAD_OK)
-        return status;
-    rad_hierarchy_options options = solve->hierarchy;
-    interrupt_requested = 0;
-    options.stop = &interrupt_requested;
-    void (*previous)(int) = signal(SIGINT, on_interrupt);
-    cli_progress_mark();
-    status = rad_solve_hierarchical(out->scene, out->mesh, occluders, &options, out->B,
-                                    &out->hierarchy, error);
-    signal(SIGINT, previous == SIG_ERR ? SIG_DFL : previous);
-    rad_tracer_destroy(occluders);
-    cli_progress_end();
-    out->hierarchical = true;
-    out->seconds_solve = cli_now() - t0;
-    if (status != RAD_OK)
-        return status;
-    const rad_hierarchy_report *r = &out->hierarchy;
-    if (r->interrupted)
-        cli_warn("interrupted: refinement and gathering stopped after %u passes and %u sweeps "
-                 "(change %.3g); going on with the solution so far",
-                 r->passes, r->sweeps, r->residual);
-    else if (!r->converged)
-        cli_warn("the hierarchical solver stopped at its sweep limit (%u) with change %.3g, "
-                 "above the tolerance",
-                 r->sweeps, r->residual);
-    if (r->memory_capped)
-        cli_warn("--max-memory: the links reached the budget (%.1f MB of links); refinement "
-                 "stopped there, so the answer is coarser than the threshold asks",
-                 r->link_bytes / 1048576.0);
-    return RAD_OK;
-}
-
-/* B from the form factors and the solver. */
-static rad_status solve_here(const cli_shared *shared, const cli_solve *solve, cli_solved *out,
-                             rad_error *error)
-{
-    rad_tracer *occluders = NULL;
-    rad_formfactors *ff = NULL;
-    rad_system system = {0};
-    double t0 = cli_now();
-    rad_status status =
-        rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, out->scene, &occluders, error);
-    cli_progress_mark();
-    if (status == RAD_OK)
-        status = rad_formfactors_compute(out->mesh, occluders, &shared->formfactor, &ff,
-                                         &out->formfactors, error);
-    if (status != RAD_OK)
-        goto done;
-    double t_ff = cli_now();
-    out->seconds_form_factors = t_ff - t0;
-    rad_formfactors_check(ff, out->mesh, &out->check);
-    double t_check = cli_now();
-    out->seconds_check = t_check - t_ff;
-    status = rad_system_from_mesh(out->scene, out->mesh, ff, &system, error);
-    if (status == RAD_OK)
-        status = rad_solve(&system, &solve->options, out->B, &out->report, error);
-    if (status != RAD_OK)
-        goto done;
-    cli_progress_end();
-    if (!out->report.converged)
-        cli_warn("the solver stopped at its iteration limit (%u) with residual %.3g, above the "
-                 "tolerance",
-                 out->report.iterations, out->report.criterion);
-    out->seconds_solve = cli_now() - t_check;
-done:
-    rad_system_free_arrays(&system);
-    rad_formfactors_destroy(ff);
-    rad_tracer_destroy(occluders);
-    return status;
+    /* the fewest digits (6 or more) that tell the two sizes apart */
+    int digits = 6;
+    char saved[32], given[32];
+    do {
+        snprintf(saved, sizeof(saved), "%.*g", digits, solution->patch_size);
+        snprintf(given, sizeof(given), "%.*g", digits, given_size);
+    } while (strcmp(saved, given) == 0 && ++digits <= 17);
+    error->status = RAD_ERR_INVALID;
+    snprintf(error->message, sizeof(error->message),
+             "%s: solved with --patch-size %s, not %s (leave --patch-size out to use the "
+             "file's)",
+             solution->source, saved, given);
+    return RAD_ERR_INVALID;
 }
 
 rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
-                           const cli_solve *solve, uint32_t target_patches, cli_solved *out,
-                           rad_error *error)
+                           const cli_solve *solve, cli_solved *out, rad_error *error)
 {
     memset(out, 0, sizeof(*out));
     rad_solution *solution = NULL;
@@ -226,10 +144,6 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
     rad_status status = cli_load_scene(scene_path, &out->scene, error);
     if (status != RAD_OK)
         goto done;
-    if (!rad_scene_has_emitter(out->scene))
-        cli_warn("%s: no surface emits light (no material with non-zero Ke): the result will "
-                 "be black (--emit NAME=R,G,B makes a surface a light)",
-                 out->scene->source);
     double t_load = cli_now();
     out->seconds_load = t_load - t0;
 
@@ -239,31 +153,17 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         if (status != RAD_OK)
             goto done;
         if (patch_size > 0 && patch_size != solution->patch_size) {
-            status = error->status = RAD_ERR_INVALID;
-            /* the fewest digits (6 or more) that tell the two sizes apart */
-            int digits = 6;
-            char saved[32], given[32];
-            do {
-                snprintf(saved, sizeof(saved), "%.*g", digits, solution->patch_size);
-                snprintf(given, sizeof(given), "%.*g", digits, patch_size);
-            } while (strcmp(saved, given) == 0 && ++digits <= 17);
-            snprintf(error->message, sizeof(error->message),
-                     "%s: solved with --patch-size %s, not %s (leave --patch-size out "
-                     "to use the file's)",
-                     solve->solution_path, saved, given);
+            status = patch_size_mismatch(solution, patch_size, error);
             goto done;
         }
         patch_size = solution->patch_size;
     }
     if (!(patch_size > 0))
-        patch_size = rad_mesh_default_patch_size(
-            out->scene, solve->hierarchical ? HIERARCHICAL_TARGET_PATCHES : target_patches);
+        patch_size = rad_default_patch_size(out->scene, solve->options.solver);
     status = rad_mesh_build(out->scene, patch_size, &out->mesh, error);
     if (status != RAD_OK)
         goto done;
     out->seconds_mesh = cli_now() - t_load;
-    bool hierarchical = solve->hierarchical ||
-                        (!solve->solver_given && out->mesh->patch_count > DENSE_MAX_PATCHES);
 
     if (solution) {
         status = rad_solution_match(solution, out->scene, out->mesh, error);
@@ -280,8 +180,22 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         snprintf(error->message, sizeof(error->message), "out of memory");
         goto done;
     }
-    status = hierarchical ? solve_hierarchical(solve, out, error)
-                          : solve_here(shared, solve, out, error);
+    /* Ctrl-C stops a solver that can stop cleanly with the solution so far; any other
+     * solve ends at once, as a plain program does */
+    rad_scene_solve_options options = solve->options;
+    bool stoppable = rad_solve_scene_choice(out->mesh, &options, NULL, 0) ==
+                     RAD_SOLVER_HIERARCHICAL;
+    void (*previous)(int) = SIG_DFL;
+    interrupt_requested = 0;
+    if (stoppable) {
+        options.stop = &interrupt_requested;
+        previous = signal(SIGINT, on_interrupt);
+    }
+    cli_progress_mark();
+    status = rad_solve_scene(out->scene, out->mesh, &options, out->B, &out->report, error);
+    if (stoppable)
+        signal(SIGINT, previous == SIG_ERR ? SIG_DFL : previous);
+    cli_progress_end();
     if (status != RAD_OK || !solve->save_solution_path)
         goto done;
     double t_save = cli_now();
@@ -306,6 +220,7 @@ void cli_solved_free(cli_solved *solved)
 
 void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *stats)
 {
+    const rad_scene_solve_report *r = &s->report;
     stats_string(stats, "scene", s->scene->source);
     stats_integer(stats, "triangles", s->scene->triangle_count);
     stats_integer(stats, "patches", s->mesh->patch_count);
@@ -316,9 +231,18 @@ void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *st
         stats_string(stats, "solution", solve->solution_path);
         return;
     }
-    if (s->hierarchical) {
-        const rad_hierarchy_report *h = &s->hierarchy;
-        stats_string(stats, "solver", "hierarchical");
+    stats_string(stats, "solver", rad_solver_name(r->solver));
+    stats_bool(stats, "solver_chosen", r->solver_chosen);
+    stats_string(stats, "solver_reason", r->reason);
+    stats_integer(stats, "iterations", r->iterations);
+    stats_number(stats, "final_residual", r->residual);
+    stats_bool(stats, "converged", r->converged);
+    stats_number(stats, "seconds_inputs", r->seconds_inputs);
+    stats_number(stats, "seconds_solve", r->seconds_solve);
+    if (solve->save_solution_path)
+        stats_number(stats, "seconds_save_solution", s->seconds_save);
+    if (r->solver == RAD_SOLVER_HIERARCHICAL) {
+        const rad_hierarchy_report *h = &r->hierarchy;
         stats_integer(stats, "leaves", h->leaves);
         stats_integer(stats, "elements", h->elements);
         stats_integer(stats, "clusters", h->clusters);
@@ -327,22 +251,17 @@ void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *st
         stats_integer(stats, "link_bytes", h->link_bytes);
         stats_integer(stats, "rays_cast", h->rays);
         stats_integer(stats, "refinement_passes", h->passes);
-        stats_integer(stats, "iterations", h->sweeps);
         stats_integer(stats, "threads", (unsigned long long)h->threads);
-        stats_number(stats, "final_residual", h->residual);
-        stats_bool(stats, "converged", h->converged);
+        stats_number(stats, "last_change", h->change);
         stats_bool(stats, "memory_capped", h->memory_capped);
         stats_bool(stats, "interrupted", h->interrupted);
         stats_number(stats, "seconds_hierarchy", h->seconds_build);
         stats_number(stats, "seconds_refine", h->seconds_refine);
         stats_number(stats, "seconds_gather", h->seconds_gather);
         stats_number(stats, "seconds_final_gather", h->seconds_final);
-        stats_number(stats, "seconds_solve", s->seconds_solve);
-        if (solve->save_solution_path)
-            stats_number(stats, "seconds_save_solution", s->seconds_save);
         return;
     }
-    const rad_formfactor_report *ff = &s->formfactors;
+    const rad_formfactor_report *ff = &r->formfactors;
     stats_integer(stats, "patch_pairs", ff->pairs);
     stats_integer(stats, "patch_pairs_facing", ff->pairs_facing);
     stats_integer(stats, "patch_pairs_refined", ff->pairs_refined);
@@ -352,50 +271,44 @@ void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *st
     stats_integer(stats, "threads", (unsigned long long)ff->threads);
     stats_number(stats, "tracing_rays_per_second",
                  ff->tracing_seconds > 0 ? ff->rays / (ff->tracing_seconds / ff->threads) : 0);
-    stats_number(stats, "seconds_form_factors", s->seconds_form_factors);
-    stats_number(stats, "seconds_solve", s->seconds_solve);
-    stats_string(stats, "solver", solver_name(solve->options.solver));
-    stats_integer(stats, "iterations", s->report.iterations);
-    stats_number(stats, "solver_criterion", s->report.criterion);
-    stats_number(stats, "final_residual", s->report.residual);
-    stats_bool(stats, "converged", s->report.converged);
-    stats_number(stats, "seconds_check", s->seconds_check);
-    stats_number(stats, "reciprocity_residual", s->check.reciprocity);
-    stats_number(stats, "largest_row_sum", s->check.largest_row_sum);
-    stats_number(stats, "closure_residual", s->check.closure);
-    stats_number(stats, "largest_form_factor", s->check.largest_factor);
-    stats_integer(stats, "patches_seeing_nothing", s->check.empty_rows);
-    if (solve->save_solution_path)
-        stats_number(stats, "seconds_save_solution", s->seconds_save);
+    stats_number(stats, "seconds_form_factors", r->seconds_form_factors);
+    stats_number(stats, "solver_criterion", r->solve.criterion);
+    stats_number(stats, "reciprocity_residual", r->check.reciprocity);
+    stats_number(stats, "largest_row_sum", r->check.largest_row_sum);
+    stats_number(stats, "closure_residual", r->check.closure);
+    stats_number(stats, "largest_form_factor", r->check.largest_factor);
+    stats_integer(stats, "patches_seeing_nothing", r->check.empty_rows);
 }
 
 void cli_solved_summary(const cli_solved *s, const cli_solve *solve, char *text, size_t size)
 {
+    const rad_scene_solve_report *r = &s->report;
     if (s->from_file) {
         snprintf(text, size, "%u patches, solution read from %s", s->mesh->patch_count,
                  solve->solution_path);
         return;
     }
-    if (s->hierarchical) {
-        const rad_hierarchy_report *h = &s->hierarchy;
+    const char *chosen = r->solver_chosen ? " (chosen: " : "";
+    if (r->solver == RAD_SOLVER_HIERARCHICAL) {
+        const rad_hierarchy_report *h = &r->hierarchy;
         snprintf(text, size,
-                 "%u patches, %llu elements, %llu clusters, %llu links, %.1f M rays, %u sweeps "
-                 "(change %.2g)%s%s; tree %.2f s, refine %.2f s, gather %.2f s, final gather "
-                 "%.2f s; peak %.0f MB",
-                 s->mesh->patch_count, (unsigned long long)h->elements,
+                 "%u patches, hierarchical%s%s%s, %llu elements, %llu clusters, %llu links, "
+                 "%.1f M rays, %u sweeps (residual %.2g)%s%s; tree %.2f s, refine %.2f s, "
+                 "gather %.2f s, final gather %.2f s; peak %.0f MB",
+                 s->mesh->patch_count, chosen, r->solver_chosen ? r->reason : "",
+                 r->solver_chosen ? ")" : "", (unsigned long long)h->elements,
                  (unsigned long long)h->clusters, (unsigned long long)h->links, h->rays / 1e6,
-                 h->sweeps, h->residual, h->memory_capped ? ", memory capped" : "",
+                 h->iterations, r->residual, h->memory_capped ? ", memory capped" : "",
                  h->interrupted ? ", interrupted" : "", h->seconds_build, h->seconds_refine,
-                 h->seconds_gather, h->seconds_final,
-                 rad_peak_memory_bytes() / 1048576.0);
+                 h->seconds_gather, h->seconds_final, rad_peak_memory_bytes() / 1048576.0);
         return;
     }
     char solved[64];
-    if (solve->options.solver == RAD_SOLVER_DIRECT)
+    if (r->solver == RAD_SOLVER_DIRECT)
         snprintf(solved, sizeof(solved), "direct solve");
     else
-        snprintf(solved, sizeof(solved), "%u %s", s->report.iterations,
-                 solve->options.solver == RAD_SOLVER_SHOOT ? "shots" : "sweeps");
+        snprintf(solved, sizeof(solved), "%s, %u %s", rad_solver_name(r->solver), r->iterations,
+                 r->solver == RAD_SOLVER_SHOOT ? "shots" : "sweeps");
     snprintf(text, size, "%u patches, %.1f M rays, %s (residual %.2g)", s->mesh->patch_count,
-             s->formfactors.rays / 1e6, solved, s->report.residual);
+             r->formfactors.rays / 1e6, solved, r->residual);
 }

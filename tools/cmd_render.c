@@ -27,21 +27,7 @@ static const char usage[] =
     "  --specular           the two-pass method: surfaces with Ks > 0 (MTL) also show\n"
     "                       mirror reflections of the radiosity-lit scene\n"
     "  --max-depth N        mirror reflections followed with --specular (default 5)\n"
-    "Solution:\n"
-    "  --solution FILE      render the solution saved in FILE (by --save-solution) instead\n"
-    "                       of solving; refused if FILE belongs to another scene (--emit,\n"
-    "                       --albedo) or meshing; the solver options are then ignored\n"
-    "  --save-solution FILE also write the solution to FILE, for later --solution runs\n"
-    CLI_SOLVER_HELP
-    "  --visibility-rays N  most occlusion rays per patch pair (default 16; 4 first,\n"
-    "                       all N only where those 4 disagree)\n"
-    "  --quadrature M       M x M points per patch for the analytic form factor (default 1)\n"
-    CLI_SCENE_HELP
-    "  --threads N          worker threads (default: all cores)\n"
-    "  --seed N             seed of every random choice (default 1)\n"
-    "  --stats FILE.json    write counts, times, residuals and peak memory\n"
-    "  -h, --help           this text\n"
-    "\n" CLI_INTERRUPT_HELP;
+    CLI_SOLVE_HELP;
 
 enum { OPT_SPECULAR = OPT_OWN, OPT_MAX_DEPTH, OPT_COUNT };
 
@@ -55,8 +41,6 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_MAX_DEPTH] = {"max-depth", 0, true},
 };
 
-/* Patches the default patch size aims at. */
-#define DEFAULT_TARGET_PATCHES 3000u
 #define RENDER_MAX_SPP 256u
 
 typedef struct render_settings {
@@ -100,8 +84,6 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
     s->render.threads = s->shared.threads;
     s->render.seed = s->shared.seed;
     s->render.progress = cli_progress;
-    s->render.width = s->view.width;
-    s->render.height = s->view.height;
     *exit_code = EXIT_OK;
     return true;
 }
@@ -112,8 +94,7 @@ int command_render(int argc, char **argv)
     int exit_code;
     if (!parse_settings(argc, argv, &s, &exit_code))
         return exit_code;
-    if (!cli_output_writable(s.output) || (s.stats_path && !cli_output_writable(s.stats_path)) ||
-        (s.solve.save_solution_path && !cli_output_writable(s.solve.save_solution_path)))
+    if (!cli_solve_outputs_writable(&s.shared, &s.solve))
         return EXIT_ERROR;
 
     rad_error error = {0};
@@ -122,8 +103,7 @@ int command_render(int argc, char **argv)
     rad_image *image = NULL;
     double t0 = cli_now(), t_solved, t_render, t_write;
 
-    status = cli_solve_scene(s.scene_path, &s.shared, &s.solve, DEFAULT_TARGET_PATCHES, &solved,
-                             &error);
+    status = cli_solve_scene(s.scene_path, &s.shared, &s.solve, &solved, &error);
     if (status != RAD_OK)
         goto fail;
     t_solved = cli_now();
@@ -154,7 +134,7 @@ int command_render(int argc, char **argv)
     if (status != RAD_OK)
         goto fail;
     t_write = cli_now();
-    if (cli_progress_enabled()) { /* a summary for a person watching; quiet in scripts */
+    {
         char summary[384];
         cli_solved_summary(&solved, &s.solve, summary, sizeof(summary));
         fprintf(stderr, "radiosity: %s, %.2f s: wrote %s\n", summary, t_write - t0, s.output);
@@ -173,7 +153,7 @@ int command_render(int argc, char **argv)
         if (!stats_write(&stats, s.stats_path))
             exit_code = EXIT_ERROR;
     }
-    if (exit_code == EXIT_OK && solved.hierarchical && solved.hierarchy.interrupted)
+    if (exit_code == EXIT_OK && solved.report.interrupted)
         exit_code = EXIT_INTERRUPTED; /* the image is complete, of the solution so far */
     goto done;
 fail:

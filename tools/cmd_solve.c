@@ -26,19 +26,7 @@ static const char usage[] =
     "\n"
     "  -o, --output FILE    the lit mesh (.ply, .glb or .obj)\n"
     "  --exposure EV        display colour: radiance times 2^EV (default: automatic)\n"
-    "  --save-solution FILE also write the solution, for `render --solution FILE`\n"
-    "  --solution FILE      take the solution saved in FILE instead of solving; refused if\n"
-    "                       FILE belongs to another scene (--emit, --albedo) or meshing\n"
-    CLI_SOLVER_HELP
-    "  --visibility-rays N  most occlusion rays per patch pair (default 16; 4 first,\n"
-    "                       all N only where those 4 disagree)\n"
-    "  --quadrature M       M x M points per patch for the analytic form factor (default 1)\n"
-    CLI_SCENE_HELP
-    "  --threads N          worker threads (default: all cores)\n"
-    "  --seed N             seed of every random choice (default 1)\n"
-    "  --stats FILE.json    write counts, times, residuals and peak memory\n"
-    "  -h, --help           this text\n"
-    "\n" CLI_INTERRUPT_HELP;
+    CLI_SOLVE_HELP;
 
 static const cli_option options[OPT_OWN] = {
     CLI_BASE_OPTIONS,
@@ -47,9 +35,6 @@ static const cli_option options[OPT_OWN] = {
     CLI_SCENE_OPTIONS,
     [OPT_EXPOSURE] = {"exposure", 0, true},
 };
-
-/* Same as render: the solution file of one is the solution file of the other. */
-#define DEFAULT_TARGET_PATCHES 3000u
 
 static bool mesh_output_ok(const char *path)
 {
@@ -95,17 +80,14 @@ int command_solve(int argc, char **argv)
         return EXIT_USAGE;
     if (!cli_parse_solve(&args, &shared, &solve))
         return EXIT_USAGE;
-    if ((shared.output && !cli_output_writable(shared.output)) ||
-        (shared.stats_path && !cli_output_writable(shared.stats_path)) ||
-        (solve.save_solution_path && !cli_output_writable(solve.save_solution_path)))
+    if (!cli_solve_outputs_writable(&shared, &solve))
         return EXIT_ERROR;
 
     int exit_code = EXIT_OK;
     rad_error error = {0};
     cli_solved solved;
     double t0 = cli_now();
-    rad_status status = cli_solve_scene(scene_path, &shared, &solve, DEFAULT_TARGET_PATCHES,
-                                        &solved, &error);
+    rad_status status = cli_solve_scene(scene_path, &shared, &solve, &solved, &error);
     double t_solved = cli_now();
     if (status == RAD_OK && shared.output)
         status = rad_lit_mesh_write(solved.mesh, solved.B, shared.output, &write, &error);
@@ -115,7 +97,7 @@ int command_solve(int argc, char **argv)
         exit_code = EXIT_ERROR;
         goto done;
     }
-    if (cli_progress_enabled()) {
+    {
         char summary[384];
         cli_solved_summary(&solved, &solve, summary, sizeof(summary));
         fprintf(stderr, "radiosity: %s, %.2f s: wrote %s\n", summary, t_write - t0,
@@ -132,7 +114,7 @@ int command_solve(int argc, char **argv)
         if (!stats_write(&stats, shared.stats_path))
             exit_code = EXIT_ERROR;
     }
-    if (exit_code == EXIT_OK && solved.hierarchical && solved.hierarchy.interrupted)
+    if (exit_code == EXIT_OK && solved.report.interrupted)
         exit_code = EXIT_INTERRUPTED; /* the files are complete, of the solution so far */
 done:
     cli_progress_end();

@@ -11,6 +11,10 @@
 
 static inline rad_rgb rgb_add(rad_rgb a, rad_rgb b) { return (rad_rgb){a.r + b.r, a.g + b.g, a.b + b.b}; }
 static inline rad_rgb rgb_mul(rad_rgb a, rad_rgb b) { return (rad_rgb){a.r * b.r, a.g * b.g, a.b * b.b}; }
+static inline rad_rgb rgb_max0(rad_rgb a)
+{
+    return (rad_rgb){a.r > 0 ? a.r : 0, a.g > 0 ? a.g : 0, a.b > 0 ? a.b : 0};
+}
 static inline rad_rgb rgb_scale(rad_rgb a, double s) { return (rad_rgb){a.r * s, a.g * s, a.b * s}; }
 static inline void rgb_add_to(rad_rgb *sum, rad_rgb a)
 {

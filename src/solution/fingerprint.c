@@ -3,7 +3,7 @@
  * depends on, so a solution file is never applied to another scene or meshing.
  *
  * What is hashed: the scene's positions and triangles, each patch's albedo and exitance
- * as rad_system_from_mesh hands them to the solver (so however materials come to patches,
+ * as rad_patch_inputs_build hands them to every solver (so however materials come to patches,
  * the fingerprint follows), the patch size, and the mesh's counts and patch vertices. Not
  * hashed: names, the file's path, cameras and specular terms, which do not change B. The
  * mesh's computed coordinates are left out on purpose: they follow from the hashed inputs,
@@ -15,8 +15,8 @@
 rad_status rad_solution_fingerprint(const rad_scene *scene, const rad_mesh *mesh,
                                     uint64_t *fingerprint, rad_error *error)
 {
-    rad_system system = {0};
-    rad_status status = rad_system_from_mesh(scene, mesh, NULL, &system, error);
+    rad_patch_inputs *inputs = NULL;
+    rad_status status = rad_patch_inputs_build(scene, mesh, &inputs, error);
     if (status != RAD_OK)
         return status;
     uint64_t h = RAD_HASH_START;
@@ -42,7 +42,7 @@ rad_status rad_solution_fingerprint(const rad_scene *scene, const rad_mesh *mesh
         h = hash_u32(h, patch->vertex_count);
         for (uint32_t k = 0; k < patch->vertex_count; k++)
             h = hash_u32(h, patch->vertex[k]);
-        const rad_rgb *rho = &system.albedo[p], *E = &system.exitance[p];
+        const rad_rgb *rho = &inputs->albedo[p], *E = &inputs->exitance[p];
         h = hash_f64(h, rho->r);
         h = hash_f64(h, rho->g);
         h = hash_f64(h, rho->b);
@@ -50,7 +50,7 @@ rad_status rad_solution_fingerprint(const rad_scene *scene, const rad_mesh *mesh
         h = hash_f64(h, E->g);
         h = hash_f64(h, E->b);
     }
-    rad_system_free_arrays(&system);
+    rad_patch_inputs_destroy(inputs);
     *fingerprint = h;
     return RAD_OK;
 }

@@ -66,8 +66,13 @@ static rad_status resolve_options(const rad_solve_options *options, uint32_t n,
     rad_solve_options zero = {0};
     const rad_solve_options *o = options ? options : &zero;
 
-    if (o->solver != RAD_SOLVER_JACOBI && o->solver != RAD_SOLVER_GAUSS_SEIDEL &&
-        o->solver != RAD_SOLVER_SHOOT && o->solver != RAD_SOLVER_DIRECT)
+    if (o->solver == RAD_SOLVER_HIERARCHICAL)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "rad_solve: the hierarchical solver needs the mesh "
+                        "(rad_solve_hierarchical, or rad_solve_scene)");
+    if (o->solver != RAD_SOLVER_AUTO && o->solver != RAD_SOLVER_JACOBI &&
+        o->solver != RAD_SOLVER_GAUSS_SEIDEL && o->solver != RAD_SOLVER_SHOOT &&
+        o->solver != RAD_SOLVER_DIRECT)
         return rad_fail(error, RAD_ERR_INVALID, "rad_solve: unknown solver %d",
                         (int)o->solver);
     if (!(o->tolerance >= 0 && isfinite(o->tolerance)))
@@ -142,6 +147,7 @@ rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
 
     double start = wall_seconds();
     switch (options ? options->solver : RAD_SOLVER_JACOBI) {
+    case RAD_SOLVER_AUTO:
     case RAD_SOLVER_JACOBI:
         status = solve_jacobi(system, &params, B, report, error);
         break;
@@ -154,6 +160,8 @@ rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
     case RAD_SOLVER_DIRECT:
         status = solve_direct(system, &params, B, report, error);
         break;
+    case RAD_SOLVER_HIERARCHICAL: /* refused by resolve_options */
+        break;
     }
     if (status != RAD_OK)
         return status;
@@ -162,4 +170,34 @@ rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
     report->residual = solve_residual(system, B, params.threads);
     solve_progress(&params, 0);
     return RAD_OK;
+}
+
+static const struct {
+    rad_solver solver;
+    const char *name;
+} solver_names[] = {{RAD_SOLVER_AUTO, "auto"},
+                    {RAD_SOLVER_JACOBI, "gather"},
+                    {RAD_SOLVER_GAUSS_SEIDEL, "gauss-seidel"},
+                    {RAD_SOLVER_SHOOT, "shoot"},
+                    {RAD_SOLVER_DIRECT, "direct"},
+                    {RAD_SOLVER_HIERARCHICAL, "hierarchical"}};
+
+const char *rad_solver_name(rad_solver solver)
+{
+    for (size_t k = 0; k < sizeof(solver_names) / sizeof(solver_names[0]); k++)
+        if (solver_names[k].solver == solver)
+            return solver_names[k].name;
+    return "unknown";
+}
+
+bool rad_solver_from_name(const char *name, rad_solver *solver)
+{
+    if (strcmp(name, "jacobi") == 0)
+        name = "gather";
+    for (size_t k = 0; k < sizeof(solver_names) / sizeof(solver_names[0]); k++)
+        if (strcmp(solver_names[k].name, name) == 0) {
+            *solver = solver_names[k].solver;
+            return true;
+        }
+    return false;
 }

@@ -15,8 +15,9 @@
 #include "core/error.h"
 #include "solve/solve_internal.h"
 
-/* 4096^2 doubles = 128 MiB and ~45 Gflop per factorisation: the largest system worth it. */
-enum { DIRECT_MAX_PATCHES = 4096 };
+/* RAD_DIRECT_MAX_PATCHES: 4096^2 doubles = 128 MiB and ~45 Gflop per factorisation, the
+ * largest system worth it. */
+#define DIRECT_MAX_PATCHES RAD_DIRECT_MAX_PATCHES
 
 /* A pivot smaller than this times the largest entry of M means M is singular (to double
  * precision). M has a unit diagonal and entries in [-1, 1], so this is an absolute scale. */

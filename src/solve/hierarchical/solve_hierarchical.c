@@ -26,7 +26,7 @@
 
 #define DEFAULT_THRESHOLD 0.25
 #define DEFAULT_TOLERANCE 1e-4
-#define DEFAULT_MAX_SWEEPS 1000u
+#define DEFAULT_MAX_ITERATIONS 1000u
 #define DEFAULT_VISIBILITY_RAYS 16u
 #define SWEEPS_PER_PASS 1u
 #define MAX_CORRECTION_FACTOR 1.0
@@ -34,10 +34,9 @@
 #define MAX_PASSES 256u
 
 typedef struct hsolver {
-    const rad_scene *scene;
     const rad_mesh *mesh;
     hier_tree tree;
-    rad_rgb *emission, *albedo; /* per patch */
+    const rad_rgb *emission, *albedo; /* per patch: the patch inputs' E and rho */
     rad_rgb *node_B, *gathered, *down;
     rad_rgb *correction, *scale; /* per node (leaves only): the final gather's, or NULL:
                                     a leaf gathers down x scale + correction */
@@ -108,8 +107,8 @@ static double sweep(hsolver *s)
         if (n->patch != HNODE_NONE) {
             uint32_t p = n->patch;
             rad_rgb h = s->down[k];
-            if (s->correction)
-                h = rgb_add(rgb_mul(h, s->scale[k]), s->correction[k]);
+            if (s->correction) /* irradiance is never negative, however corrected */
+                h = rgb_max0(rgb_add(rgb_mul(h, s->scale[k]), s->correction[k]));
             rad_rgb b = rgb_add(s->emission[p], rgb_mul(s->albedo[p], h));
             change += n->area * (fabs(b.r - s->patch_B[p].r) + fabs(b.g - s->patch_B[p].g) +
                                  fabs(b.b - s->patch_B[p].b));
@@ -144,8 +143,6 @@ static void update_brightness(hsolver *s)
 static void hsolver_free(hsolver *s)
 {
     hier_tree_free(&s->tree);
-    free(s->emission);
-    free(s->albedo);
     free(s->node_B);
     free(s->gathered);
     free(s->down);
@@ -160,7 +157,19 @@ static void hsolver_free(hsolver *s)
 
 static bool stopped(const rad_hierarchy_options *o) { return o->stop && *o->stop; }
 
-rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
+/* Progress of refinement after `passes` passes: about 4 passes per level of the tree
+ * (measured: 87 at 1M leaves' 21 levels), linear up to 90 % of that; past it the fraction
+ * keeps creeping towards 1 (each pass a tenth of the way), never stuck at one value. */
+static double refine_fraction(uint32_t passes, uint32_t nodes)
+{
+    double expected = 4.0 * log2((double)nodes + 2) + 8;
+    double linear = passes / expected;
+    if (linear <= 0.9)
+        return linear;
+    return 1 - 0.1 * pow(0.9, passes - 0.9 * expected);
+}
+
+rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *inputs,
                                   const rad_tracer *occluders,
                                   const rad_hierarchy_options *options, rad_rgb *B,
                                   rad_hierarchy_report *report, rad_error *error)
@@ -175,9 +184,14 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
         return rad_fail(error, RAD_ERR_INVALID, "the refinement threshold must be >= 0");
     if (!(o.tolerance >= 0))
         return rad_fail(error, RAD_ERR_INVALID, "the tolerance must be >= 0");
+    if (!inputs || inputs->n != mesh->patch_count)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "rad_solve_hierarchical: the patch inputs are for %u patches, the mesh "
+                        "has %u",
+                        inputs ? inputs->n : 0, mesh->patch_count);
     double threshold = o.refine_threshold > 0 ? o.refine_threshold : DEFAULT_THRESHOLD;
     double tolerance = o.tolerance > 0 ? o.tolerance : DEFAULT_TOLERANCE;
-    uint32_t max_sweeps = o.max_sweeps ? o.max_sweeps : DEFAULT_MAX_SWEEPS;
+    uint32_t max_sweeps = o.max_iterations ? o.max_iterations : DEFAULT_MAX_ITERATIONS;
     unsigned rays = o.visibility_rays ? o.visibility_rays : DEFAULT_VISIBILITY_RAYS;
     uint64_t budget = o.max_memory;
     if (budget == 0)
@@ -187,7 +201,6 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
 
     hsolver s;
     memset(&s, 0, sizeof(s));
-    s.scene = scene;
     s.mesh = mesh;
     s.threads = o.threads > 0 ? o.threads : omp_get_max_threads();
     rep.threads = s.threads;
@@ -201,24 +214,21 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
     if (!hier_tree_build(mesh, &s.tree))
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory building the element tree");
     uint32_t nodes = s.tree.node_count;
-    s.emission = rad_alloc_array(n, sizeof(rad_rgb));
-    s.albedo = rad_alloc_array(n, sizeof(rad_rgb));
+    s.emission = inputs->exitance;
+    s.albedo = inputs->albedo;
     s.patch_B = rad_alloc_array(n, sizeof(rad_rgb));
     s.brightness = rad_alloc_array(n, sizeof(float));
     s.node_B = rad_alloc_array(nodes, sizeof(rad_rgb));
     s.gathered = rad_alloc_array(nodes, sizeof(rad_rgb));
     s.down = rad_alloc_array(nodes, sizeof(rad_rgb));
     s.offsets = rad_alloc_array((size_t)nodes + 1, sizeof(size_t));
-    if (!s.emission || !s.albedo || !s.patch_B || !s.node_B || !s.gathered || !s.down ||
+    if (!s.patch_B || !s.node_B || !s.gathered || !s.down ||
         !s.offsets || !s.brightness) {
         hsolver_free(&s);
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the hierarchy");
     }
     double brightest_total = 0;
     for (uint32_t p = 0; p < n; p++) {
-        const rad_material *m = &scene->materials[mesh->patches[p].material];
-        s.emission[p] = rgb_scale(m->emission, 3.14159265358979323846);
-        s.albedo[p] = m->albedo;
         s.patch_B[p] = s.emission[p];
         double a = mesh->patches[p].area;
         s.emitted += a * (s.emission[p].r + s.emission[p].g + s.emission[p].b);
@@ -260,10 +270,10 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
                          o.seed,
                          s.threads};
 
-    double residual = s.emitted > 0 ? 1 : 0;
+    double sweep_change = s.emitted > 0 ? 1 : 0;
     bool refining = s.store.count > 0, converged = false;
     uint32_t quiet_passes = 0;
-    while (!stopped(&o) && rep.sweeps < max_sweeps) {
+    while (!stopped(&o) && rep.iterations < max_sweeps) {
         size_t split = 0;
         if (refining && !rep.memory_capped && rep.passes < MAX_PASSES) {
             double tr = now_seconds();
@@ -280,34 +290,33 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
             if (rr.capped)
                 rep.memory_capped = true;
             rep.seconds_refine += now_seconds() - tr;
-            if (o.progress) /* about 4 passes per level of the tree (measured: 87 at 1M
-                                leaves' 21 levels) */
-                o.progress(o.progress_user, "refine",
-                           fmin(0.99, rep.passes / (4.0 * log2((double)nodes + 2) + 8)));
+            if (o.progress)
+                o.progress(o.progress_user, "refine", refine_fraction(rep.passes, nodes));
         }
         double tg = now_seconds();
         sort_by_receiver(&s);
         if (split > 0) {
             quiet_passes = 0;
-            for (unsigned k = 0; k < SWEEPS_PER_PASS && rep.sweeps < max_sweeps; k++) {
-                residual = sweep(&s);
-                rep.sweeps++;
+            for (unsigned k = 0; k < SWEEPS_PER_PASS && rep.iterations < max_sweeps; k++) {
+                sweep_change = sweep(&s);
+                rep.iterations++;
             }
             rep.seconds_gather += now_seconds() - tg;
             continue;
         }
         /* nothing split: sweep to the tolerance, then look once more */
-        double first = residual;
-        while (residual > tolerance && rep.sweeps < max_sweeps && !stopped(&o)) {
-            residual = sweep(&s);
-            rep.sweeps++;
-            if (o.progress && first > tolerance && residual > 0)
+        double first = sweep_change;
+        while (sweep_change > tolerance && rep.iterations < max_sweeps && !stopped(&o)) {
+            sweep_change = sweep(&s);
+            rep.iterations++;
+            if (o.progress && first > tolerance && sweep_change > 0)
                 o.progress(o.progress_user, "gather",
-                           fmin(0.99, fmax(0, log(first / residual) / log(first / tolerance))));
+                           fmin(0.99, fmax(0, log(first / sweep_change) /
+                                                  log(first / tolerance))));
         }
         rep.seconds_gather += now_seconds() - tg;
-        if (residual <= tolerance && (quiet_passes > 0 || !refining || rep.memory_capped ||
-                                      rep.passes >= MAX_PASSES)) {
+        if (sweep_change <= tolerance && (quiet_passes > 0 || !refining ||
+                                          rep.memory_capped || rep.passes >= MAX_PASSES)) {
             converged = true;
             break;
         }
@@ -344,9 +353,9 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
             as_scale(s.down[k].b, &s.correction[k].b, &s.scale[k].b);
         }
         double change = s.correction ? 1 : 0;
-        while (change > tolerance && rep.sweeps < max_sweeps && !stopped(&o)) {
-            residual = change = sweep(&s);
-            rep.sweeps++;
+        while (change > tolerance && rep.iterations < max_sweeps && !stopped(&o)) {
+            sweep_change = change = sweep(&s);
+            rep.iterations++;
         }
         converged = converged && change <= tolerance;
         if (o.progress)
@@ -355,17 +364,20 @@ rad_status rad_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
     }
     rep.interrupted = stopped(&o);
     rep.converged = converged && !rep.interrupted;
-    rep.residual = residual;
+    rep.change = sweep_change;
+    /* the sweep_change of the B handed out: one more sweep, measured and not applied */
+    memcpy(B, s.patch_B, (size_t)n * sizeof(rad_rgb));
+    rep.residual = sweep(&s);
     rep.links = s.store.count;
     for (size_t l = 0; l < s.store.count; l++)
         rep.links_partial += s.store.links[l].visible < LINK_VISIBLE;
     rep.link_bytes = s.store.peak_bytes;
-    if (!isfinite(residual)) { /* never hand out a diverged answer as a solution */
+    if (!isfinite(sweep_change) || !isfinite(rep.residual)) { /* never hand out a diverged
+                                                              answer as a solution */
         hsolver_free(&s);
         return rad_fail(error, RAD_ERR_INTERNAL,
                         "the hierarchical solution diverged (a bug: please report the scene)");
     }
-    memcpy(B, s.patch_B, (size_t)n * sizeof(rad_rgb));
     hsolver_free(&s);
     if (report)
         *report = rep;

@@ -1,0 +1,195 @@
+/*
+ * solve_scene.c - rad_solve_scene: from a scene and its mesh to the radiosity of every
+ * patch, whatever the solver. The one path every caller takes (the CLI's render and solve,
+ * the tests, a program using the library):
+ *
+ *   patch inputs (rad_patch_inputs_build: albedo with textures, emission)   once
+ *   the solver: the caller's, or the automatic choice by size and memory    reported
+ *   dense:        occluders -> form factors (checked) -> rad_solve
+ *   hierarchical: occluders -> rad_solve_hierarchical
+ *   B: finite, and at least each patch's own exitance
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <omp.h>
+
+#include "core/error.h"
+#include "core/memory.h"
+
+/* The automatic choice keeps the dense matrix to this share of the machine's memory (the
+ * form-factor computation itself refuses above 3/4). */
+#define AUTO_DENSE_MEMORY_SHARE 0.5
+
+static double seconds_now(void) { return omp_get_wtime(); }
+
+double rad_default_patch_size(const rad_scene *scene, rad_solver solver)
+{
+    return rad_mesh_default_patch_size(scene, solver == RAD_SOLVER_HIERARCHICAL
+                                                  ? RAD_HIERARCHICAL_DEFAULT_PATCHES
+                                                  : RAD_DEFAULT_PATCHES);
+}
+
+rad_solver rad_solve_scene_choice(const rad_mesh *mesh, const rad_scene_solve_options *options,
+                                  char *reason, size_t size)
+{
+    rad_scene_solve_options zero = {0};
+    const rad_scene_solve_options *o = options ? options : &zero;
+    uint32_t patches = mesh->patch_count;
+    char ignored[8];
+    if (!reason) {
+        reason = ignored;
+        size = sizeof(ignored);
+    }
+    if (o->solver != RAD_SOLVER_AUTO) {
+        snprintf(reason, size, "asked for");
+        return o->solver;
+    }
+    double matrix_bytes = (double)patches * patches * sizeof(float);
+    uint64_t physical = rad_physical_memory_bytes();
+    if (patches > RAD_DENSE_MAX_PATCHES) {
+        snprintf(reason, size, "%u patches > %u: no dense matrix", patches,
+                 RAD_DENSE_MAX_PATCHES);
+        return RAD_SOLVER_HIERARCHICAL;
+    }
+    if (physical && matrix_bytes > AUTO_DENSE_MEMORY_SHARE * (double)physical) {
+        snprintf(reason, size, "the %.1f GB matrix would not fit in half of the memory",
+                 matrix_bytes / 1e9);
+        return RAD_SOLVER_HIERARCHICAL;
+    }
+    snprintf(reason, size, "%u patches <= %u: dense matrix", patches, RAD_DENSE_MAX_PATCHES);
+    return RAD_SOLVER_JACOBI;
+}
+
+static rad_status solve_dense(const rad_mesh *mesh, const rad_patch_inputs *inputs,
+                              const rad_tracer *occluders, const rad_scene_solve_options *o,
+                              rad_solver solver, rad_rgb *B, rad_scene_solve_report *r,
+                              rad_error *error)
+{
+    rad_formfactor_options ff_options = {o->quadrature, o->visibility_rays, o->seed,
+                                         o->threads, o->progress, o->progress_user};
+    rad_formfactors *ff = NULL;
+    double t0 = seconds_now();
+    rad_status status =
+        rad_formfactors_compute(mesh, occluders, &ff_options, &ff, &r->formfactors, error);
+    if (status != RAD_OK)
+        return status;
+    rad_formfactors_check(ff, mesh, &r->check);
+    double t1 = seconds_now();
+    r->seconds_form_factors = t1 - t0;
+    rad_system system = rad_system_of(inputs, ff);
+    rad_solve_options solve_options = {solver,    o->tolerance, o->max_iterations,
+                                       true,      o->threads,   o->progress,
+                                       o->progress_user};
+    status = rad_solve(&system, &solve_options, B, &r->solve, error);
+    rad_formfactors_destroy(ff);
+    r->seconds_solve = seconds_now() - t1;
+    if (status != RAD_OK)
+        return status;
+    r->iterations = r->solve.iterations;
+    r->residual = r->solve.residual;
+    r->converged = r->solve.converged || solver == RAD_SOLVER_DIRECT;
+    if (!r->converged)
+        rad_warn(o->log, o->log_user,
+                 "the %s solver stopped at its iteration limit (%u) with %s %.3g, above the "
+                 "tolerance",
+                 rad_solver_name(solver), r->solve.iterations,
+                 solver == RAD_SOLVER_SHOOT ? "unshot fraction" : "criterion",
+                 r->solve.criterion);
+    return RAD_OK;
+}
+
+static rad_status solve_hierarchy(const rad_mesh *mesh, const rad_patch_inputs *inputs,
+                                  const rad_tracer *occluders,
+                                  const rad_scene_solve_options *o, rad_rgb *B,
+                                  rad_scene_solve_report *r, rad_error *error)
+{
+    rad_hierarchy_options h = {o->refine_threshold, o->visibility_rays, o->tolerance,
+                               o->max_iterations,   o->max_memory,      o->seed,
+                               o->threads,          o->stop,            o->progress,
+                               o->progress_user};
+    double t0 = seconds_now();
+    rad_status status =
+        rad_solve_hierarchical(mesh, inputs, occluders, &h, B, &r->hierarchy, error);
+    r->seconds_solve = seconds_now() - t0;
+    if (status != RAD_OK)
+        return status;
+    const rad_hierarchy_report *hr = &r->hierarchy;
+    r->iterations = hr->iterations;
+    r->residual = hr->residual;
+    r->converged = hr->converged;
+    r->interrupted = hr->interrupted;
+    if (hr->interrupted)
+        rad_warn(o->log, o->log_user,
+                 "interrupted: refinement and gathering stopped after %u passes and %u "
+                 "sweeps (residual %.3g); going on with the solution so far",
+                 hr->passes, hr->iterations, hr->residual);
+    else if (!hr->converged)
+        rad_warn(o->log, o->log_user,
+                 "the hierarchical solver stopped at its sweep limit (%u) with change %.3g, "
+                 "above the tolerance",
+                 hr->iterations, hr->change);
+    if (hr->memory_capped)
+        rad_warn(o->log, o->log_user,
+                 "--max-memory: the links reached the budget (%.1f MB of links); refinement "
+                 "stopped there, so the answer is coarser than the threshold asks",
+                 hr->link_bytes / 1048576.0);
+    return RAD_OK;
+}
+
+rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
+                           const rad_scene_solve_options *options, rad_rgb *B,
+                           rad_scene_solve_report *report, rad_error *error)
+{
+    rad_scene_solve_options o = {0};
+    if (options)
+        o = *options;
+    rad_scene_solve_report r = {0};
+    if (!scene || !mesh || !B)
+        return rad_fail(error, RAD_ERR_INVALID, "rad_solve_scene: no scene, mesh or B");
+    if (mesh->patch_count == 0)
+        return rad_fail(error, RAD_ERR_INVALID, "%s: the mesh has no patches", scene->source);
+    if ((unsigned)o.solver > RAD_SOLVER_HIERARCHICAL)
+        return rad_fail(error, RAD_ERR_INVALID, "rad_solve_scene: unknown solver %d",
+                        (int)o.solver);
+    double t0 = seconds_now();
+    r.patches = mesh->patch_count;
+    r.solver_chosen = o.solver == RAD_SOLVER_AUTO;
+    r.solver = rad_solve_scene_choice(mesh, &o, r.reason, sizeof(r.reason));
+    if (!rad_scene_has_emitter(scene))
+        rad_warn(o.log, o.log_user,
+                 "%s: no surface emits light (no material with non-zero Ke): the result "
+                 "will be black (--emit NAME=R,G,B makes a surface a light)",
+                 scene->source);
+
+    rad_patch_inputs *inputs = NULL;
+    rad_tracer *occluders = NULL;
+    rad_status status = rad_patch_inputs_build(scene, mesh, &inputs, error);
+    r.seconds_inputs = seconds_now() - t0;
+    if (status == RAD_OK)
+        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
+    if (status == RAD_OK)
+        status = r.solver == RAD_SOLVER_HIERARCHICAL
+                     ? solve_hierarchy(mesh, inputs, occluders, &o, B, &r, error)
+                     : solve_dense(mesh, inputs, occluders, &o, r.solver, B, &r, error);
+    rad_tracer_destroy(occluders);
+    /* every value finite and at least the patch's own exitance (what comes in is >= 0) */
+    for (uint32_t i = 0; status == RAD_OK && i < mesh->patch_count; i++) {
+        rad_rgb *b = &B[i];
+        const rad_rgb *e = &inputs->exitance[i];
+        if (!(isfinite(b->r) && isfinite(b->g) && isfinite(b->b)))
+            status = rad_fail(error, RAD_ERR_INTERNAL,
+                              "%s: the %s solution of patch %u is not finite (a bug: please "
+                              "report the scene)",
+                              scene->source, rad_solver_name(r.solver), i);
+        b->r = fmax(b->r, e->r);
+        b->g = fmax(b->g, e->g);
+        b->b = fmax(b->b, e->b);
+    }
+    rad_patch_inputs_destroy(inputs);
+    r.seconds = seconds_now() - t0;
+    if (report)
+        *report = r;
+    return status;
+}
