@@ -154,8 +154,7 @@ enum {
     "--save-solution, rendered or written as a lit mesh, each file complete), then exits\n"  \
     "with status 130; a second Ctrl-C ends the run at once. Progress (each phase, its time\n" \
     "and the time left) shows on a terminal; RADIOSITY_PROGRESS=lines prints it as lines\n"  \
-    "elsewhere too, RADIOSITY_PROGRESS=0 never. The run ends with a summary line on stderr\n" \
-    "(patches, time, residual, what was written); --quiet leaves it out, warnings stay.\n"
+    "elsewhere too, RADIOSITY_PROGRESS=0 never.\n"
 
 #define CLI_SCENE_OPTIONS                                                                  \
     [OPT_EMIT] = {"emit", 0, true}, [OPT_ALBEDO] = {"albedo", 0, true}
@@ -272,12 +271,9 @@ void cli_summary(const char *format, ...) __attribute__((format(printf, 1, 2)));
 /* False after --quiet. */
 bool cli_summary_wanted(void);
 
-/* Old names kept for cli_solve.c, cmd_render.c and cmd_solve.c until they call
- * rad_clock_seconds and cli_finish: cli_now is the library's clock, and
- * cli_progress_enabled (which only ever guarded their summary lines) now says whether a
- * summary is wanted. */
+/* The old name of the library's clock, kept for cli_solve.c, cmd_render.c and cmd_solve.c
+ * until they call rad_clock_seconds. */
 static inline double cli_now(void) { return rad_clock_seconds(); }
-static inline bool cli_progress_enabled(void) { return cli_summary_wanted(); }
 
 /* The --stats report: a flat JSON object built up field by field. */
 typedef struct cli_stats {
