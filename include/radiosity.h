@@ -20,11 +20,35 @@
  *
  * Errors: fallible functions return rad_status and, when the caller passes a rad_error,
  * fill it with a one-line message of the form "file:line: what is wrong" (the file and line
- * are left out when they are not known). Warnings go to the rad_log callback of the options
- * that take one; a NULL callback drops them. No function prints or exits.
+ * are left out when they are not known); a NULL rad_error is allowed (only the status then).
+ * Warnings go to the rad_log callback of the options that take one; a NULL callback drops
+ * them. No function prints or exits.
  *
- * Ownership: every *_create / *_load / *_build returns an object the caller frees with the
- * matching *_destroy; passing NULL to a *_destroy is harmless.
+ * Ownership: every function that hands back a new object through an `out` pointer
+ * (rad_*_create, rad_*_load, rad_scene_load_files, rad_scene_cornell_box, rad_mesh_build,
+ * rad_*_compute, rad_solution_read, rad_image_read, rad_viewfactor_matrix_script_f, ...)
+ * gives it to the caller, who frees it with the *_destroy of its type (rad_scene_destroy,
+ * rad_mesh_destroy, rad_tracer_destroy, rad_formfactors_destroy,
+ * rad_viewfactor_matrix_destroy, rad_solution_destroy, rad_image_destroy); passing NULL to
+ * a *_destroy is harmless. The per-patch arrays rad_system_from_mesh allocates are freed by
+ * rad_system_free_arrays. Arrays and images the caller passes in to be filled (B, the
+ * image of rad_render, ...) stay the caller's.
+ *
+ * Options and reports: a NULL options pointer means every default, and a zero field of an
+ * options struct means that field's default (each field says which; the RAD_DEFAULT_*
+ * constants below name them for callers that show them, as the CLI's help does). A NULL
+ * report pointer (rad_*_report, the vs3 control, the path tracer's standard-error image)
+ * means it is not wanted. Every function that takes options or a report accepts NULL for
+ * it; what a function exists to compute (rad_image_compare's difference, an `out`
+ * pointer, B) is not optional.
+ *
+ * Words: `tolerance` is always when an iteration stops (its stopping value, residual or
+ * change of a sweep, is at most the tolerance); `accuracy` is always the error target of a
+ * computed quantity (a view factor's relative error). rad_compare_options.block_tolerance
+ * is the one other use, a pass mark of an image comparison (the CLI's --block-tolerance).
+ *
+ * Constants are `#define NAME value`: integers plain (they convert to the field they set,
+ * and the CLI's help quotes them), flags `(1u << k)`.
  *
  * Threads: functions that take a `threads` field run in parallel with OpenMP (0 means all
  * cores). Every random number is derived from the seed and the item being computed, never
@@ -57,7 +81,7 @@ typedef enum rad_status {
     RAD_ERR_INTERNAL     /* a bug: an invariant did not hold */
 } rad_status;
 
-enum { RAD_ERROR_MESSAGE_MAX = 1024 };
+#define RAD_ERROR_MESSAGE_MAX 1024
 
 typedef struct rad_error {
     rad_status status;
@@ -72,6 +96,25 @@ typedef void (*rad_log_fn)(void *user, const char *message);
 
 /* Receives the progress of a long phase: fraction in [0,1]. Called from one thread only. */
 typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
+
+/* ------------------------------------------------------------------------------------ */
+/* Defaults: what a zero options field (or NULL options) stands for, and what a file     */
+/* leaves out                                                                            */
+
+#define RAD_DEFAULT_QUADRATURE 1        /* rad_formfactor_options.quadrature: 1 x 1 */
+#define RAD_DEFAULT_VISIBILITY_RAYS 16  /* rad_formfactor_options.visibility_rays */
+#define RAD_DEFAULT_ACCURACY 1e-4       /* rad_viewfactor_options.accuracy */
+#define RAD_DEFAULT_MAX_RAYS 1024       /* rad_viewfactor_options.max_rays */
+#define RAD_DEFAULT_EMISSIVITY 0.9      /* rad_surface.emissivity when the file gives none */
+#define RAD_DEFAULT_RENDER_SPP 16       /* rad_render_options.samples_per_pixel */
+#define RAD_DEFAULT_EDGE_SAMPLES 64     /* rad_render_options.edge_samples */
+#define RAD_DEFAULT_MAX_DEPTH 5         /* max_depth of rad_render_options (mirror
+                                           reflections) and rad_raytrace_options */
+#define RAD_DEFAULT_RAYTRACE_SPP 4      /* rad_raytrace_options.samples_per_pixel */
+#define RAD_DEFAULT_LIGHT_SAMPLES 16    /* rad_raytrace_options.light_samples */
+#define RAD_DEFAULT_PATHTRACE_SPP 64    /* rad_pathtrace_options.samples_per_pixel */
+#define RAD_DEFAULT_BLOCK_SIZE 8        /* rad_compare_options.block_size */
+#define RAD_DEFAULT_BLOCK_TOLERANCE 0.1 /* rad_compare_options.block_tolerance */
 
 /* ------------------------------------------------------------------------------------ */
 /* Small value types                                                                     */
@@ -131,12 +174,10 @@ typedef struct rad_surface {
                           (View3D's `emit` field); 0.9 unless the input says otherwise */
 } rad_surface;
 
-enum {
-    RAD_SURFACE_OBSTRUCTION = 1u << 0, /* blocks rays but has no row or column of view
-                                          factors (View3D `O`, `--obstruction FILE`) */
-    RAD_SURFACE_TWO_SIDED = 1u << 1    /* both sides radiate: one row whose area is twice
-                                          the triangles' (`--two-sided NAME`) */
-};
+#define RAD_SURFACE_OBSTRUCTION (1u << 0) /* blocks rays but has no row or column of view
+                                            factors (View3D `O`, `--obstruction FILE`) */
+#define RAD_SURFACE_TWO_SIDED (1u << 1)   /* both sides radiate: one row whose area is
+                                            twice the triangles' (`--two-sided NAME`) */
 
 typedef struct rad_triangle {
     uint32_t vertex[3]; /* indices into rad_scene.positions, counter-clockwise = front */
@@ -483,8 +524,8 @@ typedef struct rad_viewfactor_matrix {
     uint32_t *column;      /* row_start[n] column indices J */
     double *value;         /* F_IJ */
     double *error_bound;   /* estimated absolute error of each F_IJ (about two standard
-                              errors of its sampled obstruction; the quadrature's
-                              tolerance where unobstructed) */
+                              errors of its sampled obstruction; the accuracy asked
+                              for where unobstructed) */
 } rad_viewfactor_matrix;
 
 typedef struct rad_viewfactor_options {
@@ -585,7 +626,7 @@ rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *matrix,
                                                  rad_error *error);
 
 /* Largest matrix rad_viewfactor_matrix_script_f accepts (dense LU, n^3 work). */
-#define RAD_SCRIPT_F_MAX_SURFACES 4096u
+#define RAD_SCRIPT_F_MAX_SURFACES 4096
 
 /* Grey-body total exchange factors (Hottel's script-F; View3D's `emit` option): with
  * emissivities eps_I in (0,1] (reflectance 1 - eps_I, diffuse),
@@ -1074,7 +1115,7 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
  * little-endian: magic "\x89RADSOL\n", format version (uint32, RAD_SOLUTION_VERSION),
  * patch count (uint32), fingerprint (uint64), patch size (double), then B as patch_count x
  * 3 doubles (r, g, b), then an FNV-1a 64 checksum of every byte before it. */
-enum { RAD_SOLUTION_VERSION = 1 };
+#define RAD_SOLUTION_VERSION 1
 
 typedef struct rad_solution {
     uint32_t patch_count;
@@ -1154,6 +1195,10 @@ rad_status rad_write_file_atomic(const char *path, const void *data, size_t size
 
 /* Peak resident memory of this process so far, in bytes. */
 uint64_t rad_peak_memory_bytes(void);
+
+/* Seconds on a monotonic clock (CLOCK_MONOTONIC; its zero is arbitrary): the clock of every
+ * `seconds` field of the reports above. A duration is the difference of two readings. */
+double rad_clock_seconds(void);
 
 #ifdef __cplusplus
 }

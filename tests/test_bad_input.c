@@ -36,6 +36,46 @@ static void expect_error(const char *case_name, const char *arguments, int exit_
     CHECK(test_count_files("out") == 0);
 }
 
+/* The last line of text (without its newline) in a static buffer; "" when there is none. */
+static const char *last_line(const char *text)
+{
+    static char line[4096];
+    size_t length = strlen(text);
+    if (length > 0 && text[length - 1] == '\n')
+        length--;
+    size_t start = length;
+    while (start > 0 && text[start - 1] != '\n')
+        start--;
+    snprintf(line, sizeof(line), "%.*s", (int)(length - start), text + start);
+    return line;
+}
+
+/* Every run ends with its one-line summary on stderr, terminal or not (stderr is a file
+ * here), naming what it wrote; --quiet leaves it out, and then a clean run says nothing
+ * (checked when `quiet` is true). */
+static void expect_summary(const char *arguments, const char *written, bool quiet)
+{
+    char command[1024], wrote[256];
+    snprintf(wrote, sizeof(wrote), "wrote %s", written);
+    int code = test_run_tool(arguments);
+    const char *line = last_line(test_read_text(test_path("stderr.txt")));
+    if (code != 0 || strncmp(line, "radiosity: ", 11) != 0 || !strstr(line, wrote))
+        fprintf(stderr, "[%s] exit %d, last line of stderr: %s\n", arguments, code, line);
+    CHECK(code == 0);
+    CHECK(strncmp(line, "radiosity: ", 11) == 0);
+    CHECK(strstr(line, wrote) != NULL);
+    CHECK(strncmp(line, "radiosity: warning:", 19) != 0);
+    if (!quiet)
+        return;
+    snprintf(command, sizeof(command), "%s --quiet", arguments);
+    code = test_run_tool(command);
+    const char *err = test_read_text(test_path("stderr.txt"));
+    if (code != 0 || err[0] != 0)
+        fprintf(stderr, "[%s] exit %d, stderr: %s\n", command, code, err);
+    CHECK(code == 0);
+    CHECK(err[0] == 0);
+}
+
 int main(void)
 {
     test_write_file("lamp.mtl", triangle_mtl);
@@ -143,5 +183,23 @@ int main(void)
     expect_error("viewfactors missing", "viewfactors missing.obj -o out.csv", 1, "missing.obj");
     expect_error("viewfactors unwritable", "viewfactors nan.obj -o no/dir/out.csv", 1,
                  "no/dir/out.csv");
+    /* the summary line of every command that writes, and --quiet */
+    test_write_file("plates.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                  "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                                  "o floor\nf 1 2 3 4\no roof\nf 5 8 7 6\n");
+    /* (render and solve print their summary themselves; --quiet is theirs to honour) */
+    expect_summary("render -o sum.pfm --size 8x8 --patch-size 200", "sum.pfm", false);
+    expect_summary("solve -o sum.ply --patch-size 200", "sum.ply", false);
+    expect_summary("raytrace -o sum.pfm --size 8x8", "sum.pfm", true);
+    expect_summary("pathtrace -o sum.pfm --size 8x8 --spp 2", "sum.pfm", true);
+    expect_summary("viewfactors plates.obj -o sum.csv", "sum.csv", true);
+    expect_summary("info -o sum.txt", "sum.txt", true);
+    /* --quiet keeps the warnings */
+    code = test_run_tool("pathtrace dark.obj -o sum.pfm --size 8x8 --spp 2 --quiet");
+    CHECK(code == 0);
+    const char *err = test_read_text(test_path("stderr.txt"));
+    CHECK(strstr(err, "warning: dark.obj: no surface emits") != NULL);
+    CHECK(count_lines(err) == 1);
+
     return test_finish("test_bad_input");
 }

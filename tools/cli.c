@@ -10,30 +10,40 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <time.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
-void cli_error(const char *format, ...)
+/* One line on stderr: "radiosity: " + prefix + the formatted text. */
+static void vmessage(const char *prefix, const char *format, va_list args)
+    __attribute__((format(printf, 2, 0)));
+static void vmessage(const char *prefix, const char *format, va_list args)
 {
     cli_progress_end();
-    va_list args;
-    va_start(args, format);
-    fputs("radiosity: ", stderr);
+    fprintf(stderr, "radiosity: %s", prefix);
     vfprintf(stderr, format, args);
     fputc('\n', stderr);
+}
+
+void cli_error(const char *format, ...)
+{
+    va_list args;
+    va_start(args, format);
+    vmessage("", format, args);
     va_end(args);
 }
 
 void cli_warn(const char *format, ...)
 {
-    cli_progress_end();
     va_list args;
     va_start(args, format);
-    fputs("radiosity: warning: ", stderr);
-    vfprintf(stderr, format, args);
-    fputc('\n', stderr);
+    vmessage("warning: ", format, args);
     va_end(args);
+}
+
+int cli_failed(const rad_error *error)
+{
+    cli_error("%s", error->message);
+    return EXIT_ERROR;
 }
 
 void cli_log(void *user, const char *message)
@@ -116,6 +126,22 @@ bool cli_parse(const char *command, int argc, char **argv, const cli_option *opt
     return true;
 }
 
+const char *cli_next_value(const cli_args *args, int option, int *cursor)
+{
+    for (; *cursor < args->given_count; (*cursor)++)
+        if (args->given_option[*cursor] == option)
+            return args->given_value[(*cursor)++];
+    return NULL;
+}
+
+int cli_value_count(const cli_args *args, int option)
+{
+    int count = 0, cursor = 0;
+    while (cli_next_value(args, option, &cursor))
+        count++;
+    return count;
+}
+
 bool cli_parse_double(const char *name, const char *text, double *out)
 {
     char *end;
@@ -152,6 +178,22 @@ bool cli_parse_uint(const char *name, const char *text, unsigned long max, unsig
         return false;
     }
     *out = value;
+    return true;
+}
+
+bool cli_parse_count(const char *name, const char *text, uint32_t min, uint32_t max,
+                     uint32_t *out)
+{
+    unsigned long value;
+    if (!text)
+        return true;
+    if (!cli_parse_uint(name, text, max, &value))
+        return false;
+    if (value < min) {
+        cli_error("--%s: must be at least %u", name, (unsigned)min);
+        return false;
+    }
+    *out = (uint32_t)value;
     return true;
 }
 
@@ -203,6 +245,9 @@ typedef struct material_override {
 static material_override overrides[CLI_MAX_GIVEN];
 static int override_count;
 
+/* --quiet, for cli_summary. */
+static bool quiet;
+
 /* NAME=R,G,B; NAME may itself hold '=' (the last one splits). */
 static bool parse_override(const char *option, const char *text, material_override *out)
 {
@@ -229,6 +274,7 @@ static bool parse_override(const char *option, const char *text, material_overri
 
 bool cli_parse_shared(const cli_args *args, cli_shared *shared)
 {
+    /* --emit and --albedo apply in command-line order, mixed */
     override_count = 0;
     for (int k = 0; k < args->given_count; k++) {
         int option = args->given_option[k];
@@ -239,25 +285,21 @@ bool cli_parse_shared(const cli_args *args, cli_shared *shared)
             return false;
         override_count++;
     }
+    quiet = args->value[OPT_QUIET] != NULL;
     unsigned long value;
     memset(shared, 0, sizeof(*shared));
-    shared->seed = 1;
+    shared->seed = CLI_DEFAULT_SEED;
     shared->output = args->value[OPT_OUTPUT];
     shared->stats_path = args->value[OPT_STATS];
     if (args->value[OPT_PATCH_SIZE]) {
         if (!cli_parse_positive("patch-size", args->value[OPT_PATCH_SIZE], &shared->patch_size))
             return false;
     }
-    if (args->value[OPT_VISIBILITY_RAYS]) {
-        if (!cli_parse_uint("visibility-rays", args->value[OPT_VISIBILITY_RAYS], 256, &value))
-            return false;
-        shared->formfactor.visibility_rays = (uint32_t)value;
-    }
-    if (args->value[OPT_QUADRATURE]) {
-        if (!cli_parse_uint("quadrature", args->value[OPT_QUADRATURE], 8, &value))
-            return false;
-        shared->formfactor.quadrature = (uint32_t)value;
-    }
+    if (!cli_parse_count("visibility-rays", args->value[OPT_VISIBILITY_RAYS], 0, 256,
+                         &shared->formfactor.visibility_rays) ||
+        !cli_parse_count("quadrature", args->value[OPT_QUADRATURE], 0, 8,
+                         &shared->formfactor.quadrature))
+        return false;
     if (args->value[OPT_THREADS]) {
         if (!cli_parse_uint("threads", args->value[OPT_THREADS], 1024, &value))
             return false;
@@ -266,17 +308,15 @@ bool cli_parse_shared(const cli_args *args, cli_shared *shared)
     if (args->value[OPT_SEED] &&
         !cli_parse_uint("seed", args->value[OPT_SEED], ULONG_MAX, &shared->seed))
         return false;
-    shared->formfactor.threads = shared->threads;
-    shared->formfactor.seed = shared->seed;
-    shared->formfactor.progress = cli_progress;
+    CLI_SET_RUN_OPTIONS(shared->formfactor, *shared);
     return true;
 }
 
 bool cli_parse_view(const cli_args *args, cli_view *view)
 {
-    unsigned long value;
     memset(view, 0, sizeof(*view));
-    view->width = view->height = 512;
+    view->width = CLI_DEFAULT_WIDTH;
+    view->height = CLI_DEFAULT_HEIGHT;
     if ((args->value[OPT_EYE] && !cli_parse_vec3("eye", args->value[OPT_EYE], &view->camera.eye)) ||
         (args->value[OPT_TARGET] &&
          !cli_parse_vec3("target", args->value[OPT_TARGET], &view->camera.target)) ||
@@ -294,15 +334,8 @@ bool cli_parse_view(const cli_args *args, cli_view *view)
         cli_error("--fov: must be between 0 and 180 degrees");
         return false;
     }
-    if (args->value[OPT_SPP]) {
-        if (!cli_parse_uint("spp", args->value[OPT_SPP], 1u << 20, &value))
-            return false;
-        if (value == 0) {
-            cli_error("--spp: must be at least 1");
-            return false;
-        }
-        view->samples_per_pixel = (uint32_t)value;
-    }
+    if (!cli_parse_count("spp", args->value[OPT_SPP], 1, 1u << 20, &view->samples_per_pixel))
+        return false;
     if (args->value[OPT_EXPOSURE]) {
         if (!cli_parse_double("exposure", args->value[OPT_EXPOSURE], &view->write.exposure))
             return false;
@@ -336,10 +369,9 @@ bool cli_image_output_ok(const char *path)
     return false;
 }
 
-bool cli_parse_image_command(const char *command, const char *usage, int argc, char **argv,
-                             const cli_option *options, int option_count, cli_args *args,
-                             cli_shared *shared, cli_view *view, const char **scene_path,
-                             int *exit_code)
+bool cli_begin(const char *command, const char *usage, int argc, char **argv,
+               const cli_option *options, int option_count, cli_args *args,
+               cli_shared *shared, int *exit_code)
 {
     *exit_code = EXIT_USAGE;
     if (!cli_parse(command, argc, argv, options, option_count, args))
@@ -349,13 +381,34 @@ bool cli_parse_image_command(const char *command, const char *usage, int argc, c
         *exit_code = EXIT_OK;
         return false;
     }
-    if (!cli_parse_shared(args, shared) || !cli_parse_view(args, view))
+    if (!cli_parse_shared(args, shared))
         return false;
+    cli_progress_mark(); /* a phase nobody marked counts from here, never from 0 */
+    *exit_code = EXIT_OK;
+    return true;
+}
+
+bool cli_scene_argument(const char *command, const cli_args *args, const char **scene_path)
+{
     if (args->positional_count > 1) {
         cli_error("%s: one scene at most (see 'radiosity %s --help')", command, command);
         return false;
     }
     *scene_path = args->positional_count ? args->positional[0] : NULL;
+    return true;
+}
+
+bool cli_parse_image_command(const char *command, const char *usage, int argc, char **argv,
+                             const cli_option *options, int option_count, cli_args *args,
+                             cli_shared *shared, cli_view *view, const char **scene_path,
+                             int *exit_code)
+{
+    if (!cli_begin(command, usage, argc, argv, options, option_count, args, shared,
+                   exit_code))
+        return false;
+    *exit_code = EXIT_USAGE; /* until the command has read its own options */
+    if (!cli_parse_view(args, view) || !cli_scene_argument(command, args, scene_path))
+        return false;
     if (!shared->output) {
         cli_error("%s: no output file: give -o OUT.png, .hdr, .pfm or .exr", command);
         return false;
@@ -363,6 +416,58 @@ bool cli_parse_image_command(const char *command, const char *usage, int argc, c
     if (!cli_image_output_ok(shared->output))
         return false;
     return true;
+}
+
+rad_status cli_image_run_begin(cli_image_run *run, const char *scene_path,
+                               const cli_view *view, rad_error *error)
+{
+    memset(run, 0, sizeof(*run));
+    run->t0 = rad_clock_seconds();
+    rad_status status = cli_load_scene(scene_path, &run->scene, error);
+    run->t_load = rad_clock_seconds();
+    if (status != RAD_OK)
+        return status;
+    run->camera = cli_view_camera(view, run->scene);
+    cli_progress_mark(); /* the trace's phase starts here, after the load */
+    return rad_image_create(view->width, view->height, &run->image, error);
+}
+
+rad_status cli_image_run_write(cli_image_run *run, const char *output, const cli_view *view,
+                               rad_error *error)
+{
+    cli_progress_end();
+    run->t_trace = rad_clock_seconds();
+    rad_status status = rad_image_write(run->image, output, &view->write, error);
+    run->t_write = rad_clock_seconds();
+    return status;
+}
+
+void cli_image_run_stats(const cli_image_run *run, const cli_shared *shared,
+                         uint32_t samples_per_pixel, cli_stats *stats)
+{
+    stats_begin(stats);
+    stats_string(stats, "scene", run->scene->source);
+    stats_integer(stats, "triangles", run->scene->triangle_count);
+    stats_integer(stats, "width", run->image->width);
+    stats_integer(stats, "height", run->image->height);
+    stats_integer(stats, "samples_per_pixel", samples_per_pixel);
+    stats_integer(stats, "seed", shared->seed);
+    stats_integer(stats, "threads_requested", (unsigned long long)shared->threads);
+}
+
+void cli_image_run_times(const cli_image_run *run, cli_stats *stats)
+{
+    stats_number(stats, "seconds_load", run->t_load - run->t0);
+    stats_number(stats, "seconds_trace", run->t_trace - run->t_load);
+    stats_number(stats, "seconds_write", run->t_write - run->t_trace);
+    stats_number(stats, "seconds_total", run->t_write - run->t0);
+}
+
+void cli_image_run_free(cli_image_run *run)
+{
+    rad_image_destroy(run->image);
+    rad_scene_destroy(run->scene);
+    memset(run, 0, sizeof(*run));
 }
 
 rad_status cli_load_scene(const char *path, rad_scene **scene, rad_error *error)
@@ -392,13 +497,6 @@ rad_status cli_load_scene_logged(const char *path, rad_log_fn log, void *log_use
     return status;
 }
 
-double cli_now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 /* Progress. RADIOSITY_PROGRESS picks where it goes: unset (or "auto"), one line rewritten
  * in place about 10 times a second when stderr is a terminal, nothing otherwise; "lines"
  * (or "1"), also when stderr is not a terminal, as whole lines, at most one a second per
@@ -406,7 +504,12 @@ double cli_now(void)
  *
  * A solver may interleave phases (the hierarchical solver refines, gathers, refines
  * again), so each phase keeps its own clock: the time since the previous report (of any
- * phase) is the work the current report covers, and is added to the current phase. The
+ * phase), or since cli_progress_mark, is the work the current report covers, and is added
+ * to the current phase. A phase's first report thus covers the work before it (a long
+ * first row, the setup), so its clock, the "done in" time and the time left count all of
+ * the phase's work: a clock started at the first report would have left that out and
+ * promised too little time left, the bar then sitting near 100 % for what was never
+ * counted. Commands mark right before each library call (cli_begin marks the start). The
  * time left is the phase's rate so far carried to 1; a phase whose fraction goes back
  * down starts that estimate again; below 1 % (too little to go on) and at 99 % or more (a
  * guessed fraction's cap) no estimate is shown. */
@@ -445,9 +548,7 @@ static int progress_mode(void)
     return progress.mode;
 }
 
-bool cli_progress_enabled(void) { return progress_mode() != PROGRESS_OFF; }
-
-void cli_progress_mark(void) { progress.last_report = cli_now(); }
+void cli_progress_mark(void) { progress.last_report = rad_clock_seconds(); }
 
 static phase_clock *phase_named(const char *name)
 {
@@ -483,7 +584,7 @@ void cli_progress(void *user, const char *phase, double fraction)
     int mode = progress_mode();
     if (mode == PROGRESS_OFF)
         return;
-    double now = cli_now();
+    double now = rad_clock_seconds();
     double work = progress.last_report > 0 ? now - progress.last_report : 0;
     progress.last_report = now;
     phase_clock *clock = phase_named(phase);
@@ -600,6 +701,43 @@ void stats_string(cli_stats *stats, const char *key, const char *value)
     stats_append(stats, "\"");
 }
 
+bool cli_summary_wanted(void) { return !quiet; }
+
+static void vsummary(const char *format, va_list args) __attribute__((format(printf, 1, 0)));
+static void vsummary(const char *format, va_list args)
+{
+    if (quiet)
+        return;
+    cli_progress_end();
+    fputs("radiosity: ", stderr);
+    vfprintf(stderr, format, args);
+    fputc('\n', stderr);
+}
+
+void cli_summary(const char *format, ...)
+{
+    va_list args;
+    va_start(args, format);
+    vsummary(format, args);
+    va_end(args);
+}
+
+int cli_finish(cli_stats *stats, const char *stats_path, const char *summary_format, ...)
+{
+    if (stats_path) {
+        stats_integer(stats, "peak_memory_bytes", rad_peak_memory_bytes());
+        if (!stats_write(stats, stats_path))
+            return EXIT_ERROR;
+    }
+    if (summary_format) {
+        va_list args;
+        va_start(args, summary_format);
+        vsummary(summary_format, args);
+        va_end(args);
+    }
+    return EXIT_OK;
+}
+
 bool stats_write(cli_stats *stats, const char *path)
 {
     stats_append(stats, "\n}\n");
@@ -637,5 +775,13 @@ bool cli_output_writable(const char *path)
                   folder);
         return false;
     }
+    return true;
+}
+
+bool cli_outputs_writable(const char *const *paths, int count)
+{
+    for (int k = 0; k < count; k++)
+        if (paths[k] && !cli_output_writable(paths[k]))
+            return false;
     return true;
 }

@@ -24,11 +24,11 @@ typedef struct cli_option {
     bool takes_value;
 } cli_option;
 
-enum { CLI_MAX_GIVEN = 128 };
+enum { CLI_MAX_GIVEN = 1024 };
 
 /* A parsed command line: the values by option index (the last one given), every option
- * value in command-line order (for options that may repeat: --emit, --albedo), and
- * positional arguments. */
+ * value in command-line order (for options that may repeat: read them with
+ * cli_next_value), and positional arguments. */
 typedef struct cli_args {
     const char *value[64]; /* NULL = not given; "" for a flag given */
     const char *positional[256]; /* viewfactors takes a list of mesh files */
@@ -43,13 +43,20 @@ typedef struct cli_args {
 bool cli_parse(const char *command, int argc, char **argv, const cli_option *options,
                int option_count, cli_args *args);
 
+/* A repeatable option's values, in command-line order: start with *cursor = 0; each call
+ * returns the next value of `option`, NULL after the last. */
+const char *cli_next_value(const cli_args *args, int option, int *cursor);
+
+/* How many times `option` was given. */
+int cli_value_count(const cli_args *args, int option);
+
 /* Option groups shared by several commands, at fixed indices in every command's table:
  * BASE (every command), FORMFACTOR (render, solve, viewfactors), VIEW (commands that make
  * an image), SOLVE (render, solve), SCENE (every command that loads a scene: --emit and
  * --albedo, applied by cli_load_scene). A command's own options start at OPT_OWN. Entries
  * of a group a command does not include stay empty (NULL name) and are never matched. */
 enum {
-    OPT_OUTPUT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_HELP,            /* BASE */
+    OPT_OUTPUT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_QUIET, OPT_HELP, /* BASE */
     OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS, OPT_QUADRATURE,                /* FORMFACTOR */
     OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE, /* VIEW */
     OPT_EXR_FLOAT,
@@ -62,7 +69,29 @@ enum {
 #define CLI_BASE_OPTIONS                                                                   \
     [OPT_OUTPUT] = {"output", 'o', true}, [OPT_THREADS] = {"threads", 0, true},            \
     [OPT_SEED] = {"seed", 0, true}, [OPT_STATS] = {"stats", 0, true},                      \
-    [OPT_HELP] = {"help", 'h', false}
+    [OPT_QUIET] = {"quiet", 0, false}, [OPT_HELP] = {"help", 'h', false}
+
+/* The help lines of the BASE group; `stats` says what the --stats file holds. */
+#define CLI_BASE_HELP(stats)                                                               \
+    "  --threads N          worker threads (default: all cores)\n"                           \
+    "  --seed N             seed of every random choice (default " CLI_STR(CLI_DEFAULT_SEED) ")\n" \
+    "  --stats FILE.json    write " stats "\n" CLI_QUIET_HELP
+
+/* The help lines of --quiet and --help (every command). */
+#define CLI_QUIET_HELP                                                                     \
+    "  --quiet              no summary line at the end of the run (warnings still show)\n"   \
+    "  -h, --help           this text\n"
+
+/* A constant's value as text, for help texts: CLI_STR(RAD_DEFAULT_MAX_DEPTH) is "5". */
+#define CLI_STR(x) CLI_STR_(x)
+#define CLI_STR_(x) #x
+
+/* The seed when --seed is not given. */
+#define CLI_DEFAULT_SEED 1
+
+/* The image size when --size is not given. */
+#define CLI_DEFAULT_WIDTH 512
+#define CLI_DEFAULT_HEIGHT 512
 
 #define CLI_FORMFACTOR_OPTIONS                                                             \
     [OPT_PATCH_SIZE] = {"patch-size", 0, true},                                            \
@@ -146,15 +175,43 @@ typedef struct cli_shared {
 } cli_shared;
 
 /* Parses the BASE, FORMFACTOR and SCENE options (after cli_parse); false (after printing)
- * on a bad value. The SCENE options are kept for cli_load_scene. */
+ * on a bad value. The SCENE options are kept for cli_load_scene, --quiet for cli_summary. */
 bool cli_parse_shared(const cli_args *args, cli_shared *shared);
+
+/* The opening every command shares: parses argv against its option table, prints `usage`
+ * for --help, and reads the BASE, FORMFACTOR and SCENE groups (cli_parse_shared). Returns
+ * false with *exit_code set (EXIT_OK after --help, EXIT_USAGE on a usage error) when the
+ * command should stop. */
+bool cli_begin(const char *command, const char *usage, int argc, char **argv,
+               const cli_option *options, int option_count, cli_args *args,
+               cli_shared *shared, int *exit_code);
+
+/* The optional SCENE argument: *scene_path is it, or NULL when none is given; false after
+ * a usage error when there are more. */
+bool cli_scene_argument(const char *command, const cli_args *args, const char **scene_path);
+
+/* The help lines of the VIEW group: the camera (a heading and one line), and the
+ * image file's options. */
+#define CLI_CAMERA_HELP                                                                    \
+    "Camera (default: the scene's camera, or a view of the whole scene from -z):\n"         \
+    "  --eye X,Y,Z  --target X,Y,Z  --up X,Y,Z  --fov DEG (vertical)   --size WxH ("          \
+    CLI_STR(CLI_DEFAULT_WIDTH) "x" CLI_STR(CLI_DEFAULT_HEIGHT) ")\n"
+#define CLI_IMAGE_FILE_HELP                                                                \
+    "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"              \
+    "  --exr-float          .exr: 32-bit float channels instead of half\n"
+
+/* Sets the seed, threads and progress fields every library options struct has from the
+ * BASE options. */
+#define CLI_SET_RUN_OPTIONS(options, shared)                                               \
+    ((options).seed = (shared).seed, (options).threads = (shared).threads,                  \
+     (options).progress = cli_progress)
 
 /* What the VIEW options say. */
 typedef struct cli_view {
     rad_camera camera;                 /* fields given on the command line */
     bool has_eye, has_target, has_up, has_fov;
-    uint32_t width, height;            /* 512 x 512 by default */
-    uint32_t samples_per_pixel;        /* 0 = the command's default */
+    uint32_t width, height;            /* CLI_DEFAULT_WIDTH x CLI_DEFAULT_HEIGHT by default */
+    uint32_t samples_per_pixel;        /* 0 = the library's default */
     rad_image_write_options write;     /* exposure, --exr-float */
 } cli_view;
 
@@ -166,10 +223,9 @@ rad_camera cli_view_camera(const cli_view *view, const rad_scene *scene);
 /* True for .png, .hdr and .pfm; prints the usage error otherwise. */
 bool cli_image_output_ok(const char *path);
 
-/* The opening every image command shares: parses argv against its option table, prints
- * `usage` for --help, reads the BASE and VIEW groups, the optional SCENE and the required
- * -o OUT image. Returns false with *exit_code set (0 after --help, 2 on a usage error)
- * when the command should stop. */
+/* cli_begin for the image commands: also reads the VIEW group, the optional SCENE and the
+ * required -o OUT image. On success *exit_code is EXIT_USAGE, for the command's own
+ * checks that follow (it sets EXIT_OK when they pass). */
 bool cli_parse_image_command(const char *command, const char *usage, int argc, char **argv,
                              const cli_option *options, int option_count, cli_args *args,
                              cli_shared *shared, cli_view *view, const char **scene_path,
@@ -188,6 +244,9 @@ rad_status cli_load_scene_logged(const char *path, rad_log_fn log, void *log_use
 bool cli_parse_double(const char *name, const char *text, double *out);
 bool cli_parse_positive(const char *name, const char *text, double *out); /* > 0 */
 bool cli_parse_uint(const char *name, const char *text, unsigned long max, unsigned long *out);
+/* A count from min to max into *out; text NULL (the option not given) leaves *out as it is. */
+bool cli_parse_count(const char *name, const char *text, uint32_t min, uint32_t max,
+                     uint32_t *out);
 bool cli_parse_vec3(const char *name, const char *text, rad_vec3 *out);
 bool cli_parse_size(const char *name, const char *text, uint32_t *width, uint32_t *height);
 
@@ -201,13 +260,20 @@ void cli_log(void *user, const char *message);
  * left. */
 void cli_progress(void *user, const char *phase, double fraction);
 void cli_progress_end(void);
-bool cli_progress_enabled(void);
 /* The work from now on belongs to the next phase reported (its first report then counts
  * the time since here). */
 void cli_progress_mark(void);
 
-/* Seconds on a monotonic clock. */
-double cli_now(void);
+/* The run's last line on stderr, "radiosity: " + the formatted text, printed on every run
+ * (terminal or not) unless --quiet was given: what was computed (patches, elements,
+ * samples), the time, the residual, what was written. */
+void cli_summary(const char *format, ...) __attribute__((format(printf, 1, 2)));
+/* False after --quiet. */
+bool cli_summary_wanted(void);
+
+/* The old name of the library's clock, kept for cli_solve.c, cmd_render.c and cmd_solve.c
+ * until they call rad_clock_seconds. */
+static inline double cli_now(void) { return rad_clock_seconds(); }
 
 /* The --stats report: a flat JSON object built up field by field. */
 typedef struct cli_stats {
@@ -222,6 +288,41 @@ void stats_string(cli_stats *stats, const char *key, const char *value);
 void stats_bool(cli_stats *stats, const char *key, bool value);
 /* Closes the object and writes it atomically; false (after printing) on failure. */
 bool stats_write(cli_stats *stats, const char *path);
+
+/* How every command ends: with stats_path, adds peak_memory_bytes and writes the --stats
+ * file (stats_write); then, unless that failed, the summary line (cli_summary; none when
+ * summary_format is NULL). Returns the exit code: EXIT_OK, or EXIT_ERROR (after printing)
+ * when the stats file failed. */
+int cli_finish(cli_stats *stats, const char *stats_path, const char *summary_format, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* Prints error's message (a run that failed) and returns EXIT_ERROR. */
+int cli_failed(const rad_error *error);
+
+/* What the image commands (raytrace, pathtrace) do around their one library call: load
+ * the scene, frame it, make the image, write it, and report. */
+typedef struct cli_image_run {
+    rad_scene *scene;
+    rad_camera camera; /* cli_view_camera */
+    rad_image *image;  /* view->width x view->height */
+    double t0, t_load, t_trace, t_write; /* rad_clock_seconds at the start and after each */
+} cli_image_run;
+
+/* Loads SCENE (cli_load_scene; NULL = the built-in Cornell box), sets the camera and
+ * creates the image. The run is always freeable by cli_image_run_free. */
+rad_status cli_image_run_begin(cli_image_run *run, const char *scene_path,
+                               const cli_view *view, rad_error *error);
+/* Writes the image to `output` with the view's write options, after the trace (whose
+ * progress line it closes). */
+rad_status cli_image_run_write(cli_image_run *run, const char *output, const cli_view *view,
+                               rad_error *error);
+/* Starts the --stats report: scene, triangles, width, height, samples_per_pixel, seed,
+ * threads_requested (0 = all). */
+void cli_image_run_stats(const cli_image_run *run, const cli_shared *shared,
+                         uint32_t samples_per_pixel, cli_stats *stats);
+/* Its times: seconds_load, seconds_trace, seconds_write, seconds_total. */
+void cli_image_run_times(const cli_image_run *run, cli_stats *stats);
+void cli_image_run_free(cli_image_run *run);
 
 /* What the SOLVE options say (cli_solve.c). */
 typedef struct cli_solve {
@@ -269,6 +370,10 @@ void cli_solved_summary(const cli_solved *solved, const cli_solve *solve, char *
 
 /* Prints an error and returns false when path is a folder or its folder is not writable. */
 bool cli_output_writable(const char *path);
+
+/* cli_output_writable for each of the `count` paths that is not NULL, checked before any
+ * work; false at the first that fails. */
+bool cli_outputs_writable(const char *const *paths, int count);
 
 /* The subcommands, one file each (cmd_NAME.c); argv holds the arguments after the
  * subcommand's name. Each returns the process exit code. */

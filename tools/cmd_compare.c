@@ -30,9 +30,12 @@ static const char usage[] =
     "  -o, --output FILE        write the false-colour difference (.png, .hdr, .pfm or\n"
     "                           .exr): per pixel |A - B|_1 / |B|_1 from blue (0) through\n"
     "                           cyan, green (50 %) and yellow to red (100 % or more)\n"
-    "  --block N                block side in pixels (default 8)\n"
-    "  --block-tolerance X      relative difference a block may have (default 0.1)\n"
+    "  --block N                block side in pixels (default " CLI_STR(RAD_DEFAULT_BLOCK_SIZE) ")\n"
+    "  --block-tolerance X      relative difference a block may have (default "
+    CLI_STR(RAD_DEFAULT_BLOCK_TOLERANCE) ")\n"
     "  --stats FILE.json        write the same numbers as JSON\n"
+    "The numbers on standard output are the whole report: compare prints no summary line\n"
+    "on stderr (--quiet is accepted and changes nothing).\n"
     "  -h, --help               this text\n";
 
 enum { OPT_BLOCK = OPT_OWN, OPT_BLOCK_TOLERANCE, OPT_COUNT };
@@ -46,26 +49,14 @@ static const cli_option options[OPT_COUNT] = {
 /* The largest --block: far beyond any useful block, small enough that block^2 fits. */
 #define MAX_BLOCK 65535ul
 
-/* The library's defaults for zero options (radiosity.h), printed in the report. */
-#define DEFAULT_BLOCK 8u
-#define DEFAULT_BLOCK_TOLERANCE 0.10
-
 /* The false colours are exact at exposure 0 (2^0 = 1): the ramp's corners are 0 and 1. */
 static const rad_image_write_options false_colour_write = {.fixed_exposure = true,
                                                            .exposure = 0};
 
 static bool parse_compare_options(const cli_args *args, rad_compare_options *compare)
 {
-    unsigned long block;
-    if (args->value[OPT_BLOCK]) {
-        if (!cli_parse_uint("block", args->value[OPT_BLOCK], MAX_BLOCK, &block))
-            return false;
-        if (block == 0) {
-            cli_error("--block: must be at least 1");
-            return false;
-        }
-        compare->block_size = (uint32_t)block;
-    }
+    if (!cli_parse_count("block", args->value[OPT_BLOCK], 1, MAX_BLOCK, &compare->block_size))
+        return false;
     if (args->value[OPT_BLOCK_TOLERANCE]) {
         /* positive: 0 would mean the library's default */
         if (!cli_parse_positive("block-tolerance", args->value[OPT_BLOCK_TOLERANCE],
@@ -93,30 +84,25 @@ static void print_report(const rad_image *a, const rad_image_difference *d, uint
 int command_compare(int argc, char **argv)
 {
     cli_args args;
-    if (!cli_parse("compare", argc, argv, options, OPT_COUNT, &args))
-        return EXIT_USAGE;
-    if (args.value[OPT_HELP]) {
-        fputs(usage, stdout);
-        return EXIT_OK;
-    }
+    cli_shared shared;
+    int exit_code;
+    if (!cli_begin("compare", usage, argc, argv, options, OPT_COUNT, &args, &shared, &exit_code))
+        return exit_code;
     if (args.positional_count != 2) {
         cli_error("compare: give two images, A and the reference B (see 'radiosity compare "
                   "--help')");
         return EXIT_USAGE;
     }
-    cli_shared shared;
     rad_compare_options compare = {0};
-    if (!cli_parse_shared(&args, &shared) || !parse_compare_options(&args, &compare))
+    if (!parse_compare_options(&args, &compare))
         return EXIT_USAGE;
     const char *path_a = args.positional[0], *path_b = args.positional[1];
     const char *output = shared.output, *stats_path = shared.stats_path;
     if (output && !cli_image_output_ok(output))
         return EXIT_USAGE;
-    if ((output && !cli_output_writable(output)) ||
-        (stats_path && !cli_output_writable(stats_path)))
+    if (!cli_outputs_writable((const char *[]){output, stats_path}, 2))
         return EXIT_ERROR;
 
-    int exit_code = EXIT_OK;
     rad_error error = {0};
     rad_image *a = NULL, *b = NULL, *false_colour = NULL;
     rad_image_difference difference;
@@ -135,7 +121,7 @@ int command_compare(int argc, char **argv)
         goto done;
     }
 
-    uint32_t block = compare.block_size ? compare.block_size : DEFAULT_BLOCK;
+    uint32_t block = compare.block_size ? compare.block_size : RAD_DEFAULT_BLOCK_SIZE;
     unsigned long within =
         (unsigned long)difference.blocks_within;
     print_report(a, &difference, block, within);
@@ -150,38 +136,34 @@ int command_compare(int argc, char **argv)
         if (status != RAD_OK)
             goto fail;
     }
-    if (stats_path) {
-        cli_stats stats;
-        stats_begin(&stats);
-        stats_string(&stats, "a", path_a);
-        stats_string(&stats, "b", path_b);
-        stats_integer(&stats, "width", a->width);
-        stats_integer(&stats, "height", a->height);
-        stats_number(&stats, "rmse", difference.rmse);
-        stats_number(&stats, "mean_relative_error", difference.mean_relative_error);
-        stats_number(&stats, "mean_a_r", difference.mean_a.r);
-        stats_number(&stats, "mean_a_g", difference.mean_a.g);
-        stats_number(&stats, "mean_a_b", difference.mean_a.b);
-        stats_number(&stats, "mean_b_r", difference.mean_b.r);
-        stats_number(&stats, "mean_b_g", difference.mean_b.g);
-        stats_number(&stats, "mean_b_b", difference.mean_b.b);
-        stats_number(&stats, "worst_block_error", difference.worst_block_error); /* inf: null */
-        stats_integer(&stats, "worst_block_x", difference.worst_block_x);
-        stats_integer(&stats, "worst_block_y", difference.worst_block_y);
-        stats_integer(&stats, "block_size", block);
-        stats_integer(&stats, "block_count", difference.block_count);
-        stats_integer(&stats, "blocks_within", within);
-        stats_number(&stats, "blocks_within_tolerance", difference.blocks_within_tolerance);
-        stats_number(&stats, "block_tolerance",
-                     compare.block_tolerance > 0 ? compare.block_tolerance
-                                                    : DEFAULT_BLOCK_TOLERANCE);
-        if (!stats_write(&stats, stats_path))
-            exit_code = EXIT_ERROR;
-    }
+    cli_stats stats;
+    stats_begin(&stats);
+    stats_string(&stats, "a", path_a);
+    stats_string(&stats, "b", path_b);
+    stats_integer(&stats, "width", a->width);
+    stats_integer(&stats, "height", a->height);
+    stats_number(&stats, "rmse", difference.rmse);
+    stats_number(&stats, "mean_relative_error", difference.mean_relative_error);
+    stats_number(&stats, "mean_a_r", difference.mean_a.r);
+    stats_number(&stats, "mean_a_g", difference.mean_a.g);
+    stats_number(&stats, "mean_a_b", difference.mean_a.b);
+    stats_number(&stats, "mean_b_r", difference.mean_b.r);
+    stats_number(&stats, "mean_b_g", difference.mean_b.g);
+    stats_number(&stats, "mean_b_b", difference.mean_b.b);
+    stats_number(&stats, "worst_block_error", difference.worst_block_error); /* inf: null */
+    stats_integer(&stats, "worst_block_x", difference.worst_block_x);
+    stats_integer(&stats, "worst_block_y", difference.worst_block_y);
+    stats_integer(&stats, "block_size", block);
+    stats_integer(&stats, "block_count", difference.block_count);
+    stats_integer(&stats, "blocks_within", within);
+    stats_number(&stats, "blocks_within_tolerance", difference.blocks_within_tolerance);
+    stats_number(&stats, "block_tolerance", compare.block_tolerance > 0
+                                                ? compare.block_tolerance
+                                                : RAD_DEFAULT_BLOCK_TOLERANCE);
+    exit_code = cli_finish(&stats, stats_path, NULL); /* the report on stdout is the summary */
     goto done;
 fail:
-    cli_error("%s", error.message);
-    exit_code = EXIT_ERROR;
+    exit_code = cli_failed(&error);
 done:
     rad_image_destroy(false_colour);
     rad_image_destroy(b);

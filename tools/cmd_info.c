@@ -23,7 +23,7 @@ static const char usage[] =
     CLI_SCENE_HELP
     "  -o FILE              write the report to FILE instead of stdout\n"
     "  --stats FILE.json    load time, counts and peak memory\n"
-    "  -h, --help           this text\n";
+    CLI_QUIET_HELP;
 
 enum { OPT_COUNT = OPT_OWN };
 
@@ -201,37 +201,27 @@ int command_info(int argc, char **argv)
 {
     cli_args args;
     cli_shared shared;
-    if (!cli_parse("info", argc, argv, options, OPT_COUNT, &args))
+    const char *path;
+    int exit_code;
+    if (!cli_begin("info", usage, argc, argv, options, OPT_COUNT, &args, &shared, &exit_code))
+        return exit_code;
+    if (!cli_scene_argument("info", &args, &path))
         return EXIT_USAGE;
-    if (args.value[OPT_HELP]) {
-        fputs(usage, stdout);
-        return EXIT_OK;
-    }
-    if (!cli_parse_shared(&args, &shared))
-        return EXIT_USAGE;
-    if (args.positional_count > 1) {
-        cli_error("info: one scene at most (see 'radiosity info --help')");
-        return EXIT_USAGE;
-    }
-    if ((shared.output && !cli_output_writable(shared.output)) ||
-        (shared.stats_path && !cli_output_writable(shared.stats_path)))
+    if (!cli_outputs_writable((const char *[]){shared.output, shared.stats_path}, 2))
         return EXIT_ERROR;
-    const char *path = args.positional_count ? args.positional[0] : NULL;
 
     warnings w = {{0}, 0};
     rad_scene *scene = NULL;
     rad_error error = {0};
-    double t0 = cli_now();
+    double t0 = rad_clock_seconds();
     rad_status status = cli_load_scene_logged(path, keep_warning, &w, &scene, &error);
-    double t_load = cli_now() - t0;
-    int exit_code = EXIT_OK;
+    double t_load = rad_clock_seconds() - t0;
     report r = {0};
     if (status != RAD_OK) {
         /* the warnings that led up to the error still help */
         if (w.lines.text)
             fputs(w.lines.text, stderr);
-        cli_error("%s", error.message);
-        exit_code = EXIT_ERROR;
+        exit_code = cli_failed(&error);
         goto done;
     }
     describe(&r, scene);
@@ -243,27 +233,25 @@ int command_info(int argc, char **argv)
     }
     if (shared.output) {
         if (rad_write_file_atomic(shared.output, r.text, r.length, &error) != RAD_OK) {
-            cli_error("%s", error.message);
-            exit_code = EXIT_ERROR;
+            exit_code = cli_failed(&error);
             goto done;
         }
     } else {
         fwrite(r.text, 1, r.length, stdout);
     }
-    if (shared.stats_path) {
-        cli_stats stats;
-        stats_begin(&stats);
-        stats_string(&stats, "scene", scene->source);
-        stats_integer(&stats, "triangles", scene->triangle_count);
-        stats_integer(&stats, "vertices", scene->position_count);
-        stats_integer(&stats, "surfaces", scene->surface_count);
-        stats_integer(&stats, "materials", scene->material_count);
-        stats_integer(&stats, "warnings", w.count);
-        stats_number(&stats, "seconds_load", t_load);
-        stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
-        if (!stats_write(&stats, shared.stats_path))
-            exit_code = EXIT_ERROR;
-    }
+    cli_stats stats;
+    stats_begin(&stats);
+    stats_string(&stats, "scene", scene->source);
+    stats_integer(&stats, "triangles", scene->triangle_count);
+    stats_integer(&stats, "vertices", scene->position_count);
+    stats_integer(&stats, "surfaces", scene->surface_count);
+    stats_integer(&stats, "materials", scene->material_count);
+    stats_integer(&stats, "warnings", w.count);
+    stats_number(&stats, "seconds_load", t_load);
+    exit_code = cli_finish(&stats, shared.stats_path,
+                           "%u triangles, %u surfaces, %u materials, %u warnings, %.2f s: wrote %s",
+                           scene->triangle_count, scene->surface_count, scene->material_count,
+                           w.count, t_load, shared.output ? shared.output : "standard output");
 done:
     free(r.text);
     free(w.lines.text);

@@ -22,22 +22,17 @@ static const char usage[] =
     "tone map, sRGB 8-bit), .hdr (Radiance RGBE), .pfm (portable float map) or .exr\n"
     "(OpenEXR, half float); .hdr, .pfm and .exr hold linear radiance.\n"
     "\n"
-    "Camera (default: the scene's camera, or a view of the whole scene from -z):\n"
-    "  --eye X,Y,Z  --target X,Y,Z  --up X,Y,Z  --fov DEG (vertical)   --size WxH (512x512)\n"
-    "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"
-    "  --exr-float          .exr: 32-bit float channels instead of half\n"
+    CLI_CAMERA_HELP
+    CLI_IMAGE_FILE_HELP
     "Sampling:\n"
     "  --spp N              paths per pixel, stratified over the pixel, box filter\n"
-    "                       (default 64); the noise falls as 1/sqrt(N)\n"
+    "                       (default " CLI_STR(RAD_DEFAULT_PATHTRACE_SPP) "); the noise falls as 1/sqrt(N)\n"
     "  --max-depth N        most bounces per path (default 0: no limit, Russian roulette\n"
     "                       ends paths without bias)\n"
     "  --standard-error FILE  also write each pixel's standard error of the mean, per\n"
     "                       channel (.hdr, .pfm or .exr)\n"
     CLI_SCENE_HELP
-    "  --threads N          worker threads (default: all cores)\n"
-    "  --seed N             seed of every random choice (default 1)\n"
-    "  --stats FILE.json    write rays, times, mean radiance and peak memory\n"
-    "  -h, --help           this text\n";
+    CLI_BASE_HELP("rays, times, mean radiance and peak memory");
 
 enum { OPT_MAX_DEPTH = OPT_OWN, OPT_STANDARD_ERROR, OPT_COUNT };
 
@@ -50,7 +45,7 @@ static const cli_option options[OPT_COUNT] = {
 };
 
 typedef struct pathtrace_settings {
-    const char *scene_path, *output, *stats_path, *error_path;
+    const char *scene_path, *error_path;
     cli_shared shared;
     cli_view view;
     rad_pathtrace_options trace;
@@ -63,7 +58,6 @@ static bool parse_settings(int argc, char **argv, pathtrace_settings *s, int *ex
     if (!cli_parse_image_command("pathtrace", usage, argc, argv, options, OPT_COUNT, &args,
                                  &s->shared, &s->view, &s->scene_path, exit_code))
         return false;
-    s->output = s->shared.output;
     s->error_path = args.value[OPT_STANDARD_ERROR];
     if (s->error_path && s->view.samples_per_pixel == 1) {
         cli_error("--standard-error: needs at least 2 samples per pixel (--spp)");
@@ -80,17 +74,11 @@ static bool parse_settings(int argc, char **argv, pathtrace_settings *s, int *ex
             return false;
         }
     }
-    s->stats_path = s->shared.stats_path;
-    if (args.value[OPT_MAX_DEPTH]) {
-        unsigned long value;
-        if (!cli_parse_uint("max-depth", args.value[OPT_MAX_DEPTH], 1u << 20, &value))
-            return false;
-        s->trace.max_depth = (uint32_t)value;
-    }
-    s->trace.samples_per_pixel = s->view.samples_per_pixel; /* 0 = the library's 64 */
-    s->trace.seed = s->shared.seed;
-    s->trace.threads = s->shared.threads;
-    s->trace.progress = cli_progress;
+    if (!cli_parse_count("max-depth", args.value[OPT_MAX_DEPTH], 0, 1u << 20,
+                         &s->trace.max_depth))
+        return false;
+    s->trace.samples_per_pixel = s->view.samples_per_pixel; /* 0 = the library's default */
+    CLI_SET_RUN_OPTIONS(s->trace, s->shared);
     *exit_code = EXIT_OK;
     return true;
 }
@@ -122,85 +110,59 @@ int command_pathtrace(int argc, char **argv)
     int exit_code;
     if (!parse_settings(argc, argv, &s, &exit_code))
         return exit_code;
-    if (!cli_output_writable(s.output) || (s.stats_path && !cli_output_writable(s.stats_path)) ||
-        (s.error_path && !cli_output_writable(s.error_path)))
+    const char *output = s.shared.output;
+    if (!cli_outputs_writable((const char *[]){output, s.shared.stats_path, s.error_path}, 3))
         return EXIT_ERROR;
 
     rad_error error = {0};
-    rad_status status;
-    rad_scene *scene = NULL;
-    rad_image *image = NULL, *standard_error = NULL;
+    cli_image_run run;
+    rad_image *standard_error = NULL;
     rad_pathtrace_report report = {0};
-    double t0 = cli_now(), t_load, t_trace, t_write;
-
-    status = cli_load_scene(s.scene_path, &scene, &error);
-    if (status != RAD_OK)
-        goto fail;
-    t_load = cli_now();
-    if (!rad_scene_has_emitter(scene))
+    rad_status status = cli_image_run_begin(&run, s.scene_path, &s.view, &error);
+    if (status == RAD_OK && !rad_scene_has_emitter(run.scene))
         cli_warn("%s: no surface emits light (no material with non-zero Ke): the image will "
                  "be black (--emit NAME=R,G,B makes a surface a light)",
-                 scene->source);
-    rad_camera camera = cli_view_camera(&s.view, scene);
-
-    status = rad_image_create(s.view.width, s.view.height, &image, &error);
-    if (status == RAD_OK && (s.error_path || s.stats_path))
+                 run.scene->source);
+    if (status == RAD_OK && (s.error_path || s.shared.stats_path))
         status = rad_image_create(s.view.width, s.view.height, &standard_error, &error);
     if (status == RAD_OK)
-        status = rad_pathtrace(scene, &camera, &s.trace, image, standard_error, &report, &error);
-    if (status != RAD_OK)
-        goto fail;
-    cli_progress_end();
-    t_trace = cli_now();
-    status = rad_image_write(image, s.output, &s.view.write, &error);
+        status = rad_pathtrace(run.scene, &run.camera, &s.trace, run.image, standard_error,
+                               &report, &error);
+    if (status == RAD_OK)
+        status = cli_image_run_write(&run, output, &s.view, &error);
     if (status == RAD_OK && s.error_path)
         status = rad_image_write(standard_error, s.error_path,
                                  &(rad_image_write_options){.exr_float = s.view.write.exr_float},
                                  &error);
     if (status != RAD_OK)
         goto fail;
-    t_write = cli_now();
-    uint32_t spp = s.trace.samples_per_pixel ? s.trace.samples_per_pixel : 64;
-    if (cli_progress_enabled()) /* a summary for a person watching; quiet in scripts */
-        fprintf(stderr, "radiosity: %u samples per pixel, %.1f M rays (%.1f M/s), %.2f s: wrote %s\n",
-                spp, report.rays / 1e6,
-                report.seconds > 0 ? report.rays / report.seconds / 1e6 : 0, t_write - t0,
-                s.output);
+    run.t_write = rad_clock_seconds();
+    uint32_t spp = s.trace.samples_per_pixel ? s.trace.samples_per_pixel
+                                             : RAD_DEFAULT_PATHTRACE_SPP;
+    double rays_per_second = report.seconds > 0 ? report.rays / report.seconds : 0;
 
-    if (s.stats_path) {
-        rad_rgb mean = image_mean(image);
-        cli_stats stats;
-        stats_begin(&stats);
-        stats_string(&stats, "scene", scene->source);
-        stats_integer(&stats, "triangles", scene->triangle_count);
-        stats_integer(&stats, "width", s.view.width);
-        stats_integer(&stats, "height", s.view.height);
-        stats_integer(&stats, "samples_per_pixel", spp);
-        stats_integer(&stats, "max_depth", s.trace.max_depth);
-        stats_integer(&stats, "seed", s.trace.seed);
-        stats_integer(&stats, "threads_requested", (unsigned long long)s.trace.threads); /* 0 = all */
-        stats_integer(&stats, "rays_cast", report.rays);
-        stats_number(&stats, "rays_per_second", report.seconds > 0 ? report.rays / report.seconds : 0);
-        stats_number(&stats, "mean_radiance_r", mean.r);
-        stats_number(&stats, "mean_radiance_g", mean.g);
-        stats_number(&stats, "mean_radiance_b", mean.b);
+    rad_rgb mean = image_mean(run.image);
+    cli_stats stats;
+    cli_image_run_stats(&run, &s.shared, spp, &stats);
+    stats_integer(&stats, "max_depth", s.trace.max_depth);
+    stats_integer(&stats, "rays_cast", report.rays);
+    stats_number(&stats, "rays_per_second", rays_per_second);
+    stats_number(&stats, "mean_radiance_r", mean.r);
+    stats_number(&stats, "mean_radiance_g", mean.g);
+    stats_number(&stats, "mean_radiance_b", mean.b);
+    if (standard_error)
         stats_number(&stats, "rms_standard_error", rms_standard_error(standard_error));
-        stats_number(&stats, "seconds_load", t_load - t0);
-        stats_number(&stats, "seconds_trace", t_trace - t_load);
-        stats_number(&stats, "seconds_write", t_write - t_trace);
-        stats_number(&stats, "seconds_total", t_write - t0);
-        stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
-        if (!stats_write(&stats, s.stats_path))
-            exit_code = EXIT_ERROR;
-    }
+    cli_image_run_times(&run, &stats);
+    exit_code = cli_finish(&stats, s.shared.stats_path,
+                           "%u samples per pixel, %.1f M rays (%.1f M/s), %.2f s: wrote %s%s%s",
+                           spp, report.rays / 1e6, rays_per_second / 1e6, run.t_write - run.t0,
+                           output, s.error_path ? " and " : "", s.error_path ? s.error_path : "");
     goto done;
 fail:
-    cli_error("%s", error.message);
-    exit_code = EXIT_ERROR;
+    exit_code = cli_failed(&error);
 done:
     cli_progress_end();
     rad_image_destroy(standard_error);
-    rad_image_destroy(image);
-    rad_scene_destroy(scene);
+    cli_image_run_free(&run);
     return exit_code;
 }

@@ -25,8 +25,9 @@ static const char usage[] =
     "visibility until their error bound meets it (or --max-rays). Output by the extension\n"
     "of -o: .mtx is Matrix Market (sparse coordinates), anything else CSV (first row\n"
     "'surface,NAME1,...,NAMEn', then one row per surface), or --format; CSV to stdout\n"
-    "without -o. Obstruction surfaces have no row or column. A summary (the invariants:\n"
-    "range, reciprocity, row sums; error bounds) goes to stderr.\n"
+    "without -o. Obstruction surfaces have no row or column. The invariants (range,\n"
+    "reciprocity, row sums; error bounds) and a summary line go to stderr (not with\n"
+    "--quiet).\n"
     "\n"
     "  -o, --output FILE    write the matrix here (atomically)\n"
     "  --format F           csv, mtx or view3d (View3D's text output: header, areas,\n"
@@ -36,123 +37,78 @@ static const char usage[] =
     "  --enclosure          close the enclosure: rows sum to 1, reciprocity kept\n"
     "                       (least-squares correction; its size is reported)\n"
     "  --script-f           grey-body total exchange factors (Hottel's script-F) with\n"
-    "                       the surfaces' emissivities (View3D emit field; default 0.9)\n"
-    "  --accuracy E         relative error target of each factor (default 1e-4)\n"
+    "                       the surfaces' emissivities (View3D emit field; default "
+    CLI_STR(RAD_DEFAULT_EMISSIVITY) ")\n"
+    "  --accuracy E         relative error target of each factor (default "
+    CLI_STR(RAD_DEFAULT_ACCURACY) ")\n"
     "  --max-rays N         visibility rays per sampled polygon pair at most\n"
-    "                       (default 1024)\n"
+    "                       (default " CLI_STR(RAD_DEFAULT_MAX_RAYS) ")\n"
     CLI_SCENE_HELP
-    "  --threads N          worker threads (default: all cores)\n"
-    "  --seed N             seed of the sample points (default 1)\n"
-    "  --stats FILE.json    write counts, times, invariants and error bounds\n"
-    "  -h, --help           this text\n";
+    CLI_BASE_HELP("counts, times, invariants and error bounds");
 
 enum {
-    OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_FORMAT, OPT_ENCLOSURE, OPT_SCRIPT_F, OPT_COUNT
+    OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_FORMAT, OPT_ENCLOSURE, OPT_SCRIPT_F,
+    OPT_OBSTRUCTION, OPT_TWO_SIDED, OPT_COUNT
 };
 
 static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS, CLI_SCENE_OPTIONS, [OPT_ACCURACY] = {"accuracy", 0, true},
     [OPT_MAX_RAYS] = {"max-rays", 0, true},   [OPT_FORMAT] = {"format", 0, true},
-    [OPT_ENCLOSURE] = {"enclosure", 0, false}, [OPT_SCRIPT_F] = {"script-f", 0, false}};
+    [OPT_ENCLOSURE] = {"enclosure", 0, false}, [OPT_SCRIPT_F] = {"script-f", 0, false},
+    [OPT_OBSTRUCTION] = {"obstruction", 0, true}, [OPT_TWO_SIDED] = {"two-sided", 0, true}};
 
-/* The options that may be given several times, taken out of argv before cli_parse. */
-typedef struct repeated_options {
-    const char *obstruction[256];
-    int obstruction_count;
-    const char *two_sided[256];
-    int two_sided_count;
-} repeated_options;
-
-/* Moves --obstruction FILE and --two-sided NAME (or --NAME=VALUE) out of argv into
- * `repeated`; returns the new argc, or -1 after printing a usage error. */
-static int take_repeated(int argc, char **argv, repeated_options *repeated)
-{
-    int kept = 0;
-    for (int a = 0; a < argc; a++) {
-        const char *names[2] = {"--obstruction", "--two-sided"};
-        int which = -1;
-        const char *value = NULL;
-        for (int k = 0; k < 2; k++) {
-            size_t n = strlen(names[k]);
-            if (strncmp(argv[a], names[k], n) == 0 && (argv[a][n] == 0 || argv[a][n] == '=')) {
-                which = k;
-                value = argv[a][n] == '=' ? argv[a] + n + 1 : NULL;
-            }
-        }
-        if (which < 0) {
-            argv[kept++] = argv[a];
-            continue;
-        }
-        if (!value) {
-            if (a + 1 >= argc) {
-                cli_error("viewfactors: %s needs a value (see 'radiosity viewfactors --help')",
-                          names[which]);
-                return -1;
-            }
-            value = argv[++a];
-        }
-        const char **list = which == 0 ? repeated->obstruction : repeated->two_sided;
-        int *count = which == 0 ? &repeated->obstruction_count : &repeated->two_sided_count;
-        if (*count == 256) {
-            cli_error("viewfactors: %s given more than 256 times", names[which]);
-            return -1;
-        }
-        list[(*count)++] = value;
-    }
-    return kept;
-}
+/* --obstruction files at most; as many SCENE files (cli_args.positional). */
+#define MAX_FILES 256
 
 /* The scene: one SCENE with its own surfaces (a View3D file with its control line), or
  * several files, each one surface, plus the obstruction meshes. */
-static rad_status load_surfaces(const cli_args *args, const repeated_options *repeated,
-                                rad_scene **scene, rad_vs3_control *control, bool *is_vs3,
-                                rad_error *error)
+static rad_status load_surfaces(const cli_args *args, rad_scene **scene,
+                                rad_vs3_control *control, bool *is_vs3, rad_error *error)
 {
     rad_load_options load = {cli_log, NULL};
+    int obstructions = cli_value_count(args, OPT_OBSTRUCTION), cursor = 0;
     *is_vs3 = false;
-    if (args->positional_count == 1 && repeated->obstruction_count == 0) {
+    if (args->positional_count == 1 && obstructions == 0) {
         if (rad_scene_is_vs3(args->positional[0])) {
             *is_vs3 = true;
             return rad_scene_load_vs3(args->positional[0], &load, scene, control, error);
         }
         return cli_load_scene(args->positional[0], scene, error);
     }
-    rad_scene_file files[512];
+    rad_scene_file files[2 * MAX_FILES];
     uint32_t count = 0;
     for (int k = 0; k < args->positional_count; k++)
         files[count++] = (rad_scene_file){args->positional[k], 0, args->positional_count == 1};
-    for (int k = 0; k < repeated->obstruction_count; k++)
-        files[count++] = (rad_scene_file){repeated->obstruction[k], RAD_SURFACE_OBSTRUCTION, false};
+    for (const char *path; (path = cli_next_value(args, OPT_OBSTRUCTION, &cursor));)
+        files[count++] = (rad_scene_file){path, RAD_SURFACE_OBSTRUCTION, false};
     return rad_scene_load_files(files, count, &load, scene, error);
 }
 
 int command_viewfactors(int argc, char **argv)
 {
     cli_args args;
-    repeated_options repeated = {0};
-    argc = take_repeated(argc, argv, &repeated);
-    if (argc < 0 || !cli_parse("viewfactors", argc, argv, options, OPT_COUNT, &args))
-        return EXIT_USAGE;
-    if (args.value[OPT_HELP]) {
-        fputs(usage, stdout);
-        return EXIT_OK;
-    }
+    cli_shared shared;
+    int exit_code;
+    if (!cli_begin("viewfactors", usage, argc, argv, options, OPT_COUNT, &args, &shared,
+                   &exit_code))
+        return exit_code;
     if (args.positional_count < 1) {
         cli_error("viewfactors: give a SCENE or mesh files (see 'radiosity viewfactors --help')");
         return EXIT_USAGE;
     }
+    if (cli_value_count(&args, OPT_OBSTRUCTION) > MAX_FILES) {
+        cli_error("viewfactors: --obstruction given more than %d times", MAX_FILES);
+        return EXIT_USAGE;
+    }
     if ((args.value[OPT_EMIT] || args.value[OPT_ALBEDO]) &&
-        (args.positional_count > 1 || repeated.obstruction_count > 0 ||
+        (args.positional_count > 1 || args.value[OPT_OBSTRUCTION] ||
          rad_scene_is_vs3(args.positional[0]))) {
         cli_error("viewfactors: --emit and --albedo apply to one OBJ (or other mesh) scene "
                   "only; they do not change view factors");
         return EXIT_USAGE;
     }
-    cli_shared shared;
-    if (!cli_parse_shared(&args, &shared))
-        return EXIT_USAGE;
-    rad_viewfactor_options vf = {.seed = shared.seed, .threads = shared.threads,
-                                 .progress = cli_progress};
+    rad_viewfactor_options vf = {0};
+    CLI_SET_RUN_OPTIONS(vf, shared);
     if (args.value[OPT_ACCURACY]) {
         if (!cli_parse_double("accuracy", args.value[OPT_ACCURACY], &vf.accuracy))
             return EXIT_USAGE;
@@ -161,16 +117,8 @@ int command_viewfactors(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if (args.value[OPT_MAX_RAYS]) {
-        unsigned long value;
-        if (!cli_parse_uint("max-rays", args.value[OPT_MAX_RAYS], 1u << 24, &value))
-            return EXIT_USAGE;
-        if (value < 64) {
-            cli_error("--max-rays: must be at least 64");
-            return EXIT_USAGE;
-        }
-        vf.max_rays = (uint32_t)value;
-    }
+    if (!cli_parse_count("max-rays", args.value[OPT_MAX_RAYS], 64, 1u << 24, &vf.max_rays))
+        return EXIT_USAGE;
     const char *output = shared.output, *stats_path = shared.stats_path;
     rad_viewfactor_write_options write = {RAD_VIEWFACTOR_CSV, false, false};
     if (output)
@@ -188,11 +136,9 @@ int command_viewfactors(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if ((output && !cli_output_writable(output)) ||
-        (stats_path && !cli_output_writable(stats_path)))
+    if (!cli_outputs_writable((const char *[]){output, stats_path}, 2))
         return EXIT_ERROR;
 
-    int exit_code = EXIT_OK;
     rad_error error = {0};
     rad_scene *scene = NULL;
     rad_viewfactor_matrix *matrix = NULL;
@@ -201,11 +147,11 @@ int command_viewfactors(int argc, char **argv)
     rad_enclosure_report enclosure = {0};
     rad_vs3_control control = {0};
     bool is_vs3 = false;
-    double t0 = cli_now();
-    rad_status status = load_surfaces(&args, &repeated, &scene, &control, &is_vs3, &error);
-    for (int k = 0; k < repeated.two_sided_count && status == RAD_OK; k++)
-        status = rad_scene_set_surface_flags(scene, repeated.two_sided[k], RAD_SURFACE_TWO_SIDED,
-                                             &error);
+    double t0 = rad_clock_seconds();
+    rad_status status = load_surfaces(&args, &scene, &control, &is_vs3, &error);
+    int cursor = 0;
+    for (const char *name; status == RAD_OK && (name = cli_next_value(&args, OPT_TWO_SIDED, &cursor));)
+        status = rad_scene_set_surface_flags(scene, name, RAD_SURFACE_TWO_SIDED, &error);
     if (status == RAD_OK && is_vs3 && (control.row || control.col))
         cli_warn("%s: the control line's row/col are ignored: every factor is computed",
                  scene->source);
@@ -218,6 +164,7 @@ int command_viewfactors(int argc, char **argv)
                  scene->source, RAD_SCRIPT_F_MAX_SURFACES, scene->surface_count);
         status = RAD_ERR_UNSUPPORTED;
     }
+    cli_progress_mark();
     if (status == RAD_OK)
         status = rad_viewfactor_matrix_compute(scene, &vf, &matrix, &report, &error);
     if (status != RAD_OK)
@@ -227,23 +174,19 @@ int command_viewfactors(int argc, char **argv)
     rad_viewfactor_check check;
     rad_viewfactor_matrix_check(matrix, scene, &check);
     size_t S = scene->surface_count;
-    fprintf(stderr,
-            "radiosity: %zu surfaces, %llu polygon pairs (%llu hidden, %llu obstructed, %llu "
-            "of them sampled), %llu rays, %llu non-zero factors, %.2f s\n"
-            "radiosity: F in [%.6g, %.6g]; reciprocity residual %.2e; planar F_ii %.2g; "
-            "largest row sum %.6f",
-            S, (unsigned long long)report.polygon_pairs, (unsigned long long)report.hidden_pairs,
-            (unsigned long long)report.obstructed_pairs,
-            (unsigned long long)report.sampled_pairs, (unsigned long long)report.rays,
-            (unsigned long long)report.nonzeros, cli_now() - t0, check.smallest, check.largest,
-            check.reciprocity, check.largest_planar_self, check.largest_row_sum);
+    char closed[96] = "", capped[96] = "";
     if (check.closed)
-        fprintf(stderr, "; closed enclosure: largest |row sum - 1| %.3g", check.row_sum_deviation);
-    fprintf(stderr, "\nradiosity: largest error bound of a factor %.3g (absolute)", report.largest_error_bound);
+        snprintf(closed, sizeof(closed), "; closed enclosure: largest |row sum - 1| %.3g",
+                 check.row_sum_deviation);
     if (report.capped_pairs)
-        fprintf(stderr, " (%llu sampled pairs reached --max-rays first)",
-                (unsigned long long)report.capped_pairs);
-    fputc('\n', stderr);
+        snprintf(capped, sizeof(capped), " (%llu sampled pairs reached --max-rays first)",
+                 (unsigned long long)report.capped_pairs);
+    cli_summary("F in [%.6g, %.6g]; reciprocity residual %.2e; planar F_ii %.2g; largest row "
+                "sum %.6f%s",
+                check.smallest, check.largest, check.reciprocity, check.largest_planar_self,
+                check.largest_row_sum, closed);
+    cli_summary("largest error bound of a factor %.3g (absolute)%s", report.largest_error_bound,
+                capped);
     if (check.largest > 1 || check.smallest < 0 || check.largest_planar_self > 0) {
         snprintf(error.message, sizeof(error.message),
                  "%s: internal error: a view factor outside [0, 1] or a planar F_ii > 0",
@@ -264,10 +207,9 @@ int command_viewfactors(int argc, char **argv)
         status = rad_viewfactor_matrix_close_enclosure(matrix, scene, &enclosure, &error);
         if (status != RAD_OK)
             goto fail;
-        fprintf(stderr,
-                "radiosity: enclosure correction: largest relative change of a factor %.3g; "
-                "largest |row sum - 1| %.3g before, %.2g after; reciprocity residual %.2g\n",
-                enclosure.largest_relative_change, enclosure.row_deviation_before,
+        cli_summary("enclosure correction: largest relative change of a factor %.3g; largest "
+                    "|row sum - 1| %.3g before, %.2g after; reciprocity residual %.2g",
+                    enclosure.largest_relative_change, enclosure.row_deviation_before,
                 enclosure.row_deviation_after, enclosure.reciprocity_after);
     }
     if (write.script_f) {
@@ -284,52 +226,56 @@ int command_viewfactors(int argc, char **argv)
             goto fail;
         rad_viewfactor_matrix_destroy(matrix);
         matrix = exchange;
-        fprintf(stderr, "radiosity: script-F total exchange factors with the surfaces' "
-                        "emissivities\n");
+        cli_summary("script-F total exchange factors with the surfaces' emissivities");
     }
     status = output ? rad_viewfactor_matrix_write(scene, matrix, output, &write, &error)
                     : rad_viewfactor_matrix_print(scene, matrix, stdout, &write, &error);
     if (status != RAD_OK)
         goto fail;
-    if (stats_path) {
-        cli_stats stats;
-        stats_begin(&stats);
-        stats_string(&stats, "scene", scene->source);
-        stats_integer(&stats, "surfaces", S);
-        stats_integer(&stats, "surface_pairs", report.surface_pairs);
-        stats_integer(&stats, "polygon_pairs", report.polygon_pairs);
-        stats_integer(&stats, "hidden_pairs", report.hidden_pairs);
-        stats_integer(&stats, "obstructed_pairs", report.obstructed_pairs);
-        stats_integer(&stats, "sampled_pairs", report.sampled_pairs);
-        stats_integer(&stats, "capped_pairs", report.capped_pairs);
-        stats_integer(&stats, "rays_cast", report.rays);
-        stats_integer(&stats, "nonzeros", report.nonzeros);
-        stats_integer(&stats, "threads", (uint64_t)report.threads);
-        stats_number(&stats, "seconds_view_factors", report.seconds);
-        stats_number(&stats, "seconds_total", cli_now() - t0);
-        stats_number(&stats, "largest_error_bound", report.largest_error_bound);
-        stats_number(&stats, "reciprocity_residual", check.reciprocity);
-        stats_number(&stats, "largest_row_sum", check.largest_row_sum);
-        stats_number(&stats, "row_sum_deviation", check.row_sum_deviation);
-        stats_integer(&stats, "closed_enclosure", check.closed);
-        stats_bool(&stats, "enclosure_corrected", write.enclosure);
-        if (write.enclosure) {
-            stats_number(&stats, "enclosure_largest_relative_change",
-                         enclosure.largest_relative_change);
-            stats_number(&stats, "enclosure_row_sum_deviation_before",
-                         enclosure.row_deviation_before);
-            stats_number(&stats, "enclosure_row_sum_deviation_after",
-                         enclosure.row_deviation_after);
-        }
-        stats_bool(&stats, "script_f", write.script_f);
-        stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
-        if (!stats_write(&stats, stats_path))
-            exit_code = EXIT_ERROR;
+    double seconds = rad_clock_seconds() - t0;
+    cli_stats stats;
+    stats_begin(&stats);
+    stats_string(&stats, "scene", scene->source);
+    stats_integer(&stats, "surfaces", S);
+    stats_integer(&stats, "surface_pairs", report.surface_pairs);
+    stats_integer(&stats, "polygon_pairs", report.polygon_pairs);
+    stats_integer(&stats, "hidden_pairs", report.hidden_pairs);
+    stats_integer(&stats, "obstructed_pairs", report.obstructed_pairs);
+    stats_integer(&stats, "sampled_pairs", report.sampled_pairs);
+    stats_integer(&stats, "capped_pairs", report.capped_pairs);
+    stats_integer(&stats, "rays_cast", report.rays);
+    stats_integer(&stats, "nonzeros", report.nonzeros);
+    stats_integer(&stats, "threads", (uint64_t)report.threads);
+    stats_number(&stats, "seconds_view_factors", report.seconds);
+    stats_number(&stats, "seconds_total", seconds);
+    stats_number(&stats, "largest_error_bound", report.largest_error_bound);
+    stats_number(&stats, "reciprocity_residual", check.reciprocity);
+    stats_number(&stats, "largest_row_sum", check.largest_row_sum);
+    stats_number(&stats, "row_sum_deviation", check.row_sum_deviation);
+    stats_integer(&stats, "closed_enclosure", check.closed);
+    stats_bool(&stats, "enclosure_corrected", write.enclosure);
+    if (write.enclosure) {
+        stats_number(&stats, "enclosure_largest_relative_change",
+                     enclosure.largest_relative_change);
+        stats_number(&stats, "enclosure_row_sum_deviation_before",
+                     enclosure.row_deviation_before);
+        stats_number(&stats, "enclosure_row_sum_deviation_after",
+                     enclosure.row_deviation_after);
     }
+    stats_bool(&stats, "script_f", write.script_f);
+    exit_code = cli_finish(&stats, stats_path,
+                           "%zu surfaces, %llu polygon pairs (%llu hidden, %llu obstructed, "
+                           "%llu of them sampled), %llu rays, %llu non-zero factors, %.2f s: "
+                           "wrote %s",
+                           S, (unsigned long long)report.polygon_pairs,
+                           (unsigned long long)report.hidden_pairs,
+                           (unsigned long long)report.obstructed_pairs,
+                           (unsigned long long)report.sampled_pairs,
+                           (unsigned long long)report.rays, (unsigned long long)report.nonzeros,
+                           seconds, output ? output : "standard output");
     goto done;
 fail:
-    cli_error("%s", error.message);
-    exit_code = EXIT_ERROR;
+    exit_code = cli_failed(&error);
 done:
     free(emissivity);
     rad_viewfactor_matrix_destroy(matrix);

@@ -26,10 +26,6 @@
 
 #include "core/error.h"
 
-/* Defaults for zero-initialised options. */
-#define COMPARE_DEFAULT_BLOCK_SIZE 8u
-#define COMPARE_DEFAULT_BLOCK_TOLERANCE 0.10
-
 /* The false colour divides by max(|b|_1, this) (radiance, sum of three channels): far below
  * any radiance a float image holds in practice, so a black reference pixel shows blue where
  * a is black as well and red wherever a is not. */
@@ -117,8 +113,8 @@ rad_status rad_image_compare(const rad_image *a, const rad_image *b,
                         ", the images compared %" PRIu32 "x%" PRIu32,
                         false_colour->width, false_colour->height, a->width, a->height);
 
-    uint32_t block = COMPARE_DEFAULT_BLOCK_SIZE;
-    double tolerance = COMPARE_DEFAULT_BLOCK_TOLERANCE;
+    uint32_t block = RAD_DEFAULT_BLOCK_SIZE;
+    double tolerance = RAD_DEFAULT_BLOCK_TOLERANCE;
     if (options && options->block_size > 0)
         block = options->block_size;
     if (options && options->block_tolerance != 0) {

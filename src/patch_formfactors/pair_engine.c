@@ -21,9 +21,9 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "core/alloc.h"
+#include "core/clock.h"
 #include "core/error.h"
 #include "core/random.h"
 #include "core/tolerance.h"
@@ -31,7 +31,6 @@
 #include "geometry/contour.h"
 #include "trace/ray.h"
 
-#define DEFAULT_VISIBILITY_RAYS 16u
 #define MAX_QUADRATURE 8u
 #define MAX_STRATA 16u             /* at most 16 x 16 = 256 rays per pair */
 #define BATCH_RAYS 4096u           /* rays traced per call */
@@ -270,12 +269,7 @@ static double weighted_visibility(const engine *e, const batch *b, const pending
     return total > 0 ? visible / total : (double)visible_count(b, pair) / pair->ray_count;
 }
 
-static double now_seconds(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+static double now_seconds(void) { return rad_clock_seconds(); }
 
 /* Traces a batch (4096 segments at most: the two clock reads are noise beside it). */
 static void trace(const engine *e, thread_work *w, batch *b)
@@ -368,7 +362,7 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
 static unsigned strata_for(uint32_t rays)
 {
     if (rays == 0)
-        rays = DEFAULT_VISIBILITY_RAYS;
+        rays = RAD_DEFAULT_VISIBILITY_RAYS;
     unsigned k = (unsigned)lround(sqrt((double)rays));
     return k < 1 ? 1 : k > MAX_STRATA ? MAX_STRATA : k;
 }
@@ -381,7 +375,7 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
     if (!options)
         options = &defaults;
     uint32_t n = mesh->patch_count;
-    unsigned m = options->quadrature ? options->quadrature : 1;
+    unsigned m = options->quadrature ? options->quadrature : RAD_DEFAULT_QUADRATURE;
     if (m > MAX_QUADRATURE)
         return rad_fail(error, RAD_ERR_INVALID, "quadrature %u is above the limit %u", m,
                         MAX_QUADRATURE);
@@ -441,8 +435,7 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
                        &e.near_weights[(size_t)i * e.near_count]);
     }
 
-    struct timespec start, end;
-    clock_gettime(CLOCK_MONOTONIC, &start);
+    double start = rad_clock_seconds();
     double total_pairs = (double)n * (n - 1) / 2;
     uint64_t rows_done = 0;
 #pragma omp parallel num_threads(threads)
@@ -462,7 +455,7 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
             }
         }
     }
-    clock_gettime(CLOCK_MONOTONIC, &end);
+    double end = rad_clock_seconds();
     if (report) {
         memset(report, 0, sizeof(*report));
         report->pairs = (uint64_t)total_pairs;
@@ -473,7 +466,7 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
             report->pairs_refined += work[t].pairs_refined;
             report->tracing_seconds += work[t].tracing_seconds;
         }
-        report->seconds = (double)(end.tv_sec - start.tv_sec) + 1e-9 * (double)(end.tv_nsec - start.tv_nsec);
+        report->seconds = end - start;
     }
     if (options->progress)
         options->progress(options->progress_user, "form factors", 1);

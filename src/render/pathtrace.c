@@ -48,7 +48,6 @@
 #define SAMPLES_PER_WAVE 4u
 #define WAVE_PATHS (TILE * TILE * SAMPLES_PER_WAVE)
 
-#define DEFAULT_SPP 64u
 
 /* Secondary rays start this far in front of the surface, along its normal, and shadow rays
  * stop this far short of the light: a fraction of the scene's bounding-box diagonal
@@ -380,7 +379,7 @@ rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
                          rad_image *standard_error, rad_pathtrace_report *report,
                          rad_error *error)
 {
-    double start = omp_get_wtime();
+    double start = rad_clock_seconds();
     rad_pathtrace_options defaults = {0};
     if (!options)
         options = &defaults;
@@ -405,7 +404,7 @@ rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
     c.scene = scene;
     c.width = image->width;
     c.height = image->height;
-    c.spp = options->samples_per_pixel ? options->samples_per_pixel : DEFAULT_SPP;
+    c.spp = options->samples_per_pixel ? options->samples_per_pixel : RAD_DEFAULT_PATHTRACE_SPP;
     c.max_depth = options->max_depth;
     c.seed = options->seed;
     c.strata = (uint32_t)floor(sqrt((double)c.spp));
@@ -467,7 +466,7 @@ rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
     render_progress_finish(&progress);
     if (report) {
         report->rays = rays;
-        report->seconds = omp_get_wtime() - start;
+        report->seconds = rad_clock_seconds() - start;
     }
     goto done;
 nomem:

@@ -34,8 +34,6 @@
 #include "trace/ray.h"
 
 #define MAX_STRATA 16u
-#define DEFAULT_MAX_DEPTH 5u
-#define DEFAULT_EDGE_SAMPLES 64u /* extra samples for an edge pixel */
 #define EDGE_CONTRAST 0.1        /* relative luminance spread that makes an edge */
 #define EDGE_STREAM 0x5EED0EDCEull /* keeps edge samples' random numbers apart */
 
@@ -209,7 +207,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     rad_status status = camera_frame_make(camera, W, H, &frame, error);
     if (status != RAD_OK)
         return status;
-    unsigned spp = options->samples_per_pixel ? options->samples_per_pixel : 16;
+    unsigned spp =
+        options->samples_per_pixel ? options->samples_per_pixel : RAD_DEFAULT_RENDER_SPP;
     unsigned k = (unsigned)lround(sqrt((double)spp));
     k = k < 1 ? 1 : k > MAX_STRATA ? MAX_STRATA : k;
     if (options->threads < 0)
@@ -257,11 +256,11 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
 
     size_t per_row = (size_t)W * k * k;
     unsigned edge_k = (unsigned)lround(sqrt((double)(options->edge_samples ? options->edge_samples
-                                                                          : DEFAULT_EDGE_SAMPLES)));
+                                                                          : RAD_DEFAULT_EDGE_SAMPLES)));
     edge_k = edge_k < 1 ? 1 : edge_k > MAX_STRATA ? MAX_STRATA : edge_k;
     size_t per_row_edges = (size_t)W * edge_k * edge_k;
     size_t ray_capacity = per_row > per_row_edges ? per_row : per_row_edges;
-    unsigned max_depth = options->max_depth ? options->max_depth : DEFAULT_MAX_DEPTH;
+    unsigned max_depth = options->max_depth ? options->max_depth : RAD_DEFAULT_MAX_DEPTH;
     work = rad_alloc_array((size_t)threads, sizeof(*work));
     if (!work)
         goto nomem;

@@ -73,9 +73,6 @@
  * instead of by intersecting the plane in double precision (dimensionless). */
 #define RT_PLANE_COSINE 1e-12
 
-#define DEFAULT_SAMPLES_PER_PIXEL 4u
-#define DEFAULT_LIGHT_SAMPLES 16u
-#define DEFAULT_MAX_DEPTH 5u
 #define MAX_STRATA 1024u          /* k of k x k samples per pixel: 1M samples at most */
 #define MAX_LIGHT_SAMPLES 65536u  /* per shading point */
 
@@ -414,10 +411,10 @@ rad_status rad_raytrace(const rad_scene *scene, const rad_camera *camera,
     if (status != RAD_OK)
         return status;
     uint32_t spp = options->samples_per_pixel ? options->samples_per_pixel
-                                              : DEFAULT_SAMPLES_PER_PIXEL;
+                                              : RAD_DEFAULT_RAYTRACE_SPP;
     long k = lround(sqrt((double)spp));
     ctx.strata = k < 1 ? 1 : k > (long)MAX_STRATA ? MAX_STRATA : (uint32_t)k;
-    ctx.max_depth = options->max_depth ? options->max_depth : DEFAULT_MAX_DEPTH;
+    ctx.max_depth = options->max_depth ? options->max_depth : RAD_DEFAULT_MAX_DEPTH;
     ctx.scene = scene;
     ctx.lights = options->lights;
     ctx.light_count = options->light_count;
@@ -448,7 +445,7 @@ rad_status rad_raytrace(const rad_scene *scene, const rad_camera *camera,
         goto done;
     if (emitters.count > 0) {
         ctx.light_samples = options->light_samples ? options->light_samples
-                                                   : DEFAULT_LIGHT_SAMPLES;
+                                                   : RAD_DEFAULT_LIGHT_SAMPLES;
     }
     normal = rad_alloc_array(scene->triangle_count, sizeof(*normal));
     workspaces = rad_alloc_array((size_t)threads, sizeof(*workspaces));

@@ -128,7 +128,7 @@ uint32_t scene_builder_surface(scene_builder *b, const char *name)
         return UINT32_MAX;
     rad_surface *surface = &b->surfaces[b->surface_count];
     memset(surface, 0, sizeof(*surface));
-    surface->emissivity = 0.9;
+    surface->emissivity = RAD_DEFAULT_EMISSIVITY;
     memcpy(surface->name, clipped, sizeof(clipped));
     b->surface_slots[s] = (uint32_t)b->surface_count + 1;
     return (uint32_t)b->surface_count++;

@@ -9,7 +9,7 @@
  */
 #include <math.h>
 #include <string.h>
-#include <time.h>
+#include "core/clock.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -26,17 +26,7 @@ enum { SOLVE_DEFAULT_SWEEPS = 10000, SOLVE_DEFAULT_SHOTS_PER_PATCH = 1000 };
 /* Progress is reported only when the fraction grew by at least this much. */
 #define SOLVE_PROGRESS_STEP 0.01
 
-static double wall_seconds(void)
-{
-#ifdef _OPENMP
-    return omp_get_wtime();
-#else
-    struct timespec now;
-    if (!timespec_get(&now, TIME_UTC))
-        return 0;
-    return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
-#endif
-}
+static double wall_seconds(void) { return rad_clock_seconds(); }
 
 
 static rad_status check_system(const rad_system *system, rad_error *error)

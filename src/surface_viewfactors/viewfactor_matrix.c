@@ -28,8 +28,6 @@
 #include "surface_viewfactors/pair_transfer.h"
 #include "surface_viewfactors/vf_geometry.h"
 
-#define DEFAULT_ACCURACY 1e-4
-#define DEFAULT_MAX_RAYS 1024u
 
 typedef struct row_entry {
     uint32_t column;
@@ -56,7 +54,7 @@ typedef struct engine {
     uint64_t seed;
 } engine;
 
-static double now_seconds(void) { return omp_get_wtime(); }
+static double now_seconds(void) { return rad_clock_seconds(); }
 
 /* `plane` is flat and `other` lies wholly behind or on its plane. */
 static bool behind_plane(const vf_geometry *g, const vf_surface *plane, const vf_surface *other)
@@ -257,8 +255,8 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
                         "view factors: threads must be >= 0 and accuracy in [0, 1)");
     double start = now_seconds();
     int threads = options->threads > 0 ? options->threads : omp_get_max_threads();
-    engine e = {.accuracy = options->accuracy > 0 ? options->accuracy : DEFAULT_ACCURACY,
-                .max_rays = options->max_rays ? options->max_rays : DEFAULT_MAX_RAYS,
+    engine e = {.accuracy = options->accuracy > 0 ? options->accuracy : RAD_DEFAULT_ACCURACY,
+                .max_rays = options->max_rays ? options->max_rays : RAD_DEFAULT_MAX_RAYS,
                 .seed = options->seed};
     if (e.max_rays < 64)
         e.max_rays = 64;

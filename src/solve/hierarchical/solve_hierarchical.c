@@ -13,7 +13,7 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+#include "core/clock.h"
 
 #include "core/alloc.h"
 #include "core/error.h"
@@ -48,12 +48,7 @@ typedef struct hsolver {
     int threads;
 } hsolver;
 
-static double now_seconds(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+static double now_seconds(void) { return rad_clock_seconds(); }
 
 static void pull(hsolver *s)
 {
