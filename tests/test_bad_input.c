@@ -187,9 +187,8 @@ int main(void)
     test_write_file("plates.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                                   "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
                                   "o floor\nf 1 2 3 4\no roof\nf 5 8 7 6\n");
-    /* (render and solve print their summary themselves; --quiet is theirs to honour) */
-    expect_summary("render -o sum.pfm --size 8x8 --patch-size 200", "sum.pfm", false);
-    expect_summary("solve -o sum.ply --patch-size 200", "sum.ply", false);
+    expect_summary("render -o sum.pfm --size 8x8 --patch-size 200", "sum.pfm", true);
+    expect_summary("solve -o sum.ply --patch-size 200", "sum.ply", true);
     expect_summary("raytrace -o sum.pfm --size 8x8", "sum.pfm", true);
     expect_summary("pathtrace -o sum.pfm --size 8x8 --spp 2", "sum.pfm", true);
     expect_summary("viewfactors plates.obj -o sum.csv", "sum.csv", true);

@@ -271,10 +271,6 @@ void cli_summary(const char *format, ...) __attribute__((format(printf, 1, 2)));
 /* False after --quiet. */
 bool cli_summary_wanted(void);
 
-/* The old name of the library's clock, kept for cli_solve.c, cmd_render.c and cmd_solve.c
- * until they call rad_clock_seconds. */
-static inline double cli_now(void) { return rad_clock_seconds(); }
-
 /* The --stats report: a flat JSON object built up field by field. */
 typedef struct cli_stats {
     char text[8192];

@@ -140,11 +140,11 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
 {
     memset(out, 0, sizeof(*out));
     rad_solution *solution = NULL;
-    double t0 = cli_now();
+    double t0 = rad_clock_seconds();
     rad_status status = cli_load_scene(scene_path, &out->scene, error);
     if (status != RAD_OK)
         goto done;
-    double t_load = cli_now();
+    double t_load = rad_clock_seconds();
     out->seconds_load = t_load - t0;
 
     double patch_size = shared->patch_size;
@@ -163,10 +163,10 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
     status = rad_mesh_build(out->scene, patch_size, &out->mesh, error);
     if (status != RAD_OK)
         goto done;
-    out->seconds_mesh = cli_now() - t_load;
-    double t_mesh = cli_now();
+    out->seconds_mesh = rad_clock_seconds() - t_load;
+    double t_mesh = rad_clock_seconds();
     status = rad_patch_inputs_build(out->scene, out->mesh, &out->inputs, error);
-    out->seconds_inputs = cli_now() - t_mesh;
+    out->seconds_inputs = rad_clock_seconds() - t_mesh;
     if (status != RAD_OK)
         goto done;
 
@@ -204,9 +204,9 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
     cli_progress_end();
     if (status != RAD_OK || !solve->save_solution_path)
         goto done;
-    double t_save = cli_now();
+    double t_save = rad_clock_seconds();
     status = rad_solution_write(out->scene, out->mesh, out->B, solve->save_solution_path, error);
-    out->seconds_save = cli_now() - t_save;
+    out->seconds_save = rad_clock_seconds() - t_save;
 done:
     rad_solution_destroy(solution);
     if (status != RAD_OK)

@@ -101,12 +101,12 @@ int command_render(int argc, char **argv)
     rad_status status;
     cli_solved solved;
     rad_image *image = NULL;
-    double t0 = cli_now(), t_solved, t_render, t_write;
+    double t0 = rad_clock_seconds(), t_solved, t_render, t_write;
 
     status = cli_solve_scene(s.scene_path, &s.shared, &s.solve, &solved, &error);
     if (status != RAD_OK)
         goto fail;
-    t_solved = cli_now();
+    t_solved = rad_clock_seconds();
     rad_camera camera = cli_view_camera(&s.view, solved.scene);
     if (s.specular)
         s.render.materials = solved.scene->materials;
@@ -118,7 +118,7 @@ int command_render(int argc, char **argv)
         status = rad_render(solved.mesh, solved.B, &camera, &s.render, image, &error);
     if (status != RAD_OK)
         goto fail;
-    t_render = cli_now();
+    t_render = rad_clock_seconds();
     if (rad_scene_has_emitter(solved.scene)) {
         /* lit surfaces, a black image: the camera sees only backs (surfaces are one-sided),
          * as the default view from outside a closed room does */
@@ -134,32 +134,24 @@ int command_render(int argc, char **argv)
     status = rad_image_write(image, s.output, &s.view.write, &error);
     if (status != RAD_OK)
         goto fail;
-    t_write = cli_now();
-    {
-        char summary[384];
-        cli_solved_summary(&solved, &s.solve, summary, sizeof(summary));
-        fprintf(stderr, "radiosity: %s, %.2f s: wrote %s\n", summary, t_write - t0, s.output);
-    }
-
-    if (s.stats_path) {
-        cli_stats stats;
-        stats_begin(&stats);
-        cli_solved_stats(&solved, &s.solve, &stats);
-        stats_number(&stats, "seconds_render", t_render - t_solved);
-        stats_number(&stats, "seconds_write", t_write - t_render);
-        stats_number(&stats, "seconds_total", t_write - t0);
-        stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
-        stats_integer(&stats, "width", s.view.width);
-        stats_integer(&stats, "height", s.view.height);
-        if (!stats_write(&stats, s.stats_path))
-            exit_code = EXIT_ERROR;
-    }
+    t_write = rad_clock_seconds();
+    cli_stats stats;
+    stats_begin(&stats);
+    cli_solved_stats(&solved, &s.solve, &stats);
+    stats_number(&stats, "seconds_render", t_render - t_solved);
+    stats_number(&stats, "seconds_write", t_write - t_render);
+    stats_number(&stats, "seconds_total", t_write - t0);
+    stats_integer(&stats, "width", s.view.width);
+    stats_integer(&stats, "height", s.view.height);
+    char summary[384];
+    cli_solved_summary(&solved, &s.solve, summary, sizeof(summary));
+    exit_code = cli_finish(&stats, s.stats_path, "%s, %.2f s: wrote %s", summary, t_write - t0,
+                           s.output);
     if (exit_code == EXIT_OK && solved.report.interrupted)
         exit_code = EXIT_INTERRUPTED; /* the image is complete, of the solution so far */
     goto done;
 fail:
-    cli_error("%s", error.message);
-    exit_code = EXIT_ERROR;
+    exit_code = cli_failed(&error);
 done:
     cli_progress_end();
     rad_image_destroy(image);

@@ -53,24 +53,17 @@ int command_solve(int argc, char **argv)
     cli_shared shared;
     cli_solve solve;
     rad_lit_mesh_options write = {0};
-    if (!cli_parse("solve", argc, argv, options, OPT_OWN, &args))
-        return EXIT_USAGE;
-    if (args.value[OPT_HELP]) {
-        fputs(usage, stdout);
-        return EXIT_OK;
-    }
-    if (!cli_parse_shared(&args, &shared))
-        return EXIT_USAGE;
+    const char *scene_path = NULL;
+    int exit_code;
+    if (!cli_begin("solve", usage, argc, argv, options, OPT_OWN, &args, &shared, &exit_code))
+        return exit_code;
     if (args.value[OPT_EXPOSURE]) {
         if (!cli_parse_double("exposure", args.value[OPT_EXPOSURE], &write.exposure))
             return EXIT_USAGE;
         write.fixed_exposure = true;
     }
-    if (args.positional_count > 1) {
-        cli_error("solve: one scene at most (see 'radiosity solve --help')");
+    if (!cli_scene_argument("solve", &args, &scene_path))
         return EXIT_USAGE;
-    }
-    const char *scene_path = args.positional_count ? args.positional[0] : NULL;
     if (!shared.output && !args.value[OPT_SAVE_SOLUTION]) {
         cli_error("solve: nothing to write: give -o OUT.ply, .glb or .obj, or "
                   "--save-solution FILE");
@@ -83,37 +76,28 @@ int command_solve(int argc, char **argv)
     if (!cli_solve_outputs_writable(&shared, &solve))
         return EXIT_ERROR;
 
-    int exit_code = EXIT_OK;
     rad_error error = {0};
     cli_solved solved;
-    double t0 = cli_now();
+    double t0 = rad_clock_seconds();
     rad_status status = cli_solve_scene(scene_path, &shared, &solve, &solved, &error);
-    double t_solved = cli_now();
+    double t_solved = rad_clock_seconds();
     if (status == RAD_OK && shared.output)
         status = rad_lit_mesh_write(solved.mesh, solved.B, shared.output, &write, &error);
-    double t_write = cli_now();
+    double t_write = rad_clock_seconds();
     if (status != RAD_OK) {
-        cli_error("%s", error.message);
-        exit_code = EXIT_ERROR;
+        exit_code = cli_failed(&error);
         goto done;
     }
-    {
-        char summary[384];
-        cli_solved_summary(&solved, &solve, summary, sizeof(summary));
-        fprintf(stderr, "radiosity: %s, %.2f s: wrote %s\n", summary, t_write - t0,
-                shared.output ? shared.output : solve.save_solution_path);
-    }
-    if (shared.stats_path) {
-        cli_stats stats;
-        stats_begin(&stats);
-        cli_solved_stats(&solved, &solve, &stats);
-        stats_integer(&stats, "vertices", solved.mesh->vertex_count);
-        stats_number(&stats, "seconds_write", t_write - t_solved);
-        stats_number(&stats, "seconds_total", t_write - t0);
-        stats_integer(&stats, "peak_memory_bytes", rad_peak_memory_bytes());
-        if (!stats_write(&stats, shared.stats_path))
-            exit_code = EXIT_ERROR;
-    }
+    cli_stats stats;
+    stats_begin(&stats);
+    cli_solved_stats(&solved, &solve, &stats);
+    stats_integer(&stats, "vertices", solved.mesh->vertex_count);
+    stats_number(&stats, "seconds_write", t_write - t_solved);
+    stats_number(&stats, "seconds_total", t_write - t0);
+    char summary[384];
+    cli_solved_summary(&solved, &solve, summary, sizeof(summary));
+    exit_code = cli_finish(&stats, shared.stats_path, "%s, %.2f s: wrote %s", summary,
+                           t_write - t0, shared.output ? shared.output : solve.save_solution_path);
     if (exit_code == EXIT_OK && solved.report.interrupted)
         exit_code = EXIT_INTERRUPTED; /* the files are complete, of the solution so far */
 done:
