@@ -45,7 +45,37 @@ typedef struct pair_counts {
         capped_pairs, rays;
 } pair_counts;
 
+/* Progress by polygon pairs, the unit of work (a row's cost is its polygons times the
+ * polygons of the surfaces after it, not its surface count): every thread adds what it
+ * finished; OpenMP thread 0 reports, after each of its own polygons, so a long row still
+ * moves the bar. */
+typedef struct pair_progress {
+    rad_progress_fn report; /* NULL: none */
+    void *user;
+    double total;           /* polygon pairs of the whole matrix */
+    double done;            /* atomic */
+    double reported;        /* thread 0 only: the last fraction sent */
+} pair_progress;
+
+static void progress_add(pair_progress *p, double pairs)
+{
+    double done;
+#pragma omp atomic capture
+    {
+        p->done += pairs;
+        done = p->done;
+    }
+    if (!p->report || omp_get_thread_num() != 0)
+        return;
+    double fraction = fmin(done / fmax(p->total, 1), 0.999);
+    if (fraction >= p->reported + 0.001) {
+        p->reported = fraction;
+        p->report(p->user, "view factors", fraction);
+    }
+}
+
 typedef struct engine {
+    pair_progress *progress;
     const vf_geometry *geometry;
     const occluder_tree *tree;
     const rad_tracer *occluders;
@@ -160,8 +190,10 @@ static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_work
         if (b->polygon_count == 0 || (J == I && a->planar))
             continue;
         counts->surface_pairs++;
-        if (J != I && surfaces_face_away(g, a, b))
+        if (J != I && surfaces_face_away(g, a, b)) {
+            progress_add(e->progress, (double)a->polygon_count * b->polygon_count);
             continue;
+        }
         double transfer = 0, variance = 0;
         for (uint32_t pk = 0; pk < a->polygon_count; pk++) {
             uint32_t pi = a->first_polygon + pk;
@@ -172,8 +204,8 @@ static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_work
                 transfer += G;
                 /* sampled parts are independent: their bounds add in quadrature */
                 variance += bound * bound;
-                
             }
+            progress_add(e->progress, b->first_polygon + b->polygon_count - q_first);
         }
         if (J == I)
             transfer *= 2, variance *= 4;
@@ -286,9 +318,16 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     e.tree = tree;
     e.occluders = occluders;
 
-    /* progress counts surface pairs: row I has n - I of them */
-    double total_pairs = 0.5 * (double)n * ((double)n + 1);
-    double done_pairs = 0;
+    /* polygon pairs (I, J >= I) the rows will visit */
+    pair_progress progress = {options->progress, options->progress_user, 0, 0, 0};
+    double polygons_after = 0;
+    for (uint32_t I = n; I-- > 0;) {
+        double p = geometry.surfaces[I].polygon_count;
+        double self = geometry.surfaces[I].planar ? 0 : 0.5 * p * (p - 1);
+        progress.total += p * polygons_after + self;
+        polygons_after += p;
+    }
+    e.progress = &progress;
     pair_counts totals = {0};
     bool out_of_memory = false;
 #pragma omp parallel num_threads(threads)
@@ -311,15 +350,6 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
 #pragma omp atomic write
                 out_of_memory = true;
             }
-            double done;
-#pragma omp atomic capture
-            {
-                done_pairs += (double)(n - I);
-                done = done_pairs;
-            }
-            if (options->progress && omp_get_thread_num() == 0)
-                options->progress(options->progress_user, "view factors",
-                                  fmin(done / fmax(total_pairs, 1), 0.999));
         }
         pair_workspace_free(&w);
 #pragma omp critical
