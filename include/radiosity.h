@@ -115,6 +115,12 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 #define RAD_DEFAULT_PATHTRACE_SPP 64    /* rad_pathtrace_options.samples_per_pixel */
 #define RAD_DEFAULT_BLOCK_SIZE 8        /* rad_compare_options.block_size */
 #define RAD_DEFAULT_BLOCK_TOLERANCE 0.1 /* rad_compare_options.block_tolerance */
+#define RAD_DEFAULT_TOLERANCE 1e-4      /* tolerance of rad_solve_options,
+                                           rad_hierarchy_options, rad_scene_solve_options */
+#define RAD_DEFAULT_MAX_SWEEPS 10000    /* rad_solve_options.max_iterations: gathering */
+#define RAD_DEFAULT_SHOTS_PER_PATCH 1000 /* rad_solve_options.max_iterations: shooting, n x */
+#define RAD_DEFAULT_HIERARCHY_SWEEPS 1000 /* rad_hierarchy_options.max_iterations */
+#define RAD_DEFAULT_REFINE_THRESHOLD 0.25 /* rad_hierarchy_options.refine_threshold */
 
 /* ------------------------------------------------------------------------------------ */
 /* Small value types                                                                     */
@@ -732,7 +738,7 @@ rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
                      rad_rgb *B, rad_solve_report *report, rad_error *error);
 
 /* Largest system the direct solver takes. */
-#define RAD_DIRECT_MAX_PATCHES 4096u
+#define RAD_DIRECT_MAX_PATCHES 4096
 
 /* The relative residual used by every solver's report. */
 double rad_system_residual(const rad_system *system, const rad_rgb *B);
@@ -814,10 +820,10 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
 
 /* Leaf patches the default patch size aims at: RAD_DEFAULT_PATCHES for the dense solvers
  * (and RAD_SOLVER_AUTO), RAD_HIERARCHICAL_DEFAULT_PATCHES for the hierarchical one. */
-#define RAD_DEFAULT_PATCHES 3000u
-#define RAD_HIERARCHICAL_DEFAULT_PATCHES 30000u
+#define RAD_DEFAULT_PATCHES 3000
+#define RAD_HIERARCHICAL_DEFAULT_PATCHES 30000
 /* RAD_SOLVER_AUTO picks the dense gather up to this many patches, else hierarchical. */
-#define RAD_DENSE_MAX_PATCHES 4096u
+#define RAD_DENSE_MAX_PATCHES 4096
 
 /* The patch size for `solver` on this scene (rad_mesh_default_patch_size of the targets
  * above). */

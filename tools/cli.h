@@ -122,23 +122,32 @@ enum {
     "  --solver NAME        gather (Jacobi), gauss-seidel, shoot, direct (LU, small\n"       \
     "                       scenes only), or hierarchical (links between element and\n"     \
     "                       cluster trees, no n x n matrix: large scenes). Default: the\n"  \
-    "                       library's choice: gather up to 4096 patches, else\n"           \
+    "                       library's choice: gather up to " CLI_STR(RAD_DENSE_MAX_PATCHES)   \
+    " patches, else\n"                                                                     \
     "                       hierarchical (the summary and --stats say which ran)\n"         \
     "  --refine-threshold X hierarchical: split a link while B x F x A exceeds X times\n"   \
-    "                       the emitted power per patch (default 0.25; smaller = finer)\n"  \
+    "                       the emitted power per patch (default "                     \
+    CLI_STR(RAD_DEFAULT_REFINE_THRESHOLD) "; smaller = finer)\n"  \
     "  --max-memory SIZE    hierarchical: bytes the links may use (K, M, G suffixes;\n"     \
     "                       default half the machine's memory); refinement stops there\n"   \
     "                       and the run says so\n"                                          \
     "  --tolerance X        relative residual, or unshot fraction for shoot, or change of\n" \
-    "                       a sweep for hierarchical (default 1e-4)\n"                     \
-    "  --max-iterations N   sweeps, or shots for shoot (default 10000 sweeps, 1000 n\n"     \
-    "                       shots for n patches, 1000 sweeps for hierarchical)\n"          \
-    "  --patch-size L       longest patch edge in scene units (default: about 3000\n"       \
-    "                       patches, 30000 with --solver hierarchical, or the one\n"        \
+    "                       a sweep for hierarchical (default "                            \
+    CLI_STR(RAD_DEFAULT_TOLERANCE) ")\n"                                                   \
+    "  --max-iterations N   sweeps, or shots for shoot (default "                          \
+    CLI_STR(RAD_DEFAULT_MAX_SWEEPS) " sweeps,\n"                                           \
+    "                       " CLI_STR(RAD_DEFAULT_SHOTS_PER_PATCH) " n shots for n patches, " \
+    CLI_STR(RAD_DEFAULT_HIERARCHY_SWEEPS) " sweeps for hierarchical)\n"                    \
+    "  --patch-size L       longest patch edge in scene units (default: about "            \
+    CLI_STR(RAD_DEFAULT_PATCHES) "\n"                                                      \
+    "                       patches, " CLI_STR(RAD_HIERARCHICAL_DEFAULT_PATCHES)              \
+    " with --solver hierarchical, or the one\n"                                            \
     "                       --solution's file was solved with)\n"                           \
-    "  --visibility-rays N  most occlusion rays per patch pair or link (default 16; 4\n"    \
+    "  --visibility-rays N  most occlusion rays per patch pair or link (default "          \
+    CLI_STR(RAD_DEFAULT_VISIBILITY_RAYS) "; 4\n"                                          \
     "                       first, all N only where those 4 disagree)\n"                   \
-    "  --quadrature M       M x M points per patch for the analytic form factor (default 1)\n" \
+    "  --quadrature M       M x M points per patch for the analytic form factor (default " \
+    CLI_STR(RAD_DEFAULT_QUADRATURE) ")\n"                                                 \
     CLI_SCENE_HELP                                                                         \
     "  --threads N          worker threads (default: all cores)\n"                          \
     "  --seed N             seed of every random choice (default 1)\n"                      \

@@ -20,8 +20,9 @@
 #include "solve/solve_internal.h"
 
 /* Defaults for the zero values of rad_solve_options (see radiosity.h). */
-#define SOLVE_DEFAULT_TOLERANCE 1e-4 /* relative residual / unshot fraction */
-enum { SOLVE_DEFAULT_SWEEPS = 10000, SOLVE_DEFAULT_SHOTS_PER_PATCH = 1000 };
+#define SOLVE_DEFAULT_TOLERANCE RAD_DEFAULT_TOLERANCE /* residual / unshot fraction */
+#define SOLVE_DEFAULT_SWEEPS RAD_DEFAULT_MAX_SWEEPS
+#define SOLVE_DEFAULT_SHOTS_PER_PATCH RAD_DEFAULT_SHOTS_PER_PATCH
 
 /* Progress is reported only when the fraction grew by at least this much. */
 #define SOLVE_PROGRESS_STEP 0.01

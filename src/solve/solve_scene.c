@@ -49,7 +49,7 @@ rad_solver rad_solve_scene_choice(const rad_mesh *mesh, const rad_scene_solve_op
     double matrix_bytes = (double)patches * patches * sizeof(float);
     uint64_t physical = rad_physical_memory_bytes();
     if (patches > RAD_DENSE_MAX_PATCHES) {
-        snprintf(reason, size, "%u patches > %u: no dense matrix", patches,
+        snprintf(reason, size, "%u patches > %d: no dense matrix", patches,
                  RAD_DENSE_MAX_PATCHES);
         return RAD_SOLVER_HIERARCHICAL;
     }
@@ -58,7 +58,7 @@ rad_solver rad_solve_scene_choice(const rad_mesh *mesh, const rad_scene_solve_op
                  matrix_bytes / 1e9);
         return RAD_SOLVER_HIERARCHICAL;
     }
-    snprintf(reason, size, "%u patches <= %u: dense matrix", patches, RAD_DENSE_MAX_PATCHES);
+    snprintf(reason, size, "%u patches <= %d: dense matrix", patches, RAD_DENSE_MAX_PATCHES);
     return RAD_SOLVER_JACOBI;
 }
 
@@ -69,7 +69,7 @@ static rad_status solve_dense(const rad_mesh *mesh, const rad_patch_inputs *inpu
 {
     if (solver == RAD_SOLVER_DIRECT && mesh->patch_count > RAD_DIRECT_MAX_PATCHES)
         return rad_fail(error, RAD_ERR_UNSUPPORTED,
-                        "the direct solver is for small scenes: %u patches (limit %u): use a "
+                        "the direct solver is for small scenes: %u patches (limit %d): use a "
                         "larger --patch-size or another solver",
                         mesh->patch_count, RAD_DIRECT_MAX_PATCHES);
     rad_formfactor_options ff_options = {o->quadrature, o->visibility_rays, o->seed,

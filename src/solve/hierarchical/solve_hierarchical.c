@@ -24,10 +24,10 @@
 #include "solve/hierarchical/final_gather.h"
 #include "solve/hierarchical/hierarchy.h"
 
-#define DEFAULT_THRESHOLD 0.25
-#define DEFAULT_TOLERANCE 1e-4
-#define DEFAULT_MAX_ITERATIONS 1000u
-#define DEFAULT_VISIBILITY_RAYS 16u
+#define DEFAULT_THRESHOLD RAD_DEFAULT_REFINE_THRESHOLD
+#define DEFAULT_TOLERANCE RAD_DEFAULT_TOLERANCE
+#define DEFAULT_MAX_ITERATIONS RAD_DEFAULT_HIERARCHY_SWEEPS
+#define DEFAULT_VISIBILITY_RAYS RAD_DEFAULT_VISIBILITY_RAYS
 #define SWEEPS_PER_PASS 1u
 #define MAX_CORRECTION_FACTOR 1.0
 #define FULL_CHECK_EVERY 8u /* passes; the others look only at links not settled */
