@@ -162,10 +162,12 @@ static void describe(report *r, const rad_scene *scene)
     say(r, "materials: %u\n", nm);
     for (uint32_t m = 0; m < nm; m++) {
         const rad_material *material = &scene->materials[m];
-        say(r, "  %-24s albedo (%.4g, %.4g, %.4g)%s  emission (%.4g, %.4g, %.4g)  %u triangles%s\n",
+        say(r, "  %-24s albedo (%.4g, %.4g, %.4g)%s  emission (%.4g, %.4g, %.4g)%s  %u "
+               "triangles%s\n",
             material->name, material->albedo.r, material->albedo.g, material->albedo.b,
             material->albedo_texture ? " x texture" : "", material->emission.r,
-            material->emission.g, material->emission.b, material_triangles[m],
+            material->emission.g, material->emission.b,
+            material->emission_texture ? " x texture" : "", material_triangles[m],
             material_triangles[m] ? "" : " (unused)");
     }
     unsigned emitters = 0;
@@ -176,20 +178,26 @@ static void describe(report *r, const rad_scene *scene)
         const rad_material *material = &scene->materials[m];
         if (!emits(material) || !material_triangles[m])
             continue;
-        /* power of a Lambertian emitter: pi L_e A (per unit of the scene's length squared) */
+        /* power of a Lambertian emitter: pi L_e A (per unit of the scene's length squared);
+         * with an emission texture, times the texture's mean over the surface (not shown) */
         double k = 3.14159265358979323846 * material_area[m];
-        say(r, "  %-24s radiance (%.4g, %.4g, %.4g)  area %.6g  power (%.6g, %.6g, %.6g)\n",
+        say(r, "  %-24s radiance (%.4g, %.4g, %.4g)%s  area %.6g  power (%.6g, %.6g, %.6g)%s\n",
             material->name, material->emission.r, material->emission.g, material->emission.b,
-            material_area[m], k * material->emission.r, k * material->emission.g,
-            k * material->emission.b);
+            material->emission_texture ? " x texture" : "", material_area[m],
+            k * material->emission.r, k * material->emission.g, k * material->emission.b,
+            material->emission_texture ? " x the texture's mean" : "");
     }
     say(r, "textures: %u\n", scene->texture_count);
     for (uint32_t t = 0; t < scene->texture_count; t++) {
         const rad_texture *texture = &scene->textures[t];
         say(r, "  %s  %u x %u  used by", texture->source, texture->width, texture->height);
         for (uint32_t m = 0; m < nm; m++)
+        {
             if (scene->materials[m].albedo_texture == t + 1)
-                say(r, " %s", scene->materials[m].name);
+                say(r, " %s (albedo)", scene->materials[m].name);
+            if (scene->materials[m].emission_texture == t + 1)
+                say(r, " %s (emission)", scene->materials[m].name);
+        }
         say(r, "\n");
     }
     free(listed_for);
