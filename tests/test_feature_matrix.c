@@ -195,25 +195,6 @@ static void print_summary(void)
 /* sRGB and PNG                                                                        */
 
 /* The sRGB transfer curve (IEC 61966-2-1) decoded exactly, for the reference. */
-static double srgb_to_linear(unsigned byte)
-{
-    double c = byte / 255.0;
-    return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
-}
-
-static void write_png(const char *name, uint32_t width, uint32_t height,
-                      const unsigned char *rgb)
-{
-    png_image image;
-    memset(&image, 0, sizeof(image));
-    image.version = PNG_IMAGE_VERSION;
-    image.width = width;
-    image.height = height;
-    image.format = PNG_FORMAT_RGB;
-    if (!png_image_write_to_file(&image, test_path(name), 0, rgb, 0, NULL))
-        test_fail(__FILE__, __LINE__, "cannot write %s", name);
-}
-
 /* Mean linear value of a texture's bytes, per channel. The surface mean of a bilinearly
  * filtered, wrapped texture over whole periods equals its texel mean; a patch's albedo is
  * the mean of 8 x 8 midpoint samples, which sample each texel's interpolation kernel
@@ -223,9 +204,9 @@ static rad_rgb texel_mean(const unsigned char *rgb, uint32_t count)
 {
     rad_rgb m = {0, 0, 0};
     for (uint32_t k = 0; k < count; k++) {
-        m.r += srgb_to_linear(rgb[3 * k]) / count;
-        m.g += srgb_to_linear(rgb[3 * k + 1]) / count;
-        m.b += srgb_to_linear(rgb[3 * k + 2]) / count;
+        m.r += test_srgb_to_linear(rgb[3 * k]) / count;
+        m.g += test_srgb_to_linear(rgb[3 * k + 1]) / count;
+        m.b += test_srgb_to_linear(rgb[3 * k + 2]) / count;
     }
     return m;
 }
@@ -241,8 +222,8 @@ static void write_textures(void)
     for (int y = 0; y < 4; y++)
         for (int x = 0; x < 4; x++)
             memcpy(&checker[(y * 4 + x) * 3], (x + y) % 2 ? checker_a : checker_b, 3);
-    write_png("checker.png", 4, 4, checker);
-    write_png("glow.png", 2, 2, glow);
+    test_write_png("checker.png", 4, 4, checker);
+    test_write_png("glow.png", 2, 2, glow);
 }
 
 /* ---------------------------------------------------------------------------------- */
@@ -1064,7 +1045,7 @@ static void run_furnace(void)
 {
     unsigned char grey[2 * 2 * 3];
     memset(grey, FURNACE_BYTE, sizeof(grey));
-    write_png("grey.png", 2, 2, grey);
+    test_write_png("grey.png", 2, 2, grey);
     test_write_file("tfurnace.mtl", "newmtl glow\nKd 1 1 1\nKe 1 1 1\nmap_Kd grey.png\n");
     static obj_text o;
     memset(&o, 0, sizeof(o));
@@ -1083,7 +1064,7 @@ static void run_furnace(void)
     quad(&o, V3(0, 0, 0), V3(1, 0, 0), V3(0, 1, 0));
     test_write_file("tfurnace.obj", o.text);
 
-    double rho = srgb_to_linear(FURNACE_BYTE), expected = 1 / (1 - rho);
+    double rho = test_srgb_to_linear(FURNACE_BYTE), expected = 1 / (1 - rho);
     printf("textured furnace: rho = %.6f (sRGB %d), L = 1 / (1 - rho) = %.6f\n", rho,
            FURNACE_BYTE, expected);
     rad_scene *scene = load("tfurnace.obj");

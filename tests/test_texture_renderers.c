@@ -31,12 +31,6 @@
 #include "render/emitters.h"
 #include "testlib.h"
 
-static double srgb_to_linear(unsigned value)
-{
-    double c = value / 255.0;
-    return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
-}
-
 /* A grey PNG of width x 1 whose first `split` columns are sRGB `left`, the rest `right`. */
 static void write_stripes(const char *name, uint32_t width, uint32_t split, unsigned left,
                           unsigned right)
@@ -44,14 +38,7 @@ static void write_stripes(const char *name, uint32_t width, uint32_t split, unsi
     unsigned char rgb[3 * 256];
     for (uint32_t x = 0; x < width && x < 256; x++)
         memset(&rgb[3 * x], (int)(x < split ? left : right), 3);
-    png_image image;
-    memset(&image, 0, sizeof(image));
-    image.version = PNG_IMAGE_VERSION;
-    image.width = width;
-    image.height = 1;
-    image.format = PNG_FORMAT_RGB;
-    if (!png_image_write_to_file(&image, test_path(name), 0, rgb, 0, NULL))
-        test_fail(__FILE__, __LINE__, "cannot write %s", name);
+    test_write_png(name, width, 1, rgb);
 }
 
 static rad_scene *load(const char *name)
@@ -131,7 +118,7 @@ static void write_textured_cube(const char *name, const char *mtl)
 static void textured_furnace(void)
 {
     const unsigned value = 188; /* sRGB: linear 0.5029 */
-    double t = srgb_to_linear(value);
+    double t = test_srgb_to_linear(value);
     write_stripes("grey188.png", 4, 4, value, value);
     test_write_file("cube.mtl", "newmtl glow\nKd 1 1 1\nmap_Kd grey188.png\n"
                                 "Ke 2 2 2\nmap_Ke grey188.png\n");
@@ -209,7 +196,7 @@ static void whitted_texel_ratio(void)
     rad_error error;
     CHECK(rad_raytrace(painted, &camera, &options, a, &error) == RAD_OK);
     CHECK(rad_raytrace(white, &camera, &options, b, &error) == RAD_OK);
-    double t_dark = srgb_to_linear(dark), t_bright = srgb_to_linear(bright);
+    double t_dark = test_srgb_to_linear(dark), t_bright = test_srgb_to_linear(bright);
     double worst = 0, sum[2] = {0, 0}, expected_sum[2] = {0, 0};
     unsigned count[2] = {0, 0};
     for (uint32_t y = 0; y < size; y++)
@@ -570,7 +557,7 @@ static void import_emission_textures(void)
     if (scene && rad_mesh_build(scene, 10, &mesh, &error) == RAD_OK &&
         rad_patch_inputs_build(scene, mesh, &inputs, &error) == RAD_OK) {
         CHECK(scene->materials[scene->triangles[0].material].emission_texture == 1);
-        double t = srgb_to_linear(value);
+        double t = test_srgb_to_linear(value);
         printf("glTF emissiveTexture (sRGB %u = linear %.5f) x factor (1, 0.5, 0.25) x "
                "strength 4: E = (%.5f, %.5f, %.5f), pi x 4 t x factor = (%.5f, %.5f, %.5f)\n",
                value, t, inputs->exitance[0].r, inputs->exitance[0].g, inputs->exitance[0].b,

@@ -21,18 +21,6 @@
 
 #include "testlib.h"
 
-static void write_png(const char *name, uint32_t width, uint32_t height, const unsigned char *rgb)
-{
-    png_image image;
-    memset(&image, 0, sizeof(image));
-    image.version = PNG_IMAGE_VERSION;
-    image.width = width;
-    image.height = height;
-    image.format = PNG_FORMAT_RGB;
-    if (!png_image_write_to_file(&image, test_path(name), 0, rgb, 0, NULL))
-        test_fail(__FILE__, __LINE__, "cannot write %s", name);
-}
-
 static void write_grey_jpeg(const char *name, unsigned value)
 {
     FILE *file = fopen(test_path(name), "wb");
@@ -61,12 +49,6 @@ static void write_grey_jpeg(const char *name, unsigned value)
     jpeg_finish_compress(&info);
     jpeg_destroy_compress(&info);
     fclose(file);
-}
-
-static double srgb_to_linear(double c)
-{
-    c /= 255;
-    return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
 }
 
 /* The floor [0,2] x [0,2] at y = 0 facing up, u along x and v along z, with `material`. */
@@ -118,7 +100,7 @@ static void patch_averages(void)
 {
     /* 2 x 1: black | white */
     const unsigned char stripes[6] = {0, 0, 0, 255, 255, 255};
-    write_png("stripes.png", 2, 1, stripes);
+    test_write_png("stripes.png", 2, 1, stripes);
     test_write_file("stripes.mtl", "newmtl striped\nKd 1 0.5 0.25\nmap_Kd stripes.png\n");
     test_write_file("stripes.obj", floor_obj("stripes.mtl", "striped", false));
     rad_rgb albedo[16];
@@ -133,7 +115,7 @@ static void patch_averages(void)
     test_write_file("grey.mtl", "newmtl grey\nKd 1 1 1\nmap_Kd grey.jpg\n");
     test_write_file("grey.obj", floor_obj("grey.mtl", "grey", false));
     CHECK(floor_albedo("grey.obj", 10, albedo, centroid, 16) == 1);
-    CHECK_NEAR(albedo[0].g, srgb_to_linear(128), 0.02);
+    CHECK_NEAR(albedo[0].g, test_srgb_to_linear(128), 0.02);
 }
 
 /* 1 x 2: white on top (v = 1 end), black below. OBJ's v and glTF's v (1 - OBJ's) must both
@@ -141,7 +123,7 @@ static void patch_averages(void)
 static void which_way_up(void)
 {
     const unsigned char rows[6] = {255, 255, 255, 0, 0, 0};
-    write_png("updown.png", 1, 2, rows);
+    test_write_png("updown.png", 1, 2, rows);
     test_write_file("updown.mtl", "newmtl updown\nKd 1 1 1\nmap_Kd updown.png\n");
     test_write_file("updown.obj", floor_obj("updown.mtl", "updown", false));
     /* the same floor as glTF: positions, glTF texture coordinates (v down), indices */

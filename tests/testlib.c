@@ -4,6 +4,8 @@
 #include "testlib.h"
 
 #include <dirent.h>
+#include <math.h>
+#include <png.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -179,4 +181,22 @@ rad_status test_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
         status = rad_solve_hierarchical(mesh, inputs, occluders, options, B, report, error);
     rad_patch_inputs_destroy(inputs);
     return status;
+}
+
+void test_write_png(const char *name, uint32_t width, uint32_t height, const unsigned char *rgb)
+{
+    png_image image;
+    memset(&image, 0, sizeof(image));
+    image.version = PNG_IMAGE_VERSION;
+    image.width = width;
+    image.height = height;
+    image.format = PNG_FORMAT_RGB;
+    if (!png_image_write_to_file(&image, test_path(name), 0, rgb, 0, NULL))
+        test_fail(__FILE__, __LINE__, "cannot write %s", name);
+}
+
+double test_srgb_to_linear(unsigned byte)
+{
+    double c = byte / 255.0;
+    return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
 }

@@ -92,4 +92,11 @@ rad_status test_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
                                    const rad_hierarchy_options *options, rad_rgb *B,
                                    rad_hierarchy_report *report, rad_error *error);
 
+/* Writes an 8-bit RGB PNG (libpng) of width x height into the scratch folder; fails the
+ * test when it cannot. */
+void test_write_png(const char *name, uint32_t width, uint32_t height, const unsigned char *rgb);
+
+/* The linear value of an 8-bit sRGB byte (IEC 61966-2-1), the reference for textures. */
+double test_srgb_to_linear(unsigned byte);
+
 #endif
