@@ -7,8 +7,10 @@
  * answer is reconstructed smoothly and rendered from a camera.
  *
  * The pipeline, one stage per section below:
- *   scene (import or built-in) -> mesh of patches -> tracer (ray queries) ->
- *   form factors -> solve -> reconstruct + render -> image / view-factor output.
+ *   scene (import or built-in) -> mesh of patches -> patch inputs -> rad_solve_scene (the
+ *   one entry point: form factors and a dense solver, or the hierarchical solver) ->
+ *   reconstruct + render -> image / lit mesh / solution file; and, beside it, surface
+ *   view factors for engineers. Tracers (ray queries) serve every stage that needs rays.
  *
  * Conventions shared by every function (see shared/docs/METHOD.md):
  *   - F_ij is the fraction of the energy leaving patch i that arrives at patch j.
@@ -25,14 +27,14 @@
  * them. No function prints or exits.
  *
  * Ownership: every function that hands back a new object through an `out` pointer
- * (rad_*_create, rad_*_load, rad_scene_load_files, rad_scene_cornell_box, rad_mesh_build,
+ * (rad_*_create, rad_*_load, rad_scene_load_files, rad_scene_cornell_box, rad_*_build,
  * rad_*_compute, rad_solution_read, rad_image_read, rad_viewfactor_matrix_script_f, ...)
  * gives it to the caller, who frees it with the *_destroy of its type (rad_scene_destroy,
- * rad_mesh_destroy, rad_tracer_destroy, rad_formfactors_destroy,
+ * rad_mesh_destroy, rad_patch_inputs_destroy, rad_tracer_destroy, rad_formfactors_destroy,
  * rad_viewfactor_matrix_destroy, rad_solution_destroy, rad_image_destroy); passing NULL to
- * a *_destroy is harmless. The per-patch arrays rad_system_from_mesh allocates are freed by
- * rad_system_free_arrays. Arrays and images the caller passes in to be filled (B, the
- * image of rad_render, ...) stay the caller's.
+ * a *_destroy is harmless. rad_system_of only points into what it is given: nothing to
+ * free. Arrays and images the caller passes in to be filled (B, the image of rad_render,
+ * ...) stay the caller's.
  *
  * Options and reports: a NULL options pointer means every default, and a zero field of an
  * options struct means that field's default (each field says which; the RAD_DEFAULT_*
