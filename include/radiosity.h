@@ -1135,7 +1135,7 @@ typedef struct rad_solution {
 
 /* A hash of what the solution depends on: the scene's positions and triangles (vertices,
  * materials, surfaces), each patch's albedo and exitance as the solve sees them
- * (rad_system_from_mesh), the patch size, and the mesh's vertex count, patch count and
+ * (rad_patch_inputs_build), the patch size, and the mesh's vertex count, patch count and
  * patch vertices. Floating-point values are hashed bit for bit. */
 rad_status rad_solution_fingerprint(const rad_scene *scene, const rad_mesh *mesh,
                                     uint64_t *fingerprint, rad_error *error);
