@@ -11,6 +11,7 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "geometry/contour.h"
+#include "geometry/polygon_integral.h"
 #include "trace/ray.h"
 
 /* Deepest subdivision of the outer triangle: 4^12 cells would be far past any need. */
@@ -27,12 +28,6 @@
 
 /* Largest k of a round's k x k stratified segments per replicate. */
 #define MAX_STRATA 32u
-
-/* The 7-point degree-5 rule on a triangle (Radon; Strang and Fix): barycentric points. */
-static const double rule_a1 = 0.059715871789769820, rule_b1 = 0.470142064105115090;
-static const double rule_a2 = 0.797426985353087322, rule_b2 = 0.101286507323456338;
-static const double rule_w0 = 0.225, rule_w1 = 0.132394152788506181,
-                    rule_w2 = 0.125939180544827153;
 
 typedef struct outer_context {
     rad_vec3 normal;         /* of the outer polygon */
@@ -64,78 +59,17 @@ static inline double point_factor(outer_context *c, rad_vec3 x)
     return factor;
 }
 
-static inline rad_vec3 barycentric(rad_vec3 a, rad_vec3 b, rad_vec3 c, double u, double v,
-                                   double w)
+static double point_factor_callback(void *context, rad_vec3 x)
 {
-    return v3(u * a.x + v * b.x + w * c.x, u * a.y + v * b.y + w * c.y,
-              u * a.z + v * b.z + w * c.z);
-}
-
-/* The 7-point rule times the area; *centre receives the 1-point (centroid) rule. */
-static double rule7(outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d, double area,
-                    double *centre)
-{
-    double f0 = point_factor(c, barycentric(a, b, d, 1.0 / 3, 1.0 / 3, 1.0 / 3));
-    double s1 = point_factor(c, barycentric(a, b, d, rule_a1, rule_b1, rule_b1)) +
-                point_factor(c, barycentric(a, b, d, rule_b1, rule_a1, rule_b1)) +
-                point_factor(c, barycentric(a, b, d, rule_b1, rule_b1, rule_a1));
-    double s2 = point_factor(c, barycentric(a, b, d, rule_a2, rule_b2, rule_b2)) +
-                point_factor(c, barycentric(a, b, d, rule_b2, rule_a2, rule_b2)) +
-                point_factor(c, barycentric(a, b, d, rule_b2, rule_b2, rule_a2));
-    *centre = f0 * area;
-    return (rule_w0 * f0 + rule_w1 * s1 + rule_w2 * s2) * area;
-}
-
-/* Integral over triangle (a, b, d) whose rule7 value is `whole`; *error accumulates the
- * estimated error of what is returned. */
-static double adapt(outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d, double area,
-                    double whole, double tolerance, int depth, double *error)
-{
-    rad_vec3 ab = v3_scale(v3_add(a, b), 0.5), bd = v3_scale(v3_add(b, d), 0.5),
-             da = v3_scale(v3_add(d, a), 0.5);
-    double quarter = 0.25 * area, unused;
-    double part[4] = {rule7(c, a, ab, da, quarter, &unused), rule7(c, ab, b, bd, quarter, &unused),
-                      rule7(c, da, bd, d, quarter, &unused), rule7(c, ab, bd, da, quarter, &unused)};
-    double sum = part[0] + part[1] + part[2] + part[3];
-    double difference = fabs(sum - whole);
-    if (difference <= tolerance || depth >= c->max_depth || c->failed) {
-        *error += difference;
-        return sum;
-    }
-    double t = 0.5 * tolerance;
-    return adapt(c, a, ab, da, quarter, part[0], t, depth + 1, error) +
-           adapt(c, ab, b, bd, quarter, part[1], t, depth + 1, error) +
-           adapt(c, da, bd, d, quarter, part[2], t, depth + 1, error) +
-           adapt(c, ab, bd, da, quarter, part[3], t, depth + 1, error);
-}
-
-static double integrate_triangle(outer_context *c, rad_vec3 a, rad_vec3 b, rad_vec3 d,
-                                 double accuracy, double *error)
-{
-    double area = 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(d, a)));
-    double centre;
-    double whole = rule7(c, a, b, d, area, &centre);
-    /* the floor keeps a pair that transfers (almost) nothing from refining forever */
-    double tolerance = fmax(accuracy * fabs(whole), 1e-15 * area);
-    if (fabs(whole - centre) <= tolerance) {
-        /* the 1-point rule already agrees: the degree-5 value is far better than that */
-        *error += fabs(whole - centre);
-        return whole;
-    }
-    return adapt(c, a, b, d, area, whole, tolerance, 1, error);
+    return point_factor(context, x);
 }
 
 /* G = int over the smaller polygon of F(x -> the other, as far as it is visible). */
 static double integrate_outer(outer_context *c, const vf_polygon *outer, double accuracy,
                               double *bound)
 {
-    double error = 0, sum = 0;
-    /* each fan triangle to the relative accuracy: so is their sum */
-    for (unsigned k = 1; k + 1 < outer->count; k++)
-        sum += integrate_triangle(c, outer->vertex[0], outer->vertex[k], outer->vertex[k + 1],
-                                  accuracy, &error);
-    *bound = error;
-    return sum;
+    polygon_integral integral = {point_factor_callback, c, c->max_depth, &c->failed};
+    return polygon_integrate(&integral, outer->vertex, outer->count, accuracy, bound);
 }
 
 double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accuracy,
@@ -171,6 +105,13 @@ void pair_workspace_free(pair_workspace *workspace)
     free(workspace->rays);
     free(workspace->occluded);
     free(workspace->weight);
+}
+
+static inline rad_vec3 barycentric(rad_vec3 a, rad_vec3 b, rad_vec3 c, double u, double v,
+                                   double w)
+{
+    return v3(u * a.x + v * b.x + w * c.x, u * a.y + v * b.y + w * c.y,
+              u * a.z + v * b.z + w * c.z);
 }
 
 /* A point of the polygon from (s, t) in the unit square, uniform in area: a quad picks

@@ -35,7 +35,7 @@ typedef struct gather_buffers {
     shadowed *pending;
     size_t pending_capacity;
     rad_ray *rays;
-    uint8_t *occluded;
+    uint8_t *occluded, *blocked;
     double *kernel;
     float *weight;
     size_t ray_capacity;
@@ -61,6 +61,10 @@ static bool reserve(gather_buffers *b, size_t pending, size_t rays)
         if (!o)
             return false;
         b->occluded = o;
+        uint8_t *blocked = realloc(b->blocked, capacity);
+        if (!blocked)
+            return false;
+        b->blocked = blocked;
         double *k = realloc(b->kernel, capacity * sizeof(*k));
         if (!k)
             return false;
@@ -117,9 +121,10 @@ static bool gather_leaf(const final_gather_context *c, uint32_t k, gather_buffer
     if (traced > 0) {
         for (size_t m = 0; m < traced; m++)
             hier_segments(t, c->seed, k, b->pending[m].source, c->rays, b->rays + m * c->rays,
-                          b->kernel + m * c->rays, c->leaf_brightness, b->weight + m * c->rays);
+                          b->kernel + m * c->rays, c->leaf_brightness, b->weight + m * c->rays,
+                          b->blocked + m * c->rays);
         size_t count = traced * c->rays;
-        rad_tracer_occluded(c->occluders, b->rays, (uint32_t)count, b->occluded);
+        hier_occluded(c->occluders, b->rays, (uint32_t)count, b->blocked, b->occluded);
         *rays_cast += count;
         for (size_t m = 0; m < traced; m++) {
             double visible = hier_visible_share(b->kernel + m * c->rays, b->weight + m * c->rays,
@@ -154,6 +159,7 @@ int hier_final_gather(const final_gather_context *c, rad_rgb *correction, uint64
         free(b.pending);
         free(b.rays);
         free(b.occluded);
+        free(b.blocked);
         free(b.kernel);
         free(b.weight);
     }

@@ -16,6 +16,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "mesh/near_contacts.h"
 #include "radiosity.h"
 
 #define HNODE_NONE UINT32_MAX
@@ -50,6 +51,7 @@ typedef struct hier_tree {
     struct leaf_shape *shapes; /* per leaf, in leaf order: what sampling needs */
     uint32_t planar_count, cluster_count;
     double plane_epsilon; /* scene units: the front-of-plane guard */
+    near_contacts contacts; /* what segments' left-out ends could miss (near_contacts.h) */
 } hier_tree;
 
 /* Builds the tree over every patch of the mesh. 0 on allocation failure. */
@@ -115,7 +117,12 @@ rad_vec3 hier_sample_point(const hier_tree *tree, uint32_t node, double u1, doub
  * leaf_weight of the source leaf each ends on (by leaf-order position). */
 void hier_segments(const hier_tree *tree, uint64_t seed, uint32_t receiver, uint32_t source,
                    unsigned count, rad_ray *rays, double *kernel, const float *leaf_weight,
-                   float *weight);
+                   float *weight, uint8_t *blocked);
+
+/* rad_tracer_occluded, then the segments hier_segments found blocked by a near contact
+ * (`blocked`) counted as occluded too. */
+void hier_occluded(const rad_tracer *occluders, const rad_ray *rays, uint32_t count,
+                   const uint8_t *blocked, uint8_t *occluded);
 
 /* The visible share of a link from its segments: the open ones' kernel x weight over all
  * of it (weight NULL: 1; the plain open fraction when all of it is 0). Weighting by the

@@ -245,7 +245,7 @@ static unsigned greatest_divisor(unsigned a, unsigned b)
 
 void hier_segments(const hier_tree *tree, uint64_t seed, uint32_t receiver, uint32_t source,
                    unsigned count, rad_ray *rays, double *kernel, const float *leaf_weight,
-                   float *weight)
+                   float *weight, uint8_t *blocked)
 {
     double area = tree->nodes[source].area;
     rad_rng rng = rad_rng_seed(seed, receiver, source);
@@ -274,7 +274,19 @@ void hier_segments(const hier_tree *tree, uint64_t seed, uint32_t receiver, uint
         if (weight)
             weight[k] = leaf_weight[at_b];
         ray_segment(&rays[k], a, b);
+        uint32_t from = tree->order[at_a], to = tree->order[at_b];
+        blocked[k] = (near_contacts_any(&tree->contacts, from) ||
+                      near_contacts_any(&tree->contacts, to)) &&
+                     near_contacts_block(&tree->contacts, from, to, a, b);
     }
+}
+
+void hier_occluded(const rad_tracer *occluders, const rad_ray *rays, uint32_t count,
+                   const uint8_t *blocked, uint8_t *occluded)
+{
+    rad_tracer_occluded(occluders, rays, count, occluded);
+    for (uint32_t k = 0; k < count; k++)
+        occluded[k] |= blocked[k];
 }
 
 double hier_visible_share(const double *kernel, const float *weight, const uint8_t *occluded,

@@ -85,11 +85,11 @@ typedef struct pending {
 
 typedef struct thread_buffers {
     rad_ray *rays;
-    uint8_t *occluded;
+    uint8_t *occluded, *blocked;
     double *kernel;
     pending *pend;
     rad_ray *more_rays;
-    uint8_t *more_occluded;
+    uint8_t *more_occluded, *more_blocked;
     double *more_kernel;
     float *weight, *more_weight;
 } thread_buffers;
@@ -159,14 +159,14 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
                                                 planes ? e.factor : -1.0};
             hier_segments(c->tree, c->seed, child->receiver, child->source, FIRST_RAYS,
                           &tb->rays[ray_count], &tb->kernel[ray_count], c->leaf_brightness,
-                          &tb->weight[ray_count]);
+                          &tb->weight[ray_count], &tb->blocked[ray_count]);
             ray_count += FIRST_RAYS;
             pending_count++;
             slot++;
         }
     }
     if (ray_count > 0)
-        rad_tracer_occluded(c->occluders, tb->rays, ray_count, tb->occluded);
+        hier_occluded(c->occluders, tb->rays, ray_count, tb->blocked, tb->occluded);
     *rays_cast += ray_count;
     unsigned extra = c->visibility_rays > FIRST_RAYS ? c->visibility_rays - FIRST_RAYS : 0;
     for (uint32_t k = 0; k < pending_count; k++) {
@@ -188,8 +188,10 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
         /* partly visible, or hidden between larger nodes (a gap the first few missed) */
         if (visible < FIRST_RAYS && extra > 0 && (visible > 0 || !leaves)) {
             hier_segments(c->tree, c->seed + 1, child->receiver, child->source, extra,
-                          tb->more_rays, tb->more_kernel, c->leaf_brightness, tb->more_weight);
-            rad_tracer_occluded(c->occluders, tb->more_rays, extra, tb->more_occluded);
+                          tb->more_rays, tb->more_kernel, c->leaf_brightness, tb->more_weight,
+                          tb->more_blocked);
+            hier_occluded(c->occluders, tb->more_rays, extra, tb->more_blocked,
+                          tb->more_occluded);
             *rays_cast += extra;
             for (unsigned r = 0; r < extra; r++) {
                 bool open = !tb->more_occluded[r];
@@ -344,6 +346,7 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
         size_t most = 4 * (size_t)CHUNK_LINKS;
         tb.rays = rad_alloc_array(most * FIRST_RAYS, sizeof(rad_ray));
         tb.occluded = rad_alloc_array(most * FIRST_RAYS, 1);
+        tb.blocked = rad_alloc_array(most * FIRST_RAYS, 1);
         tb.kernel = rad_alloc_array(most * FIRST_RAYS, sizeof(double));
         tb.more_kernel = rad_alloc_array(MAX_RAYS, sizeof(double));
         tb.weight = rad_alloc_array(most * FIRST_RAYS, sizeof(float));
@@ -351,8 +354,10 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
         tb.pend = rad_alloc_array(most, sizeof(pending));
         tb.more_rays = rad_alloc_array(MAX_RAYS, sizeof(rad_ray));
         tb.more_occluded = rad_alloc_array(MAX_RAYS, 1);
-        bool have = tb.rays && tb.occluded && tb.kernel && tb.pend && tb.more_rays &&
-                    tb.more_occluded && tb.more_kernel && tb.weight && tb.more_weight;
+        tb.more_blocked = rad_alloc_array(MAX_RAYS, 1);
+        bool have = tb.rays && tb.occluded && tb.blocked && tb.kernel && tb.pend &&
+                    tb.more_rays && tb.more_occluded && tb.more_blocked && tb.more_kernel &&
+                    tb.weight && tb.more_weight;
         refine_context local = *c;
         local.visibility_rays = extra_rays;
 #pragma omp for schedule(dynamic, 1)
@@ -367,6 +372,7 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
         }
         free(tb.rays);
         free(tb.occluded);
+        free(tb.blocked);
         free(tb.kernel);
         free(tb.more_kernel);
         free(tb.weight);
@@ -374,6 +380,7 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
         free(tb.pend);
         free(tb.more_rays);
         free(tb.more_occluded);
+        free(tb.more_blocked);
     }
     if (failed) {
         free(action);

@@ -247,6 +247,11 @@ int hier_tree_build(const rad_mesh *mesh, hier_tree *tree)
         build_clusters(&b, groups, group_total, HNODE_NONE, patch_ids, centroids);
         for (uint32_t k = 0; k < n; k++)
             describe_leaf(mesh, tree->order[k], &tree->shapes[k]);
+        rad_error unused;
+        ok = near_contacts_build(mesh, near_contacts_reach(mesh), tree->plane_epsilon,
+                                 &tree->contacts, &unused) == RAD_OK;
+    }
+    if (ok) {
         double running = 0;
         for (uint32_t k = 0; k < n; k++) {
             running += mesh->patches[tree->order[k]].area;
@@ -271,5 +276,6 @@ void hier_tree_free(hier_tree *tree)
     free(tree->order);
     free(tree->cumulative);
     free(tree->shapes);
+    near_contacts_free(&tree->contacts);
     memset(tree, 0, sizeof(*tree));
 }

@@ -1,0 +1,191 @@
+/*
+ * near_contacts.c - patches within a hair of each other, see near_contacts.h.
+ *
+ * Candidates come from a sweep along the scene's longest axis over the patches' bounding
+ * boxes grown by the reach; a candidate is kept when the boxes overlap in all three axes,
+ * some corner of it lies in front of the patch's plane and its nearest corner lies within
+ * the reach of that plane. The list is conservative (a box test, not the exact distance
+ * between the two polygons): an extra entry costs a test, a missing one a leak.
+ */
+#include "mesh/near_contacts.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/tolerance.h"
+#include "core/vec3.h"
+
+typedef struct patch_box {
+    double lo[3], hi[3];
+    double key; /* lo along the sweep axis */
+    uint32_t patch;
+} patch_box;
+
+static int by_low(const void *a, const void *b)
+{
+    double x = ((const patch_box *)a)->key, y = ((const patch_box *)b)->key;
+    if (x != y)
+        return x < y ? -1 : 1;
+    uint32_t p = ((const patch_box *)a)->patch, q = ((const patch_box *)b)->patch;
+    return (p > q) - (p < q);
+}
+
+static double coordinate(rad_vec3 v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+
+/* True when patch k can block a segment leaving patch i's front within `reach` of it. */
+static bool stands_in_front(const rad_mesh *mesh, uint32_t i, uint32_t k, double reach,
+                            double plane_epsilon)
+{
+    const rad_patch *pi = &mesh->patches[i], *pk = &mesh->patches[k];
+    rad_vec3 origin = mesh->vertices[pi->vertex[0]];
+    double nearest = INFINITY, farthest = -INFINITY;
+    for (unsigned c = 0; c < pk->vertex_count; c++) {
+        double d = v3_dot(pi->normal, v3_sub(mesh->vertices[pk->vertex[c]], origin));
+        nearest = fmin(nearest, d);
+        farthest = fmax(farthest, d);
+    }
+    return farthest > plane_epsilon && nearest < reach;
+}
+
+double near_contacts_reach(const rad_mesh *mesh)
+{
+    rad_vec3 lo, hi;
+    v3_bounds(mesh->vertices, mesh->vertex_count, &lo, &hi);
+    /* a segment is at most the diagonal long; twice the end fraction for margin */
+    return 2.0 * RAD_SEGMENT_END_EPSILON * v3_length(v3_sub(hi, lo));
+}
+
+rad_status near_contacts_build(const rad_mesh *mesh, double reach, double plane_epsilon,
+                               near_contacts *out, rad_error *error)
+{
+    uint32_t n = mesh->patch_count;
+    *out = (near_contacts){.patch_count = n, .mesh = mesh, .plane_epsilon = plane_epsilon};
+    patch_box *boxes = rad_alloc_array(n, sizeof(*boxes));
+    uint32_t *count = rad_alloc_array((size_t)n + 1, sizeof(*count));
+    out->start = rad_alloc_array((size_t)n + 1, sizeof(*out->start));
+    uint32_t *pairs = NULL; /* (i, k) in pairs, two per entry */
+    size_t pair_count = 0, pair_capacity = 0;
+    if (!boxes || !count || !out->start)
+        goto nomem;
+    rad_vec3 scene_lo, scene_hi;
+    v3_bounds(mesh->vertices, mesh->vertex_count, &scene_lo, &scene_hi);
+    rad_vec3 size = v3_sub(scene_hi, scene_lo);
+    int axis = size.x >= size.y && size.x >= size.z ? 0 : size.y >= size.z ? 1 : 2;
+    for (uint32_t i = 0; i < n; i++) {
+        const rad_patch *p = &mesh->patches[i];
+        patch_box *b = &boxes[i];
+        b->patch = i;
+        for (int a = 0; a < 3; a++) {
+            b->lo[a] = INFINITY;
+            b->hi[a] = -INFINITY;
+        }
+        for (unsigned c = 0; c < p->vertex_count; c++)
+            for (int a = 0; a < 3; a++) {
+                double x = coordinate(mesh->vertices[p->vertex[c]], a);
+                b->lo[a] = fmin(b->lo[a], x - reach);
+                b->hi[a] = fmax(b->hi[a], x + reach);
+            }
+    }
+    for (uint32_t i = 0; i < n; i++)
+        boxes[i].key = boxes[i].lo[axis];
+    qsort(boxes, n, sizeof(*boxes), by_low);
+    for (uint32_t s = 0; s < n; s++)
+        for (uint32_t t = s + 1; t < n && boxes[t].lo[axis] <= boxes[s].hi[axis]; t++) {
+            const patch_box *a = &boxes[s], *b = &boxes[t];
+            if (a->lo[0] > b->hi[0] || b->lo[0] > a->hi[0] || a->lo[1] > b->hi[1] ||
+                b->lo[1] > a->hi[1] || a->lo[2] > b->hi[2] || b->lo[2] > a->hi[2])
+                continue;
+            uint32_t i = a->patch, k = b->patch;
+            for (int side = 0; side < 2; side++, i = b->patch, k = a->patch) {
+                if (!stands_in_front(mesh, i, k, reach, plane_epsilon))
+                    continue;
+                if (!rad_grow_array((void **)&pairs, &pair_capacity, 2 * (pair_count + 1),
+                                    sizeof(*pairs)))
+                    goto nomem;
+                pairs[2 * pair_count] = i;
+                pairs[2 * pair_count + 1] = k;
+                pair_count++;
+                count[i]++;
+            }
+        }
+    out->contact = rad_alloc_array(pair_count, sizeof(*out->contact));
+    if (!out->contact)
+        goto nomem;
+    for (uint32_t i = 0; i < n; i++)
+        out->start[i + 1] = out->start[i] + count[i];
+    for (uint32_t i = 0; i < n; i++)
+        count[i] = out->start[i];
+    for (size_t p = 0; p < pair_count; p++)
+        out->contact[count[pairs[2 * p]]++] = pairs[2 * p + 1];
+    free(boxes);
+    free(count);
+    free(pairs);
+    return RAD_OK;
+nomem:
+    free(boxes);
+    free(count);
+    free(pairs);
+    near_contacts_free(out);
+    return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the near contacts of %u patches", n);
+}
+
+void near_contacts_free(near_contacts *contacts)
+{
+    free(contacts->start);
+    free(contacts->contact);
+    contacts->start = contacts->contact = NULL;
+}
+
+/* Moller-Trumbore in double: the segment a + t d crosses triangle (v0, v1, v2) at some t in
+ * (t_low, t_high). */
+static bool segment_crosses(rad_vec3 a, rad_vec3 d, rad_vec3 v0, rad_vec3 v1, rad_vec3 v2,
+                            double t_low, double t_high)
+{
+    rad_vec3 e1 = v3_sub(v1, v0), e2 = v3_sub(v2, v0);
+    rad_vec3 p = v3_cross(d, e2);
+    double det = v3_dot(e1, p);
+    if (det == 0)
+        return false;
+    double inverse = 1.0 / det;
+    rad_vec3 s = v3_sub(a, v0);
+    double u = v3_dot(s, p) * inverse;
+    if (u < 0 || u > 1)
+        return false;
+    rad_vec3 q = v3_cross(s, e1);
+    double v = v3_dot(d, q) * inverse;
+    if (v < 0 || u + v > 1)
+        return false;
+    double t = v3_dot(e2, q) * inverse;
+    return t > t_low && t < t_high;
+}
+
+static bool crosses_patch(const rad_mesh *mesh, uint32_t k, rad_vec3 a, rad_vec3 d,
+                          double t_low, double t_high)
+{
+    const rad_patch *p = &mesh->patches[k];
+    const rad_vec3 *v = mesh->vertices;
+    if (segment_crosses(a, d, v[p->vertex[0]], v[p->vertex[1]], v[p->vertex[2]], t_low, t_high))
+        return true;
+    return p->vertex_count == 4 && segment_crosses(a, d, v[p->vertex[0]], v[p->vertex[2]],
+                                                   v[p->vertex[3]], t_low, t_high);
+}
+
+bool near_contacts_block(const near_contacts *contacts, uint32_t from, uint32_t to, rad_vec3 a,
+                         rad_vec3 b)
+{
+    rad_vec3 d = v3_sub(b, a);
+    double length = v3_length(d);
+    if (!(length > 2 * contacts->plane_epsilon))
+        return false;
+    double t_low = contacts->plane_epsilon / length, t_high = 1 - t_low;
+    uint32_t ends[2] = {from, to};
+    for (int e = 0; e < 2; e++)
+        for (uint32_t c = contacts->start[ends[e]]; c < contacts->start[ends[e] + 1]; c++) {
+            uint32_t k = contacts->contact[c];
+            if (k != from && k != to && crosses_patch(contacts->mesh, k, a, d, t_low, t_high))
+                return true;
+        }
+    return false;
+}
