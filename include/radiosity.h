@@ -485,6 +485,10 @@ typedef struct rad_formfactor_report {
     double seconds;            /* wall-clock time of the whole computation */
     double tracing_seconds;    /* time spent tracing, summed over threads */
     int threads;               /* threads used */
+    uint32_t rows_trimmed;     /* rows whose sum came out above 1 (no patch sees more than
+                                  its hemisphere), scaled back to 1 keeping reciprocity */
+    double largest_row_sum;    /* the largest row sum before that */
+    uint32_t largest_row;      /* its patch */
 } rad_formfactor_report;
 
 /* The dense n x n matrix, row-major: F[i * n + j] = F_ij. Reciprocity holds exactly by
@@ -496,9 +500,13 @@ typedef struct rad_formfactors {
 
 /* Computes every F_ij of the mesh. `occluders` is a tracer over the scene's triangles (any
  * backend). The unoccluded point-to-patch factor is analytic (Lambert's contour formula,
- * integrated over each patch by an m x m midpoint rule, averaged over both directions);
- * visibility is the fraction of unoccluded rays between stratified points of the two
- * patches (4 first, the full count where those 4 disagree). */
+ * integrated over the smaller patch: an m x m midpoint rule for pairs far apart, 4 x 4
+ * for pairs close by, adaptive for touching pairs); visibility is the fraction of
+ * unoccluded rays between stratified points of the two patches (4 first, the full count
+ * where those 4 disagree), with surfaces within a hair of either end tested in double
+ * precision. No row sums to more than 1: a row that came out above (sampling error next to
+ * a slot, a gap narrower than the patches) is scaled back, each F_ij and F_ji by the same
+ * factor, and counted in the report. */
 rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occluders,
                                    const rad_formfactor_options *options,
                                    rad_formfactors **out, rad_formfactor_report *report,
@@ -727,17 +735,25 @@ typedef struct rad_solve_report {
     double residual;         /* sum_i A_i |B - E - rho F B|_1 / sum_i A_i |E|_1, all solvers */
     bool converged;          /* criterion <= tolerance */
     double seconds;
+    uint32_t patch;          /* after an error about one patch (a row that creates energy,
+                                a diverging or non-finite value): that patch, else
+                                UINT32_MAX */
 } rad_solve_report;
 
 /* Fills B (n values, exitance). RAD_ERR_INVALID for a negative thread count, a
- * non-positive area, an albedo outside [0,1], a negative exitance or the hierarchical
- * solver (it needs the mesh: rad_solve_hierarchical); the direct solver refuses more than
+ * non-positive area, an albedo outside [0,1], a negative exitance, a row whose rho_i x
+ * sum_j F_ij exceeds 1 + RAD_ROW_SUM_SLACK (it creates energy: no solver converges), an
+ * iteration that diverges or stops being finite anyway (report->patch names the patch) or
+ * the hierarchical solver (it needs the mesh: rad_solve_hierarchical); the direct solver refuses more than
  * RAD_DIRECT_MAX_PATCHES patches (RAD_ERR_UNSUPPORTED) and a singular system
  * (RAD_ERR_INVALID), and reports iterations 0. Shooting derives F_ji from F_ij by
  * reciprocity, so its residual levels off near float precision (about 1e-7). With the
  * ambient term on, `residual` measures B including it. */
 rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
                      rad_rgb *B, rad_solve_report *report, rad_error *error);
+
+/* How far above 1 rad_solve lets rho_i x sum_j F_ij go (float rounding of the rows). */
+#define RAD_ROW_SUM_SLACK 1e-3
 
 /* Largest system the direct solver takes. */
 #define RAD_DIRECT_MAX_PATCHES 4096

@@ -65,10 +65,13 @@ rad_status near_contacts_build(const rad_mesh *mesh, double reach, double plane_
     patch_box *boxes = rad_alloc_array(n, sizeof(*boxes));
     uint32_t *count = rad_alloc_array((size_t)n + 1, sizeof(*count));
     out->start = rad_alloc_array((size_t)n + 1, sizeof(*out->start));
+    out->offset = rad_alloc_array(n, sizeof(*out->offset));
     uint32_t *pairs = NULL; /* (i, k) in pairs, two per entry */
     size_t pair_count = 0, pair_capacity = 0;
-    if (!boxes || !count || !out->start)
+    if (!boxes || !count || !out->start || !out->offset)
         goto nomem;
+    for (uint32_t i = 0; i < n; i++)
+        out->offset[i] = v3_dot(mesh->patches[i].normal, mesh->vertices[mesh->patches[i].vertex[0]]);
     rad_vec3 scene_lo, scene_hi;
     v3_bounds(mesh->vertices, mesh->vertex_count, &scene_lo, &scene_hi);
     rad_vec3 size = v3_sub(scene_hi, scene_lo);
@@ -135,7 +138,9 @@ void near_contacts_free(near_contacts *contacts)
 {
     free(contacts->start);
     free(contacts->contact);
+    free(contacts->offset);
     contacts->start = contacts->contact = NULL;
+    contacts->offset = NULL;
 }
 
 /* Moller-Trumbore in double: the segment a + t d crosses triangle (v0, v1, v2) at some t in
@@ -172,6 +177,23 @@ static bool crosses_patch(const rad_mesh *mesh, uint32_t k, rad_vec3 a, rad_vec3
                                                    v[p->vertex[3]], t_low, t_high);
 }
 
+/* The end `a` of a segment a + t d, t in [0, 1], of the given length: does it cross one
+ * of patch `end`'s contacts (other than `other`) within t in (t_low, zone]? */
+static bool blocked_near(const near_contacts *contacts, uint32_t end, uint32_t other,
+                         rad_vec3 a, rad_vec3 d, double length, double t_low, double zone)
+{
+    const rad_mesh *mesh = contacts->mesh;
+    for (uint32_t c = contacts->start[end]; c < contacts->start[end + 1]; c++) {
+        uint32_t k = contacts->contact[c];
+        /* the zone is zone x length long: a plane farther from a than that is not reached */
+        double distance = v3_dot(mesh->patches[k].normal, a) - contacts->offset[k];
+        if (k != other && fabs(distance) <= zone * length &&
+            crosses_patch(mesh, k, a, d, t_low, zone))
+            return true;
+    }
+    return false;
+}
+
 bool near_contacts_block(const near_contacts *contacts, uint32_t from, uint32_t to, rad_vec3 a,
                          rad_vec3 b)
 {
@@ -179,13 +201,9 @@ bool near_contacts_block(const near_contacts *contacts, uint32_t from, uint32_t 
     double length = v3_length(d);
     if (!(length > 2 * contacts->plane_epsilon))
         return false;
-    double t_low = contacts->plane_epsilon / length, t_high = 1 - t_low;
-    uint32_t ends[2] = {from, to};
-    for (int e = 0; e < 2; e++)
-        for (uint32_t c = contacts->start[ends[e]]; c < contacts->start[ends[e] + 1]; c++) {
-            uint32_t k = contacts->contact[c];
-            if (k != from && k != to && crosses_patch(contacts->mesh, k, a, d, t_low, t_high))
-                return true;
-        }
-    return false;
+    double t_low = contacts->plane_epsilon / length;
+    /* what the tracer leaves out, and a little more so that nothing falls between */
+    double zone = fmin(0.5, 1.01 * RAD_SEGMENT_END_EPSILON + t_low);
+    return blocked_near(contacts, from, to, a, d, length, t_low, zone) ||
+           blocked_near(contacts, to, from, b, v3_scale(d, -1), length, t_low, zone);
 }

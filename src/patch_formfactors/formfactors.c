@@ -30,6 +30,47 @@ static void store_pair(void *data, int thread, uint32_t i, uint32_t j, double G)
     sink->F[j * sink->n + i] = (float)(G / sink->patches[j].area);
 }
 
+/* Scales rows summing above 1 back to 1: F_ij and F_ji both by min(s_i, s_j) with
+ * s_i = min(1, 1 / row_i), so reciprocity holds and no row exceeds 1 afterwards. */
+static rad_status trim_rows(float *F, size_t n, rad_formfactor_report *report)
+{
+    double *scale = rad_alloc_array(n, sizeof(*scale));
+    if (!scale)
+        return RAD_ERR_NOMEM;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        double row = 0;
+        for (size_t j = 0; j < n; j++)
+            row += F[i * n + j];
+        scale[i] = row;
+    }
+    double largest = 0;
+    size_t largest_row = 0, trimmed = 0;
+    for (size_t i = 0; i < n; i++) {
+        double row = scale[i];
+        if (row > largest) {
+            largest = row;
+            largest_row = i;
+        }
+        scale[i] = row > 1 ? 1 / row : 1;
+        trimmed += row > 1;
+    }
+    if (trimmed) {
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++)
+            for (size_t j = 0; j < n; j++) {
+                double s = scale[i] < scale[j] ? scale[i] : scale[j];
+                if (s < 1)
+                    F[i * n + j] = (float)(F[i * n + j] * s);
+            }
+    }
+    free(scale);
+    report->rows_trimmed = (uint32_t)trimmed;
+    report->largest_row_sum = largest;
+    report->largest_row = (uint32_t)largest_row;
+    return RAD_OK;
+}
+
 rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occluders,
                                    const rad_formfactor_options *options,
                                    rad_formfactors **out, rad_formfactor_report *report,
@@ -60,7 +101,13 @@ rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occlu
                         n, n, (double)n * n * sizeof(float) / 1e9);
     }
     dense_sink sink = {F, mesh->patches, n};
+    rad_formfactor_report local;
+    if (!report)
+        report = &local;
     rad_status status = pair_engine_run(mesh, occluders, options, store_pair, &sink, report, error);
+    if (status == RAD_OK && trim_rows(F, n, report) != RAD_OK)
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the row sums of %zu patches",
+                          n);
     if (status != RAD_OK) {
         free(F);
         free(result);

@@ -45,11 +45,11 @@
  * a box on a floor, walls a hair apart) are integrated adaptively over the smaller patch
  * (polygon_integral.h) to TOUCHING_ACCURACY, each fan triangle split at most
  * TOUCHING_MAX_DEPTH times: seen from close by, the exact point factor steps across the
- * other patch's edges, and a step left in cells of 4^-6 of the patch costs at most about
+ * other patch's edges, and a step left in cells of 4^-4 of the patch costs at most about
  * 1e-2 of the pair along that edge. */
 #define TOUCHING_DISTANCE 1.0
 #define TOUCHING_ACCURACY 1e-3
-#define TOUCHING_MAX_DEPTH 6
+#define TOUCHING_MAX_DEPTH 4
 
 /* Everything the kernel needs about one patch, precomputed. */
 typedef struct patch_geometry {

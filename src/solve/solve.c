@@ -61,6 +61,72 @@ static rad_status check_system(const rad_system *system, rad_error *error)
     return RAD_OK;
 }
 
+/* No row of rho F may sum above 1 (+ slack): such a system creates energy. O(n^2) once,
+ * cheaper than one sweep. */
+static rad_status check_energy(const rad_system *system, int threads, rad_solve_report *report,
+                               rad_error *error)
+{
+    const uint32_t n = system->n;
+    double worst = 0;
+    uint32_t worst_patch = 0;
+    (void)threads; /* unused without OpenMP */
+    const uint32_t blocks = solve_block_count(n);
+    double block_worst[SOLVE_BLOCKS];
+    uint32_t block_patch[SOLVE_BLOCKS];
+#pragma omp parallel for schedule(static) num_threads(threads) if (n >= SOLVE_PARALLEL_MIN)
+    for (uint32_t b = 0; b < blocks; b++) {
+        block_worst[b] = 0;
+        block_patch[b] = solve_block_begin(n, blocks, b);
+        for (uint32_t i = solve_block_begin(n, blocks, b); i < solve_block_begin(n, blocks, b + 1);
+             i++) {
+            const float *row = system->F + (size_t)i * n;
+            double sum = 0;
+            for (uint32_t j = 0; j < n; j++)
+                sum += row[j];
+            rad_rgb rho = system->albedo[i];
+            double gain = sum * fmax(rho.r, fmax(rho.g, rho.b));
+            if (!(gain <= block_worst[b])) {
+                block_worst[b] = gain;
+                block_patch[b] = i;
+            }
+        }
+    }
+    for (uint32_t b = 0; b < blocks; b++)
+        if (!(block_worst[b] <= worst)) {
+            worst = block_worst[b];
+            worst_patch = block_patch[b];
+        }
+    if (worst <= 1 + RAD_ROW_SUM_SLACK)
+        return RAD_OK;
+    report->patch = worst_patch;
+    double sum = 0;
+    for (uint32_t j = 0; j < n; j++)
+        sum += system->F[(size_t)worst_patch * n + j];
+    return rad_fail(error, RAD_ERR_INVALID,
+                    "rad_solve: the form factors of patch %u sum to %.6g and its albedo is "
+                    "%.3g: the system creates energy (rho x row sum must be at most 1), so no "
+                    "solver converges",
+                    worst_patch, sum, worst / sum);
+}
+
+rad_status solve_fail_diverged(const rad_system *system, const char *solver,
+                               uint32_t iterations, double criterion, double smallest,
+                               uint32_t patch, rad_solve_report *report, rad_error *error)
+{
+    const uint32_t n = system->n;
+    double sum = 0;
+    for (uint32_t j = 0; j < n; j++)
+        sum += system->F[(size_t)patch * n + j];
+    report->patch = patch;
+    report->iterations = iterations;
+    report->criterion = criterion;
+    return rad_fail(error, RAD_ERR_INVALID,
+                    "rad_solve: the %s solver diverges: after %u iterations its criterion is "
+                    "%.3g, up from %.3g; patch %u changes the most (its form factors sum to "
+                    "%.6g)",
+                    solver, iterations, criterion, smallest, patch, sum);
+}
+
 static rad_status resolve_options(const rad_solve_options *options, uint32_t n,
                                   solve_params *params, rad_error *error)
 {
@@ -135,6 +201,7 @@ rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
     if (!report)
         report = &local;
     memset(report, 0, sizeof(*report));
+    report->patch = UINT32_MAX;
 
     rad_status status = check_system(system, error);
     if (status != RAD_OK)
@@ -146,6 +213,9 @@ rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
     if (status != RAD_OK)
         return status;
 
+    status = check_energy(system, params.threads, report, error);
+    if (status != RAD_OK)
+        return status;
     double start = wall_seconds();
     switch (options ? options->solver : RAD_SOLVER_JACOBI) {
     case RAD_SOLVER_AUTO:

@@ -46,10 +46,11 @@ rad_status solve_gauss_seidel(const rad_system *system, solve_params *params, ra
     }
 
     const double scale = solve_criterion_scale(system);
-    double criterion = INFINITY;
+    double criterion = INFINITY, smallest = INFINITY;
     uint32_t sweeps = 0;
     while (sweeps < params->max_iterations) {
-        double sum = 0;
+        double sum = 0, largest = -1;
+        uint32_t worst = 0;
         for (uint32_t i = 0; i < n; i++) {
             const float *row = F + (size_t)i * n;
             double lo[3], hi[3];
@@ -58,13 +59,23 @@ rad_status solve_gauss_seidel(const rad_system *system, solve_params *params, ra
             double y0 = (E[i].r + rho[i].r * (lo[0] + hi[0])) * inv[0][i];
             double y1 = (E[i].g + rho[i].g * (lo[1] + hi[1])) * inv[1][i];
             double y2 = (E[i].b + rho[i].b * (lo[2] + hi[2])) * inv[2][i];
-            sum += area[i] * (fabs(y0 - x0[i]) + fabs(y1 - x1[i]) + fabs(y2 - x2[i]));
+            double change = area[i] * (fabs(y0 - x0[i]) + fabs(y1 - x1[i]) + fabs(y2 - x2[i]));
+            sum += change;
+            if (!(change <= largest)) {
+                largest = change;
+                worst = i;
+            }
             x0[i] = y0;
             x1[i] = y1;
             x2[i] = y2;
         }
         sweeps++;
         criterion = sum / scale;
+        if (solve_diverging(criterion, &smallest)) {
+            free(work);
+            return solve_fail_diverged(system, "gauss-seidel", sweeps, criterion, smallest,
+                                       worst, report, error);
+        }
         solve_progress(params, criterion);
         if (criterion <= params->tolerance)
             break;

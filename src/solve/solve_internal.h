@@ -13,6 +13,8 @@
 #ifndef RAD_SOLVE_INTERNAL_H
 #define RAD_SOLVE_INTERNAL_H
 
+#include <math.h>
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "radiosity.h"
@@ -91,6 +93,27 @@ double solve_residual(const rad_system *system, const rad_rgb *B, int threads);
 /* Reports progress from the criterion: the fraction is log(criterion) / log(tolerance)
  * clamped to [0,1], sent only when it grew by at least 1% (or reached 1). */
 void solve_progress(solve_params *params, double criterion);
+
+/* A solver's criterion falls (Jacobi and shooting: never rises) when no row of rho F sums
+ * above 1, which rad_solve checks first; a criterion that is not finite or has grown to
+ * this many times the smallest it had means the iteration diverges. */
+#define SOLVE_DIVERGENCE_GROWTH 100.0
+
+/* Keeps *smallest up to date; true when the iteration diverges (see above). */
+static inline bool solve_diverging(double criterion, double *smallest)
+{
+    if (!(criterion < INFINITY))
+        return true;
+    if (criterion < *smallest)
+        *smallest = criterion;
+    return criterion > SOLVE_DIVERGENCE_GROWTH * *smallest;
+}
+
+/* The error for a diverging iteration: what the solver saw and the patch where it saw it
+ * (report->patch, for the caller to name its surface). Returns RAD_ERR_INVALID. */
+rad_status solve_fail_diverged(const rad_system *system, const char *solver,
+                               uint32_t iterations, double criterion, double smallest,
+                               uint32_t patch, rad_solve_report *report, rad_error *error);
 
 /* The solvers. Each returns RAD_OK or RAD_ERR_NOMEM (direct: also RAD_ERR_UNSUPPORTED for
  * too large systems, RAD_ERR_INVALID for a singular matrix). `report` is never NULL.

@@ -43,7 +43,7 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
     const double scale = solve_criterion_scale(system);
     const int threads = params->threads;
     (void)threads; /* unused without OpenMP */
-    double criterion = INFINITY;
+    double criterion = INFINITY, smallest = INFINITY;
     uint32_t sweeps = 0;
     while (sweeps < params->max_iterations) {
         const double *x0 = old[0], *x1 = old[1], *x2 = old[2];
@@ -65,6 +65,15 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
         for (uint32_t i = 0; i < n; i++)
             sum += change[i];
         criterion = sum / scale;
+        if (solve_diverging(criterion, &smallest)) {
+            uint32_t worst = 0;
+            for (uint32_t i = 1; i < n; i++)
+                if (!(change[i] <= change[worst]))
+                    worst = i;
+            free(work);
+            return solve_fail_diverged(system, "gather", sweeps, criterion, smallest, worst,
+                                       report, error);
+        }
 
         for (int c = 0; c < 3; c++) {
             double *t = old[c];

@@ -22,6 +22,10 @@
  * form-factor computation itself refuses above 3/4). */
 #define AUTO_DENSE_MEMORY_SHARE 0.5
 
+/* Rows of form factors that came out above 1 by more than this (and were scaled back) are
+ * worth a warning: the sampling error of visibility is usually far below it. */
+#define RAD_ROW_SUM_WARNING 1e-2
+
 static double seconds_now(void) { return omp_get_wtime(); }
 
 double rad_default_patch_size(const rad_scene *scene, rad_solver solver)
@@ -62,7 +66,24 @@ rad_solver rad_solve_scene_choice(const rad_mesh *mesh, const rad_scene_solve_op
     return RAD_SOLVER_JACOBI;
 }
 
-static rad_status solve_dense(const rad_mesh *mesh, const rad_patch_inputs *inputs,
+/* Rewrites an error about one patch as "SCENE: surface 'NAME' (patch P): what" so that the
+ * user learns which of their surfaces is involved. */
+static rad_status name_patch(const rad_scene *scene, const rad_mesh *mesh, uint32_t patch,
+                             rad_status status, rad_error *error)
+{
+    if (!error || patch >= mesh->patch_count)
+        return status;
+    const char *what = error->message;
+    const char *prefix = "rad_solve: ";
+    if (strncmp(what, prefix, strlen(prefix)) == 0)
+        what += strlen(prefix);
+    char copy[RAD_ERROR_MESSAGE_MAX];
+    snprintf(copy, sizeof(copy), "%s", what);
+    return rad_fail(error, status, "%s: surface '%s' (patch %u): %s", scene->source,
+                    scene->surfaces[mesh->patches[patch].surface].name, patch, copy);
+}
+
+static rad_status solve_dense(const rad_scene *scene, const rad_mesh *mesh, const rad_patch_inputs *inputs,
                               const rad_tracer *occluders, const rad_scene_solve_options *o,
                               rad_solver solver, rad_rgb *B, rad_scene_solve_report *r,
                               rad_error *error)
@@ -91,7 +112,17 @@ static rad_status solve_dense(const rad_mesh *mesh, const rad_patch_inputs *inpu
     rad_formfactors_destroy(ff);
     r->seconds_solve = seconds_now() - t1;
     if (status != RAD_OK)
-        return status;
+        return name_patch(scene, mesh, r->solve.patch, status, error);
+    if (r->formfactors.largest_row_sum > 1 + RAD_ROW_SUM_WARNING) {
+        uint32_t p = r->formfactors.largest_row;
+        rad_warn(o->log, o->log_user,
+                 "%s: the form factors of %u patches summed above 1 and were scaled back "
+                 "(the largest, %.4g, at surface '%s'): surfaces closer together than the "
+                 "patches are wide, or a narrow slot; a smaller --patch-size or more "
+                 "--visibility-rays make them exact",
+                 scene->source, r->formfactors.rows_trimmed, r->formfactors.largest_row_sum,
+                 scene->surfaces[mesh->patches[p].surface].name);
+    }
     r->iterations = r->solve.iterations;
     r->residual = r->solve.residual;
     r->converged = r->solve.converged || solver == RAD_SOLVER_DIRECT;
@@ -187,7 +218,7 @@ rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
     if (status == RAD_OK)
         status = r.solver == RAD_SOLVER_HIERARCHICAL
                      ? solve_hierarchy(mesh, inputs, occluders, &o, B, &r, error)
-                     : solve_dense(mesh, inputs, occluders, &o, r.solver, B, &r, error);
+                     : solve_dense(scene, mesh, inputs, occluders, &o, r.solver, B, &r, error);
     rad_tracer_destroy(occluders);
     /* every value finite and at least the patch's own exitance (what comes in is >= 0) */
     for (uint32_t i = 0; status == RAD_OK && i < mesh->patch_count; i++) {
@@ -195,9 +226,10 @@ rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
         const rad_rgb *e = &inputs->exitance[i];
         if (!(isfinite(b->r) && isfinite(b->g) && isfinite(b->b)))
             status = rad_fail(error, RAD_ERR_INTERNAL,
-                              "%s: the %s solution of patch %u is not finite (a bug: please "
-                              "report the scene)",
-                              scene->source, rad_solver_name(r.solver), i);
+                              "%s: surface '%s' (patch %u): the %s solution is not finite (a "
+                              "bug: please report the scene); nothing was written",
+                              scene->source, scene->surfaces[mesh->patches[i].surface].name, i,
+                              rad_solver_name(r.solver));
         b->r = fmax(b->r, e->r);
         b->g = fmax(b->g, e->g);
         b->b = fmax(b->b, e->b);

@@ -142,7 +142,7 @@ rad_status solve_shoot(const rad_system *system, solve_params *params, rad_rgb *
     const double scale = solve_criterion_scale(system);
     const int threads = params->threads;
     (void)threads; /* unused without OpenMP */
-    double criterion = INFINITY;
+    double criterion = INFINITY, smallest = INFINITY;
     uint32_t shots = 0;
     for (;;) {
         double unshot = 0, best = -1;
@@ -155,6 +155,11 @@ rad_status solve_shoot(const rad_system *system, solve_params *params, rad_rgb *
             }
         }
         criterion = unshot / scale;
+        if (solve_diverging(criterion, &smallest)) {
+            free(work);
+            return solve_fail_diverged(system, "shoot", shots, criterion, smallest, shooter,
+                                       report, error);
+        }
         solve_progress(params, criterion);
         if (criterion <= params->tolerance || shots >= params->max_iterations || !(best > 0))
             break;

@@ -1,0 +1,289 @@
+/*
+ * test_near_surfaces.c - surfaces a hair apart: the form-factor invariants and every
+ * solver's answer where the tracer alone cannot tell the surfaces apart.
+ *
+ * Scenes:
+ *   - a box inside a box, 1e-6 and 1e-4 apart: the room's ceiling is a light (Kd 0), every
+ *     other face white (rho 0.7). Each room face sees only the inner face in front of it,
+ *     so in the closed form the inner box's top has radiance rho Le and everything else
+ *     is dark (light reaches the rest only through the gap, a share of order gap / size);
+ *     rows of F sum to 1.
+ *   - a floor under a square light one unit above (unit squares: the parallel-squares
+ *     factor F = 0.19982 of VALIDATION.md), with a copy of the floor facing down: at the
+ *     same height (a coincident back face) and 1e-6 below it (a thin slab) the floor
+ *     still sees the light; 1e-6 above it (facing the floor: a closed cavity) it sees only
+ *     the copy and stays dark.
+ *   - a system whose row of F sums to 2: rad_solve refuses it and names the patch.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testlib.h"
+
+#define PI 3.14159265358979323846
+#define RHO 0.7
+#define LE 10.0
+
+static void write_materials(FILE *f)
+{
+    fprintf(f, "newmtl white\nKd %g %g %g\nnewmtl light\nKd 0 0 0\nKe %g %g %g\n", RHO, RHO,
+            RHO, LE, LE, LE);
+}
+
+/* An axis-aligned box's six faces, facing out (or in), one OBJ object per face. */
+static void write_box(FILE *f, unsigned *vertices, const char *name, const double lo[3],
+                      const double hi[3], bool inward, const char *top_material)
+{
+    static const int corner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                     {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    static const int face[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                   {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
+    static const char *face_name[6] = {"bottom", "top", "front", "back", "right", "left"};
+    for (int k = 0; k < 8; k++)
+        fprintf(f, "v %.12g %.12g %.12g\n", corner[k][0] ? hi[0] : lo[0],
+                corner[k][1] ? hi[1] : lo[1], corner[k][2] ? hi[2] : lo[2]);
+    for (int q = 0; q < 6; q++) {
+        fprintf(f, "o %s_%s\nusemtl %s\nf", name, face_name[q],
+                q == 1 && top_material ? top_material : "white");
+        for (int k = 0; k < 4; k++)
+            fprintf(f, " %u", *vertices + 1 + (unsigned)face[q][inward ? 3 - k : k]);
+        fprintf(f, "\n");
+    }
+    *vertices += 8;
+}
+
+static const char *write_box_in_box(double gap)
+{
+    static char path[512];
+    snprintf(path, sizeof(path), "%s", test_path(gap < 1e-5 ? "box_in_box_1e-6.obj"
+                                                            : "box_in_box_1e-4.obj"));
+    FILE *m = fopen(test_path("near.mtl"), "w");
+    FILE *f = fopen(path, "w");
+    CHECK(m && f);
+    if (!m || !f)
+        exit(1);
+    write_materials(m);
+    fclose(m);
+    fprintf(f, "mtllib near.mtl\n");
+    unsigned vertices = 0;
+    const double room_lo[3] = {0, 0, 0}, room_hi[3] = {1, 1, 1};
+    const double inner_lo[3] = {gap, gap, gap}, inner_hi[3] = {1 - gap, 1 - gap, 1 - gap};
+    write_box(f, &vertices, "room", room_lo, room_hi, true, "light");
+    write_box(f, &vertices, "inner", inner_lo, inner_hi, false, NULL);
+    fclose(f);
+    return path;
+}
+
+/* Floor (unit square at z = 0, facing up), light (unit square at z = 1, facing down) and
+ * a copy of the floor facing down at z = copy_z. */
+static const char *write_floor_with_copy(const char *name, double copy_z)
+{
+    static char path[512];
+    snprintf(path, sizeof(path), "%s", test_path(name));
+    FILE *m = fopen(test_path("near.mtl"), "w");
+    FILE *f = fopen(path, "w");
+    CHECK(m && f);
+    if (!m || !f)
+        exit(1);
+    write_materials(m);
+    fclose(m);
+    fprintf(f, "mtllib near.mtl\n"
+               "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+               "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n");
+    fprintf(f, "v 0 0 %.12g\nv 1 0 %.12g\nv 1 1 %.12g\nv 0 1 %.12g\n", copy_z, copy_z, copy_z,
+            copy_z);
+    fprintf(f, "o floor\nusemtl white\nf 1 2 3 4\n"
+               "o light\nusemtl light\nf 5 8 7 6\n"
+               "o copy\nusemtl white\nf 9 12 11 10\n");
+    fclose(f);
+    return path;
+}
+
+static rad_scene *load(const char *path)
+{
+    rad_scene *scene = NULL;
+    rad_error error = {0};
+    if (rad_scene_load(path, NULL, &scene, &error) != RAD_OK) {
+        fprintf(stderr, "%s\n", error.message);
+        CHECK(false);
+        exit(1);
+    }
+    return scene;
+}
+
+static int surface_index(const rad_scene *scene, const char *name)
+{
+    for (uint32_t s = 0; s < scene->surface_count; s++)
+        if (strcmp(scene->surfaces[s].name, name) == 0)
+            return (int)s;
+    fprintf(stderr, "no surface %s\n", name);
+    CHECK(false);
+    return -1;
+}
+
+/* Area-weighted mean radiance (B / pi, green channel) of a surface's patches. */
+static double mean_radiance(const rad_mesh *mesh, const rad_rgb *B, int surface)
+{
+    double sum = 0, area = 0;
+    for (uint32_t i = 0; i < mesh->patch_count; i++)
+        if ((int)mesh->patches[i].surface == surface) {
+            sum += mesh->patches[i].area * B[i].g;
+            area += mesh->patches[i].area;
+        }
+    return area > 0 ? sum / area / PI : NAN;
+}
+
+static bool all_finite(const rad_rgb *B, uint32_t n)
+{
+    for (uint32_t i = 0; i < n; i++)
+        if (!(isfinite(B[i].r) && isfinite(B[i].g) && isfinite(B[i].b)))
+            return false;
+    return true;
+}
+
+static const rad_solver solvers[] = {RAD_SOLVER_JACOBI, RAD_SOLVER_GAUSS_SEIDEL,
+                                     RAD_SOLVER_SHOOT, RAD_SOLVER_DIRECT,
+                                     RAD_SOLVER_HIERARCHICAL};
+
+/* Solves with one solver; B is mesh->patch_count long. */
+static bool solve(const rad_scene *scene, const rad_mesh *mesh, rad_solver solver, rad_rgb *B)
+{
+    rad_scene_solve_options o = {0};
+    o.solver = solver;
+    o.seed = 5;
+    rad_scene_solve_report report;
+    rad_error error = {0};
+    rad_status status = rad_solve_scene(scene, mesh, &o, B, &report, &error);
+    if (status != RAD_OK)
+        fprintf(stderr, "%s: %s\n", rad_solver_name(solver), error.message);
+    CHECK(status == RAD_OK);
+    return status == RAD_OK;
+}
+
+static void check_box_in_box(double gap)
+{
+    rad_scene *scene = load(write_box_in_box(gap));
+    rad_mesh *mesh = NULL;
+    rad_error error = {0};
+    CHECK(rad_mesh_build(scene, 0.125, &mesh, &error) == RAD_OK);
+    uint32_t n = mesh->patch_count;
+
+    /* rows of F: a closed scene, so every row sums to 1 */
+    rad_tracer *tracer = NULL;
+    CHECK(rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &tracer, &error) == RAD_OK);
+    rad_formfactors *ff = NULL;
+    rad_formfactor_report ff_report;
+    CHECK(rad_formfactors_compute(mesh, tracer, NULL, &ff, &ff_report, &error) == RAD_OK);
+    double lowest = INFINITY, highest = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        double row = 0;
+        for (uint32_t j = 0; j < n; j++)
+            row += ff->F[(size_t)i * n + j];
+        lowest = fmin(lowest, row);
+        highest = fmax(highest, row);
+    }
+    printf("box in box, gap %g: %u patches, rows of F in [%.6f, %.6f] (before trimming the "
+           "largest was %.6f)\n",
+           gap, n, lowest, highest, ff_report.largest_row_sum);
+    CHECK(highest <= 1 + 1e-6);
+    CHECK(lowest >= 1 - 2e-3);
+    rad_formfactors_destroy(ff);
+    rad_tracer_destroy(tracer);
+
+    int inner_top = surface_index(scene, "inner_top");
+    int room_floor = surface_index(scene, "room_bottom");
+    int inner_side = surface_index(scene, "inner_left");
+    rad_rgb *B = malloc(sizeof(rad_rgb) * n);
+    for (size_t s = 0; s < sizeof(solvers) / sizeof(solvers[0]); s++) {
+        if (!solve(scene, mesh, solvers[s], B))
+            continue;
+        CHECK(all_finite(B, n));
+        double top = mean_radiance(mesh, B, inner_top);
+        double floor = mean_radiance(mesh, B, room_floor);
+        double side = mean_radiance(mesh, B, inner_side);
+        printf("  %-12s inner top %.5f (closed form %.5f), room floor %.2e, inner side %.2e\n",
+               rad_solver_name(solvers[s]), top, RHO * LE, floor, side);
+        CHECK_NEAR(top, RHO * LE, 5e-3);
+        /* without the near contacts the floor sees the light through the inner bottom:
+         * about rho Le F(floor -> ceiling) = 1.4 */
+        CHECK(floor < 2e-3 * LE);
+        CHECK(side < 2e-3 * LE);
+    }
+    free(B);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+}
+
+/* The parallel-squares factor of VALIDATION.md for unit squares one unit apart. */
+static double parallel_unit_squares(void)
+{
+    double x = 1, y = 1;
+    double a = sqrt(1 + x * x), b = sqrt(1 + y * y);
+    return 2 / (PI * x * y) *
+           (log(sqrt((1 + x * x) * (1 + y * y) / (1 + x * x + y * y))) + x * b * atan(x / b) +
+            y * a * atan(y / a) - x * atan(x) - y * atan(y));
+}
+
+static void check_floor_copy(const char *name, double copy_z, bool sees_light)
+{
+    rad_scene *scene = load(write_floor_with_copy(name, copy_z));
+    rad_mesh *mesh = NULL;
+    rad_error error = {0};
+    CHECK(rad_mesh_build(scene, 0.125, &mesh, &error) == RAD_OK);
+    int floor = surface_index(scene, "floor");
+    double expected = sees_light ? RHO * LE * parallel_unit_squares() : 0;
+    rad_rgb *B = malloc(sizeof(rad_rgb) * mesh->patch_count);
+    for (size_t s = 0; s < sizeof(solvers) / sizeof(solvers[0]); s++) {
+        if (!solve(scene, mesh, solvers[s], B))
+            continue;
+        CHECK(all_finite(B, mesh->patch_count));
+        double L = mean_radiance(mesh, B, floor);
+        printf("  %-12s %s: floor %.5f (closed form %.5f)\n", rad_solver_name(solvers[s]), name,
+               L, expected);
+        if (sees_light)
+            CHECK_NEAR(L, expected, 1e-2);
+        else
+            CHECK(L < 1e-3 * LE);
+    }
+    free(B);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+}
+
+/* A 3-patch system whose second row sums to 2: refused, naming patch 1. */
+static void check_energy_refused(void)
+{
+    float F[9] = {0, 0.5f, 0.5f, 1.0f, 0, 1.0f, 0.5f, 0.5f, 0};
+    double area[3] = {1, 1, 1};
+    rad_rgb albedo[3] = {{0.5, 0.5, 0.5}, {0.9, 0.9, 0.9}, {0.5, 0.5, 0.5}};
+    rad_rgb exitance[3] = {{1, 1, 1}, {0, 0, 0}, {0, 0, 0}};
+    rad_system system = {3, F, area, albedo, exitance};
+    rad_rgb B[3];
+    const rad_solver dense[] = {RAD_SOLVER_JACOBI, RAD_SOLVER_GAUSS_SEIDEL, RAD_SOLVER_SHOOT,
+                                RAD_SOLVER_DIRECT};
+    for (size_t s = 0; s < 4; s++) {
+        rad_solve_options o = {0};
+        o.solver = dense[s];
+        rad_solve_report report;
+        rad_error error = {0};
+        rad_status status = rad_solve(&system, &o, B, &report, &error);
+        printf("  %-12s row sum 2: %s\n", rad_solver_name(dense[s]), error.message);
+        CHECK(status == RAD_ERR_INVALID);
+        CHECK(report.patch == 1);
+        CHECK(strstr(error.message, "patch 1") != NULL);
+        CHECK(strstr(error.message, "creates energy") != NULL);
+    }
+}
+
+int main(void)
+{
+    check_box_in_box(1e-6);
+    check_box_in_box(1e-4);
+    check_floor_copy("copy_coincident.obj", 0, true);
+    check_floor_copy("copy_below.obj", -1e-6, true);
+    check_floor_copy("copy_above.obj", 1e-6, false);
+    check_energy_refused();
+    return test_finish("test_near_surfaces");
+}
