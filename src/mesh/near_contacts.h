@@ -26,6 +26,7 @@ typedef struct near_contacts {
     uint32_t *start;   /* patch_count + 1: patch i's contacts are contact[start[i] .. start[i+1]) */
     uint32_t *contact; /* patch indices */
     const rad_mesh *mesh;
+    double *offset;       /* patch_count: each patch's plane, normal . x = offset */
     double plane_epsilon; /* a crossing must lie this far along the segment from an end */
 } near_contacts;
 
@@ -45,8 +46,9 @@ static inline bool near_contacts_any(const near_contacts *contacts, uint32_t pat
 }
 
 /* True when the segment from a (on patch `from`) to b (on patch `to`) crosses one of the
- * two patches' contacts other than from and to themselves, more than plane_epsilon from
- * either end. */
+ * two patches' contacts other than from and to themselves where the tracer does not look:
+ * within the first (from's contacts) or last (to's) RAD_SEGMENT_END_EPSILON of its length,
+ * and more than plane_epsilon from the end. */
 bool near_contacts_block(const near_contacts *contacts, uint32_t from, uint32_t to, rad_vec3 a,
                          rad_vec3 b);
 
