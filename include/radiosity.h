@@ -485,8 +485,9 @@ typedef struct rad_formfactor_report {
     double seconds;            /* wall-clock time of the whole computation */
     double tracing_seconds;    /* time spent tracing, summed over threads */
     int threads;               /* threads used */
-    uint32_t rows_trimmed;     /* rows whose sum came out above 1 (no patch sees more than
-                                  its hemisphere), scaled back to 1 keeping reciprocity */
+    uint32_t rows_trimmed;     /* rows whose sum came out above 1 + RAD_ROW_SUM_SLACK (no
+                                  patch sees more than its hemisphere), scaled back to 1
+                                  keeping reciprocity */
     double largest_row_sum;    /* the largest row sum before that */
     uint32_t largest_row;      /* its patch */
 } rad_formfactor_report;
@@ -504,9 +505,9 @@ typedef struct rad_formfactors {
  * for pairs close by, adaptive for touching pairs); visibility is the fraction of
  * unoccluded rays between stratified points of the two patches (4 first, the full count
  * where those 4 disagree), with surfaces within a hair of either end tested in double
- * precision. No row sums to more than 1: a row that came out above (sampling error next to
- * a slot, a gap narrower than the patches) is scaled back, each F_ij and F_ji by the same
- * factor, and counted in the report. */
+ * precision. No row sums to more than 1 + RAD_ROW_SUM_SLACK: a row that came out above
+ * (sampled visibility next to occluders or through a slot) is scaled back to 1, each F_ij
+ * and F_ji by the same factor, and counted in the report. */
 rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occluders,
                                    const rad_formfactor_options *options,
                                    rad_formfactors **out, rad_formfactor_report *report,
@@ -752,8 +753,11 @@ typedef struct rad_solve_report {
 rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
                      rad_rgb *B, rad_solve_report *report, rad_error *error);
 
-/* How far above 1 rad_solve lets rho_i x sum_j F_ij go (float rounding of the rows). */
-#define RAD_ROW_SUM_SLACK 1e-3
+/* The stated accuracy of a row sum of patch form factors: rad_formfactors_compute scales
+ * rows above 1 + this back to 1 (below it, the rows' sampling error is left alone: cutting
+ * only the high side of it would darken every scene), and rad_solve refuses a system whose
+ * rho_i x sum_j F_ij exceeds 1 + this. */
+#define RAD_ROW_SUM_SLACK 1e-2
 
 /* Largest system the direct solver takes. */
 #define RAD_DIRECT_MAX_PATCHES 4096
@@ -821,6 +825,8 @@ typedef struct rad_hierarchy_report {
     double seconds_gather;   /* sweeps and push-pull */
     double seconds_final;    /* the final gather at the leaves */
     int threads;
+    uint32_t patch;          /* after a diverging solve (RAD_ERR_INVALID): the patch whose
+                                radiosity changed the most, else UINT32_MAX */
 } rad_hierarchy_report;
 
 /* Solves the mesh's radiosity hierarchically with the patch inputs of rad_patch_inputs_build:

@@ -52,8 +52,9 @@ static rad_status trim_rows(float *F, size_t n, rad_formfactor_report *report)
             largest = row;
             largest_row = i;
         }
-        scale[i] = row > 1 ? 1 / row : 1;
-        trimmed += row > 1;
+        bool over = row > 1 + RAD_ROW_SUM_SLACK;
+        scale[i] = over ? 1 / row : 1;
+        trimmed += over;
     }
     if (trimmed) {
 #pragma omp parallel for schedule(static)

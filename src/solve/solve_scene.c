@@ -22,10 +22,6 @@
  * form-factor computation itself refuses above 3/4). */
 #define AUTO_DENSE_MEMORY_SHARE 0.5
 
-/* Rows of form factors that came out above 1 by more than this (and were scaled back) are
- * worth a warning: the sampling error of visibility is usually far below it. */
-#define RAD_ROW_SUM_WARNING 1e-2
-
 static double seconds_now(void) { return omp_get_wtime(); }
 
 double rad_default_patch_size(const rad_scene *scene, rad_solver solver)
@@ -113,13 +109,13 @@ static rad_status solve_dense(const rad_scene *scene, const rad_mesh *mesh, cons
     r->seconds_solve = seconds_now() - t1;
     if (status != RAD_OK)
         return name_patch(scene, mesh, r->solve.patch, status, error);
-    if (r->formfactors.largest_row_sum > 1 + RAD_ROW_SUM_WARNING) {
+    if (r->formfactors.rows_trimmed > 0) {
         uint32_t p = r->formfactors.largest_row;
         rad_warn(o->log, o->log_user,
                  "%s: the form factors of %u patches summed above 1 and were scaled back "
-                 "(the largest, %.4g, at surface '%s'): surfaces closer together than the "
-                 "patches are wide, or a narrow slot; a smaller --patch-size or more "
-                 "--visibility-rays make them exact",
+                 "(the largest, %.4g, at surface '%s'): sampled visibility next to "
+                 "occluders or through a slot; a smaller --patch-size or more "
+                 "--visibility-rays bring them closer to 1",
                  scene->source, r->formfactors.rows_trimmed, r->formfactors.largest_row_sum,
                  scene->surfaces[mesh->patches[p].surface].name);
     }
@@ -136,7 +132,7 @@ static rad_status solve_dense(const rad_scene *scene, const rad_mesh *mesh, cons
     return RAD_OK;
 }
 
-static rad_status solve_hierarchy(const rad_mesh *mesh, const rad_patch_inputs *inputs,
+static rad_status solve_hierarchy(const rad_scene *scene, const rad_mesh *mesh, const rad_patch_inputs *inputs,
                                   const rad_tracer *occluders,
                                   const rad_scene_solve_options *o, rad_rgb *B,
                                   rad_scene_solve_report *r, rad_error *error)
@@ -146,11 +142,12 @@ static rad_status solve_hierarchy(const rad_mesh *mesh, const rad_patch_inputs *
                                o->threads,          o->stop,            o->progress,
                                o->progress_user};
     double t0 = seconds_now();
+    r->hierarchy.patch = UINT32_MAX;
     rad_status status =
         rad_solve_hierarchical(mesh, inputs, occluders, &h, B, &r->hierarchy, error);
     r->seconds_solve = seconds_now() - t0;
     if (status != RAD_OK)
-        return status;
+        return name_patch(scene, mesh, r->hierarchy.patch, status, error);
     const rad_hierarchy_report *hr = &r->hierarchy;
     r->iterations = hr->iterations;
     r->residual = hr->residual;
@@ -217,7 +214,7 @@ rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
     if (status == RAD_OK)
         status = r.solver == RAD_SOLVER_HIERARCHICAL
-                     ? solve_hierarchy(mesh, inputs, occluders, &o, B, &r, error)
+                     ? solve_hierarchy(scene, mesh, inputs, occluders, &o, B, &r, error)
                      : solve_dense(scene, mesh, inputs, occluders, &o, r.solver, B, &r, error);
     rad_tracer_destroy(occluders);
     /* every value finite and at least the patch's own exitance (what comes in is >= 0) */

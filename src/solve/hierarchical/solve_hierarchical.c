@@ -46,7 +46,15 @@ typedef struct hsolver {
     link_store store;
     double emitted;             /* sum A |E|_1 */
     int threads;
+    bool diverged;              /* a sweep changed B by more than HIER_DIVERGED_CHANGE */
+    uint32_t changed_most;      /* the patch whose B changed the most in the last sweep */
 } hsolver;
+
+/* A sweep whose change (relative to the emitted power) is not finite or above this has
+ * diverged: with links that send out no more than they receive, a sweep moves B by at
+ * most the light still bouncing, which is below the emitted power times the albedo
+ * series and far below this. */
+#define HIER_DIVERGED_CHANGE 1e3
 
 static double now_seconds(void) { return rad_clock_seconds(); }
 
@@ -99,7 +107,7 @@ static double sweep(hsolver *s)
             rgb_add_to(&sum, rgb_scale(s->node_B[links[l].source], links[l].transfer));
         s->gathered[k] = sum;
     }
-    double change = 0;
+    double change = 0, most = -1;
     for (uint32_t k = 0; k < t->node_count; k++) {
         const hnode *n = &t->nodes[k];
         s->down[k] = n->parent == HNODE_NONE ? s->gathered[k]
@@ -110,13 +118,21 @@ static double sweep(hsolver *s)
             if (s->correction) /* irradiance is never negative, however corrected */
                 h = rgb_max0(rgb_add(rgb_mul(h, s->scale[k]), s->correction[k]));
             rad_rgb b = rgb_add(s->emission[p], rgb_mul(s->albedo[p], h));
-            change += n->area * (fabs(b.r - s->patch_B[p].r) + fabs(b.g - s->patch_B[p].g) +
-                                 fabs(b.b - s->patch_B[p].b));
+            double moved = n->area * (fabs(b.r - s->patch_B[p].r) + fabs(b.g - s->patch_B[p].g) +
+                                      fabs(b.b - s->patch_B[p].b));
+            change += moved;
+            if (!(moved <= most)) {
+                most = moved;
+                s->changed_most = p;
+            }
             s->patch_B[p] = b;
         }
     }
     pull(s);
-    return s->emitted > 0 ? change / s->emitted : 0;
+    double relative = s->emitted > 0 ? change / s->emitted : 0;
+    if (!(relative <= HIER_DIVERGED_CHANGE))
+        s->diverged = true;
+    return relative;
 }
 
 /* One channel of the final gather's correction c to what comes down d: as a factor where d
@@ -178,6 +194,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     if (options)
         o = *options;
     rad_hierarchy_report rep = {0};
+    rep.patch = UINT32_MAX;
     if (o.threads < 0)
         return rad_fail(error, RAD_ERR_INVALID, "threads must be 0 (all cores) or positive");
     if (!(o.refine_threshold >= 0) || !isfinite(o.refine_threshold))
@@ -273,7 +290,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     double sweep_change = s.emitted > 0 ? 1 : 0;
     bool refining = s.store.count > 0, converged = false;
     uint32_t quiet_passes = 0;
-    while (!stopped(&o) && rep.iterations < max_sweeps) {
+    while (!stopped(&o) && rep.iterations < max_sweeps && !s.diverged) {
         size_t split = 0;
         if (refining && !rep.memory_capped && rep.passes < MAX_PASSES) {
             double tr = now_seconds();
@@ -297,7 +314,8 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
         sort_by_receiver(&s);
         if (split > 0) {
             quiet_passes = 0;
-            for (unsigned k = 0; k < SWEEPS_PER_PASS && rep.iterations < max_sweeps; k++) {
+            for (unsigned k = 0; k < SWEEPS_PER_PASS && rep.iterations < max_sweeps && !s.diverged;
+                 k++) {
                 sweep_change = sweep(&s);
                 rep.iterations++;
             }
@@ -306,7 +324,8 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
         }
         /* nothing split: sweep to the tolerance, then look once more */
         double first = sweep_change;
-        while (sweep_change > tolerance && rep.iterations < max_sweeps && !stopped(&o)) {
+        while (sweep_change > tolerance && rep.iterations < max_sweeps && !stopped(&o) &&
+               !s.diverged) {
             sweep_change = sweep(&s);
             rep.iterations++;
             if (o.progress && first > tolerance && sweep_change > 0)
@@ -325,7 +344,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     }
     if (o.progress)
         o.progress(o.progress_user, "gather", 1);
-    if (!stopped(&o) && s.store.count > 0) {
+    if (!stopped(&o) && s.store.count > 0 && !s.diverged) {
         double tf = now_seconds();
         s.correction = rad_alloc_array(nodes, sizeof(rad_rgb));
         s.scale = rad_alloc_array(nodes, sizeof(rad_rgb));
@@ -353,7 +372,8 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             as_scale(s.down[k].b, &s.correction[k].b, &s.scale[k].b);
         }
         double change = s.correction ? 1 : 0;
-        while (change > tolerance && rep.iterations < max_sweeps && !stopped(&o)) {
+        while (change > tolerance && rep.iterations < max_sweeps && !stopped(&o) &&
+               !s.diverged) {
             sweep_change = change = sweep(&s);
             rep.iterations++;
         }
@@ -372,11 +392,17 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     for (size_t l = 0; l < s.store.count; l++)
         rep.links_partial += s.store.links[l].visible < LINK_VISIBLE;
     rep.link_bytes = s.store.peak_bytes;
-    if (!isfinite(sweep_change) || !isfinite(rep.residual)) { /* never hand out a diverged
-                                                              answer as a solution */
+    if (s.diverged || !isfinite(sweep_change) || !isfinite(rep.residual)) {
+        /* never hand out a diverged answer as a solution */
+        rep.patch = s.changed_most;
+        if (report)
+            *report = rep;
         hsolver_free(&s);
-        return rad_fail(error, RAD_ERR_INTERNAL,
-                        "the hierarchical solution diverged (a bug: please report the scene)");
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "rad_solve: the hierarchical solver diverges: after %u sweeps a sweep "
+                        "changed the radiosity by %.3g times the emitted power; patch %u "
+                        "changes the most",
+                        rep.iterations, sweep_change, rep.patch);
     }
     hsolver_free(&s);
     if (report)
