@@ -7,6 +7,7 @@
  * this file only validates, dispatches, and commits or aborts.
  */
 #include <ctype.h>
+#include <math.h>
 #include <string.h>
 
 #include "core/atomic_file.h"
@@ -62,6 +63,15 @@ rad_status rad_image_write(const rad_image *image, const char *path,
         return rad_fail(error, RAD_ERR_INVALID, "rad_image_write: no path");
     if (!image || !image->rgb || image->width == 0 || image->height == 0)
         return rad_fail(error, RAD_ERR_INVALID, "%s: no image to write", path);
+    /* a NaN or infinite pixel is never written as a result */
+    for (size_t k = 0; k < (size_t)image->width * image->height * 3; k++)
+        if (!isfinite(image->rgb[k])) {
+            size_t pixel = k / 3;
+            return rad_fail(error, RAD_ERR_INTERNAL,
+                            "%s: pixel (%zu, %zu) is not finite (a bug: please report the "
+                            "scene); nothing was written",
+                            path, pixel % image->width, pixel / image->width);
+        }
     const char *extension = extension_of(path);
     image_format format = format_of(extension);
     if (format == FORMAT_UNKNOWN)

@@ -73,6 +73,13 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
     if (options && options->fixed_exposure && !isfinite(options->exposure))
         return rad_fail(error, RAD_ERR_INVALID, "%s: exposure %g is not a finite number", path,
                         options->exposure);
+    /* a NaN or infinite radiosity is never written as a result */
+    for (uint32_t i = 0; i < mesh->patch_count; i++)
+        if (!(isfinite(B[i].r) && isfinite(B[i].g) && isfinite(B[i].b)))
+            return rad_fail(error, RAD_ERR_INVALID,
+                            "%s: patch %u has a radiosity that is not finite; nothing was "
+                            "written",
+                            path, i);
 
     rad_status status = RAD_OK;
     rad_vec3 *position = NULL, *normal = NULL;
