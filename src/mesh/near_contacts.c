@@ -66,12 +66,19 @@ rad_status near_contacts_build(const rad_mesh *mesh, double reach, double plane_
     uint32_t *count = rad_alloc_array((size_t)n + 1, sizeof(*count));
     out->start = rad_alloc_array((size_t)n + 1, sizeof(*out->start));
     out->offset = rad_alloc_array(n, sizeof(*out->offset));
+    out->radius = rad_alloc_array(n, sizeof(*out->radius));
     uint32_t *pairs = NULL; /* (i, k) in pairs, two per entry */
     size_t pair_count = 0, pair_capacity = 0;
-    if (!boxes || !count || !out->start || !out->offset)
+    if (!boxes || !count || !out->start || !out->offset || !out->radius)
         goto nomem;
-    for (uint32_t i = 0; i < n; i++)
-        out->offset[i] = v3_dot(mesh->patches[i].normal, mesh->vertices[mesh->patches[i].vertex[0]]);
+    for (uint32_t i = 0; i < n; i++) {
+        const rad_patch *p = &mesh->patches[i];
+        out->offset[i] = v3_dot(p->normal, mesh->vertices[p->vertex[0]]);
+        out->radius[i] = 0;
+        for (unsigned c = 0; c < p->vertex_count; c++)
+            out->radius[i] =
+                fmax(out->radius[i], v3_length(v3_sub(mesh->vertices[p->vertex[c]], p->centroid)));
+    }
     rad_vec3 scene_lo, scene_hi;
     v3_bounds(mesh->vertices, mesh->vertex_count, &scene_lo, &scene_hi);
     rad_vec3 size = v3_sub(scene_hi, scene_lo);
@@ -114,7 +121,8 @@ rad_status near_contacts_build(const rad_mesh *mesh, double reach, double plane_
             }
         }
     out->contact = rad_alloc_array(pair_count, sizeof(*out->contact));
-    if (!out->contact)
+    out->side = rad_alloc_array(pair_count, sizeof(*out->side));
+    if (!out->contact || !out->side)
         goto nomem;
     for (uint32_t i = 0; i < n; i++)
         out->start[i + 1] = out->start[i] + count[i];
@@ -122,6 +130,20 @@ rad_status near_contacts_build(const rad_mesh *mesh, double reach, double plane_
         count[i] = out->start[i];
     for (size_t p = 0; p < pair_count; p++)
         out->contact[count[pairs[2 * p]]++] = pairs[2 * p + 1];
+    for (uint32_t i = 0; i < n; i++) {
+        const rad_patch *p = &mesh->patches[i];
+        for (uint32_t c = out->start[i]; c < out->start[i + 1]; c++) {
+            uint32_t k = out->contact[c];
+            bool above = true, below = true;
+            for (unsigned v = 0; v < p->vertex_count; v++) {
+                double d = v3_dot(mesh->patches[k].normal, mesh->vertices[p->vertex[v]]) -
+                           out->offset[k];
+                above = above && d >= -plane_epsilon;
+                below = below && d <= plane_epsilon;
+            }
+            out->side[c] = above && !below ? 1 : below && !above ? -1 : 0;
+        }
+    }
     free(boxes);
     free(count);
     free(pairs);
@@ -139,8 +161,11 @@ void near_contacts_free(near_contacts *contacts)
     free(contacts->start);
     free(contacts->contact);
     free(contacts->offset);
+    free(contacts->radius);
+    free(contacts->side);
     contacts->start = contacts->contact = NULL;
-    contacts->offset = NULL;
+    contacts->offset = contacts->radius = NULL;
+    contacts->side = NULL;
 }
 
 /* Moller-Trumbore in double: the segment a + t d crosses triangle (v0, v1, v2) at some t in
@@ -175,6 +200,30 @@ static bool crosses_patch(const rad_mesh *mesh, uint32_t k, rad_vec3 a, rad_vec3
         return true;
     return p->vertex_count == 4 && segment_crosses(a, d, v[p->vertex[0]], v[p->vertex[2]],
                                                    v[p->vertex[3]], t_low, t_high);
+}
+
+/* Can a segment from patch `from` to patch `to` cross one of from's contacts? Not when
+ * `to` lies wholly on from's side of that contact's plane (its bounding sphere). */
+static bool may_cross(const near_contacts *contacts, uint32_t from, uint32_t to)
+{
+    const rad_mesh *mesh = contacts->mesh;
+    rad_vec3 centre = mesh->patches[to].centroid;
+    double margin = contacts->radius[to] + contacts->plane_epsilon;
+    for (uint32_t c = contacts->start[from]; c < contacts->start[from + 1]; c++) {
+        uint32_t k = contacts->contact[c];
+        if (k == to)
+            continue;
+        double d = v3_dot(mesh->patches[k].normal, centre) - contacts->offset[k];
+        int side = contacts->side[c];
+        if (side == 0 || (side > 0 && d < margin) || (side < 0 && d > -margin))
+            return true;
+    }
+    return false;
+}
+
+bool near_contacts_pair_may_block(const near_contacts *contacts, uint32_t from, uint32_t to)
+{
+    return may_cross(contacts, from, to) || may_cross(contacts, to, from);
 }
 
 /* The end `a` of a segment a + t d, t in [0, 1], of the given length: does it cross one

@@ -27,6 +27,9 @@ typedef struct near_contacts {
     uint32_t *contact; /* patch indices */
     const rad_mesh *mesh;
     double *offset;       /* patch_count: each patch's plane, normal . x = offset */
+    double *radius;       /* patch_count: largest distance from the centroid to a corner */
+    int8_t *side;         /* per contact: the side of the contact's plane the listing patch
+                             lies on (+1, -1), or 0 when the plane cuts it */
     double plane_epsilon; /* a crossing must lie this far along the segment from an end */
 } near_contacts;
 
@@ -44,6 +47,12 @@ static inline bool near_contacts_any(const near_contacts *contacts, uint32_t pat
 {
     return contacts->start[patch + 1] > contacts->start[patch];
 }
+
+/* False when no segment between patches `from` and `to` can cross a contact of either
+ * where the tracer does not look: for each contact, the other patch lies wholly on the
+ * listing patch's side of the contact's plane (the common case: a wall touching a floor
+ * and a patch inside the room). A cheap test per pair before one per segment. */
+bool near_contacts_pair_may_block(const near_contacts *contacts, uint32_t from, uint32_t to);
 
 /* True when the segment from a (on patch `from`) to b (on patch `to`) crosses one of the
  * two patches' contacts other than from and to themselves where the tracer does not look:

@@ -324,7 +324,8 @@ static void trace(const engine *e, thread_work *w, batch *b, uint32_t i)
     bool near_i = near_contacts_any(&e->contacts, i);
     for (uint32_t p = 0; p < b->pending_count; p++) {
         const pending_pair *pair = &b->pending[p];
-        if (!near_i && !near_contacts_any(&e->contacts, pair->j))
+        if ((!near_i && !near_contacts_any(&e->contacts, pair->j)) ||
+            !near_contacts_pair_may_block(&e->contacts, i, pair->j))
             continue;
         for (uint32_t r = pair->first_ray; r < pair->first_ray + pair->ray_count; r++)
             if (!b->occluded[r] &&

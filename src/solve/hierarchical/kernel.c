@@ -277,6 +277,7 @@ void hier_segments(const hier_tree *tree, uint64_t seed, uint32_t receiver, uint
         uint32_t from = tree->order[at_a], to = tree->order[at_b];
         blocked[k] = (near_contacts_any(&tree->contacts, from) ||
                       near_contacts_any(&tree->contacts, to)) &&
+                     near_contacts_pair_may_block(&tree->contacts, from, to) &&
                      near_contacts_block(&tree->contacts, from, to, a, b);
     }
 }
