@@ -372,11 +372,20 @@ typedef struct rad_patch {
                              (real data: the Cornell box's left wall folds by 0.47 degrees),
                              how far it may lie behind the input triangles, which are what
                              blocks rays: visibility rays leave from twice this in front */
+    uint32_t twin;        /* 0 for a one-sided patch; on a two-sided surface
+                             (RAD_SURFACE_TWO_SIDED), 1 + the index of the patch on the
+                             other side: the same cell, corners in reverse order (so its
+                             normal is opposite), its own vertices and its own radiosity */
 } rad_patch;
 
 /* Vertices are shared by the patches of one smooth region (coplanar input triangles of one
  * surface and one material), so values reconstructed at vertices interpolate without seams
- * inside a region and keep creases sharp between regions. */
+ * inside a region and keep creases sharp between regions. A two-sided surface's patches
+ * come twice: the front patches among the others in scene order, then, after every
+ * one-sided and front patch, their twins (rad_patch.twin) in the same order, each side a
+ * region of its own. Every solver thus sees two ordinary one-sided patches (a twin and its
+ * front are coplanar and back to back: F = 0 between them), and both sides radiate and
+ * receive. */
 typedef struct rad_mesh {
     rad_vec3 *vertices;
     uint32_t vertex_count;
@@ -389,7 +398,8 @@ typedef struct rad_mesh {
 double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patches);
 
 /* Splits every triangle (pairs of triangles forming a convex quadrilateral are merged
- * first) into patches whose edges are no longer than patch_size. */
+ * first) into patches whose edges are no longer than patch_size; the patches of
+ * RAD_SURFACE_TWO_SIDED surfaces get their twins (above). */
 rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **out,
                           rad_error *error);
 
