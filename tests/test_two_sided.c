@@ -129,6 +129,8 @@ static void test_mesh_twins(void)
             continue;
         }
         CHECK(patch->twin != 0 && patch->twin <= mesh->patch_count);
+        if (patch->twin == 0 || patch->twin > mesh->patch_count)
+            continue;
         const rad_patch *twin = &mesh->patches[patch->twin - 1];
         CHECK(twin->twin == p + 1);
         CHECK(twin->vertex_count == patch->vertex_count);
