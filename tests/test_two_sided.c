@@ -426,6 +426,16 @@ static void test_gltf_double_sided(void)
     CHECK(set == 2);
     rad_scene_destroy(scene);
 
+    /* info says which surface is two-sided and counts both sides in the emitted power,
+     * pi L_e A per side */
+    CHECK(test_run_tool("info quads.gltf") == 0);
+    const char *out = test_read_text(test_path("stdout.txt"));
+    CHECK(strstr(out, "material lamp  (two-sided)\n") != NULL);
+    CHECK(strstr(out, "  one                             2 triangles  area 4            "
+                      "material lamp\n") != NULL);
+    CHECK(strstr(out, "area 4  power (12.5664, 12.5664, 12.5664)\n") != NULL);
+    CHECK(strstr(out, "area 4  power (25.1327, 25.1327, 25.1327)\n") != NULL);
+
     const char *view = "--eye 0,0,-6 --target 0,0,0 --up 0,1,0 --fov 40 --size 64x64 --quiet";
     const char *commands[] = {"render", "raytrace", "pathtrace --spp 4"};
     for (int k = 0; k < 3; k++) {
