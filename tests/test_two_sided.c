@@ -317,8 +317,7 @@ static void test_renderers_panel(void)
  * their own vertices; a solution saved two-sided is refused by a one-sided run. */
 static void test_lit_mesh_and_solution(void)
 {
-    make_scene(true, false); /* writes the files */
-    rad_scene_destroy(load("sandwich.obj"));
+    rad_scene_destroy(make_scene(true, false)); /* writes the files */
     CHECK(test_run_tool("solve sandwich.obj --two-sided middle --patch-size 0.25 --solver "
                         "direct -o lit.obj --save-solution two.sol --quiet") == 0);
     const char *text = test_read_text(test_path("lit.obj"));
