@@ -244,10 +244,10 @@ typedef struct rad_load_options {
  * texture under an emission factor of 0 (it shows nothing). A surface is a mesh's name (OBJ o/g, glTF mesh, STL solid), else its
  * node's, else the file's name without extension. The first glTF camera becomes the
  * scene's camera. A glTF material's doubleSided makes every surface using it
- * RAD_SURFACE_TWO_SIDED. A material with a specular colour (MTL Ks) but a black diffuse
- * one is a warning: radiosity sees it black. Degenerate triangles are skipped with a
- * warning; non-finite coordinates, a missing material library or glTF buffer, a truncated .glb, an index out
- * of range, unreadable or empty files are errors. A View3D input file is read by
+ * RAD_SURFACE_TWO_SIDED. A material with a specular colour (MTL Ks) but a black diffuse one
+ * is a warning: radiosity sees it black. Degenerate triangles are skipped with a warning;
+ * non-finite coordinates, a missing material library or glTF buffer, a truncated .glb, an
+ * index out of range, unreadable or empty files are errors. A View3D input file is read by
  * rad_scene_load_vs3 below (*.vs3, or View3D content). */
 rad_status rad_scene_load(const char *path, const rad_load_options *options,
                           rad_scene **out, rad_error *error);

@@ -15,8 +15,9 @@ static const char usage[] =
     "\n"
     "Tells what was read from SCENE (any file the other commands read; none = the built-in\n"
     "Cornell box): each surface (name, triangles, area, material; two-sided ones say so),\n"
-    "each material (albedo, emitted radiance, specular colour), the emitters and their power, the bounding box, the camera the\n"
-    "image commands would use, the unit and up axis when the file says, and the warnings.\n"
+    "each material (albedo, emitted radiance, specular colour), the emitters and their\n"
+    "power, the bounding box, the camera the image commands would use, the unit and up\n"
+    "axis when the file says, and the warnings.\n"
     "The --emit, --albedo and --two-sided options show their effect. Exit status 1 when\n"
     "the scene cannot be read.\n"
     "\n"
@@ -167,8 +168,8 @@ static void describe(report *r, const rad_scene *scene)
     say(r, "materials: %u\n", nm);
     for (uint32_t m = 0; m < nm; m++) {
         const rad_material *material = &scene->materials[m];
-        say(r, "  %-24s albedo (%.4g, %.4g, %.4g)%s  emission (%.4g, %.4g, %.4g)%s", material->name,
-            material->albedo.r, material->albedo.g, material->albedo.b,
+        say(r, "  %-24s albedo (%.4g, %.4g, %.4g)%s  emission (%.4g, %.4g, %.4g)%s",
+            material->name, material->albedo.r, material->albedo.g, material->albedo.b,
             material->albedo_texture ? " x texture" : "", material->emission.r,
             material->emission.g, material->emission.b,
             material->emission_texture ? " x texture" : "");

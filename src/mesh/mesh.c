@@ -410,7 +410,8 @@ static double plan_patch_count(const mesh_plan *plan, double patch_size)
     for (size_t p = 0; p < plan->polygon_count; p++) {
         uint32_t nu, nv;
         polygon_divisions(plan->in.scene, &plan->polygons[p], patch_size, &nu, &nv);
-        count += (double)nu * nv * (polygon_two_sided(plan->in.scene, &plan->polygons[p]) ? 2 : 1);
+        double sides = polygon_two_sided(plan->in.scene, &plan->polygons[p]) ? 2 : 1;
+        count += (double)nu * nv * sides;
     }
     return count;
 }

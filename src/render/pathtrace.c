@@ -1,11 +1,12 @@
 /*
  * pathtrace.c - the Monte-Carlo reference: unbiased path tracing of Lambertian scenes.
  *
- * What it estimates: the radiance L seen through each pixel (box filter), for one-sided
- * (or two-sided: RAD_SURFACE_TWO_SIDED, both sides alike) surfaces with albedo Kd and emitted radiance Ke, the same model radiosity solves, each
- * times its texture's texel at the point (scene/material_at.h: albedo at every path vertex,
- * emission seen by every ray and at every light sample). What it is not: a general
- * renderer (no specular, no environment light).
+ * What it estimates: the radiance L seen through each pixel (box filter), for one-sided (or
+ * two-sided: RAD_SURFACE_TWO_SIDED, both sides alike) surfaces with albedo Kd and emitted
+ * radiance Ke, the same model radiosity solves, each times its texture's texel at the point
+ * (scene/material_at.h: albedo at every path vertex, emission seen by every ray and at
+ * every light sample). What it is not: a general renderer (no specular, no environment
+ * light).
  *
  * The one idea needed to read it: the image is cut into TILE x TILE tiles, and each tile is
  * traced as a sequence of WAVES. A wave holds SAMPLES_PER_WAVE samples of every pixel of
@@ -231,7 +232,9 @@ static uint32_t extend_paths(const pt_context *c, pt_workspace *w, uint32_t live
         rad_vec3 d = v3((double)w->rays[k].direction[0], (double)w->rays[k].direction[1],
                         (double)w->rays[k].direction[2]);
         /* a two-sided surface's back is a front facing the ray, with the same material */
-        rad_vec3 n = hit.front ? c->normals[hit.triangle] : v3_scale(c->normals[hit.triangle], -1);
+        rad_vec3 n = c->normals[hit.triangle];
+        if (!hit.front)
+            n = v3_scale(n, -1);
 
         rad_rgb emitted = material_emission_at(scene, hit.triangle, hit.u, hit.v);
         if (max3(emitted) > 0) {

@@ -6,12 +6,13 @@
  * pixel averages k x k jittered stratified primary rays (box filter). A hit on a front
  * face takes the radiance interpolated from the vertex values with the hit's barycentrics;
  * a back face or a miss is black. A two-sided surface's patches have twins (rad_patch.twin:
- * the same cell facing the other way, with its own radiosity): only the front patches go
- * to the tracer, and a hit on a front patch's back is shaded as its twin at that point
- * (the twin's display triangle holding the point, the barycentrics there). Pixels whose first samples disagree (silhouettes, the
- * light's rim) get edge_samples more. With the scene's materials given, a hit on a surface
- * with Ks > 0 also sends a mirror ray, weighted by Ks, whose hit is shaded the same way
- * (the radiosity solution replaces Whitted's ambient term), up to a depth.
+ * the same cell facing the other way, with its own radiosity): only the front patches go to
+ * the tracer, and a hit on a front patch's back is shaded as its twin at that point (the
+ * twin's display triangle holding the point, the barycentrics there). Pixels whose first
+ * samples disagree (silhouettes, the light's rim) get edge_samples more. With the scene's
+ * materials given, a hit on a surface with Ks > 0 also sends a mirror ray, weighted by Ks,
+ * whose hit is shaded the same way (the radiosity solution replaces Whitted's ambient
+ * term), up to a depth.
  * Random numbers come from (seed, pixel). With the scene's textures (albedo or emission),
  * a textured patch's vertices hold the irradiance (B_i - E_i) / (pi rho_i) instead, E_i and
  * rho_i the patch inputs the solve used (passed in, or built once here), and a hit shows
@@ -117,7 +118,8 @@ static uint32_t twin_triangle(const shading *sh, uint32_t twin, rad_vec3 point, 
     for (uint32_t t = sh->first_triangle[twin]; t < sh->first_triangle[twin + 1]; t++) {
         const uint32_t *corner = sh->triangles[t];
         rad_vec3 a = sh->positions[corner[0]];
-        rad_vec3 e1 = v3_sub(sh->positions[corner[1]], a), e2 = v3_sub(sh->positions[corner[2]], a);
+        rad_vec3 e1 = v3_sub(sh->positions[corner[1]], a);
+        rad_vec3 e2 = v3_sub(sh->positions[corner[2]], a);
         rad_vec3 d = v3_sub(point, a);
         double d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2);
         double d1 = v3_dot(d, e1), d2 = v3_dot(d, e2);

@@ -97,5 +97,6 @@ rad_rgb material_mean_emission(const rad_scene *scene, uint32_t triangle)
 
 bool triangle_two_sided(const rad_scene *scene, uint32_t triangle)
 {
-    return (scene->surfaces[scene->triangles[triangle].surface].flags & RAD_SURFACE_TWO_SIDED) != 0;
+    uint32_t surface = scene->triangles[triangle].surface;
+    return (scene->surfaces[surface].flags & RAD_SURFACE_TWO_SIDED) != 0;
 }
