@@ -18,7 +18,9 @@
  *     exitance that enters the radiosity equation is E = pi * L_e. Radiosity B is an
  *     exitance (same unit as E); an image pixel holds radiance L = B / pi.
  *   - Surfaces are one-sided: the front is the side from which a triangle's vertices run
- *     counter-clockwise. Every surface blocks rays from both sides.
+ *     counter-clockwise. Every surface blocks rays from both sides. A surface flagged
+ *     RAD_SURFACE_TWO_SIDED (`--two-sided NAME`, glTF doubleSided) radiates and receives
+ *     on both sides, each side with the material's values, in every solver and renderer.
  *
  * Errors: fallible functions return rad_status and, when the caller passes a rad_error,
  * fill it with a one-line message of the form "file:line: what is wrong" (the file and line
@@ -184,8 +186,11 @@ typedef struct rad_surface {
 
 #define RAD_SURFACE_OBSTRUCTION (1u << 0) /* blocks rays but has no row or column of view
                                             factors (View3D `O`, `--obstruction FILE`) */
-#define RAD_SURFACE_TWO_SIDED (1u << 1)   /* both sides radiate: one row whose area is
-                                            twice the triangles' (`--two-sided NAME`) */
+#define RAD_SURFACE_TWO_SIDED (1u << 1)   /* both sides radiate and receive: view factors
+                                            give it one row whose area is twice the
+                                            triangles'; the mesh gives each side its own
+                                            patches (rad_patch.twin) (`--two-sided NAME`,
+                                            glTF doubleSided) */
 
 typedef struct rad_triangle {
     uint32_t vertex[3]; /* indices into rad_scene.positions, counter-clockwise = front */
@@ -238,9 +243,11 @@ typedef struct rad_load_options {
  * unreadable is a warning (the value is then the factor alone), and so is an emission
  * texture under an emission factor of 0 (it shows nothing). A surface is a mesh's name (OBJ o/g, glTF mesh, STL solid), else its
  * node's, else the file's name without extension. The first glTF camera becomes the
- * scene's camera. Degenerate triangles are skipped with a warning; non-finite
- * coordinates, a missing material library or glTF buffer, a truncated .glb, an index out
- * of range, unreadable or empty files are errors. A View3D input file is read by
+ * scene's camera. A glTF material's doubleSided makes every surface using it
+ * RAD_SURFACE_TWO_SIDED. A material with a specular colour (MTL Ks) but a black diffuse one
+ * is a warning: radiosity sees it black. Degenerate triangles are skipped with a warning;
+ * non-finite coordinates, a missing material library or glTF buffer, a truncated .glb, an
+ * index out of range, unreadable or empty files are errors. A View3D input file is read by
  * rad_scene_load_vs3 below (*.vs3, or View3D content). */
 rad_status rad_scene_load(const char *path, const rad_load_options *options,
                           rad_scene **out, rad_error *error);
@@ -320,8 +327,9 @@ rad_status rad_scene_load_files(const rad_scene_file *files, uint32_t count,
                                 const rad_load_options *options, rad_scene **out,
                                 rad_error *error);
 
-/* Sets `flags` (ORed in) on the surface named `name`; RAD_ERR_INVALID naming it when the
- * scene has no such surface. */
+/* Sets `flags` (ORed in) on what `name` names: the surface by that name, else every
+ * surface with triangles of the material(s) by that name, the name matched as by
+ * rad_scene_set_material. RAD_ERR_INVALID with its message when nothing matches. */
 rad_status rad_scene_set_surface_flags(rad_scene *scene, const char *name, uint32_t flags,
                                        rad_error *error);
 
@@ -346,12 +354,16 @@ bool rad_scene_has_emitter(const rad_scene *scene);
 rad_camera rad_scene_default_camera(const rad_scene *scene);
 
 /* Sets the albedo and/or the emitted radiance (either may be NULL) of what `name` names:
- * a surface by that name, else the one material by that name. A surface keeps its other
+ * a surface by that name, else every material by that name (files repeat names; to set
+ * one of them, name a surface that uses it); matched exactly, else ignoring case when that
+ * leaves one surface or one material name. A surface keeps its other
  * material values, its textures included (a value set is the factor its texture then
  * multiplies); when its material is shared with triangles of other surfaces, it gets
  * its own copy first, so nothing else changes. RAD_ERR_INVALID, naming `name`, when
- * nothing or several materials have that name (and no surface does), or when a value is
- * out of its domain (albedo in [0,1], emission >= 0, both finite). */
+ * several names match ignoring case (the message lists them), when nothing matches
+ * ("no surface or material 'X' in FILE; did you mean 'Y'?", Y the closest name by edit
+ * distance), or when a value is out of its domain (albedo in [0,1], emission >= 0, both
+ * finite). */
 rad_status rad_scene_set_material(rad_scene *scene, const char *name, const rad_rgb *albedo,
                                   const rad_rgb *emission, rad_error *error);
 
@@ -372,11 +384,20 @@ typedef struct rad_patch {
                              (real data: the Cornell box's left wall folds by 0.47 degrees),
                              how far it may lie behind the input triangles, which are what
                              blocks rays: visibility rays leave from twice this in front */
+    uint32_t twin;        /* 0 for a one-sided patch; on a two-sided surface
+                             (RAD_SURFACE_TWO_SIDED), 1 + the index of the patch on the
+                             other side: the same cell, corners in reverse order (so its
+                             normal is opposite), its own vertices and its own radiosity */
 } rad_patch;
 
 /* Vertices are shared by the patches of one smooth region (coplanar input triangles of one
  * surface and one material), so values reconstructed at vertices interpolate without seams
- * inside a region and keep creases sharp between regions. */
+ * inside a region and keep creases sharp between regions. A two-sided surface's patches
+ * come twice: the front patches among the others in scene order, then, after every
+ * one-sided and front patch, their twins (rad_patch.twin) in the same order, each side a
+ * region of its own. Every solver thus sees two ordinary one-sided patches (a twin and its
+ * front are coplanar and back to back: F = 0 between them), and both sides radiate and
+ * receive. */
 typedef struct rad_mesh {
     rad_vec3 *vertices;
     uint32_t vertex_count;
@@ -389,7 +410,8 @@ typedef struct rad_mesh {
 double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patches);
 
 /* Splits every triangle (pairs of triangles forming a convex quadrilateral are merged
- * first) into patches whose edges are no longer than patch_size. */
+ * first) into patches whose edges are no longer than patch_size; the patches of
+ * RAD_SURFACE_TWO_SIDED surfaces get their twins (above). */
 rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **out,
                           rad_error *error);
 
@@ -994,7 +1016,8 @@ void rad_reconstruct_vertices(const rad_mesh *mesh, const rad_rgb *B,
 
 /* Renders the mesh lit by the solution B (per patch exitance) through the camera: primary
  * rays hit the patches, radiance is interpolated from vertex values (textured surfaces:
- * options->scene above); back faces and misses are black; mirror reflections are added
+ * options->scene above); back faces of one-sided patches and misses are black (a hit on
+ * the back of a patch with a twin shows the twin there); mirror reflections are added
  * when options->materials is given (above). Fills `image` (its size decides the
  * resolution). */
 rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
@@ -1033,8 +1056,9 @@ typedef struct rad_raytrace_options {
  * emitted power, L_e the emission texel at the sampled point): each sample adds
  * (K_D + K_S <V,R>^n) / pi * L_e cos(surface) cos(light) / r^2 / pdf, the Phong model read as
  * a reflectance function, so their diffuse part is exactly radiosity's direct light. Back
- * faces show black (one-sided surfaces). One sample per pixel goes through the pixel's
- * centre. Fills `image` (its size sets the resolution). */
+ * faces show black (one-sided surfaces; the back of a RAD_SURFACE_TWO_SIDED one is shaded
+ * as its front, and a two-sided emitter lights both sides). One sample per pixel goes
+ * through the pixel's centre. Fills `image` (its size sets the resolution). */
 rad_status rad_raytrace(const rad_scene *scene, const rad_camera *camera,
                         const rad_raytrace_options *options, rad_image *image,
                         rad_error *error);
@@ -1057,7 +1081,8 @@ typedef struct rad_pathtrace_report {
 } rad_pathtrace_report;
 
 /* An unbiased path tracer for the same Lambertian scenes radiosity solves (albedo Kd,
- * emitted radiance Ke, each times its texture's texel at the point; one-sided): cosine-weighted importance sampling, next-event
+ * emitted radiance Ke, each times its texture's texel at the point; one-sided unless
+ * RAD_SURFACE_TWO_SIDED): cosine-weighted importance sampling, next-event
  * estimation on emitters combined with BSDF sampling by multiple importance sampling,
  * Russian roulette. Deterministic per seed for any thread count; parallel over tiles. The
  * reference for checking radiosity images. `standard_error` (NULL, or an image of the
@@ -1114,9 +1139,11 @@ rad_status rad_image_compare(const rad_image *a, const rad_image *b,
  * luminance of the lit vertices (luminance > 0) is scaled to 0.9. Vertices are per smooth
  * region (rad_mesh), so creases and emitters stay sharp; patches are written as the
  * triangles the renderer uses: a quad as (0,1,2) and (0,2,3), a patch with T-vertices or
- * added vertices on its edges split through them, so faces meet corner to corner. Coordinates are the
- * scene's own (the built-in Cornell box is in millimetres); radiance is in the unit of the
- * emitters' Ke, the same numbers as a .pfm render. */
+ * added vertices on its edges split through them, so faces meet corner to corner; a
+ * two-sided surface's twins are faces of their own, wound to face their side, with their
+ * own vertices and colours (viewers that cull back faces show each side's). Coordinates
+ * are the scene's own (the built-in Cornell box is in millimetres); radiance is in the
+ * unit of the emitters' Ke, the same numbers as a .pfm render. */
 typedef struct rad_lit_mesh_options {
     bool fixed_exposure; /* false = automatic (above), true = use `exposure` */
     double exposure;     /* the display colour is radiance * 2^exposure */

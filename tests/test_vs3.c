@@ -296,7 +296,7 @@ static void test_files(void)
     CHECK(scene->surfaces[0].flags == RAD_SURFACE_TWO_SIDED);
     CHECK(rad_scene_set_surface_flags(scene, "west", RAD_SURFACE_TWO_SIDED, &error) ==
           RAD_ERR_INVALID);
-    CHECK(strstr(error.message, "no surface named 'west'") != NULL);
+    CHECK(strstr(error.message, "no surface or material 'west' in ") != NULL);
     rad_scene_destroy(scene);
 
     rad_scene_file same[2] = {{test_path("north.obj"), 0, false},

@@ -170,9 +170,27 @@ enum {
 
 /* The help lines of the SCENE group. */
 #define CLI_SCENE_HELP                                                                     \
-    "  --emit NAME=R,G,B    set the emitted radiance of surface NAME (or, when no surface\n" \
-    "                       has that name, of the one material named NAME); repeatable\n"  \
+    "  --emit NAME=R,G,B    set the emitted radiance of surface NAME, else of every\n"       \
+    "                       material NAME (exact, else ignoring case); repeatable\n"        \
     "  --albedo NAME=R,G,B  set its albedo (0 to 1) the same way; repeatable\n"
+
+/* --two-sided NAME (render, solve, raytrace, pathtrace; repeatable): the names given, in
+ * order, applied to the scene after loading (cli_apply_two_sided, cli_solve.c). */
+typedef struct cli_two_sided {
+    const char *name[CLI_MAX_GIVEN];
+    int count;
+} cli_two_sided;
+
+#define CLI_TWO_SIDED_HELP                                                                 \
+    "  --two-sided NAME     surface or material NAME radiates on both sides; repeatable\n"
+
+/* The values of `option` (the command's --two-sided) in *out. */
+void cli_parse_two_sided(const cli_args *args, int option, cli_two_sided *out);
+
+/* Sets RAD_SURFACE_TWO_SIDED on what each name names (rad_scene_set_surface_flags); an
+ * unknown name is an error "--two-sided: ..." naming it. */
+rad_status cli_apply_two_sided(const cli_two_sided *two_sided, rad_scene *scene,
+                               rad_error *error);
 
 /* What the BASE and FORMFACTOR options say; patch_size 0 = the command's default. */
 typedef struct cli_shared {
@@ -336,6 +354,8 @@ typedef struct cli_solve {
                                         progress */
     const char *solution_path;      /* --solution: read B from this file instead of solving */
     const char *save_solution_path; /* --save-solution: write B to this file */
+    cli_two_sided two_sided;        /* --two-sided, set by the command after cli_parse_solve;
+                                       applied by cli_solve_scene before meshing */
 } cli_solve;
 
 /* Parses the SOLVE options (after cli_parse_shared, whose threads, seed, quadrature and

@@ -5,6 +5,7 @@
  * See cli.h.
  */
 #include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,6 +35,31 @@ static bool parse_bytes(const char *name, const char *text, uint64_t *out)
     }
     *out = (uint64_t)(value * scale);
     return true;
+}
+
+void cli_parse_two_sided(const cli_args *args, int option, cli_two_sided *out)
+{
+    int cursor = 0;
+    out->count = 0;
+    for (const char *name; out->count < CLI_MAX_GIVEN &&
+                           (name = cli_next_value(args, option, &cursor));)
+        out->name[out->count++] = name;
+}
+
+rad_status cli_apply_two_sided(const cli_two_sided *two_sided, rad_scene *scene,
+                               rad_error *error)
+{
+    for (int k = 0; k < two_sided->count; k++) {
+        rad_status status =
+            rad_scene_set_surface_flags(scene, two_sided->name[k], RAD_SURFACE_TWO_SIDED, error);
+        if (status != RAD_OK) {
+            char message[RAD_ERROR_MESSAGE_MAX];
+            snprintf(message, sizeof(message), "%s", error->message);
+            snprintf(error->message, sizeof(error->message), "--two-sided: %.900s", message);
+            return status;
+        }
+    }
+    return RAD_OK;
 }
 
 bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *solve)
@@ -142,6 +168,8 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
     rad_solution *solution = NULL;
     double t0 = rad_clock_seconds();
     rad_status status = cli_load_scene(scene_path, &out->scene, error);
+    if (status == RAD_OK)
+        status = cli_apply_two_sided(&solve->two_sided, out->scene, error);
     if (status != RAD_OK)
         goto done;
     double t_load = rad_clock_seconds();

@@ -14,20 +14,23 @@ static const char usage[] =
     "usage: radiosity info [SCENE] [options]\n"
     "\n"
     "Tells what was read from SCENE (any file the other commands read; none = the built-in\n"
-    "Cornell box): each surface (name, triangles, area, material), each material (albedo,\n"
-    "emitted radiance), the emitters and their power, the bounding box, the camera the\n"
-    "image commands would use, the unit and up axis when the file says, and the warnings.\n"
-    "The --emit and --albedo options show their effect. Exit status 1 when the scene\n"
-    "cannot be read.\n"
+    "Cornell box): each surface (name, triangles, area, material; two-sided ones say so),\n"
+    "each material (albedo, emitted radiance, specular colour), the emitters and their\n"
+    "power, the bounding box, the camera the image commands would use, the unit and up\n"
+    "axis when the file says, and the warnings.\n"
+    "The --emit, --albedo and --two-sided options show their effect. Exit status 1 when\n"
+    "the scene cannot be read.\n"
     "\n"
     CLI_SCENE_HELP
+    CLI_TWO_SIDED_HELP
     "  -o FILE              write the report to FILE instead of stdout\n"
     "  --stats FILE.json    load time, counts and peak memory\n"
     CLI_QUIET_HELP;
 
-enum { OPT_COUNT = OPT_OWN };
+enum { OPT_TWO_SIDED = OPT_OWN, OPT_COUNT };
 
-static const cli_option options[OPT_COUNT] = {CLI_BASE_OPTIONS, CLI_SCENE_OPTIONS};
+static const cli_option options[OPT_COUNT] = {CLI_BASE_OPTIONS, CLI_SCENE_OPTIONS,
+                                              [OPT_TWO_SIDED] = {"two-sided", 0, true}};
 
 /* The report, built in memory and written at once. */
 typedef struct report {
@@ -124,11 +127,13 @@ static void describe(report *r, const rad_scene *scene)
     /* per material: triangles and area using it */
     uint32_t nm = scene->material_count;
     double *material_area = calloc(nm ? nm : 1, sizeof(double));
+    double *radiating_area = calloc(nm ? nm : 1, sizeof(double)); /* two-sided: twice */
     uint32_t *material_triangles = calloc(nm ? nm : 1, sizeof(uint32_t));
     uint32_t *listed_for = calloc(nm ? nm : 1, sizeof(uint32_t)); /* surface + 1 */
-    if (!material_area || !material_triangles || !listed_for) {
+    if (!material_area || !radiating_area || !material_triangles || !listed_for) {
         r->failed = true;
         free(material_area);
+        free(radiating_area);
         free(material_triangles);
         free(listed_for);
         return;
@@ -143,6 +148,7 @@ static void describe(report *r, const rad_scene *scene)
             uint32_t m = scene->triangles[t].material;
             area += a;
             material_area[m] += a;
+            radiating_area[m] += surface->flags & RAD_SURFACE_TWO_SIDED ? 2 * a : a;
             material_triangles[m]++;
         }
         /* the materials of this surface, in order of first use */
@@ -157,17 +163,20 @@ static void describe(report *r, const rad_scene *scene)
             say(r, listed == 3 ? ", ..." : "%s %s", listed ? "," : "", scene->materials[m].name);
             listed++;
         }
-        say(r, "\n");
+        say(r, "%s\n", surface->flags & RAD_SURFACE_TWO_SIDED ? "  (two-sided)" : "");
     }
     say(r, "materials: %u\n", nm);
     for (uint32_t m = 0; m < nm; m++) {
         const rad_material *material = &scene->materials[m];
-        say(r, "  %-24s albedo (%.4g, %.4g, %.4g)%s  emission (%.4g, %.4g, %.4g)%s  %u "
-               "triangles%s\n",
+        say(r, "  %-24s albedo (%.4g, %.4g, %.4g)%s  emission (%.4g, %.4g, %.4g)%s",
             material->name, material->albedo.r, material->albedo.g, material->albedo.b,
             material->albedo_texture ? " x texture" : "", material->emission.r,
             material->emission.g, material->emission.b,
-            material->emission_texture ? " x texture" : "", material_triangles[m],
+            material->emission_texture ? " x texture" : "");
+        const rad_rgb *ks = &material->specular;
+        if (ks->r > 0 || ks->g > 0 || ks->b > 0)
+            say(r, "  specular (%.4g, %.4g, %.4g)", ks->r, ks->g, ks->b);
+        say(r, "  %u triangles%s\n", material_triangles[m],
             material_triangles[m] ? "" : " (unused)");
     }
     unsigned emitters = 0;
@@ -178,9 +187,10 @@ static void describe(report *r, const rad_scene *scene)
         const rad_material *material = &scene->materials[m];
         if (!emits(material) || !material_triangles[m])
             continue;
-        /* power of a Lambertian emitter: pi L_e A (per unit of the scene's length squared);
-         * with an emission texture, times the texture's mean over the surface (not shown) */
-        double k = 3.14159265358979323846 * material_area[m];
+        /* power of a Lambertian emitter: pi L_e A (per unit of the scene's length squared),
+         * A counting both sides of two-sided surfaces; with an emission texture, times the
+         * texture's mean over the surface (not shown) */
+        double k = 3.14159265358979323846 * radiating_area[m];
         say(r, "  %-24s radiance (%.4g, %.4g, %.4g)%s  area %.6g  power (%.6g, %.6g, %.6g)%s\n",
             material->name, material->emission.r, material->emission.g, material->emission.b,
             material->emission_texture ? " x texture" : "", material_area[m],
@@ -202,6 +212,7 @@ static void describe(report *r, const rad_scene *scene)
     }
     free(listed_for);
     free(material_area);
+    free(radiating_area);
     free(material_triangles);
 }
 
@@ -223,6 +234,10 @@ int command_info(int argc, char **argv)
     rad_error error = {0};
     double t0 = rad_clock_seconds();
     rad_status status = cli_load_scene_logged(path, keep_warning, &w, &scene, &error);
+    cli_two_sided two_sided;
+    cli_parse_two_sided(&args, OPT_TWO_SIDED, &two_sided);
+    if (status == RAD_OK)
+        status = cli_apply_two_sided(&two_sided, scene, &error);
     double t_load = rad_clock_seconds() - t0;
     report r = {0};
     if (status != RAD_OK) {

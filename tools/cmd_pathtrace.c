@@ -15,7 +15,8 @@ static const char usage[] =
     "\n"
     "Renders SCENE (an OBJ+MTL or any file Assimp reads; none = the built-in Cornell box\n"
     "with its official camera) by unbiased path tracing of its Lambertian surfaces (Kd\n"
-    "albedo, Ke emitted radiance, one-sided): cosine-weighted bounces, next-event\n"
+    "albedo, Ke emitted radiance; one-sided unless two-sided: --two-sided, glTF\n"
+    "doubleSided): cosine-weighted bounces, next-event\n"
     "estimation on the emitters with multiple importance sampling, Russian roulette. The\n"
     "image is the reference a radiosity image is checked against; the same seed gives the\n"
     "same image for any thread count. OUT's extension picks the format: .png (exposure,\n"
@@ -31,10 +32,11 @@ static const char usage[] =
     "                       ends paths without bias)\n"
     "  --standard-error FILE  also write each pixel's standard error of the mean, per\n"
     "                       channel (.hdr, .pfm or .exr)\n"
+    CLI_TWO_SIDED_HELP
     CLI_SCENE_HELP
     CLI_BASE_HELP("rays, times, mean radiance and peak memory");
 
-enum { OPT_MAX_DEPTH = OPT_OWN, OPT_STANDARD_ERROR, OPT_COUNT };
+enum { OPT_MAX_DEPTH = OPT_OWN, OPT_STANDARD_ERROR, OPT_TWO_SIDED, OPT_COUNT };
 
 static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS,
@@ -42,6 +44,7 @@ static const cli_option options[OPT_COUNT] = {
     CLI_SCENE_OPTIONS,
     [OPT_MAX_DEPTH] = {"max-depth", 0, true},
     [OPT_STANDARD_ERROR] = {"standard-error", 0, true},
+    [OPT_TWO_SIDED] = {"two-sided", 0, true},
 };
 
 typedef struct pathtrace_settings {
@@ -49,6 +52,7 @@ typedef struct pathtrace_settings {
     cli_shared shared;
     cli_view view;
     rad_pathtrace_options trace;
+    cli_two_sided two_sided;
 } pathtrace_settings;
 
 static bool parse_settings(int argc, char **argv, pathtrace_settings *s, int *exit_code)
@@ -59,6 +63,7 @@ static bool parse_settings(int argc, char **argv, pathtrace_settings *s, int *ex
                                  &s->shared, &s->view, &s->scene_path, exit_code))
         return false;
     s->error_path = args.value[OPT_STANDARD_ERROR];
+    cli_parse_two_sided(&args, OPT_TWO_SIDED, &s->two_sided);
     if (s->error_path && s->view.samples_per_pixel == 1) {
         cli_error("--standard-error: needs at least 2 samples per pixel (--spp)");
         return false;
@@ -119,6 +124,8 @@ int command_pathtrace(int argc, char **argv)
     rad_image *standard_error = NULL;
     rad_pathtrace_report report = {0};
     rad_status status = cli_image_run_begin(&run, s.scene_path, &s.view, &error);
+    if (status == RAD_OK)
+        status = cli_apply_two_sided(&s.two_sided, run.scene, &error);
     if (status == RAD_OK && !rad_scene_has_emitter(run.scene))
         cli_warn("%s: no surface emits light (no material with non-zero Ke): the image will "
                  "be black (--emit NAME=R,G,B makes a surface a light)",

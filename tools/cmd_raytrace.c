@@ -19,7 +19,8 @@ static const char usage[] =
     "seen in the mirror direction. Point lights have no distance falloff (the classic\n"
     "model). The scene's emitting surfaces are area lights, sampled for soft shadows: each\n"
     "sample adds (Kd + Ks <V,R>^Ns)/pi Le cos cos' / r^2 / pdf (Phong read as a BRDF).\n"
-    "Surfaces are one-sided: back faces and the background are black. OUT's\n"
+    "Surfaces are one-sided (back faces and the background are black) unless two-sided\n"
+    "(--two-sided, glTF doubleSided): their back is shaded as their front. OUT's\n"
     "extension picks the format: .png (exposure, tone map, sRGB 8-bit), .hdr (Radiance\n"
     "RGBE), .pfm (portable float map) or .exr (OpenEXR, half float); .hdr, .pfm and .exr\n"
     "hold linear radiance.\n"
@@ -36,10 +37,12 @@ static const char usage[] =
     "                       (default " CLI_STR(RAD_DEFAULT_RAYTRACE_SPP) "; 1 = through the pixel centre)\n"
     CLI_IMAGE_FILE_HELP
     "Run:\n"
+    CLI_TWO_SIDED_HELP
     CLI_SCENE_HELP
     CLI_BASE_HELP("counts, times and peak memory");
 
-enum { OPT_LIGHT = OPT_OWN, OPT_AMBIENT, OPT_LIGHT_SAMPLES, OPT_MAX_DEPTH, OPT_COUNT };
+enum { OPT_LIGHT = OPT_OWN, OPT_AMBIENT, OPT_LIGHT_SAMPLES, OPT_MAX_DEPTH, OPT_TWO_SIDED,
+       OPT_COUNT };
 
 static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS,
@@ -49,6 +52,7 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_AMBIENT] = {"ambient", 0, true},
     [OPT_LIGHT_SAMPLES] = {"light-samples", 0, true},
     [OPT_MAX_DEPTH] = {"max-depth", 0, true},
+    [OPT_TWO_SIDED] = {"two-sided", 0, true},
 };
 
 /* Library limits the command line checks first, so that the message names the option. */
@@ -60,6 +64,7 @@ typedef struct raytrace_settings {
     cli_shared shared;
     cli_view view;
     rad_point_light *lights; /* owned */
+    cli_two_sided two_sided;
     rad_raytrace_options trace;
 } raytrace_settings;
 
@@ -141,6 +146,7 @@ static bool parse_settings(int argc, char **argv, raytrace_settings *s, int *exi
         return false;
     if (!collect_lights(&args, s))
         return false;
+    cli_parse_two_sided(&args, OPT_TWO_SIDED, &s->two_sided);
     if (args.value[OPT_AMBIENT] && !parse_rgb("ambient", args.value[OPT_AMBIENT], &s->trace.ambient))
         return false;
     if (!cli_parse_count("light-samples", args.value[OPT_LIGHT_SAMPLES], 1, MAX_LIGHT_SAMPLES,
@@ -170,6 +176,8 @@ int command_raytrace(int argc, char **argv)
     rad_error error = {0};
     cli_image_run run;
     rad_status status = cli_image_run_begin(&run, s.scene_path, &s.view, &error);
+    if (status == RAD_OK)
+        status = cli_apply_two_sided(&s.two_sided, run.scene, &error);
     bool emitters = status == RAD_OK && rad_scene_has_emitter(run.scene);
     bool ambient = s.trace.ambient.r > 0 || s.trace.ambient.g > 0 || s.trace.ambient.b > 0;
     if (status == RAD_OK && !emitters && s.trace.light_count == 0)

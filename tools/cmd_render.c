@@ -14,9 +14,9 @@ static const char usage[] =
     "Solves the radiosity of SCENE (an OBJ+MTL or any file Assimp reads; none = the\n"
     "built-in Cornell box with its official camera) and renders it to OUT. OUT's extension\n"
     "picks the format: .png (exposure, tone map, sRGB 8-bit), .hdr (Radiance RGBE), .pfm\n"
-    "(portable float map) or .exr (OpenEXR, half float; --exr-float for 32-bit); .hdr,\n"
-    ".pfm and .exr hold linear radiance. With --solution FILE nothing is solved: the\n"
-    "saved solution of the same scene is rendered from any camera.\n"
+    "(portable float map) or .exr (OpenEXR); .hdr, .pfm and .exr hold linear radiance.\n"
+    "With --solution FILE nothing is solved: the saved solution of the same scene is\n"
+    "rendered from any camera.\n"
     "\n"
     "Camera (default: the scene's camera, or a view of the whole scene from -z):\n"
     "  --eye X,Y,Z  --target X,Y,Z  --up X,Y,Z  --fov DEG (vertical)   --size WxH (512x512)\n"
@@ -27,9 +27,10 @@ static const char usage[] =
     "  --specular           the two-pass method: surfaces with Ks > 0 (MTL) also show\n"
     "                       mirror reflections of the radiosity-lit scene\n"
     "  --max-depth N        mirror reflections followed with --specular (default 5)\n"
+    CLI_TWO_SIDED_HELP
     CLI_SOLVE_HELP;
 
-enum { OPT_SPECULAR = OPT_OWN, OPT_MAX_DEPTH, OPT_COUNT };
+enum { OPT_SPECULAR = OPT_OWN, OPT_MAX_DEPTH, OPT_TWO_SIDED, OPT_COUNT };
 
 static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS,
@@ -39,6 +40,7 @@ static const cli_option options[OPT_COUNT] = {
     CLI_SCENE_OPTIONS,
     [OPT_SPECULAR] = {"specular", 0, false},
     [OPT_MAX_DEPTH] = {"max-depth", 0, true},
+    [OPT_TWO_SIDED] = {"two-sided", 0, true},
 };
 
 #define RENDER_MAX_SPP 256u
@@ -81,6 +83,7 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
     }
     if (!cli_parse_solve(&args, &s->shared, &s->solve))
         return false;
+    cli_parse_two_sided(&args, OPT_TWO_SIDED, &s->solve.two_sided);
     s->render.threads = s->shared.threads;
     s->render.seed = s->shared.seed;
     s->render.progress = cli_progress;

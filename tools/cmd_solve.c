@@ -26,14 +26,18 @@ static const char usage[] =
     "\n"
     "  -o, --output FILE    the lit mesh (.ply, .glb or .obj)\n"
     "  --exposure EV        display colour: radiance times 2^EV (default: automatic)\n"
+    CLI_TWO_SIDED_HELP
     CLI_SOLVE_HELP;
 
-static const cli_option options[OPT_OWN] = {
+enum { OPT_TWO_SIDED = OPT_OWN, OPT_COUNT };
+
+static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS,
     CLI_FORMFACTOR_OPTIONS,
     CLI_SOLVE_OPTIONS,
     CLI_SCENE_OPTIONS,
     [OPT_EXPOSURE] = {"exposure", 0, true},
+    [OPT_TWO_SIDED] = {"two-sided", 0, true},
 };
 
 static bool mesh_output_ok(const char *path)
@@ -55,7 +59,7 @@ int command_solve(int argc, char **argv)
     rad_lit_mesh_options write = {0};
     const char *scene_path = NULL;
     int exit_code;
-    if (!cli_begin("solve", usage, argc, argv, options, OPT_OWN, &args, &shared, &exit_code))
+    if (!cli_begin("solve", usage, argc, argv, options, OPT_COUNT, &args, &shared, &exit_code))
         return exit_code;
     if (args.value[OPT_EXPOSURE]) {
         if (!cli_parse_double("exposure", args.value[OPT_EXPOSURE], &write.exposure))
@@ -73,6 +77,7 @@ int command_solve(int argc, char **argv)
         return EXIT_USAGE;
     if (!cli_parse_solve(&args, &shared, &solve))
         return EXIT_USAGE;
+    cli_parse_two_sided(&args, OPT_TWO_SIDED, &solve.two_sided);
     if (!cli_solve_outputs_writable(&shared, &solve))
         return EXIT_ERROR;
 

@@ -3,6 +3,11 @@
  * display colour, in .ply, .glb or .obj (the encoders are lit_mesh_ply.c, lit_mesh_glb.c
  * and lit_mesh_obj.c; see lit_mesh.h for why they are ours).
  *
+ * A two-sided surface needs nothing here: the mesh gives each side its own patches and
+ * vertices (rad_patch.twin), wound to face their side, so the file holds both sides as
+ * ordinary faces, each with its own colours and normals (a viewer that culls back faces
+ * shows the side it faces; the .glb's material is single-sided, glTF's default).
+ *
  * Everything that can fail without touching the disk is settled first; then the file is
  * written under a temporary name and renamed, so a failed write leaves nothing.
  */

@@ -13,6 +13,10 @@
  *      computed from that edge's lower-numbered end, so two polygons that split a shared
  *      edge into the same count produce bitwise-identical points, which the weld table
  *      then merges into shared vertices.
+ * Then the back sides: each patch of a two-sided surface (RAD_SURFACE_TWO_SIDED) gets a
+ * twin after all the others, its corners in reverse order and its vertices in a region of
+ * their own (the front region's number + the region count), at the same positions bit for
+ * bit, so both sides are ordinary one-sided patches to every solver and renderer.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -245,6 +249,7 @@ typedef struct mesh_plan {
     mesh_input in;
     polygon *polygons;
     size_t polygon_count;
+    uint32_t region_count;
 } mesh_plan;
 
 static void plan_free(mesh_plan *plan)
@@ -323,6 +328,7 @@ static rad_status plan_build(const rad_scene *scene, mesh_plan *plan, rad_error 
         if (region_of_root[root] == UINT32_MAX)
             region_of_root[root] = region_count++;
     }
+    plan->region_count = region_count;
 
     /* 2. quads: pair triangles across a shared longest edge, when the four corners are
      * convex (the region test already bounds the fold to a degree). The bilinear cells of
@@ -391,16 +397,51 @@ done:
     return status;
 }
 
-/* The exact number of patches subdividing at this size makes. */
+static bool polygon_two_sided(const rad_scene *scene, const polygon *poly)
+{
+    uint32_t surface = scene->triangles[poly->triangle].surface;
+    return (scene->surfaces[surface].flags & RAD_SURFACE_TWO_SIDED) != 0;
+}
+
+/* The exact number of patches subdividing at this size makes, twins included. */
 static double plan_patch_count(const mesh_plan *plan, double patch_size)
 {
     double count = 0;
     for (size_t p = 0; p < plan->polygon_count; p++) {
         uint32_t nu, nv;
         polygon_divisions(plan->in.scene, &plan->polygons[p], patch_size, &nu, &nv);
-        count += (double)nu * nv;
+        double sides = polygon_two_sided(plan->in.scene, &plan->polygons[p]) ? 2 : 1;
+        count += (double)nu * nv * sides;
     }
     return count;
+}
+
+/* The back side of patches [first, end) of one polygon (region `region`): a twin per
+ * patch, corners reversed (0, n-1, ..., 1: the same triangles for the renderer's split,
+ * the opposite normal), its vertices in region `region` + the plan's region count. */
+static int add_twins(mesh_output *out, const mesh_plan *plan, uint32_t region, size_t first,
+                     size_t end)
+{
+    for (size_t k = first; k < end; k++) {
+        if (!rad_grow_array((void **)&out->patches, &out->patch_capacity, out->patch_count + 1,
+                            sizeof(*out->patches)))
+            return 0;
+        const rad_patch *front = &out->patches[k];
+        rad_patch *back = &out->patches[out->patch_count];
+        *back = *front;
+        for (uint32_t c = 0; c < front->vertex_count; c++) {
+            uint32_t corner = c == 0 ? 0 : front->vertex_count - c;
+            back->vertex[c] = rad_weld_insert(&out->weld, plan->region_count + region,
+                                              out->weld.positions[front->vertex[corner]]);
+            if (back->vertex[c] == UINT32_MAX)
+                return 0;
+        }
+        back->normal = v3_scale(front->normal, -1);
+        back->twin = (uint32_t)k + 1;
+        out->patches[k].twin = (uint32_t)out->patch_count + 1;
+        out->patch_count++;
+    }
+    return 1;
 }
 
 double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patches)
@@ -463,13 +504,29 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
                           patch_size, count, MESH_MAX_PATCHES);
         goto done;
     }
+    size_t *first_patch = rad_alloc_array(plan.polygon_count + 1, sizeof(*first_patch));
+    if (!first_patch)
+        goto nomem;
     for (size_t p = 0; p < plan.polygon_count; p++) {
+        first_patch[p] = result.patch_count;
         int ok = plan.polygons[p].count == 3
                      ? subdivide_triangle(&result, &plan.polygons[p], patch_size)
                      : subdivide_quad(&result, &plan.polygons[p], patch_size);
-        if (!ok)
+        if (!ok) {
+            free(first_patch);
             goto nomem;
+        }
     }
+    first_patch[plan.polygon_count] = result.patch_count;
+    /* the back sides, after every front */
+    for (size_t p = 0; p < plan.polygon_count; p++)
+        if (polygon_two_sided(scene, &plan.polygons[p]) &&
+            !add_twins(&result, &plan, plan.polygons[p].region, first_patch[p],
+                       first_patch[p + 1])) {
+            free(first_patch);
+            goto nomem;
+        }
+    free(first_patch);
     mesh->patch_count = (uint32_t)result.patch_count;
     mesh->patches = result.patches;
     result.patches = NULL;

@@ -107,4 +107,14 @@ void emitters_sample(const emitter_set *set, const rad_scene *scene, double u0, 
     sample->v = wc;
     sample->pdf_area = set->pdf_area_of[t];
     sample->radiance = material_emission_at(scene, t, wb, wc);
+    sample->two_sided = triangle_two_sided(scene, t);
+}
+
+double emitter_cosine(const emitter_sample *sample, rad_vec3 wi, rad_vec3 *facing)
+{
+    double cosine = -v3_dot(sample->normal, wi);
+    bool back = sample->two_sided && cosine < 0;
+    if (facing)
+        *facing = back ? v3_scale(sample->normal, -1) : sample->normal;
+    return back ? -cosine : cosine;
 }

@@ -43,11 +43,19 @@ typedef struct emitter_sample {
     double u, v;        /* the point's barycentrics on the triangle (as rad_hit) */
     double pdf_area;    /* density of this point per unit area */
     rad_rgb radiance;   /* L_e at the point: the material's, times its emission texel
-                           (one-sided: front only) */
+                           (front only, unless two_sided) */
+    bool two_sided;     /* the triangle's surface radiates from both sides */
 } emitter_sample;
 
 /* u0 picks the triangle, (u1, u2) the point; all in [0,1). The set must not be empty. */
 void emitters_sample(const emitter_set *set, const rad_scene *scene, double u0, double u1,
                      double u2, emitter_sample *sample);
+
+/* The cosine at the light for light arriving along unit direction wi (from the shading
+ * point towards the sample): -<normal, wi>, <= 0 when the point is behind a one-sided
+ * emitter; for a two-sided one its absolute value. *facing receives the unit normal of the
+ * side that faces the point (where shadow rays end, just off the light); NULL: not
+ * wanted. */
+double emitter_cosine(const emitter_sample *sample, rad_vec3 wi, rad_vec3 *facing);
 
 #endif

@@ -1,11 +1,12 @@
 /*
  * pathtrace.c - the Monte-Carlo reference: unbiased path tracing of Lambertian scenes.
  *
- * What it estimates: the radiance L seen through each pixel (box filter), for one-sided
- * surfaces with albedo Kd and emitted radiance Ke, the same model radiosity solves, each
- * times its texture's texel at the point (scene/material_at.h: albedo at every path vertex,
- * emission seen by every ray and at every light sample). What it is not: a general
- * renderer (no specular, no environment light).
+ * What it estimates: the radiance L seen through each pixel (box filter), for one-sided (or
+ * two-sided: RAD_SURFACE_TWO_SIDED, both sides alike) surfaces with albedo Kd and emitted
+ * radiance Ke, the same model radiosity solves, each times its texture's texel at the point
+ * (scene/material_at.h: albedo at every path vertex, emission seen by every ray and at
+ * every light sample). What it is not: a general renderer (no specular, no environment
+ * light).
  *
  * The one idea needed to read it: the image is cut into TILE x TILE tiles, and each tile is
  * traced as a sequence of WAVES. A wave holds SAMPLES_PER_WAVE samples of every pixel of
@@ -15,7 +16,8 @@
  * (seed, pixel, sample), and a tile's results are summed in sample order, so the image is
  * bitwise the same for any thread count and any tile schedule.
  *
- * Per path vertex: a back face or a miss ends the path (one-sided surfaces); emission is
+ * Per path vertex: a miss or the back of a one-sided surface ends the path (the back of a
+ * two-sided one is its front turned towards the ray, emitting too); emission is
  * added with weight 1 on the camera ray and with the power-heuristic MIS weight against
  * light sampling on BSDF-sampled rays; next-event estimation samples a point on the
  * emitters (power-proportional by their mean emission, the sample's radiance the texel
@@ -188,9 +190,9 @@ static int queue_light_sample(const pt_context *c, pt_workspace *w, uint32_t slo
     if (!(distance2 > 0) || !(light.pdf_area > 0))
         return 0;
     rad_vec3 wi = v3_scale(to_light, 1.0 / sqrt(distance2));
-    double cos_surface = v3_dot(n, wi), cos_light = -v3_dot(light.normal, wi);
+    double cos_surface = v3_dot(n, wi), cos_light = emitter_cosine(&light, wi, NULL);
     if (!(cos_surface > 0) || !(cos_light > 0))
-        return 0; /* behind the surface, or the light's back (it emits from its front only) */
+        return 0; /* behind the surface, or a one-sided light's back (it emits from its front) */
     double pdf_light = light.pdf_area * distance2 / cos_light; /* per solid angle */
     double pdf_bsdf = cos_surface / RAD_PI;
     /* Kd/pi Le cos_s cos_l / r^2 / pdf_area = Kd Le (cos_s / pi) / pdf_light */
@@ -224,11 +226,15 @@ static uint32_t extend_paths(const pt_context *c, pt_workspace *w, uint32_t live
         const rad_hit hit = w->hits[k];
         uint32_t p = w->active[k];
         pt_path *path = &w->paths[p];
-        if (hit.triangle == RAD_NO_HIT || !hit.front)
-            continue; /* escaped, or met a surface's back: one-sided, nothing comes back */
+        if (hit.triangle == RAD_NO_HIT ||
+            (!hit.front && !triangle_two_sided(scene, hit.triangle)))
+            continue; /* escaped, or met a one-sided surface's back: nothing comes back */
         rad_vec3 d = v3((double)w->rays[k].direction[0], (double)w->rays[k].direction[1],
                         (double)w->rays[k].direction[2]);
+        /* a two-sided surface's back is a front facing the ray, with the same material */
         rad_vec3 n = c->normals[hit.triangle];
+        if (!hit.front)
+            n = v3_scale(n, -1);
 
         rad_rgb emitted = material_emission_at(scene, hit.triangle, hit.u, hit.v);
         if (max3(emitted) > 0) {

@@ -5,10 +5,14 @@
  * patches with T-vertices on their edges through those) and handed to a tracer; each
  * pixel averages k x k jittered stratified primary rays (box filter). A hit on a front
  * face takes the radiance interpolated from the vertex values with the hit's barycentrics;
- * a back face or a miss is black. Pixels whose first samples disagree (silhouettes, the
- * light's rim) get edge_samples more. With the scene's materials given, a hit on a surface
- * with Ks > 0 also sends a mirror ray, weighted by Ks, whose hit is shaded the same way
- * (the radiosity solution replaces Whitted's ambient term), up to a depth.
+ * a back face or a miss is black. A two-sided surface's patches have twins (rad_patch.twin:
+ * the same cell facing the other way, with its own radiosity): only the front patches go to
+ * the tracer, and a hit on a front patch's back is shaded as its twin at that point (the
+ * twin's display triangle holding the point, the barycentrics there). Pixels whose first
+ * samples disagree (silhouettes, the light's rim) get edge_samples more. With the scene's
+ * materials given, a hit on a surface with Ks > 0 also sends a mirror ray, weighted by Ks,
+ * whose hit is shaded the same way (the radiosity solution replaces Whitted's ambient
+ * term), up to a depth.
  * Random numbers come from (seed, pixel). With the scene's textures (albedo or emission),
  * a textured patch's vertices hold the irradiance (B_i - E_i) / (pi rho_i) instead, E_i and
  * rho_i the patch inputs the solve used (passed in, or built once here), and a hit shows
@@ -52,7 +56,10 @@ typedef struct shading {
     const rad_mesh *mesh;
     const uint32_t (*triangles)[3]; /* render triangles, into mesh vertices */
     const uint32_t *patch_of;       /* render triangle -> patch */
+    const uint32_t *first_triangle; /* per patch (and one past the last): its first render
+                                       triangle; NULL when no patch has a twin */
     const rad_rgb *radiance;        /* per mesh vertex */
+    const rad_vec3 *positions;      /* per display vertex */
     const rad_material *materials;  /* NULL: no mirror rays */
     float t_near;
     double leave;                   /* how far mirror rays start off a surface (scene units) */
@@ -100,6 +107,37 @@ static rad_rgb textured_radiance(const shading *sh, const rad_ray *ray, const ra
     return rgb_add(emission, rgb_mul(albedo, irradiance));
 }
 
+/* The twin's render triangle under `point` (a point of its front patch's plane) and the
+ * barycentrics there: of the twin's triangles, the one where the point is deepest inside
+ * (the largest least barycentric), so a point on their shared edge takes either. */
+static uint32_t twin_triangle(const shading *sh, uint32_t twin, rad_vec3 point, double *u,
+                              double *v)
+{
+    uint32_t best = RAD_NO_HIT;
+    double best_depth = -INFINITY;
+    for (uint32_t t = sh->first_triangle[twin]; t < sh->first_triangle[twin + 1]; t++) {
+        const uint32_t *corner = sh->triangles[t];
+        rad_vec3 a = sh->positions[corner[0]];
+        rad_vec3 e1 = v3_sub(sh->positions[corner[1]], a);
+        rad_vec3 e2 = v3_sub(sh->positions[corner[2]], a);
+        rad_vec3 d = v3_sub(point, a);
+        double d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2);
+        double d1 = v3_dot(d, e1), d2 = v3_dot(d, e2);
+        double det = d11 * d22 - d12 * d12;
+        if (!(det > 0))
+            continue;
+        double bu = (d22 * d1 - d12 * d2) / det, bv = (d11 * d2 - d12 * d1) / det;
+        double depth = fmin(1 - bu - bv, fmin(bu, bv));
+        if (depth > best_depth) {
+            best_depth = depth;
+            best = t;
+            *u = bu;
+            *v = bv;
+        }
+    }
+    return best;
+}
+
 /* Adds each hit's interpolated radiance (times the ray's weight) to its sample and, when
  * mirrors are allowed, writes the mirror rays of specular hits to the front of the arrays.
  * Returns how many rays are left for the next bounce. */
@@ -108,20 +146,36 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
     uint32_t next = 0;
     for (uint32_t r = 0; r < count; r++) {
         const rad_hit *hit = &w->hits[r];
-        if (hit->triangle == RAD_NO_HIT || !hit->front)
+        if (hit->triangle == RAD_NO_HIT)
             continue;
-        const uint32_t *v = sh->triangles[hit->triangle];
+        uint32_t triangle = hit->triangle;
+        double hit_u = hit->u, hit_v = hit->v;
+        uint32_t patch_index = sh->patch_of[triangle];
+        if (!hit->front) {
+            /* the back of a one-sided patch is black; of a two-sided one, its twin */
+            uint32_t twin = sh->mesh->patches[patch_index].twin;
+            if (twin == 0 || !sh->first_triangle)
+                continue;
+            const rad_ray *ray = &w->rays[r];
+            rad_vec3 point = v3(ray->origin[0] + (double)hit->t * ray->direction[0],
+                                ray->origin[1] + (double)hit->t * ray->direction[1],
+                                ray->origin[2] + (double)hit->t * ray->direction[2]);
+            triangle = twin_triangle(sh, twin - 1, point, &hit_u, &hit_v);
+            if (triangle == RAD_NO_HIT)
+                continue;
+            patch_index = twin - 1;
+        }
+        const uint32_t *v = sh->triangles[triangle];
         const rad_rgb *L = sh->radiance;
         rad_rgb weight = w->weight[r];
-        rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit->u - hit->v),
-                                       rgb_add(rgb_scale(L[v[1]], hit->u), rgb_scale(L[v[2]], hit->v)));
-        uint32_t patch_index = sh->patch_of[hit->triangle];
+        rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit_u - hit_v),
+                                       rgb_add(rgb_scale(L[v[1]], hit_u), rgb_scale(L[v[2]], hit_v)));
         if (patch_material_textured(sh->textures, sh->mesh->patches[patch_index].material))
             interpolated = textured_radiance(sh, &w->rays[r], hit, patch_index, interpolated);
         rgb_add_to(&w->sum[w->sample[r]], rgb_mul(weight, interpolated));
         if (!mirrors || !sh->materials)
             continue;
-        const rad_patch *patch = &sh->mesh->patches[sh->patch_of[hit->triangle]];
+        const rad_patch *patch = &sh->mesh->patches[patch_index];
         rad_rgb ks = sh->materials[patch->material].specular;
         if (!(ks.r > 0 || ks.g > 0 || ks.b > 0))
             continue;
@@ -227,6 +281,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     const rad_patch_inputs *inputs = NULL;
     rad_patch_inputs *built_inputs = NULL;
     rad_rgb *shaded = NULL;
+    uint32_t *first_triangle = NULL;
     status = display_mesh_build(mesh, true, &display, error);
     if (status != RAD_OK)
         goto done;
@@ -239,9 +294,24 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     if (status != RAD_OK)
         goto done;
     display_mesh_radiance(mesh, &display, shaded ? shaded : B, radiance);
+    /* the tracer sees the front patches: the twins come after them (rad_mesh), and so do
+     * their display triangles, which are in patch order */
+    uint32_t traced = display.triangle_count;
+    while (traced > 0 && mesh->patches[display.patch_of[traced - 1]].twin != 0 &&
+           mesh->patches[display.patch_of[traced - 1]].twin - 1 < display.patch_of[traced - 1])
+        traced--;
+    if (traced < display.triangle_count) {
+        first_triangle = rad_alloc_array((size_t)mesh->patch_count + 1, sizeof(*first_triangle));
+        if (!first_triangle)
+            goto nomem;
+        for (uint32_t p = 0, t = 0; p <= mesh->patch_count; p++) {
+            while (t < display.triangle_count && display.patch_of[t] < p)
+                t++;
+            first_triangle[p] = t;
+        }
+    }
     status = rad_tracer_create(RAD_TRACER_EMBREE, positions, display.vertex_count,
-                               (const uint32_t(*)[3])display.triangles, display.triangle_count,
-                               &tracer, error);
+                               (const uint32_t(*)[3])display.triangles, traced, &tracer, error);
     if (status != RAD_OK)
         goto done;
 
@@ -276,9 +346,12 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         if (!w->rays || !w->hits || !w->weight || !w->sample || !w->sum || !w->edge || !w->level)
             goto nomem;
     }
-    shading shade = {mesh, (const uint32_t(*)[3])display.triangles, display.patch_of, radiance,
+    shading shade = {mesh,      (const uint32_t(*)[3])display.triangles,
+                     display.patch_of, first_triangle,
+                     radiance,  positions,
                      options->materials,
-                     t_near, leave, lookup, inputs};
+                     t_near,    leave,
+                     lookup,    inputs};
 
     render_progress progress =
         render_progress_start(options->progress, options->progress_user, "render", H);
@@ -370,5 +443,6 @@ done:
     patch_material_lookup_destroy(lookup);
     rad_patch_inputs_destroy(built_inputs);
     free(shaded);
+    free(first_triangle);
     return status;
 }

@@ -16,7 +16,9 @@
  *
  * What it is not: a physically based renderer. Point lights have no distance falloff (the
  * classic model: I_L is what reaches every point); the Phong lobe is not energy-normalised;
- * surfaces are one-sided (a back face, and a miss, is black).
+ * surfaces are one-sided (a back face, and a miss, is black), except two-sided ones
+ * (RAD_SURFACE_TWO_SIDED), whose back is shaded as their front with the normal turned
+ * towards the viewer, and which emit from both sides.
  *
  * Area lights. Every emitting triangle is part of one area light, sampled `light_samples`
  * times per shading point (emitters_sample: triangle by power, then a point uniformly on
@@ -233,7 +235,8 @@ static void shade_direct(const rt_context *ctx, rt_workspace *ws, const rad_mate
         if (!(r2 > 0))
             continue;
         rad_vec3 L = v3_scale(D, 1 / sqrt(r2));
-        double cos_surface = v3_dot(N, L), cos_light = -v3_dot(es.normal, L);
+        rad_vec3 light_normal;
+        double cos_surface = v3_dot(N, L), cos_light = emitter_cosine(&es, L, &light_normal);
         if (cos_surface <= RT_GRAZING_COSINE || cos_light <= RT_GRAZING_COSINE)
             continue;
         double g = cos_surface * cos_light / (RAD_PI * r2 * es.pdf_area * n);
@@ -242,7 +245,7 @@ static void shade_direct(const rt_context *ctx, rt_workspace *ws, const rad_mate
         rad_rgb add = rgb_mul(rgb_mul(weight, brdf), rgb_scale(es.radiance, g));
         if (rgb_is_zero(add))
             continue;
-        rad_vec3 to = v3_add(es.point, v3_scale(es.normal, ctx->offset));
+        rad_vec3 to = v3_add(es.point, v3_scale(light_normal, ctx->offset));
         queue_shadow(ctx, ws, from, to, ctx->offset, sample, add);
     }
 }
@@ -261,12 +264,16 @@ static void trace_packet(const rt_context *ctx, rt_workspace *ws, uint32_t count
         uint32_t alive = 0;
         for (uint32_t i = 0; i < count; i++) {
             const rad_hit *hit = &ws->hits[i];
-            if (hit->triangle == RAD_NO_HIT || !hit->front)
+            if (hit->triangle == RAD_NO_HIT ||
+                (!hit->front && !triangle_two_sided(scene, hit->triangle)))
                 continue; /* black: a miss, or the back of a one-sided surface */
             rt_path path = ws->paths[i];
             const rad_triangle *tri = &scene->triangles[hit->triangle];
             const rad_material *m = &scene->materials[tri->material];
-            rad_vec3 N = ctx->normal[hit->triangle], d = path.direction;
+            /* a two-sided surface's back: shaded as a front facing the viewer */
+            rad_vec3 N = hit->front ? ctx->normal[hit->triangle]
+                                    : v3_scale(ctx->normal[hit->triangle], -1);
+            rad_vec3 d = path.direction;
             /* the hit point in double precision: the ray meets the triangle's plane */
             double dn = v3_dot(d, N);
             double t = fabs(dn) > RT_PLANE_COSINE

@@ -440,6 +440,15 @@ static rad_status map_material(import_state *state, unsigned index, uint32_t *ou
                              state->path, material.name, ambient.r, ambient.g, ambient.b,
                              material.name);
             }
+            /* Ks without Kd: radiosity and the path tracer see a black surface */
+            if (fmax(material.albedo.r, fmax(material.albedo.g, material.albedo.b)) <= 0 &&
+                fmax(material.specular.r, fmax(material.specular.g, material.specular.b)) > 0)
+                rad_warn(state->options ? state->options->log : NULL,
+                         state->options ? state->options->log_user : NULL,
+                         "%s: material '%s' has a specular colour Ks but no diffuse Kd: "
+                         "radiosity treats it as black (diffuse albedo 0); only the Whitted "
+                         "tracer (raytrace) and render --specular show its specular part",
+                         state->path, material.name);
         }
         if (!is_default)
             take_textures(state, m, &material);
@@ -487,6 +496,15 @@ static rad_status add_mesh(import_state *state, const struct aiMesh *mesh,
     rad_status status = map_material(state, mesh->mMaterialIndex, &material, error);
     if (status != RAD_OK)
         return status;
+    /* glTF doubleSided (Assimp's TWOSIDED; only glTF's: Collada exporters set theirs on
+     * everything): every surface using the material radiates on both sides */
+    int two_sided = 0;
+    unsigned one = 1;
+    if (state->gltf &&
+        aiGetMaterialIntegerArray(state->ai->mMaterials[mesh->mMaterialIndex], AI_MATKEY_TWOSIDED,
+                                  &two_sided, &one) == aiReturn_SUCCESS &&
+        two_sided)
+        scene_builder_set_surface_flags(state->builder, surface, RAD_SURFACE_TWO_SIDED);
     const struct aiVector3D *uvs =
         state->textured[mesh->mMaterialIndex] ? mesh->mTextureCoords[0] : NULL;
     for (unsigned f = 0; f < mesh->mNumFaces; f++) {

@@ -94,3 +94,9 @@ rad_rgb material_mean_emission(const rad_scene *scene, uint32_t triangle)
     }
     return rgb_mul(emission, rgb_scale(sum, 1.0 / (n * n)));
 }
+
+bool triangle_two_sided(const rad_scene *scene, uint32_t triangle)
+{
+    uint32_t surface = scene->triangles[triangle].surface;
+    return (scene->surfaces[surface].flags & RAD_SURFACE_TWO_SIDED) != 0;
+}

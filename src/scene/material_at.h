@@ -30,6 +30,10 @@ bool material_textured(const rad_scene *scene, uint32_t material);
 rad_rgb material_albedo_at(const rad_scene *scene, uint32_t triangle, double u, double v);
 rad_rgb material_emission_at(const rad_scene *scene, uint32_t triangle, double u, double v);
 
+/* The triangle's surface is two-sided (RAD_SURFACE_TWO_SIDED): its back radiates and
+ * reflects as its front does, with the same material. */
+bool triangle_two_sided(const rad_scene *scene, uint32_t triangle);
+
 /* The material emits somewhere: an emission factor > 0 in some channel and, with an
  * emission texture, a texel that is not black in such a channel. O(texels). */
 bool material_emits(const rad_scene *scene, uint32_t material);

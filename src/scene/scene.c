@@ -1,7 +1,14 @@
 /*
  * scene.c - queries on a loaded rad_scene: area, bounds, emitters, a framing camera;
- * and changing a surface's or material's values after loading (command-line overrides).
+ * and changing a surface's or material's values or flags after loading (command-line
+ * overrides), with the one rule for finding what a NAME the user typed means.
+ *
+ * A NAME means, in this order: the surface of exactly that name; else every material of
+ * exactly that name (exporters repeat names: "Material" in each object); else the same
+ * two steps ignoring case, when that leaves one name. Several names ignoring case, or none
+ * at all, is an error that lists them, or says the closest name by edit distance.
  */
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -129,16 +136,130 @@ static void apply(rad_material *m, const rad_rgb *albedo, const rad_rgb *emissio
         m->emission = *emission;
 }
 
+/* What a NAME resolved to: one surface, or the name every chosen material has. */
+typedef struct name_match {
+    uint32_t surface;       /* the surface, or UINT32_MAX */
+    const char *material;   /* the materials' name (a scene material's own), or NULL */
+} name_match;
+
+static bool same_name(const char *a, const char *b, bool ignore_case)
+{
+    if (!ignore_case)
+        return strcmp(a, b) == 0;
+    for (; *a && *b; a++, b++)
+        if (tolower((unsigned char)*a) != tolower((unsigned char)*b))
+            return false;
+    return *a == *b;
+}
+
+static size_t length_at_most(const char *text, size_t most)
+{
+    size_t n = 0;
+    while (n < most && text[n])
+        n++;
+    return n;
+}
+
+/* Levenshtein distance, case ignored, of two names (at most 127 characters each: the
+ * longer ones are cut there). */
+static unsigned edit_distance(const char *a, const char *b)
+{
+    enum { MAX = 128 };
+    unsigned row[MAX + 1];
+    size_t n = length_at_most(b, MAX), m = length_at_most(a, MAX);
+    for (size_t j = 0; j <= n; j++)
+        row[j] = (unsigned)j;
+    for (size_t i = 1; i <= m; i++) {
+        unsigned diagonal = row[0];
+        row[0] = (unsigned)i;
+        for (size_t j = 1; j <= n; j++) {
+            unsigned above = row[j];
+            unsigned change = diagonal + (tolower((unsigned char)a[i - 1]) !=
+                                          tolower((unsigned char)b[j - 1]));
+            unsigned best = above + 1 < row[j - 1] + 1 ? above + 1 : row[j - 1] + 1;
+            row[j] = change < best ? change : best;
+            diagonal = above;
+        }
+    }
+    return row[n];
+}
+
+/* Appends " 'NAME'" (comma-separated) to list unless it is there already. */
+static void list_name(char *list, size_t size, const char *name)
+{
+    char quoted[160];
+    snprintf(quoted, sizeof(quoted), "'%.140s'", name);
+    if (strstr(list, quoted))
+        return;
+    size_t length = strlen(list);
+    snprintf(list + length, size - length, "%s%s", length ? ", " : "", quoted);
+}
+
+/* The scene's surface or materials that `name` means (the rule at the top of this file).
+ * RAD_ERR_INVALID naming the file when nothing or several names match: `what` says what
+ * was looked for ("surface or material"). */
+static rad_status find_name(const rad_scene *scene, const char *name, const char *what,
+                            name_match *match, rad_error *error)
+{
+    match->surface = UINT32_MAX;
+    match->material = NULL;
+    for (int ignore_case = 0; ignore_case <= 1; ignore_case++) {
+        char list[512] = "";
+        unsigned names = 0;
+        for (uint32_t s = 0; s < scene->surface_count; s++)
+            if (same_name(scene->surfaces[s].name, name, ignore_case)) {
+                match->surface = s;
+                names++;
+                list_name(list, sizeof(list), scene->surfaces[s].name);
+            }
+        if (names == 0)
+            for (uint32_t m = 0; m < scene->material_count; m++)
+                if (same_name(scene->materials[m].name, name, ignore_case) &&
+                    (!match->material || strcmp(match->material, scene->materials[m].name))) {
+                    match->material = scene->materials[m].name;
+                    names++;
+                    list_name(list, sizeof(list), match->material);
+                }
+        if (names == 1)
+            return RAD_OK;
+        if (names > 1)
+            return rad_fail(error, RAD_ERR_INVALID,
+                            "no %s '%s' in %s, and %u %s ignoring case: %s; give one of them "
+                            "exactly",
+                            what, name, scene->source, names,
+                            match->surface != UINT32_MAX ? "surfaces" : "materials", list);
+    }
+    const char *closest = NULL;
+    unsigned best = UINT32_MAX;
+    for (uint32_t s = 0; s < scene->surface_count; s++) {
+        unsigned d = edit_distance(name, scene->surfaces[s].name);
+        if (d < best)
+            best = d, closest = scene->surfaces[s].name;
+    }
+    for (uint32_t m = 0; m < scene->material_count; m++) {
+        unsigned d = edit_distance(name, scene->materials[m].name);
+        if (d < best)
+            best = d, closest = scene->materials[m].name;
+    }
+    if (!closest)
+        return rad_fail(error, RAD_ERR_INVALID, "no %s '%s' in %s", what, name, scene->source);
+    return rad_fail(error, RAD_ERR_INVALID, "no %s '%s' in %s; did you mean '%s'?", what, name,
+                    scene->source, closest);
+}
+
 rad_status rad_scene_set_material(rad_scene *scene, const char *name, const rad_rgb *albedo,
                                   const rad_rgb *emission, rad_error *error)
 {
     if ((albedo && !rgb_in(albedo, 1)) || (emission && !rgb_in(emission, INFINITY)))
         return rad_fail(error, RAD_ERR_INVALID,
                         "'%s': albedo must be in [0,1] and emission finite and >= 0", name);
-    for (uint32_t s = 0; s < scene->surface_count; s++) {
+    name_match match;
+    rad_status status = find_name(scene, name, "surface or material", &match, error);
+    if (status != RAD_OK)
+        return status;
+    if (match.surface != UINT32_MAX) {
+        uint32_t s = match.surface;
         const rad_surface *surface = &scene->surfaces[s];
-        if (strcmp(surface->name, name) != 0)
-            continue;
         /* each material of this surface: changed in place when no other surface uses it,
          * else replaced by a changed copy for this surface's triangles */
         uint32_t count = scene->material_count;
@@ -164,25 +285,37 @@ rad_status rad_scene_set_material(rad_scene *scene, const char *name, const rad_
                 char original[sizeof(scene->materials[m].name)];
                 memcpy(original, scene->materials[m].name, sizeof(original));
                 snprintf(scene->materials[target].name, sizeof(scene->materials[target].name),
-                         "%.60s@%.60s", original, name);
+                         "%.60s@%.60s", original, surface->name);
             }
         }
         free(use);
         return RAD_OK;
     }
-    uint32_t found = UINT32_MAX, matches = 0;
+    /* every material of that name (copy it: applying changes none of the names) */
+    char material[sizeof(scene->materials[0].name)];
+    snprintf(material, sizeof(material), "%s", match.material);
     for (uint32_t m = 0; m < scene->material_count; m++)
-        if (strcmp(scene->materials[m].name, name) == 0) {
-            found = m;
-            matches++;
-        }
-    if (matches == 0)
-        return rad_fail(error, RAD_ERR_INVALID, "%s: no surface or material named '%s'",
-                        scene->source, name);
-    if (matches > 1)
-        return rad_fail(error, RAD_ERR_INVALID,
-                        "%s: no surface is named '%s' and %u materials are: name a surface",
-                        scene->source, name, matches);
-    apply(&scene->materials[found], albedo, emission);
+        if (strcmp(scene->materials[m].name, material) == 0)
+            apply(&scene->materials[m], albedo, emission);
+    return RAD_OK;
+}
+
+rad_status rad_scene_set_surface_flags(rad_scene *scene, const char *name, uint32_t flags,
+                                       rad_error *error)
+{
+    name_match match;
+    rad_status status = find_name(scene, name, "surface or material", &match, error);
+    if (status != RAD_OK)
+        return status;
+    if (match.surface != UINT32_MAX) {
+        scene->surfaces[match.surface].flags |= flags;
+        return RAD_OK;
+    }
+    /* every surface with a triangle of a material of that name */
+    for (uint32_t t = 0; t < scene->triangle_count; t++) {
+        const rad_triangle *triangle = &scene->triangles[t];
+        if (strcmp(scene->materials[triangle->material].name, match.material) == 0)
+            scene->surfaces[triangle->surface].flags |= flags;
+    }
     return RAD_OK;
 }

@@ -125,14 +125,3 @@ rad_status rad_scene_load_files(const rad_scene_file *files, uint32_t count,
     }
     return scene_builder_finish(builder, out, error);
 }
-
-rad_status rad_scene_set_surface_flags(rad_scene *scene, const char *name, uint32_t flags,
-                                       rad_error *error)
-{
-    for (uint32_t s = 0; s < scene->surface_count; s++)
-        if (strcmp(scene->surfaces[s].name, name) == 0) {
-            scene->surfaces[s].flags |= flags;
-            return RAD_OK;
-        }
-    return rad_fail(error, RAD_ERR_INVALID, "%s: no surface named '%s'", scene->source, name);
-}
