@@ -23,6 +23,7 @@
 #include <ctype.h>
 #include <errno.h>
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -109,100 +110,279 @@ static rad_status check_stl(const char *path, FILE *file, rad_error *error)
     return RAD_OK;
 }
 
-/* An OBJ face's vertex indices (the first number of each v/vt/vn corner): 0, or a relative
- * index before the first vertex, is an error at this line; the largest absolute index is
- * kept to be checked against the vertex count at the end. */
-static rad_status check_obj_face(const char *path, unsigned long number, const char *corners,
-                                 unsigned long vertices, long long *largest,
-                                 unsigned long *largest_line, rad_error *error)
+/* The numbered lists of an OBJ file a face corner refers to (v/vt/vn). */
+enum { OBJ_VERTEX, OBJ_UV, OBJ_NORMAL, OBJ_LISTS };
+static const char *const obj_list_name[OBJ_LISTS] = {"vertex", "texture coordinate", "normal"};
+
+/* What the OBJ pre-check has seen, and the copy of the file Assimp reads instead of it
+ * when the file must be told differently (see check_obj). */
+typedef struct obj_check {
+    const char *path;
+    const rad_load_options *options;
+    char folder[4096];
+    unsigned long line;
+    unsigned long defined[OBJ_LISTS];     /* v, vt, vn lines so far */
+    long long largest[OBJ_LISTS];         /* the largest absolute index of each list */
+    unsigned long largest_line[OBJ_LISTS];
+    char *copy;                           /* the file as Assimp is to read it */
+    size_t copy_length, copy_capacity;
+    bool copy_differs;                    /* Assimp must read `copy`, not the file */
+} obj_check;
+
+static bool append_text(obj_check *c, const char *text, size_t n)
+{
+    if (!rad_grow_array((void **)&c->copy, &c->copy_capacity, c->copy_length + n + 1, 1))
+        return false;
+    memcpy(c->copy + c->copy_length, text, n);
+    c->copy_length += n;
+    c->copy[c->copy_length] = 0;
+    return true;
+}
+
+static bool is_regular_file(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/* A face's corners (v, v/vt, v//vn, v/vt/vn): each index is a number, not 0, and a
+ * relative (negative) one does not reach before the first entry of its list; the largest
+ * absolute index of each list is kept to be checked against the list's length at the end.
+ * Indices are compared without negating them (INT64_MIN has no positive counterpart). */
+static rad_status check_obj_face(obj_check *c, const char *corners, rad_error *error)
 {
     const char *cursor = corners;
     for (;;) {
         while (isspace((unsigned char)*cursor))
             cursor++;
-        if (!*cursor)
+        if (!*cursor || *cursor == '#')
             return RAD_OK;
-        char *end;
-        long long index = strtoll(cursor, &end, 10);
-        if (end == cursor)
-            return RAD_OK; /* malformed: Assimp reports it */
-        if (index == 0 || (index < 0 && (unsigned long long)-index > vertices))
-            return rad_fail(error, RAD_ERR_PARSE,
-                            "%s:%lu: face vertex %lld: %s", path, number, index,
-                            index == 0 ? "OBJ indices start at 1"
-                                       : "before the first vertex");
-        if (index > *largest) {
-            *largest = index;
-            *largest_line = number;
+        const char *corner = cursor;
+        size_t corner_length = strcspn(corner, " \t\r\n");
+        for (int list = 0; list < OBJ_LISTS; list++) {
+            if (list > 0) {
+                if (*cursor != '/')
+                    break;
+                cursor++;
+                if (list == OBJ_UV && *cursor == '/')
+                    continue; /* v//vn */
+            }
+            char *end;
+            errno = 0;
+            long long index = strtoll(cursor, &end, 10);
+            if (end == cursor || (*end && !isspace((unsigned char)*end) && *end != '/'))
+                return rad_fail(error, RAD_ERR_PARSE,
+                                "%s:%lu: face corner '%.*s' is not v, v/vt, v//vn or v/vt/vn "
+                                "with whole-number indices",
+                                c->path, c->line, (int)(corner_length > 40 ? 40 : corner_length),
+                                corner);
+            int width = (int)(end - cursor);
+            const char *name = obj_list_name[list];
+            if (index == 0)
+                return rad_fail(error, RAD_ERR_PARSE,
+                                "%s:%lu: face refers to %s 0: OBJ indices start at 1", c->path,
+                                c->line, name);
+            if (index < 0 && (errno == ERANGE || index < -(long long)c->defined[list]))
+                return rad_fail(error, RAD_ERR_PARSE,
+                                "%s:%lu: face refers to %s %.*s (counting back) but only %lu "
+                                "%s defined above it",
+                                c->path, c->line, name, width, cursor, c->defined[list],
+                                c->defined[list] == 1 ? "is" : "are");
+            if (index > 0 && errno == ERANGE)
+                return rad_fail(error, RAD_ERR_PARSE,
+                                "%s:%lu: face refers to %s %.*s, beyond any file's count",
+                                c->path, c->line, name, width, cursor);
+            if (index > c->largest[list]) {
+                c->largest[list] = index;
+                c->largest_line[list] = c->line;
+            }
+            cursor = end;
         }
-        while (*end && !isspace((unsigned char)*end))
-            end++; /* the corner's /vt/vn */
-        cursor = end;
+        if (*cursor && !isspace((unsigned char)*cursor))
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s:%lu: face corner '%.*s' is not v, v/vt, v//vn or v/vt/vn with "
+                            "whole-number indices",
+                            c->path, c->line, (int)(corner_length > 40 ? 40 : corner_length),
+                            corner);
     }
 }
 
-/* OBJ checks Assimp does not make (or makes without a line number): material libraries
- * exist, vertex coordinates finite, face indices name vertices of the file. */
-static rad_status check_obj(const char *path, FILE *file, rad_error *error)
+/* A v, vt or vn line (`numbers` after its keyword): at least `least` numbers, finite and
+ * within single precision; v's optional weight w is not 0 (Assimp divides by it). The
+ * line goes to the copy with numbers written ".5" as "0.5" (Assimp 5.2 does not count
+ * them as numbers, and then reads the wrong values). */
+static rad_status check_obj_numbers(obj_check *c, const char *keyword, const char *numbers,
+                                    int least, rad_error *error)
 {
-    char folder[4096];
-    folder_of(path, folder, sizeof(folder));
-    char line[8192];
-    unsigned long number = 0, vertices = 0, largest_line = 0;
-    long long largest = 0;
-    while (fgets(line, sizeof(line), file)) {
-        number++;
+    const char *cursor = numbers;
+    int count = 0;
+    double value[4] = {0, 0, 0, 1};
+    bool ok = append_text(c, keyword, strlen(keyword));
+    for (;;) {
+        const char *start = cursor;
+        while (*cursor == ' ' || *cursor == '\t')
+            cursor++;
+        ok = ok && append_text(c, start, (size_t)(cursor - start));
+        if (!*cursor || *cursor == '#' || *cursor == '\r' || *cursor == '\n')
+            break;
+        char *end;
+        double number = strtod(cursor, &end);
+        if (end == cursor || (*end && !isspace((unsigned char)*end)))
+            break; /* not a number: what follows is not a coordinate */
+        if (!isfinite(number))
+            return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: %s coordinate is not a finite number",
+                            c->path, c->line, keyword);
+        if (fabs(number) > FLT_MAX)
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s:%lu: %s coordinate %g is beyond single precision", c->path,
+                            c->line, keyword, number);
+        if (count < 4)
+            value[count] = number;
+        count++;
+        if (*cursor == '.') {
+            ok = ok && append_text(c, "0", 1);
+            c->copy_differs = true;
+        }
+        ok = ok && append_text(c, cursor, (size_t)(end - cursor));
+        cursor = end;
+    }
+    ok = ok && append_text(c, cursor, strlen(cursor));
+    if (!ok)
+        return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
+    if (count < least)
+        return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: '%s' line with %d number%s, %d expected",
+                        c->path, c->line, keyword, count, count == 1 ? "" : "s", least);
+    if (strcmp(keyword, "v") == 0 && count == 4 && value[3] == 0)
+        return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: vertex weight w is 0", c->path, c->line);
+    return RAD_OK;
+}
+
+/* One material library `name` of an mtllib line, written to the copy as the path Assimp
+ * opens: the file beside the OBJ (or at its absolute path); else, as Blender and Assimp
+ * do, a file of its base name beside the OBJ, with a warning. */
+static rad_status add_obj_library(obj_check *c, const char *name, rad_error *error)
+{
+    char library[8192 + 4096];
+    snprintf(library, sizeof(library), "%s%s", name[0] == '/' ? "" : c->folder, name);
+    struct stat st;
+    bool exists = stat(library, &st) == 0;
+    if (exists && !S_ISREG(st.st_mode))
+        return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s' is not a file",
+                        c->path, c->line, name);
+    if (!exists) {
+        const char *base = strrchr(name, '/') ? strrchr(name, '/') + 1 : name;
+        char beside[8192 + 4096];
+        snprintf(beside, sizeof(beside), "%s%s", c->folder, base);
+        if (base == name || !*base || !is_regular_file(beside))
+            return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s' not found%s%s%s",
+                            c->path, c->line, name, base == name ? "" : " (nor '",
+                            base == name ? "" : base, base == name ? "" : "' beside the OBJ)");
+        rad_warn(c->options ? c->options->log : NULL, c->options ? c->options->log_user : NULL,
+                 "%s:%lu: material library '%s' not found; '%s' beside the OBJ is read instead",
+                 c->path, c->line, name, base);
+        snprintf(library, sizeof(library), "%s", beside);
+        c->copy_differs = true;
+    }
+    if (!append_text(c, "mtllib ", 7) || !append_text(c, library, strlen(library)) ||
+        !append_text(c, "\n", 1))
+        return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
+    return RAD_OK;
+}
+
+/* An mtllib line's libraries: the whole rest of the line when it names a file (a name
+ * with spaces), else each word (several libraries on one line, which Assimp 5.2 would
+ * look up as one name). */
+static rad_status check_obj_libraries(obj_check *c, char *names, rad_error *error)
+{
+    while (isspace((unsigned char)*names))
+        names++;
+    char *end = names + strlen(names);
+    while (end > names && isspace((unsigned char)end[-1]))
+        *--end = 0;
+    if (!*names)
+        return append_text(c, "\n", 1) ? RAD_OK
+                                         : rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory",
+                                                    c->path);
+    char whole[8192 + 4096];
+    snprintf(whole, sizeof(whole), "%s%s", names[0] == '/' ? "" : c->folder, names);
+    if (is_regular_file(whole) || !strpbrk(names, " \t"))
+        return add_obj_library(c, names, error);
+    c->copy_differs = true; /* one mtllib line for each */
+    for (char *word = strtok(names, " \t"); word; word = strtok(NULL, " \t")) {
+        rad_status status = add_obj_library(c, word, error);
+        if (status != RAD_OK)
+            return status;
+    }
+    return RAD_OK;
+}
+
+/* The next line of `file` into *line (grown as needed); false at the end. */
+static bool read_line(FILE *file, char **line, size_t *capacity)
+{
+    size_t length = 0;
+    for (;;) {
+        if (!rad_grow_array((void **)line, capacity, length + 4096, 1))
+            return false;
+        if (!fgets(*line + length, (int)(*capacity - length), file))
+            return length > 0;
+        length += strlen(*line + length);
+        if (length > 0 && (*line)[length - 1] == '\n')
+            return true;
+    }
+}
+
+/* OBJ checks Assimp does not make (or makes without a line number, or gets wrong): face
+ * indices name entries of the file, v/vt/vn lines hold enough finite numbers, material
+ * libraries exist. Fills c->copy with the file as Assimp is to read it; c->copy_differs
+ * says when that is not the file itself: numbers written ".5", several libraries on one
+ * mtllib line, a library found by its base name beside the OBJ. */
+static rad_status check_obj(obj_check *c, FILE *file, rad_error *error)
+{
+    folder_of(c->path, c->folder, sizeof(c->folder));
+    char *line = NULL;
+    size_t capacity = 0;
+    rad_status status = RAD_OK;
+    static const struct {
+        const char *keyword;
+        int list, least;
+    } data[] = {{"v", OBJ_VERTEX, 3}, {"vt", OBJ_UV, 2}, {"vn", OBJ_NORMAL, 3}};
+    while (status == RAD_OK && read_line(file, &line, &capacity)) {
+        c->line++;
         char *p = line;
         while (*p == ' ' || *p == '\t')
             p++;
-        if (p[0] == 'f' && (p[1] == ' ' || p[1] == '\t')) {
-            rad_status status = check_obj_face(path, number, p + 2, vertices, &largest,
-                                               &largest_line, error);
-            if (status != RAD_OK)
-                return status;
+        size_t word = strcspn(p, " \t\r\n");
+        bool handled = false;
+        for (size_t k = 0; k < sizeof(data) / sizeof(data[0]) && !handled; k++)
+            if (word == strlen(data[k].keyword) && strncmp(p, data[k].keyword, word) == 0 &&
+                p[word]) {
+                handled = true;
+                c->defined[data[k].list]++;
+                status = check_obj_numbers(c, data[k].keyword, p + word, data[k].least, error);
+            }
+        if (handled)
             continue;
-        }
-        if (p[0] == 'v' && (p[1] == ' ' || p[1] == '\t'))
-            vertices++;
-        if (strncmp(p, "mtllib", 6) == 0 && isspace((unsigned char)p[6])) {
-            char *name = p + 6;
-            while (isspace((unsigned char)*name))
-                name++;
-            char *end = name + strlen(name);
-            while (end > name && isspace((unsigned char)end[-1]))
-                *--end = 0;
-            char library[8192 + 4096];
-            snprintf(library, sizeof(library), "%s%s", name[0] == '/' ? "" : folder, name);
-            struct stat st;
-            if (stat(library, &st) != 0)
-                return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s' not found",
-                                path, number, name);
-            if (!S_ISREG(st.st_mode))
-                return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s' is not a file",
-                                path, number, name);
-        } else if (p[0] == 'v' && (p[1] == ' ' || p[1] == '\t')) {
-            char *cursor = p + 2;
-            for (int k = 0; k < 3; k++) {
-                char *end;
-                double value = strtod(cursor, &end);
-                if (end == cursor)
-                    break; /* malformed: Assimp reports it */
-                if (!isfinite(value))
-                    return rad_fail(error, RAD_ERR_PARSE,
-                                    "%s:%lu: vertex coordinate is not a finite number", path,
-                                    number);
-                if (fabs(value) > FLT_MAX)
-                    return rad_fail(error, RAD_ERR_PARSE,
-                                    "%s:%lu: vertex coordinate %g is beyond single precision",
-                                    path, number, value);
-                cursor = end;
+        if (word == 1 && p[0] == 'f') {
+            status = check_obj_face(c, p + 1, error);
+            char *comment = strchr(p, '#');
+            if (comment) { /* Assimp 5.2 reads a comment after a face as corners */
+                strcpy(comment, "\n");
+                c->copy_differs = true;
             }
         }
+        if (status == RAD_OK && word == 6 && strncmp(p, "mtllib", 6) == 0)
+            status = check_obj_libraries(c, p + 6, error);
+        else if (status == RAD_OK && !append_text(c, line, strlen(line)))
+            status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
     }
-    if ((unsigned long long)largest > vertices)
-        return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: face vertex %lld: the file has %lu vertices",
-                        path, largest_line, largest, vertices);
-    return RAD_OK;
+    free(line);
+    for (int list = 0; list < OBJ_LISTS && status == RAD_OK; list++)
+        if ((unsigned long long)c->largest[list] > c->defined[list])
+            status = rad_fail(error, RAD_ERR_PARSE,
+                              "%s:%lu: face refers to %s %lld but only %lu %s defined", c->path,
+                              c->largest_line[list], obj_list_name[list], c->largest[list],
+                              c->defined[list], c->defined[list] == 1 ? "is" : "are");
+    return status;
 }
 
 static rad_rgb material_color(const struct aiMaterial *material, const char *key,
@@ -633,12 +813,36 @@ static void take_frame(const struct aiScene *ai, bool metres_y_up, scene_builder
     scene_builder_set_frame(builder, up, unit);
 }
 
-/* Assimp's message on one line. */
-static void one_line(char *text)
+/* Assimp's failure to read `path`, in our words where we know what it means (the checks
+ * above catch what they can first, with a line), with Assimp's own on one line after. */
+static rad_status assimp_failure(const char *path, const char *assimp, rad_error *error)
 {
-    for (; *text; text++)
+    static const struct {
+        const char *assimp, *meaning;
+    } known[] = {
+        {"vertex index out of range", "a face refers to a vertex the file does not define"},
+        {"normal index out of range", "a face refers to a normal the file does not define"},
+        {"color index out of range", "a face refers to a vertex colour the file does not define"},
+        {"Invalid number of components", "a v, vt or vn line has the wrong number of numbers"},
+        {"Division by zero", "a vertex has weight w = 0"},
+        {"Invalid face index", "a face corner is not a whole-number index"},
+        {"Not supported token in face", "a face corner is not v, v/vt, v//vn or v/vt/vn"},
+        {"as a real number", "a number cannot be read"},
+        {"No suitable reader found", "not a scene format Assimp reads"},
+        {"Unable to open file", "cannot be opened"},
+    };
+    const char *meaning = "a construct Assimp cannot read";
+    for (size_t k = 0; k < sizeof(known) / sizeof(known[0]); k++)
+        if (strstr(assimp, known[k].assimp)) {
+            meaning = known[k].meaning;
+            break;
+        }
+    rad_status status = rad_fail(error, RAD_ERR_PARSE, "%s: cannot read the scene: %s (Assimp: %s)",
+                                 path, meaning, assimp);
+    for (char *text = error ? error->message : NULL; text && *text; text++)
         if (*text == '\n' || *text == '\r')
             *text = ' ';
+    return status;
 }
 
 /* View3D content: the first data line (not blank, not a `!` or `/` comment) starts with
@@ -708,8 +912,9 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
     import_state state = {NULL, NULL, NULL, path, NULL, false, "", options, NULL, NULL, 0};
     gltf_info gltf = {0};
     bool is_gltf = has_extension(path, ".gltf") || has_extension(path, ".glb");
+    obj_check obj = {.path = path, .options = options};
     if (has_extension(path, ".obj"))
-        status = check_obj(path, file, error);
+        status = check_obj(&obj, file, error);
     else if (has_extension(path, ".stl"))
         status = check_stl(path, file, error);
     else if (has_extension(path, ".ply")) {
@@ -722,21 +927,30 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
         status = gltf_info_read(path, &gltf, error);
         state.gltf = &gltf;
     }
-    if (status != RAD_OK)
+    if (status == RAD_OK && obj.copy_differs && obj.copy_length > UINT_MAX)
+        status = rad_fail(error, RAD_ERR_UNSUPPORTED,
+                          "%s: an OBJ of more than 4 GiB with .5 numbers, a comment after a "
+                          "face or libraries to find is not supported",
+                          path);
+    if (status != RAD_OK) {
+        free(obj.copy);
         return status;
+    }
     const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
     snprintf(state.stem, sizeof(state.stem), "%s", base);
     char *dot = strrchr(state.stem, '.');
     if (dot && dot != state.stem)
         *dot = 0;
 
+    /* an OBJ that must be told differently: Assimp reads the checked copy, whose
+     * mtllib lines name their files from the working folder */
+    unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType;
     const struct aiScene *ai =
-        aiImportFile(path, aiProcess_Triangulate | aiProcess_SortByPType);
+        obj.copy_differs ? aiImportFileFromMemory(obj.copy, (unsigned)obj.copy_length, flags, "obj")
+                         : aiImportFile(path, flags);
+    free(obj.copy);
     if (!ai) {
-        status = rad_fail(error, RAD_ERR_PARSE, "%s: cannot read the scene: %s", path,
-                          aiGetErrorString());
-        if (error)
-            one_line(error->message);
+        status = assimp_failure(path, aiGetErrorString(), error);
         gltf_info_free(&gltf);
         return status;
     }
