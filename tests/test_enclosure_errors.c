@@ -5,7 +5,8 @@
  * a surface of zero or infinite area, a factor that is NaN or negative, a factor stored
  * without its reciprocal, an empty row, a singular system (two facing plates), and a
  * correction that would turn a factor negative. Through the tool: the singular case, one
- * line (the last, after the summary of the computed factors), exit 1, no output file. (Out of memory is the one failure not provoked here.)
+ * line (the last, after the summary of the computed factors), exit 1, no output file.
+ * (Out of memory is the one failure not provoked here.)
  */
 #include <math.h>
 #include <stdio.h>

@@ -2,18 +2,23 @@
  * import_assimp.c - reading scene files through Assimp's C API.
  *
  * Assimp does the parsing. This file only (1) checks, for OBJ files, what Assimp passes
- * over silently and what a user must hear about with a line number: a material library
- * that is not there, and non-finite vertex coordinates; for glTF files, runs our own
+ * over silently, gets wrong, or refuses without a line number: a material library that is
+ * not there, face indices outside their v/vt/vn list (or beyond 64 bits), v/vt/vn lines
+ * short of numbers or not finite; and hands Assimp a corrected copy of the file where it
+ * would misread it (numbers written ".5", a comment after a face, several libraries on
+ * one mtllib line, a library found by its base name beside the OBJ); every failure of
+ * Assimp itself is put in our words after the file's name; for glTF files, runs our own
  * reading (gltf_json.c) first; (2) walks Assimp's node tree, applying node transforms, and
  * hands triangles, materials and surface names to the scene builder. A surface is an
  * Assimp mesh name (OBJ `o`/`g`, glTF mesh, STL solid), else its node's name, else the
  * file's name without folder and extension; (3) maps materials onto METHOD.md's units:
  * Kd / glTF baseColorFactor = albedo, Ke / glTF emissiveFactor x emissiveStrength =
  * emitted radiance; a format's "no material" (STL, PLY without a material element, OBJ
- * faces before any usemtl, glTF primitives without one) gets RAD_DEFAULT_ALBEDO; albedo
+ * faces before any usemtl or under a usemtl no library defines (a warning), glTF
+ * primitives without one) gets RAD_DEFAULT_ALBEDO; albedo
  * and emission textures are decoded once each and triangles of textured materials keep
- * their texture coordinates; (4) takes the first glTF camera, and the up axis and unit from the file's
- * metadata.
+ * their texture coordinates; (4) takes the first glTF camera, and the up axis and unit
+ * from the file's metadata.
  * View3D input files are recognised here and handed to import_vs3.c.
  */
 #include <assimp/cimport.h>
@@ -114,6 +119,55 @@ static rad_status check_stl(const char *path, FILE *file, rad_error *error)
 enum { OBJ_VERTEX, OBJ_UV, OBJ_NORMAL, OBJ_LISTS };
 static const char *const obj_list_name[OBJ_LISTS] = {"vertex", "texture coordinate", "normal"};
 
+/* A set of material names, "\nNAME\n" each (a usemtl line names a material by the rest
+ * of its line, spaces included). */
+typedef struct obj_names {
+    char *text;
+    size_t length, capacity;
+    char last[256]; /* the name found last (files repeat usemtl lines) */
+    bool with_lines; /* "\nNAME\tLINE\n" each */
+} obj_names;
+
+static bool names_has(obj_names *set, const char *name)
+{
+    if (strcmp(set->last, name) == 0)
+        return true;
+    char key[300];
+    snprintf(key, sizeof(key), "\n%.256s%c", name, set->with_lines ? '\t' : '\n');
+    if (!set->text || !strstr(set->text, key))
+        return false;
+    snprintf(set->last, sizeof(set->last), "%s", name);
+    return true;
+}
+
+/* Adds name (and its line, when the set keeps lines); false out of memory. */
+static bool names_add(obj_names *set, const char *name, unsigned long line)
+{
+    char entry[300];
+    int n = set->with_lines ? snprintf(entry, sizeof(entry), "%.256s\t%lu\n", name, line)
+                 : snprintf(entry, sizeof(entry), "%.256s\n", name);
+    if (!rad_grow_array((void **)&set->text, &set->capacity, set->length + (size_t)n + 2, 1))
+        return false;
+    if (set->length == 0)
+        set->text[set->length++] = '\n';
+    memcpy(set->text + set->length, entry, (size_t)n + 1);
+    set->length += (size_t)n;
+    return true;
+}
+
+/* The rest of a line after its keyword, without the blanks around it, in place. */
+static char *rest_of_line(char *text)
+{
+    while (isspace((unsigned char)*text))
+        text++;
+    char *end = text + strlen(text);
+    while (end > text && isspace((unsigned char)end[-1]))
+        *--end = 0;
+    return text;
+}
+
+static bool read_line(FILE *file, char **line, size_t *capacity);
+
 /* What the OBJ pre-check has seen, and the copy of the file Assimp reads instead of it
  * when the file must be told differently (see check_obj). */
 typedef struct obj_check {
@@ -127,6 +181,9 @@ typedef struct obj_check {
     char *copy;                           /* the file as Assimp is to read it */
     size_t copy_length, copy_capacity;
     bool copy_differs;                    /* Assimp must read `copy`, not the file */
+    obj_names materials_defined;          /* newmtl names of the file's libraries */
+    obj_names materials_used;             /* usemtl names, each once, with its first line */
+    obj_names materials_undefined;        /* used but not defined: the default albedo */
 } obj_check;
 
 static bool append_text(obj_check *c, const char *text, size_t n)
@@ -166,6 +223,8 @@ static rad_status check_obj_face(obj_check *c, const char *corners, rad_error *e
                 cursor++;
                 if (list == OBJ_UV && *cursor == '/')
                     continue; /* v//vn */
+                if (!*cursor || isspace((unsigned char)*cursor))
+                    break; /* "v/" or "v/vt/": an empty last slot, as Assimp reads it */
             }
             char *end;
             errno = 0;
@@ -286,7 +345,23 @@ static rad_status add_obj_library(obj_check *c, const char *name, rad_error *err
     if (!append_text(c, "mtllib ", 7) || !append_text(c, library, strlen(library)) ||
         !append_text(c, "\n", 1))
         return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
-    return RAD_OK;
+    FILE *file = fopen(library, "rb");
+    if (!file)
+        return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s': cannot open: %s",
+                        c->path, c->line, name, strerror(errno));
+    char *line = NULL;
+    size_t capacity = 0;
+    bool ok = true;
+    while (ok && read_line(file, &line, &capacity)) {
+        char *p = line;
+        while (*p == ' ' || *p == '\t')
+            p++;
+        if (strncmp(p, "newmtl", 6) == 0 && isspace((unsigned char)p[6]))
+            ok = names_add(&c->materials_defined, rest_of_line(p + 6), 0);
+    }
+    free(line);
+    fclose(file);
+    return ok ? RAD_OK : rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
 }
 
 /* An mtllib line's libraries: the whole rest of the line when it names a file (a name
@@ -294,11 +369,7 @@ static rad_status add_obj_library(obj_check *c, const char *name, rad_error *err
  * look up as one name). */
 static rad_status check_obj_libraries(obj_check *c, char *names, rad_error *error)
 {
-    while (isspace((unsigned char)*names))
-        names++;
-    char *end = names + strlen(names);
-    while (end > names && isspace((unsigned char)end[-1]))
-        *--end = 0;
+    names = rest_of_line(names);
     if (!*names)
         return append_text(c, "\n", 1) ? RAD_OK
                                          : rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory",
@@ -346,8 +417,30 @@ static rad_status check_obj(obj_check *c, FILE *file, rad_error *error)
         const char *keyword;
         int list, least;
     } data[] = {{"v", OBJ_VERTEX, 3}, {"vt", OBJ_UV, 2}, {"vn", OBJ_NORMAL, 3}};
+    unsigned long continued = 0; /* lines joined to the one before by a trailing '\\' */
     while (status == RAD_OK && read_line(file, &line, &capacity)) {
-        c->line++;
+        c->line += 1 + continued;
+        continued = 0;
+        for (;;) { /* a '\\' at the end continues the line on the next (Assimp joins them) */
+            size_t n = strlen(line);
+            while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r'))
+                n--;
+            if (n == 0 || line[n - 1] != '\\')
+                break;
+            line[n - 1] = ' ';
+            line[n] = 0;
+            char *more = NULL;
+            size_t more_capacity = 0;
+            bool read = read_line(file, &more, &more_capacity);
+            if (read && !rad_grow_array((void **)&line, &capacity, n + strlen(more) + 1, 1))
+                read = false;
+            if (read)
+                strcpy(line + n, more);
+            free(more);
+            if (!read)
+                break;
+            continued++;
+        }
         char *p = line;
         while (*p == ' ' || *p == '\t')
             p++;
@@ -370,12 +463,40 @@ static rad_status check_obj(obj_check *c, FILE *file, rad_error *error)
                 c->copy_differs = true;
             }
         }
+        if (status == RAD_OK && word == 6 && strncmp(p, "usemtl", 6) == 0) {
+            char name[256];
+            snprintf(name, sizeof(name), "%s", p + 6);
+            char *used = rest_of_line(name);
+            if (*used && !names_has(&c->materials_used, used) &&
+                !names_add(&c->materials_used, used, c->line))
+                status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
+        }
         if (status == RAD_OK && word == 6 && strncmp(p, "mtllib", 6) == 0)
             status = check_obj_libraries(c, p + 6, error);
         else if (status == RAD_OK && !append_text(c, line, strlen(line)))
             status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
     }
     free(line);
+    /* materials used but defined by no library (Assimp 5.2 makes them up, grey 0.6): the
+     * default albedo, as faces without a material, and a warning at their first use */
+    char *entry = c->materials_used.text ? c->materials_used.text + 1 : NULL;
+    while (status == RAD_OK && entry && *entry) {
+        char *tab = strchr(entry, '\t'), *end = tab ? strchr(tab, '\n') : NULL;
+        if (!end)
+            break;
+        *tab = 0;
+        unsigned long first = strtoul(tab + 1, NULL, 10);
+        if (!names_has(&c->materials_defined, entry)) {
+            rad_warn(c->options ? c->options->log : NULL,
+                     c->options ? c->options->log_user : NULL,
+                     "%s:%lu: usemtl '%s': no material library of the file defines it; its "
+                     "faces get the default albedo %g",
+                     c->path, first, entry, RAD_DEFAULT_ALBEDO);
+            if (!names_add(&c->materials_undefined, entry, 0))
+                status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
+        }
+        entry = end + 1;
+    }
     for (int list = 0; list < OBJ_LISTS && status == RAD_OK; list++)
         if ((unsigned long long)c->largest[list] > c->defined[list])
             status = rad_fail(error, RAD_ERR_PARSE,
@@ -383,6 +504,16 @@ static rad_status check_obj(obj_check *c, FILE *file, rad_error *error)
                               c->largest_line[list], obj_list_name[list], c->largest[list],
                               c->defined[list], c->defined[list] == 1 ? "is" : "are");
     return status;
+}
+
+static void obj_check_free(obj_check *c)
+{
+    free(c->copy);
+    free(c->materials_defined.text);
+    free(c->materials_used.text);
+    free(c->materials_undefined.text);
+    c->copy = NULL;
+    c->materials_defined.text = c->materials_used.text = c->materials_undefined.text = NULL;
 }
 
 static rad_rgb material_color(const struct aiMaterial *material, const char *key,
@@ -406,6 +537,7 @@ typedef struct import_state {
     uint8_t *textured;      /* Assimp material index -> it has a texture (albedo or emission) */
     texture_key *cache;     /* textures already read (TEXTURE_CACHE at most) */
     unsigned cache_count;
+    obj_names *obj_undefined; /* an OBJ's materials no library defines, else NULL */
 } import_state;
 
 static bool near_value(double a, double b)
@@ -579,9 +711,13 @@ static rad_status map_material(import_state *state, unsigned index, uint32_t *ou
         bool is_default = strncmp(name.data, AI_DEFAULT_MATERIAL_NAME,
                                   strlen(AI_DEFAULT_MATERIAL_NAME)) == 0 ||
                           gltf_default || state->ply_without_materials;
+        /* an OBJ's usemtl that no library defines: no material, under its own name */
+        bool undefined = state->obj_undefined && names_has(state->obj_undefined, name.data);
         rad_material material = {0};
-        if (is_default) {
-            snprintf(material.name, sizeof(material.name), "default");
+        if (is_default || undefined) {
+            snprintf(material.name, sizeof(material.name), "%.*s",
+                     (int)sizeof(material.name) - 1, undefined ? name.data : "default");
+            is_default = true;
             material.albedo = (rad_rgb){RAD_DEFAULT_ALBEDO, RAD_DEFAULT_ALBEDO, RAD_DEFAULT_ALBEDO};
         } else {
             if (name.data[0])
@@ -820,6 +956,7 @@ static rad_status assimp_failure(const char *path, const char *assimp, rad_error
     static const struct {
         const char *assimp, *meaning;
     } known[] = {
+        {"too small", "the file is empty or too short to hold a scene"},
         {"vertex index out of range", "a face refers to a vertex the file does not define"},
         {"normal index out of range", "a face refers to a normal the file does not define"},
         {"color index out of range", "a face refers to a vertex colour the file does not define"},
@@ -909,10 +1046,10 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
     }
     rewind(file);
     rad_status status = RAD_OK;
-    import_state state = {NULL, NULL, NULL, path, NULL, false, "", options, NULL, NULL, 0};
+    import_state state = {NULL, NULL, NULL, path, NULL, false, "", options, NULL, NULL, 0, NULL};
     gltf_info gltf = {0};
     bool is_gltf = has_extension(path, ".gltf") || has_extension(path, ".glb");
-    obj_check obj = {.path = path, .options = options};
+    obj_check obj = {.path = path, .options = options, .materials_used.with_lines = true};
     if (has_extension(path, ".obj"))
         status = check_obj(&obj, file, error);
     else if (has_extension(path, ".stl"))
@@ -933,7 +1070,7 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
                           "face or libraries to find is not supported",
                           path);
     if (status != RAD_OK) {
-        free(obj.copy);
+        obj_check_free(&obj);
         return status;
     }
     const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
@@ -946,15 +1083,19 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
      * mtllib lines name their files from the working folder */
     unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType;
     const struct aiScene *ai =
-        obj.copy_differs ? aiImportFileFromMemory(obj.copy, (unsigned)obj.copy_length, flags, "obj")
-                         : aiImportFile(path, flags);
+        obj.copy_differs
+            ? aiImportFileFromMemory(obj.copy, (unsigned)obj.copy_length, flags, "obj")
+            : aiImportFile(path, flags);
     free(obj.copy);
+    obj.copy = NULL;
     if (!ai) {
         status = assimp_failure(path, aiGetErrorString(), error);
         gltf_info_free(&gltf);
+        obj_check_free(&obj);
         return status;
     }
     state.ai = ai;
+    state.obj_undefined = obj.materials_undefined.length ? &obj.materials_undefined : NULL;
 
     scene_builder *builder = NULL;
     status = scene_builder_create(path, options, &builder, error);
@@ -986,6 +1127,7 @@ done:
     free(state.textured);
     free(state.cache);
     gltf_info_free(&gltf);
+    obj_check_free(&obj);
     aiReleaseImport(ai);
     return status;
 }

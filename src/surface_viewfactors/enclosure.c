@@ -168,7 +168,8 @@ rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *m,
     uint32_t *colour = rad_alloc_array(n, sizeof(*colour));
     uint32_t *queue = rad_alloc_array(n, sizeof(*queue));
     if (!active || !G || !w || !diagonal || !rhs || !mu || !work || !colour || !queue) {
-        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for the enclosure correction", source);
+        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for the enclosure correction",
+                          source);
         goto done;
     }
     for (uint32_t I = 0; I < n; I++)
@@ -179,8 +180,9 @@ rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *m,
         if (!active[I])
             continue;
         if (!(m->area[I] > 0) || !isfinite(m->area[I])) {
-            status = rad_fail(error, RAD_ERR_INVALID, "%s: the enclosure correction: %s has area %g",
-                              source, surface_name(scene, I, name, sizeof(name)), m->area[I]);
+            status = rad_fail(error, RAD_ERR_INVALID,
+                              "%s: the enclosure correction: %s has area %g", source,
+                              surface_name(scene, I, name, sizeof(name)), m->area[I]);
             goto done;
         }
         double row = 0, fixed = 0;
