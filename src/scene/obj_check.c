@@ -156,18 +156,16 @@ static rad_status check_obj_face(obj_check *c, const char *corners, rad_error *e
  * within single precision; v's optional weight w is not 0 (Assimp divides by it). The
  * line goes to the copy with numbers written ".5" as "0.5" (Assimp 5.2 does not count
  * them as numbers, and then reads the wrong values). */
-static rad_status check_obj_numbers(obj_check *c, const char *keyword, const char *numbers,
-                                    int least, rad_error *error)
+static rad_status check_obj_numbers(obj_check *c, const char *keyword, const char *line,
+                                    const char *numbers, int least, rad_error *error)
 {
     const char *cursor = numbers;
     int count = 0;
     double value[4] = {0, 0, 0, 1};
-    bool ok = append_text(c, keyword, strlen(keyword));
+    bool leading_point = false;
     for (;;) {
-        const char *start = cursor;
         while (*cursor == ' ' || *cursor == '\t')
             cursor++;
-        ok = ok && append_text(c, start, (size_t)(cursor - start));
         if (!*cursor || *cursor == '#' || *cursor == '\r' || *cursor == '\n')
             break;
         char *end;
@@ -184,22 +182,32 @@ static rad_status check_obj_numbers(obj_check *c, const char *keyword, const cha
         if (count < 4)
             value[count] = number;
         count++;
-        if (*cursor == '.') {
-            ok = ok && append_text(c, "0", 1);
-            c->copy_differs = true;
-        }
-        ok = ok && append_text(c, cursor, (size_t)(end - cursor));
+        leading_point |= *cursor == '.';
         cursor = end;
     }
-    ok = ok && append_text(c, cursor, strlen(cursor));
-    if (!ok)
-        return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
     if (count < least)
         return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: '%s' line with %d number%s, %d expected",
                         c->path, c->line, keyword, count, count == 1 ? "" : "s", least);
     if (strcmp(keyword, "v") == 0 && count == 4 && value[3] == 0)
         return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: vertex weight w is 0", c->path, c->line);
-    return RAD_OK;
+    bool ok = true;
+    if (!leading_point)
+        ok = append_text(c, line, strlen(line));
+    else { /* the line again, a 0 before each number that starts with the point */
+        c->copy_differs = true;
+        ok = append_text(c, line, (size_t)(numbers - line));
+        for (cursor = numbers; ok && *cursor;) {
+            size_t blank = strspn(cursor, " \t");
+            ok = append_text(c, cursor, blank);
+            cursor += blank;
+            if (ok && *cursor == '.')
+                ok = append_text(c, "0", 1);
+            size_t word = strcspn(cursor, " \t");
+            ok = ok && append_text(c, cursor, word);
+            cursor += word;
+        }
+    }
+    return ok ? RAD_OK : rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
 }
 
 /* One material library `name` of an mtllib line, written to the copy as the path Assimp
@@ -327,7 +335,8 @@ rad_status obj_check_read(const char *path, const rad_load_options *options, FIL
                 p[word]) {
                 handled = true;
                 c->defined[data[k].list]++;
-                status = check_obj_numbers(c, data[k].keyword, p + word, data[k].least, error);
+                status = check_obj_numbers(c, data[k].keyword, line, p + word,
+                                           data[k].least, error);
             }
         if (handled)
             continue;
