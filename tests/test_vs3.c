@@ -351,6 +351,14 @@ static void test_subsurface_checks(void)
                  "vertex number 99999999999999999999 is larger than this reader supports");
     expect_error(SQUARE "S 16777217 1 2 3 4 0 0 0.9 a\n", RAD_ERR_UNSUPPORTED, 6,
                  "surface number 16777217 is larger than this reader supports (16777216)");
+    expect_error(SQUARE "S 1 1 2 3 99999999999 0 0 0.9 a\n", RAD_ERR_PARSE, 6,
+                 "surface 1: vertex 99999999999 is not a vertex of the file (numbers go up to "
+                 "16777216)");
+    expect_error(SQUARE "S 1 1 2 3 4 0 0 0.9 a\nS 2 1 2 3 0 1 18446744073709551616 0.9 b\n",
+                 RAD_ERR_PARSE, 7,
+                 "surface 2: cmb 18446744073709551616 is not a surface of the file");
+    expect_error(SQUARE "C maxU=99999999999\n", RAD_ERR_PARSE, 6,
+                 "maxU must be at most 4294967294, not '99999999999'");
     expect_error("F 3\nV 1 0 0 0\nV 2 1e308 0 0\nV 3 1e308 1e308 0\nV 4 0 1e308 0\n"
                  "S 1 1 2 3 4 0 0 0.9 a\n",
                  RAD_ERR_PARSE, 3,

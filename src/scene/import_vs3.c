@@ -192,8 +192,10 @@ static rad_status parse_control(vs3_reader *r, char **token, int count, unsigned
                 known = true;
                 if (!parse_count(value_text, counts[i].value))
                     return rad_fail(error, RAD_ERR_PARSE,
-                                    "%s:%lu: %s must be a whole number, not '%s'", r->path,
-                                    line, name, value_text);
+                                    value_text[0] && !value_text[strspn(value_text, "0123456789")]
+                                        ? "%s:%lu: %s must be at most 4294967294, not '%s'"
+                                        : "%s:%lu: %s must be a whole number, not '%s'",
+                                    r->path, line, name, value_text);
             }
         if (!known)
             rad_warn(r->options.log, r->options.log_user,
@@ -258,6 +260,18 @@ static rad_status parse_surface(vs3_reader *r, vs3_kind kind, char **token, int 
         return RAD_ERR_UNSUPPORTED;
     p.line = line;
     p.kind = kind;
+    /* a reference (vertex, base, cmb) written as digits beyond any number read: to none */
+    static const char *const field[6] = {"vertex", "vertex", "vertex", "vertex", "base",
+                                         "cmb"};
+    for (int k = 2; k < 8 && k < count; k++)
+        if (!token[k][strspn(token[k], "0123456789")] &&
+            !(parse_count(token[k], &p.base) && p.base <= VS3_LARGEST_NUMBER))
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s:%lu: surface %s: %s %s is not %s (numbers go up to %d)", r->path,
+                            line, token[1], field[k - 2], token[k],
+                            k < 6 ? "a vertex of the file" : "a surface of the file",
+                            VS3_LARGEST_NUMBER);
+    p.base = 0;
     bool ok = count >= 9 && parse_count(token[1], &p.number) && p.number > 0;
     for (int k = 0; ok && k < 4; k++)
         ok = parse_count(token[2 + k], &p.vertex[k]);
