@@ -87,7 +87,7 @@ int main(void)
     /* a face that names a vertex that does not exist */
     test_write_file("badindex.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n");
     expect_error("index", "render badindex.obj -o out.png", 1,
-                 "badindex.obj:3: face vertex 3: the file has 2 vertices");
+                 "badindex.obj:3: face refers to vertex 3 but only 2 are defined");
 
     /* a material library that is not there: file and line */
     test_write_file("nomtl.obj", "# a comment\nmtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");

@@ -93,14 +93,15 @@ int main(void)
     /* an OBJ face naming a vertex beyond the file's */
     test_write_file("beyond.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
     expect_error("obj index", "render beyond.obj -o out.png",
-                 "beyond.obj:4: face vertex 9: the file has 3 vertices");
+                 "beyond.obj:4: face refers to vertex 9 but only 3 are defined");
     /* relative (negative) indices count back from the face; 0 is no OBJ index */
     test_write_file("relative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nf 1/1 2//2 -4\n");
     expect_error("obj relative index", "render relative.obj -o out.png",
-                 "relative.obj:5: face vertex -4: before the first vertex");
+                 "relative.obj:5: face refers to vertex -4 (counting back) but only 3 are defined "
+                 "above it");
     test_write_file("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
     expect_error("obj index 0", "render zero.obj -o out.png",
-                 "zero.obj:4: face vertex 0: OBJ indices start at 1");
+                 "zero.obj:4: face refers to vertex 0: OBJ indices start at 1");
 
     /* empty scenes: a glTF with no meshes, an empty OBJ */
     test_write_file("empty.gltf", "{\"asset\":{\"version\":\"2.0\"},\"scenes\":[{\"nodes\":[]}]}");

@@ -267,6 +267,115 @@ static void test_errors(void)
     expect_error(SQUARE "Q 1 2\n", RAD_ERR_PARSE, 6, "not a View3D line");
 }
 
+/* What a base and the surfaces cut out of it may be, and what they may not: cut out of
+ * a cut-out (each keeps what the next does not cover); covering the base entirely (the
+ * base would have no area: refused), overlapping each other (the overlap would count
+ * twice: refused, naming both and their lines) or touching along an edge (fine); a
+ * number or coordinate out of range (refused as such, not as "zero area"). */
+static void test_subsurface_checks(void)
+{
+    const char *nested = "F 3\nV 1 0 0 0\nV 2 3 0 0\nV 3 3 3 0\nV 4 0 3 0\n"
+                         "V 5 0.5 0.5 0\nV 6 2.5 0.5 0\nV 7 2.5 2.5 0\nV 8 0.5 2.5 0\n"
+                         "V 9 1 1 0\nV 10 2 1 0\nV 11 2 2 0\nV 12 1 2 0\n"
+                         "S 1 1 2 3 4 0 0 0.9 wall\n"
+                         "S 2 5 6 7 8 1 0 0.9 frame\n"
+                         "S 3 9 10 11 12 2 0 0.9 pane\n";
+    rad_scene *scene = NULL;
+    rad_error error = {0};
+    CHECK(rad_scene_load_vs3(test_write_file("nested.vs3", nested), NULL, &scene, NULL,
+                             &error) == RAD_OK);
+    if (scene) {
+        CHECK_NEAR(surface_area(scene, "wall"), 9.0 - 4.0, 1e-12);
+        CHECK_NEAR(surface_area(scene, "frame"), 4.0 - 1.0, 1e-12);
+        CHECK_NEAR(surface_area(scene, "pane"), 1.0, 1e-12);
+    } else {
+        fprintf(stderr, "%s\n", error.message);
+    }
+    rad_scene_destroy(scene);
+    /* two halves touching along x = 0.5: no overlap, the base keeps nothing but is not
+     * covered by one; so one of them is a triangle, and the base keeps a quarter */
+    const char *touching = SQUARE "V 5 0.5 0 0\nV 6 0.5 1 0\n"
+                                  "S 1 1 2 3 4 0 0 0.9 a\nS 2 1 5 6 4 1 0 0.9 left\n"
+                                  "S 3 5 2 3 0 1 0 0.9 right\n";
+    scene = NULL;
+    CHECK(rad_scene_load_vs3(test_write_file("touching.vs3", touching), NULL, &scene, NULL,
+                             &error) == RAD_OK);
+    if (scene) {
+        CHECK_NEAR(surface_area(scene, "a"), 0.25, 1e-12);
+        CHECK_NEAR(surface_area(scene, "left"), 0.5, 1e-12);
+        CHECK_NEAR(surface_area(scene, "right"), 0.25, 1e-12);
+    }
+    rad_scene_destroy(scene);
+
+    expect_error(SQUARE "S 1 1 2 3 4 0 0 0.9 a\nS 2 1 2 3 4 1 0 0.9 b\n", RAD_ERR_PARSE, 6,
+                 "surface 1 'a' is covered entirely by what is cut out of it (surface 2 'b', "
+                 "line 7): nothing of it would be left to have view factors");
+    /* covered by a subsurface and a null surface together */
+    expect_error(SQUARE "V 5 0.5 0 0\nV 6 0.5 1 0\nS 1 1 2 3 4 0 0 0.9 a\n"
+                        "S 2 1 5 6 4 1 0 0.9 b\nN 3 5 6 3 2 1 0 0.9 c\n",
+                 RAD_ERR_PARSE, 8,
+                 "surface 1 'a' is covered entirely by what is cut out of it (surface 2 'b', "
+                 "line 9, and more)");
+    /* a mask covering its base */
+    expect_error(SQUARE "S 1 1 2 3 4 0 0 0.9 a\nM 2 4 3 2 1 1 0 0.9 m\n", RAD_ERR_PARSE, 6,
+                 "surface 1 'a' is covered entirely");
+    expect_error(SQUARE "V 5 0.6 0 0\nV 6 0.6 1 0\nV 7 0.4 0 0\nV 8 0.4 1 0\n"
+                        "S 1 1 2 3 4 0 0 0.9 a\nS 2 1 5 6 4 1 0 0.9 left\n"
+                        "S 3 7 2 3 8 1 0 0.9 right\n",
+                 RAD_ERR_PARSE, 12,
+                 "surface 3 'right' overlaps surface 2 'left' (line 11) by area 0.2, both cut "
+                 "out of base surface 1: the overlap would be counted twice");
+    /* a null surface inside a subsurface's place: overlap too */
+    expect_error(SQUARE "V 5 0.25 0.25 0\nV 6 0.75 0.25 0\nV 7 0.75 0.75 0\nV 8 0.25 0.75 0\n"
+                        "S 1 1 2 3 4 0 0 0.9 a\nS 2 5 6 7 8 1 0 0.9 window\n"
+                        "N 3 8 7 6 5 1 0 0.9 hole\n",
+                 RAD_ERR_PARSE, 12, "surface 3 'hole' overlaps surface 2 'window' (line 11)");
+    /* the class around them: outside, not coplanar, reversed, base after it or itself */
+    expect_error(SQUARE "V 5 0.5 0.5 0\nV 6 1.5 0.5 0\nV 7 1.5 1.5 0\nS 1 1 2 3 4 0 0 0.9 a\n"
+                        "S 2 5 6 7 0 1 0 0.9 b\n",
+                 RAD_ERR_PARSE, 10, "surface 2 is not inside its base surface 1");
+    expect_error(SQUARE "V 5 0.2 0.2 0.1\nV 6 0.8 0.2 0.1\nV 7 0.8 0.8 0.1\n"
+                        "S 1 1 2 3 4 0 0 0.9 a\nS 2 5 6 7 0 1 0 0.9 b\n",
+                 RAD_ERR_PARSE, 10, "surface 2 is not in the plane of its base surface 1");
+    expect_error(SQUARE "V 5 0.2 0.2 0\nV 6 0.8 0.2 0\nV 7 0.8 0.8 0\n"
+                        "S 1 1 2 3 4 0 0 0.9 a\nS 2 7 6 5 0 1 0 0.9 b\n",
+                 RAD_ERR_PARSE, 10, "surface 2 must face the same way as its base surface 1");
+    expect_error(SQUARE "S 1 1 2 3 4 1 0 0.9 a\n", RAD_ERR_PARSE, 6,
+                 "surface 1: base 1 is not a surface defined before it");
+    expect_error(SQUARE "S 1 1 2 3 0 2 0 0.9 a\nS 2 1 3 4 0 0 0 0.9 b\n", RAD_ERR_PARSE, 6,
+                 "surface 1: base 2 is not a surface defined before it");
+    /* numbers and coordinates out of range */
+    expect_error(SQUARE "V 4294967294 1 1 1\n", RAD_ERR_UNSUPPORTED, 6,
+                 "vertex number 4294967294 is larger than this reader supports (16777216)");
+    expect_error(SQUARE "V 99999999999999999999 1 1 1\n", RAD_ERR_UNSUPPORTED, 6,
+                 "vertex number 99999999999999999999 is larger than this reader supports");
+    expect_error(SQUARE "S 16777217 1 2 3 4 0 0 0.9 a\n", RAD_ERR_UNSUPPORTED, 6,
+                 "surface number 16777217 is larger than this reader supports (16777216)");
+    expect_error(SQUARE "S 1 1 2 3 99999999999 0 0 0.9 a\n", RAD_ERR_PARSE, 6,
+                 "surface 1: vertex 99999999999 is not a vertex of the file (numbers go up to "
+                 "16777216)");
+    expect_error(SQUARE "S 1 1 2 3 4 0 0 0.9 a\nS 2 1 2 3 0 1 18446744073709551616 0.9 b\n",
+                 RAD_ERR_PARSE, 7,
+                 "surface 2: cmb 18446744073709551616 is not a surface of the file");
+    expect_error(SQUARE "C maxU=99999999999\n", RAD_ERR_PARSE, 6,
+                 "maxU must be at most 4294967294, not '99999999999'");
+    expect_error("F 3\nV 1 0 0 0\nV 2 1e308 0 0\nV 3 1e308 1e308 0\nV 4 0 1e308 0\n"
+                 "S 1 1 2 3 4 0 0 0.9 a\n",
+                 RAD_ERR_PARSE, 3,
+                 "vertex 2: coordinate 1e308 is out of the supported range (magnitude at most "
+                 "3.40282e+38)");
+    expect_error(SQUARE "V 5 -1e39 0 0\n", RAD_ERR_PARSE, 6, "coordinate -1e39 is out of the");
+    expect_error(SQUARE "V 5 1e400 0 0\n", RAD_ERR_PARSE, 6, "finite coordinates");
+    /* an underflowing coordinate is the double nearest it (about 0) */
+    scene = NULL;
+    CHECK(rad_scene_load_vs3(test_write_file("tiny.vs3", "F 3\nV 1 1e-400 0 0\nV 2 1 0 0\n"
+                                                         "V 3 1 1 0\nS 1 1 2 3 0 0 0 0.9 t\n"),
+                             NULL, &scene, NULL, &error) == RAD_OK);
+    if (scene)
+        CHECK_NEAR(surface_area(scene, "t"), 0.5, 1e-12);
+    rad_scene_destroy(scene);
+}
+
 static void test_files(void)
 {
     test_write_file("north.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
@@ -397,6 +506,7 @@ int main(void)
     test_combined_and_triangles();
     test_subsurfaces();
     test_errors();
+    test_subsurface_checks();
     test_files();
     return test_finish("test_vs3");
 }

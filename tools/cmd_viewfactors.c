@@ -215,7 +215,8 @@ int command_viewfactors(int argc, char **argv)
     if (write.script_f) {
         emissivity = calloc(S ? S : 1, sizeof(*emissivity));
         if (!emissivity) {
-            snprintf(error.message, sizeof(error.message), "out of memory for %zu surfaces", S);
+            snprintf(error.message, sizeof(error.message), "%s: out of memory for %zu surfaces",
+                     scene->source, S);
             goto fail;
         }
         for (size_t I = 0; I < S; I++)

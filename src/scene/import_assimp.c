@@ -1,19 +1,25 @@
 /*
  * import_assimp.c - reading scene files through Assimp's C API.
  *
- * Assimp does the parsing. This file only (1) checks, for OBJ files, what Assimp passes
- * over silently and what a user must hear about with a line number: a material library
- * that is not there, and non-finite vertex coordinates; for glTF files, runs our own
+ * Assimp does the parsing. This file only (1) checks, for OBJ files (obj_check.c), what
+ * Assimp passes over silently, gets wrong, or refuses without a line number: a material
+ * library that is not there, face indices outside their v/vt/vn list (or beyond 64 bits),
+ * v/vt/vn lines short of numbers or not finite; and hands Assimp a corrected copy of the
+ * file where it would misread it (numbers written ".5", a comment after a face, several
+ * libraries on one mtllib line, a library found by its base name beside the OBJ); every
+ * failure of Assimp itself is put in our words after the file's name; for glTF files,
+ * runs our own
  * reading (gltf_json.c) first; (2) walks Assimp's node tree, applying node transforms, and
  * hands triangles, materials and surface names to the scene builder. A surface is an
  * Assimp mesh name (OBJ `o`/`g`, glTF mesh, STL solid), else its node's name, else the
  * file's name without folder and extension; (3) maps materials onto METHOD.md's units:
  * Kd / glTF baseColorFactor = albedo, Ke / glTF emissiveFactor x emissiveStrength =
  * emitted radiance; a format's "no material" (STL, PLY without a material element, OBJ
- * faces before any usemtl, glTF primitives without one) gets RAD_DEFAULT_ALBEDO; albedo
+ * faces before any usemtl or under a usemtl no library defines (a warning), glTF
+ * primitives without one) gets RAD_DEFAULT_ALBEDO; albedo
  * and emission textures are decoded once each and triangles of textured materials keep
- * their texture coordinates; (4) takes the first glTF camera, and the up axis and unit from the file's
- * metadata.
+ * their texture coordinates; (4) takes the first glTF camera, and the up axis and unit
+ * from the file's metadata.
  * View3D input files are recognised here and handed to import_vs3.c.
  */
 #include <assimp/cimport.h>
@@ -22,7 +28,7 @@
 #include <assimp/scene.h>
 #include <ctype.h>
 #include <errno.h>
-#include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,6 +40,7 @@
 #include "core/error.h"
 #include "core/vec3.h"
 #include "scene/gltf_json.h"
+#include "scene/obj_check.h"
 #include "scene/ply_check.h"
 #include "scene/scene_builder.h"
 #include "scene/texture.h"
@@ -109,102 +116,6 @@ static rad_status check_stl(const char *path, FILE *file, rad_error *error)
     return RAD_OK;
 }
 
-/* An OBJ face's vertex indices (the first number of each v/vt/vn corner): 0, or a relative
- * index before the first vertex, is an error at this line; the largest absolute index is
- * kept to be checked against the vertex count at the end. */
-static rad_status check_obj_face(const char *path, unsigned long number, const char *corners,
-                                 unsigned long vertices, long long *largest,
-                                 unsigned long *largest_line, rad_error *error)
-{
-    const char *cursor = corners;
-    for (;;) {
-        while (isspace((unsigned char)*cursor))
-            cursor++;
-        if (!*cursor)
-            return RAD_OK;
-        char *end;
-        long long index = strtoll(cursor, &end, 10);
-        if (end == cursor)
-            return RAD_OK; /* malformed: Assimp reports it */
-        if (index == 0 || (index < 0 && (unsigned long long)-index > vertices))
-            return rad_fail(error, RAD_ERR_PARSE,
-                            "%s:%lu: face vertex %lld: %s", path, number, index,
-                            index == 0 ? "OBJ indices start at 1"
-                                       : "before the first vertex");
-        if (index > *largest) {
-            *largest = index;
-            *largest_line = number;
-        }
-        while (*end && !isspace((unsigned char)*end))
-            end++; /* the corner's /vt/vn */
-        cursor = end;
-    }
-}
-
-/* OBJ checks Assimp does not make (or makes without a line number): material libraries
- * exist, vertex coordinates finite, face indices name vertices of the file. */
-static rad_status check_obj(const char *path, FILE *file, rad_error *error)
-{
-    char folder[4096];
-    folder_of(path, folder, sizeof(folder));
-    char line[8192];
-    unsigned long number = 0, vertices = 0, largest_line = 0;
-    long long largest = 0;
-    while (fgets(line, sizeof(line), file)) {
-        number++;
-        char *p = line;
-        while (*p == ' ' || *p == '\t')
-            p++;
-        if (p[0] == 'f' && (p[1] == ' ' || p[1] == '\t')) {
-            rad_status status = check_obj_face(path, number, p + 2, vertices, &largest,
-                                               &largest_line, error);
-            if (status != RAD_OK)
-                return status;
-            continue;
-        }
-        if (p[0] == 'v' && (p[1] == ' ' || p[1] == '\t'))
-            vertices++;
-        if (strncmp(p, "mtllib", 6) == 0 && isspace((unsigned char)p[6])) {
-            char *name = p + 6;
-            while (isspace((unsigned char)*name))
-                name++;
-            char *end = name + strlen(name);
-            while (end > name && isspace((unsigned char)end[-1]))
-                *--end = 0;
-            char library[8192 + 4096];
-            snprintf(library, sizeof(library), "%s%s", name[0] == '/' ? "" : folder, name);
-            struct stat st;
-            if (stat(library, &st) != 0)
-                return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s' not found",
-                                path, number, name);
-            if (!S_ISREG(st.st_mode))
-                return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s' is not a file",
-                                path, number, name);
-        } else if (p[0] == 'v' && (p[1] == ' ' || p[1] == '\t')) {
-            char *cursor = p + 2;
-            for (int k = 0; k < 3; k++) {
-                char *end;
-                double value = strtod(cursor, &end);
-                if (end == cursor)
-                    break; /* malformed: Assimp reports it */
-                if (!isfinite(value))
-                    return rad_fail(error, RAD_ERR_PARSE,
-                                    "%s:%lu: vertex coordinate is not a finite number", path,
-                                    number);
-                if (fabs(value) > FLT_MAX)
-                    return rad_fail(error, RAD_ERR_PARSE,
-                                    "%s:%lu: vertex coordinate %g is beyond single precision",
-                                    path, number, value);
-                cursor = end;
-            }
-        }
-    }
-    if ((unsigned long long)largest > vertices)
-        return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: face vertex %lld: the file has %lu vertices",
-                        path, largest_line, largest, vertices);
-    return RAD_OK;
-}
-
 static rad_rgb material_color(const struct aiMaterial *material, const char *key,
                               unsigned type, unsigned index, rad_rgb fallback)
 {
@@ -226,6 +137,7 @@ typedef struct import_state {
     uint8_t *textured;      /* Assimp material index -> it has a texture (albedo or emission) */
     texture_key *cache;     /* textures already read (TEXTURE_CACHE at most) */
     unsigned cache_count;
+    obj_names *obj_undefined; /* an OBJ's materials no library defines, else NULL */
 } import_state;
 
 static bool near_value(double a, double b)
@@ -399,9 +311,13 @@ static rad_status map_material(import_state *state, unsigned index, uint32_t *ou
         bool is_default = strncmp(name.data, AI_DEFAULT_MATERIAL_NAME,
                                   strlen(AI_DEFAULT_MATERIAL_NAME)) == 0 ||
                           gltf_default || state->ply_without_materials;
+        /* an OBJ's usemtl that no library defines: no material, under its own name */
+        bool undefined = state->obj_undefined && obj_names_has(state->obj_undefined, name.data);
         rad_material material = {0};
-        if (is_default) {
-            snprintf(material.name, sizeof(material.name), "default");
+        if (is_default || undefined) {
+            snprintf(material.name, sizeof(material.name), "%.*s",
+                     (int)sizeof(material.name) - 1, undefined ? name.data : "default");
+            is_default = true;
             material.albedo = (rad_rgb){RAD_DEFAULT_ALBEDO, RAD_DEFAULT_ALBEDO, RAD_DEFAULT_ALBEDO};
         } else {
             if (name.data[0])
@@ -651,12 +567,37 @@ static void take_frame(const struct aiScene *ai, bool metres_y_up, scene_builder
     scene_builder_set_frame(builder, up, unit);
 }
 
-/* Assimp's message on one line. */
-static void one_line(char *text)
+/* Assimp's failure to read `path`, in our words where we know what it means (the checks
+ * above catch what they can first, with a line), with Assimp's own on one line after. */
+static rad_status assimp_failure(const char *path, const char *assimp, rad_error *error)
 {
-    for (; *text; text++)
+    static const struct {
+        const char *assimp, *meaning;
+    } known[] = {
+        {"too small", "the file is empty or too short to hold a scene"},
+        {"vertex index out of range", "a face refers to a vertex the file does not define"},
+        {"normal index out of range", "a face refers to a normal the file does not define"},
+        {"color index out of range", "a face refers to a vertex colour the file does not define"},
+        {"Invalid number of components", "a v, vt or vn line has the wrong number of numbers"},
+        {"Division by zero", "a vertex has weight w = 0"},
+        {"Invalid face index", "a face corner is not a whole-number index"},
+        {"Not supported token in face", "a face corner is not v, v/vt, v//vn or v/vt/vn"},
+        {"as a real number", "a number cannot be read"},
+        {"No suitable reader found", "not a scene format Assimp reads"},
+        {"Unable to open file", "cannot be opened"},
+    };
+    const char *meaning = "a construct Assimp cannot read";
+    for (size_t k = 0; k < sizeof(known) / sizeof(known[0]); k++)
+        if (strstr(assimp, known[k].assimp)) {
+            meaning = known[k].meaning;
+            break;
+        }
+    rad_status status = rad_fail(error, RAD_ERR_PARSE, "%s: cannot read the scene: %s (Assimp: %s)",
+                                 path, meaning, assimp);
+    for (char *text = error ? error->message : NULL; text && *text; text++)
         if (*text == '\n' || *text == '\r')
             *text = ' ';
+    return status;
 }
 
 /* View3D content: the first data line (not blank, not a `!` or `/` comment) starts with
@@ -723,11 +664,12 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
     }
     rewind(file);
     rad_status status = RAD_OK;
-    import_state state = {NULL, NULL, NULL, path, NULL, false, "", options, NULL, NULL, 0};
+    import_state state = {NULL, NULL, NULL, path, NULL, false, "", options, NULL, NULL, 0, NULL};
     gltf_info gltf = {0};
     bool is_gltf = has_extension(path, ".gltf") || has_extension(path, ".glb");
+    obj_check obj = {0};
     if (has_extension(path, ".obj"))
-        status = check_obj(path, file, error);
+        status = obj_check_read(path, options, file, &obj, error);
     else if (has_extension(path, ".stl"))
         status = check_stl(path, file, error);
     else if (has_extension(path, ".ply")) {
@@ -740,25 +682,38 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
         status = gltf_info_read(path, &gltf, error);
         state.gltf = &gltf;
     }
-    if (status != RAD_OK)
+    if (status == RAD_OK && obj.copy_differs && obj.copy_length > UINT_MAX)
+        status = rad_fail(error, RAD_ERR_UNSUPPORTED,
+                          "%s: an OBJ of more than 4 GiB with .5 numbers, a comment after a "
+                          "face or libraries to find is not supported",
+                          path);
+    if (status != RAD_OK) {
+        obj_check_free(&obj);
         return status;
+    }
     const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
     snprintf(state.stem, sizeof(state.stem), "%s", base);
     char *dot = strrchr(state.stem, '.');
     if (dot && dot != state.stem)
         *dot = 0;
 
+    /* an OBJ that must be told differently: Assimp reads the checked copy, whose
+     * mtllib lines name their files from the working folder */
+    unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType;
     const struct aiScene *ai =
-        aiImportFile(path, aiProcess_Triangulate | aiProcess_SortByPType);
+        obj.copy_differs
+            ? aiImportFileFromMemory(obj.copy, (unsigned)obj.copy_length, flags, "obj")
+            : aiImportFile(path, flags);
+    free(obj.copy);
+    obj.copy = NULL;
     if (!ai) {
-        status = rad_fail(error, RAD_ERR_PARSE, "%s: cannot read the scene: %s", path,
-                          aiGetErrorString());
-        if (error)
-            one_line(error->message);
+        status = assimp_failure(path, aiGetErrorString(), error);
         gltf_info_free(&gltf);
+        obj_check_free(&obj);
         return status;
     }
     state.ai = ai;
+    state.obj_undefined = obj.materials_undefined.length ? &obj.materials_undefined : NULL;
 
     scene_builder *builder = NULL;
     status = scene_builder_create(path, options, &builder, error);
@@ -790,6 +745,7 @@ done:
     free(state.textured);
     free(state.cache);
     gltf_info_free(&gltf);
+    obj_check_free(&obj);
     aiReleaseImport(ai);
     return status;
 }

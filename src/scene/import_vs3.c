@@ -15,6 +15,7 @@
  */
 #include <ctype.h>
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -30,6 +31,14 @@
 /* A convex piece of a polygon cut around holes has at most 4 + (number of hole edges
  * applied) corners; this bounds it (a wall with a dozen windows fits). */
 enum { VS3_PIECE_CORNERS = 64 };
+
+/* The largest vertex or surface number read: the reader keeps tables indexed by number,
+ * so a larger one would cost memory for numbers no file uses. */
+enum { VS3_LARGEST_NUMBER = 1 << 24 };
+
+/* Coordinates are at most single precision's largest in magnitude: the ray tracer holds
+ * them in floats. */
+#define VS3_LARGEST_COORDINATE FLT_MAX
 
 typedef enum vs3_kind { VS3_SURFACE, VS3_OBSTRUCTION, VS3_MASK, VS3_NULL } vs3_kind;
 
@@ -96,7 +105,8 @@ static bool parse_double(const char *text, double *out)
     char *end;
     errno = 0;
     double value = strtod(text, &end);
-    if (end == text || *end || errno == ERANGE || !isfinite(value))
+    /* an underflow (1e-400) is the nearest double, near 0; an overflow is refused */
+    if (end == text || *end || (errno == ERANGE && fabs(value) >= 1) || !isfinite(value))
         return false;
     *out = value;
     return true;
@@ -113,6 +123,20 @@ static bool parse_count(const char *text, uint32_t *out)
         return false;
     *out = (uint32_t)value;
     return true;
+}
+
+/* A vertex or surface number written as digits but beyond VS3_LARGEST_NUMBER: refused in
+ * those words (not as a malformed line). */
+static rad_status check_number_size(vs3_reader *r, const char *text, const char *what,
+                                    unsigned long line, rad_error *error)
+{
+    uint32_t number;
+    if (text[strspn(text, "0123456789")] || (parse_count(text, &number) &&
+                                              number <= VS3_LARGEST_NUMBER))
+        return RAD_OK;
+    return rad_fail(error, RAD_ERR_UNSUPPORTED,
+                    "%s:%lu: %s number %s is larger than this reader supports (%d)", r->path,
+                    line, what, text, VS3_LARGEST_NUMBER);
 }
 
 static rad_status parse_control(vs3_reader *r, char **token, int count, unsigned long line,
@@ -168,8 +192,10 @@ static rad_status parse_control(vs3_reader *r, char **token, int count, unsigned
                 known = true;
                 if (!parse_count(value_text, counts[i].value))
                     return rad_fail(error, RAD_ERR_PARSE,
-                                    "%s:%lu: %s must be a whole number, not '%s'", r->path,
-                                    line, name, value_text);
+                                    value_text[0] && !value_text[strspn(value_text, "0123456789")]
+                                        ? "%s:%lu: %s must be at most 4294967294, not '%s'"
+                                        : "%s:%lu: %s must be a whole number, not '%s'",
+                                    r->path, line, name, value_text);
             }
         if (!known)
             rad_warn(r->options.log, r->options.log_user,
@@ -183,6 +209,17 @@ static rad_status parse_vertex(vs3_reader *r, char **token, int count, unsigned 
 {
     uint32_t number;
     double x[3];
+    if (count >= 2 && check_number_size(r, token[1], "vertex", line, error) != RAD_OK)
+        return RAD_ERR_UNSUPPORTED;
+    for (int k = 2; k < 5 && k < count; k++) {
+        char *end;
+        double value = strtod(token[k], &end);
+        if (end != token[k] && !*end && isfinite(value) && fabs(value) > VS3_LARGEST_COORDINATE)
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s:%lu: vertex %s: coordinate %s is out of the supported range "
+                            "(magnitude at most %g)",
+                            r->path, line, token[1], token[k], VS3_LARGEST_COORDINATE);
+    }
     if (count < 5 || !parse_count(token[1], &number) || number == 0 ||
         !parse_double(token[2], &x[0]) || !parse_double(token[3], &x[1]) ||
         !parse_double(token[4], &x[2]))
@@ -219,8 +256,22 @@ static rad_status parse_surface(vs3_reader *r, vs3_kind kind, char **token, int 
 {
     vs3_polygon p;
     memset(&p, 0, sizeof(p));
+    if (count >= 2 && check_number_size(r, token[1], "surface", line, error) != RAD_OK)
+        return RAD_ERR_UNSUPPORTED;
     p.line = line;
     p.kind = kind;
+    /* a reference (vertex, base, cmb) written as digits beyond any number read: to none */
+    static const char *const field[6] = {"vertex", "vertex", "vertex", "vertex", "base",
+                                         "cmb"};
+    for (int k = 2; k < 8 && k < count; k++)
+        if (!token[k][strspn(token[k], "0123456789")] &&
+            !(parse_count(token[k], &p.base) && p.base <= VS3_LARGEST_NUMBER))
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s:%lu: surface %s: %s %s is not %s (numbers go up to %d)", r->path,
+                            line, token[1], field[k - 2], token[k],
+                            k < 6 ? "a vertex of the file" : "a surface of the file",
+                            VS3_LARGEST_NUMBER);
+    p.base = 0;
     bool ok = count >= 9 && parse_count(token[1], &p.number) && p.number > 0;
     for (int k = 0; ok && k < 4; k++)
         ok = parse_count(token[2 + k], &p.vertex[k]);
@@ -447,6 +498,8 @@ static rad_status check_inside_base(vs3_reader *r, const vs3_polygon *p, const v
     return RAD_OK;
 }
 
+static rad_status check_holes(vs3_reader *r, rad_error *error);
+
 /* Step 2: references and checks. */
 static rad_status resolve(vs3_reader *r, rad_error *error)
 {
@@ -503,7 +556,7 @@ static rad_status resolve(vs3_reader *r, rad_error *error)
                                 r->path, p->line, p->number, p->cmb);
         }
     }
-    return RAD_OK;
+    return check_holes(r, error);
 }
 
 /* Clips a convex polygon (in place) to the side of the plane where side() >= 0. */
@@ -534,6 +587,84 @@ typedef struct vs3_piece {
 static double piece_area(const vs3_piece *p)
 {
     return p->count < 3 ? 0 : 0.5 * v3_length(newell_normal(p->corner, p->count));
+}
+
+/* The corners of hole h counter-clockwise about its base's normal (a null surface or mask
+ * faces the other way). */
+static vs3_piece hole_piece(const vs3_polygon *h)
+{
+    vs3_piece piece;
+    piece.count = h->corner_count;
+    for (uint32_t k = 0; k < h->corner_count; k++)
+        piece.corner[k] = h->kind == VS3_SURFACE ? h->corner[k]
+                                                 : h->corner[h->corner_count - 1 - k];
+    return piece;
+}
+
+/* Step 2c: the holes of a base (its subsurfaces, null surfaces and masks, all cut out of
+ * it) do not overlap, which would count the overlap twice (in two surfaces, and out of the
+ * base twice); and they leave some of the base: a base covered entirely would have no
+ * area, so no view factors, and vanish from the matrix. Both are refused. Each hole is
+ * convex, so the overlap of two is one hole clipped by the other's edges. */
+static rad_status check_holes(vs3_reader *r, rad_error *error)
+{
+    size_t n = r->polygon_count;
+    uint32_t *first = rad_alloc_array(n, sizeof(*first)); /* per base: its first hole + 1 */
+    uint32_t *next = rad_alloc_array(n, sizeof(*next));   /* per hole: the next one + 1 */
+    double *covered = rad_alloc_array(n, sizeof(*covered));
+    rad_status status = RAD_OK;
+    if (!first || !next || !covered) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", r->path);
+        goto done;
+    }
+    for (size_t i = n; i-- > 0;) {
+        uint32_t base = r->polygon[i].base_index;
+        if (base == UINT32_MAX)
+            continue;
+        next[i] = first[base];
+        first[base] = (uint32_t)i + 1;
+        covered[base] += r->polygon[i].area;
+    }
+    for (size_t b = 0; b < n && status == RAD_OK; b++) {
+        const vs3_polygon *base = &r->polygon[b];
+        for (uint32_t i = first[b]; i && status == RAD_OK; i = next[i - 1]) {
+            const vs3_polygon *one = &r->polygon[i - 1];
+            vs3_piece edges = hole_piece(one);
+            for (uint32_t j = next[i - 1]; j; j = next[j - 1]) {
+                const vs3_polygon *other = &r->polygon[j - 1];
+                vs3_piece overlap = hole_piece(other);
+                for (uint32_t e = 0; e < edges.count && overlap.count >= 3; e++)
+                    overlap.count = clip(overlap.corner, overlap.count, edges.corner[e],
+                                         edges.corner[(e + 1) % edges.count], base->normal, 1);
+                double area = piece_area(&overlap);
+                if (area > RAD_QUAD_FLATNESS * fmin(one->area, other->area)) {
+                    status = rad_fail(error, RAD_ERR_PARSE,
+                                      "%s:%lu: surface %u '%s' overlaps surface %u '%s' (line "
+                                      "%lu) by area %g, both cut out of base surface %u: the "
+                                      "overlap would be counted twice",
+                                      r->path, other->line, other->number, other->name,
+                                      one->number, one->name, one->line, area, base->number);
+                    break;
+                }
+            }
+        }
+        if (status == RAD_OK && first[b] &&
+            base->area - covered[b] <= RAD_QUAD_FLATNESS * base->area) {
+            const vs3_polygon *hole = &r->polygon[first[b] - 1];
+            status = rad_fail(error, RAD_ERR_PARSE,
+                              "%s:%lu: surface %u '%s' is covered entirely by what is cut out "
+                              "of it (surface %u '%s', line %lu%s): nothing of it would be "
+                              "left to have view factors; remove it, and give what covers it "
+                              "base 0",
+                              r->path, base->line, base->number, base->name, hole->number,
+                              hole->name, hole->line, next[first[b] - 1] ? ", and more" : "");
+        }
+    }
+done:
+    free(first);
+    free(next);
+    free(covered);
+    return status;
 }
 
 /* Adds a convex polygon as a fan of triangles, skipping slivers left by clipping. */

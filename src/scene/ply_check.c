@@ -4,6 +4,7 @@
 #include "ply_check.h"
 
 #include <ctype.h>
+#include <errno.h>
 #include <limits.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -18,6 +19,8 @@ typedef enum ply_format { PLY_ASCII, PLY_LITTLE, PLY_BIG } ply_format;
 typedef struct ply_property {
     int size;       /* bytes of a scalar, or of the list's items */
     int count_size; /* bytes of a list's count; 0 = a scalar */
+    bool item_signed, item_float;
+    bool vertex_indices; /* a face's vertex_indices (or vertex_index) */
 } ply_property;
 
 typedef struct ply_element {
@@ -26,6 +29,16 @@ typedef struct ply_element {
     int property_count;
     ply_property properties[PLY_MAX_PROPERTIES];
 } ply_element;
+
+static bool type_is_float(const char *type)
+{
+    return strncmp(type, "float", 5) == 0 || strcmp(type, "double") == 0;
+}
+
+static bool type_is_signed(const char *type)
+{
+    return type[0] != 'u';
+}
 
 /* Bytes of a PLY scalar type, 0 if unknown. */
 static int type_size(const char *type)
@@ -43,7 +56,8 @@ static int type_size(const char *type)
     return 0;
 }
 
-/* A list count of `size` bytes, in the file's byte order. */
+/* A list item or count of `size` bytes, in the file's byte order, as a signed value when
+ * `is_signed` (a count is never: PLY counts are unsigned in practice, uchar or int). */
 static unsigned long long binary_count(const unsigned char *bytes, int size, ply_format format)
 {
     unsigned long long value = 0;
@@ -70,10 +84,47 @@ static bool next_token(FILE *file, char *token, size_t size, unsigned long *line
     return true;
 }
 
+/* A face's vertex index (`text` as written, or `value` read from a binary file) names one
+ * of the file's `vertices` (PLY counts from 0): Assimp 5.2 keeps only the low 32 bits, so
+ * 4294967296 would be vertex 0 without a word. */
+static rad_status check_vertex_index(const char *path, unsigned long line, const char *text,
+                                     long long value, unsigned long long row,
+                                     unsigned long long vertices, rad_error *error)
+{
+    char where[32] = "";
+    if (line)
+        snprintf(where, sizeof(where), ":%lu", line);
+    char written[64];
+    if (text) {
+        char *end;
+        errno = 0;
+        value = strtoll(text, &end, 10);
+        if (end == text || *end)
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s%s: face %llu: vertex index '%s' is not a whole number", path,
+                            where, row, text);
+        snprintf(written, sizeof(written), "%s", text);
+        if (errno == ERANGE)
+            value = -1; /* out of any range: refused below, as written */
+    } else {
+        snprintf(written, sizeof(written), "%lld", value);
+    }
+    if (value < 0 || (unsigned long long)value >= vertices)
+        return rad_fail(error, RAD_ERR_PARSE,
+                        "%s%s: face %llu refers to vertex %s but only %llu %s defined (PLY "
+                        "counts from 0)",
+                        path, where, row, written, vertices, vertices == 1 ? "is" : "are");
+    return RAD_OK;
+}
+
 static rad_status check_body(const char *path, FILE *file, ply_format format,
                              const ply_element *elements, int element_count,
                              unsigned long line, rad_error *error)
 {
+    unsigned long long vertices = 0;
+    for (int e = 0; e < element_count; e++)
+        if (strcmp(elements[e].name, "vertex") == 0)
+            vertices = elements[e].rows;
     for (int e = 0; e < element_count; e++) {
         const ply_element *element = &elements[e];
         for (unsigned long long row = 0; row < element->rows; row++)
@@ -86,21 +137,49 @@ static rad_status check_body(const char *path, FILE *file, ply_format format,
                     ended = !next_token(file, token, sizeof(token), &line);
                     if (!ended && property->count_size) {
                         char *end;
+                        errno = 0;
                         items = strtoull(token, &end, 10);
-                        if (*end || token[0] == '-')
+                        if (*end || end == token || token[0] == '-' || errno == ERANGE)
                             return rad_fail(error, RAD_ERR_PARSE,
                                             "%s:%lu: %s %llu: list length '%s' is not a count",
                                             path, line, element->name, row, token);
                     } else
                         items = 0;
-                    for (unsigned long long k = 0; k < items && !ended; k++)
+                    for (unsigned long long k = 0; k < items && !ended; k++) {
                         ended = !next_token(file, token, sizeof(token), &line);
+                        if (!ended && property->vertex_indices) {
+                            rad_status status = check_vertex_index(path, line, token, 0, row,
+                                                                   vertices, error);
+                            if (status != RAD_OK)
+                                return status;
+                        }
+                    }
                 } else {
                     unsigned char bytes[8];
                     if (property->count_size) {
                         ended = fread(bytes, 1, (size_t)property->count_size, file) !=
                                 (size_t)property->count_size;
                         items = ended ? 0 : binary_count(bytes, property->count_size, format);
+                    }
+                    if (property->vertex_indices && !property->item_float) {
+                        /* read each index (a face has a handful) */
+                        for (unsigned long long k = 0; k < items && !ended; k++) {
+                            ended = fread(bytes, 1, (size_t)property->size, file) !=
+                                    (size_t)property->size;
+                            if (ended)
+                                break;
+                            unsigned long long bits =
+                                binary_count(bytes, property->size, format);
+                            long long value = (long long)bits;
+                            if (property->item_signed && property->size < 8 &&
+                                bits >> (8 * property->size - 1))
+                                value = (long long)bits - (1ll << (8 * property->size));
+                            rad_status status = check_vertex_index(path, 0, NULL, value, row,
+                                                                   vertices, error);
+                            if (status != RAD_OK)
+                                return status;
+                        }
+                        items = 0;
                     }
                     /* skip the items, then read their last byte: fseek passes the end */
                     ended = ended || items > (unsigned long long)LONG_MAX / 8 ||
@@ -131,8 +210,8 @@ rad_status ply_check(const char *path, FILE *file, rad_error *error)
     rad_status status = RAD_OK;
     while (status == RAD_OK && fgets(line_text, sizeof(line_text), file)) {
         line++;
-        char word[64] = "", a[64] = "", b[64] = "", c[64] = "";
-        int n = sscanf(line_text, "%63s %63s %63s %63s", word, a, b, c);
+        char word[64] = "", a[64] = "", b[64] = "", c[64] = "", d[64] = "";
+        int n = sscanf(line_text, "%63s %63s %63s %63s %63s", word, a, b, c, d);
         if (n < 1 || strcmp(word, "ply") == 0 || strcmp(word, "comment") == 0 ||
             strcmp(word, "obj_info") == 0)
             continue;
@@ -153,10 +232,15 @@ rad_status ply_check(const char *path, FILE *file, rad_error *error)
                                   line, a);
         } else if (strcmp(word, "element") == 0) {
             char *end;
+            errno = 0;
             unsigned long long rows = strtoull(b, &end, 10);
-            if (n < 3 || *end || b[0] == '-')
+            if (n < 3 || *end || end == b || b[0] == '-')
                 status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: element '%s' has no row count",
                                   path, line, a);
+            else if (errno == ERANGE)
+                status = rad_fail(error, RAD_ERR_PARSE,
+                                  "%s:%lu: element '%s': row count %s is out of range", path,
+                                  line, a, b);
             else if (element_count == PLY_MAX_ELEMENTS)
                 status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: more than %d elements", path,
                                   line, PLY_MAX_ELEMENTS);
@@ -168,11 +252,20 @@ rad_status ply_check(const char *path, FILE *file, rad_error *error)
         } else if (strcmp(word, "property") == 0) {
             ply_element *e = element_count ? &element_list[element_count - 1] : NULL;
             bool list = strcmp(a, "list") == 0;
-            int size = type_size(list ? c : a), count_size = list ? type_size(b) : 0;
+            const char *type = list ? c : a, *name = list ? d : b;
+            int size = type_size(type), count_size = list ? type_size(b) : 0;
             if (!e || e->property_count == PLY_MAX_PROPERTIES || !size || (list && !count_size))
                 status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: bad property line", path, line);
+            else if (list && type_is_float(b))
+                status = rad_fail(error, RAD_ERR_PARSE,
+                                  "%s:%lu: property '%s': a list's length is of type '%s', not "
+                                  "a whole number",
+                                  path, line, name, b);
             else
-                e->properties[e->property_count++] = (ply_property){size, count_size};
+                e->properties[e->property_count++] = (ply_property){
+                    size, count_size, type_is_signed(type), type_is_float(type),
+                    list && strcmp(e->name, "face") == 0 &&
+                        (strcmp(name, "vertex_indices") == 0 || strcmp(name, "vertex_index") == 0)};
         }
     }
     if (status == RAD_OK && (!has_format || !ended))

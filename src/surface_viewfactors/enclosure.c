@@ -150,9 +150,12 @@ rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *m,
     memset(report, 0, sizeof(*report));
     uint32_t n = m->n;
     uint64_t nz = m->row_start[n];
+    /* every failure names the scene's file: the user's handle on what to fix */
+    const char *source = scene ? scene->source : "view-factor matrix";
     if (scene && scene->surface_count != n)
         return rad_fail(error, RAD_ERR_INVALID,
-                        "the matrix has %u surfaces, the scene %u", n, scene->surface_count);
+                        "%s: the enclosure correction: the matrix has %u surfaces, the scene %u",
+                        source, n, scene->surface_count);
     rad_status status = RAD_OK;
     char name[160];
     bool *active = rad_alloc_array(n, sizeof(*active));
@@ -165,7 +168,8 @@ rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *m,
     uint32_t *colour = rad_alloc_array(n, sizeof(*colour));
     uint32_t *queue = rad_alloc_array(n, sizeof(*queue));
     if (!active || !G || !w || !diagonal || !rhs || !mu || !work || !colour || !queue) {
-        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the enclosure correction");
+        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for the enclosure correction",
+                          source);
         goto done;
     }
     for (uint32_t I = 0; I < n; I++)
@@ -175,14 +179,23 @@ rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *m,
     for (uint32_t I = 0; I < n; I++) {
         if (!active[I])
             continue;
-        if (!(m->area[I] > 0)) {
-            status = rad_fail(error, RAD_ERR_INVALID, "%s has area %g",
+        if (!(m->area[I] > 0) || !isfinite(m->area[I])) {
+            status = rad_fail(error, RAD_ERR_INVALID,
+                              "%s: the enclosure correction: %s has area %g", source,
                               surface_name(scene, I, name, sizeof(name)), m->area[I]);
             goto done;
         }
         double row = 0, fixed = 0;
         for (uint64_t k = m->row_start[I]; k < m->row_start[I + 1]; k++) {
             uint32_t J = m->column[k];
+            if (!(m->value[k] >= 0) || !isfinite(m->value[k])) {
+                status = rad_fail(error, RAD_ERR_INVALID,
+                                  "%s: the enclosure correction: F from %s to surface %u is %g, "
+                                  "not a view factor",
+                                  source, surface_name(scene, I, name, sizeof(name)), J + 1,
+                                  m->value[k]);
+                goto done;
+            }
             row += m->value[k];
             if (!active[J] || m->value[k] == 0) {
                 fixed += m->area[I] * m->value[k];
@@ -191,8 +204,9 @@ rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *m,
             uint64_t t = vf_matrix_entry(m, J, I);
             if (t == UINT64_MAX) {
                 status = rad_fail(error, RAD_ERR_INVALID,
-                                  "F from %s to surface %u is stored without its reciprocal",
-                                  surface_name(scene, I, name, sizeof(name)), J + 1);
+                                  "%s: the enclosure correction: F from %s to surface %u is "
+                                  "stored without its reciprocal",
+                                  source, surface_name(scene, I, name, sizeof(name)), J + 1);
                 goto done;
             }
             G[k] = 0.5 * (m->area[I] * m->value[k] + m->area[J] * m->value[t]);
@@ -213,18 +227,18 @@ rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *m,
         diagonal[I] = weight;
         if (!(weight > 0)) {
             status = rad_fail(error, RAD_ERR_INVALID,
-                              "%s sees nothing (an empty row): it cannot be part of a closed "
-                              "enclosure",
-                              surface_name(scene, I, name, sizeof(name)));
+                              "%s: the enclosure correction: %s sees nothing (an empty row): "
+                              "it cannot be part of a closed enclosure",
+                              source, surface_name(scene, I, name, sizeof(name)));
             goto done;
         }
     }
     uint32_t singular = find_singular_group(m, active, w, colour, queue);
     if (singular) {
         status = rad_fail(error, RAD_ERR_INVALID,
-                          "the enclosure correction is singular: %s and the surfaces it "
+                          "%s: the enclosure correction is singular: %s and the surfaces it "
                           "sees split into two sets that see only each other",
-                          surface_name(scene, singular - 1, name, sizeof(name)));
+                          source, surface_name(scene, singular - 1, name, sizeof(name)));
         goto done;
     }
 
@@ -255,15 +269,19 @@ rad_status rad_viewfactor_matrix_close_enclosure(rad_viewfactor_matrix *m,
             for (uint64_t k = m->row_start[I]; active[I] && k < m->row_start[I + 1]; k++)
                 delta[k] += w[k] * (mu[I] + mu[m->column[k]]);
     }
-    for (uint64_t k = 0; k < nz; k++)
-        if (w[k] > 0 && !(delta[k] > 0)) {
-            status = rad_fail(error, RAD_ERR_INVALID,
-                              "the enclosure correction would make a view factor negative: "
-                              "the matrix is too far from closed (largest row-sum deviation "
-                              "%g)",
-                              report->row_deviation_before);
-            goto done;
-        }
+    for (uint32_t I = 0; I < n; I++)
+        for (uint64_t k = m->row_start[I]; active[I] && k < m->row_start[I + 1]; k++)
+            if (w[k] > 0 && !(delta[k] > 0)) {
+                char other[160];
+                status = rad_fail(error, RAD_ERR_INVALID,
+                                  "%s: the enclosure correction would make the view factor from "
+                                  "%s to %s negative: the matrix is too far from closed "
+                                  "(largest row-sum deviation %g)",
+                                  source, surface_name(scene, I, name, sizeof(name)),
+                                  surface_name(scene, m->column[k], other, sizeof(other)),
+                                  report->row_deviation_before);
+                goto done;
+            }
 
     /* write back */
     for (uint32_t I = 0; I < n; I++)
