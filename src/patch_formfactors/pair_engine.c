@@ -3,12 +3,13 @@
  *
  * For a pair (i, j), i < j, of patches that face each other:
  *   - the unoccluded transfer G_ij = A_i Fhat_ij is Lambert's contour formula (contour.c)
- *     integrated over the smaller patch by the midpoint rule on an m x m split; for pairs
- *     close to each other the split is finer and the estimates from both sides are
- *     averaged, weighted towards the smaller patch;
+ *     integrated over the smaller patch: the midpoint rule on an m x m split, a 4 x 4 one
+ *     for pairs close by, adaptive quadrature (polygon_integral.c) for touching pairs;
  *   - visibility is the fraction of segments between jittered stratified points of the
  *     two patches that no triangle of the scene blocks: 2 x 2 segments first; when they
- *     disagree (a shadow boundary crosses the pair) the full k x k set decides.
+ *     disagree (a shadow boundary crosses the pair) the full k x k set decides. Surfaces
+ *     within a hair of either end, where the tracer does not look, are tested in double
+ *     precision (near_contacts.c).
  * Pairs where either patch is wholly behind the other's plane need no work (G = 0).
  *
  * Random numbers come from (seed, i, j), so the result is the same for any thread count.
