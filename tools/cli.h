@@ -11,6 +11,12 @@
 
 #include "radiosity.h"
 
+/* The library's allocation functions (src/core/alloc.h: zeroed, overflow-checked, NULL on
+ * failure, released with free()), so that the tool's own allocations pass the same
+ * failure hook as the library's. */
+void *rad_alloc_array(size_t count, size_t size);
+void *rad_resize_array(void *array, size_t count, size_t size);
+
 /* EXIT_INTERRUPTED (128 + SIGINT, what a shell reports for a run ended by Ctrl-C): a
  * hierarchical solve was stopped by Ctrl-C, and the outputs were written, complete, with
  * the solution so far. */

@@ -179,7 +179,7 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         out->from_file = true;
         goto done;
     }
-    out->B = calloc(out->mesh->patch_count ? out->mesh->patch_count : 1, sizeof(*out->B));
+    out->B = rad_alloc_array(out->mesh->patch_count, sizeof(*out->B));
     if (!out->B) {
         status = error->status = RAD_ERR_NOMEM;
         snprintf(error->message, sizeof(error->message), "out of memory");

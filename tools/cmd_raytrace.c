@@ -119,7 +119,7 @@ static bool parse_light(const char *text, rad_point_light *light)
 static bool collect_lights(const cli_args *args, raytrace_settings *s)
 {
     int count = cli_value_count(args, OPT_LIGHT), cursor = 0;
-    s->lights = calloc((size_t)(count > 0 ? count : 1), sizeof(*s->lights));
+    s->lights = rad_alloc_array((size_t)(count > 0 ? count : 1), sizeof(*s->lights));
     if (!s->lights) {
         cli_error("out of memory");
         return false;

@@ -450,7 +450,7 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
     if (status != RAD_OK)
         return status;
     mesh_output result = {&plan.in, {0}, NULL, 0, 0};
-    rad_mesh *mesh = calloc(1, sizeof(*mesh));
+    rad_mesh *mesh = rad_alloc_array(1, sizeof(*mesh));
     if (!mesh || !rad_weld_init(&result.weld, 16))
         goto nomem;
 

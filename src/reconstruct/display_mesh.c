@@ -746,7 +746,7 @@ void display_mesh_positions(const rad_mesh *mesh, const display_mesh *display,
 void display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, const rad_rgb *B,
                            rad_rgb *vertex_radiance)
 {
-    double *weight = calloc(mesh->vertex_count ? mesh->vertex_count : 1, sizeof(*weight));
+    double *weight = rad_alloc_array(mesh->vertex_count, sizeof(*weight));
     memset(vertex_radiance, 0,
            (display ? display->vertex_count : mesh->vertex_count) * sizeof(*vertex_radiance));
     if (!weight)

@@ -245,11 +245,11 @@ static int grow_store(link_store *store, size_t needed)
         capacity = needed;
     if ((uint64_t)capacity * 2 * sizeof(hlink) > store->max_bytes)
         capacity = needed;
-    hlink *a = realloc(store->links, capacity * sizeof(hlink));
+    hlink *a = rad_resize_array(store->links, capacity, sizeof(hlink));
     if (!a)
         return 0;
     store->links = a;
-    hlink *b = realloc(store->spare, capacity * sizeof(hlink));
+    hlink *b = rad_resize_array(store->spare, capacity, sizeof(hlink));
     if (!b)
         return 0;
     store->spare = b;
