@@ -385,7 +385,8 @@ typedef struct rad_mesh {
     double patch_size; /* the longest-edge limit the mesh was built with */
 } rad_mesh;
 
-/* A patch size that gives roughly `target_patches` patches for the scene's area. */
+/* A patch size that gives roughly `target_patches` patches for the scene's area; 0 when
+ * out of memory. */
 double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patches);
 
 /* Splits every triangle (pairs of triangles forming a convex quadrilateral are merged
@@ -828,7 +829,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
 #define RAD_DENSE_MAX_PATCHES 4096
 
 /* The patch size for `solver` on this scene (rad_mesh_default_patch_size of the targets
- * above). */
+ * above; 0 when out of memory). */
 double rad_default_patch_size(const rad_scene *scene, rad_solver solver);
 
 typedef struct rad_scene_solve_options {

@@ -158,8 +158,12 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         }
         patch_size = solution->patch_size;
     }
-    if (!(patch_size > 0))
-        patch_size = rad_default_patch_size(out->scene, solve->options.solver);
+    if (!(patch_size > 0) &&
+        !((patch_size = rad_default_patch_size(out->scene, solve->options.solver)) > 0)) {
+        status = error->status = RAD_ERR_NOMEM;
+        snprintf(error->message, sizeof(error->message), "out of memory");
+        goto done;
+    }
     status = rad_mesh_build(out->scene, patch_size, &out->mesh, error);
     if (status != RAD_OK)
         goto done;

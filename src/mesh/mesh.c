@@ -410,7 +410,7 @@ double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patch
     double fallback = sqrt(rad_scene_area(scene) / target_patches);
     mesh_plan plan;
     if (plan_build(scene, &plan, NULL) != RAD_OK)
-        return fallback;
+        return 0; /* out of memory */
     /* the count falls as the size grows: bisect (in log space) for the size whose count is
      * closest to the target */
     rad_vec3 lo_corner, hi_corner;

@@ -238,7 +238,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     status = textures_begin(options, mesh, B, &lookup, &inputs, &built_inputs, &shaded, error);
     if (status != RAD_OK)
         goto done;
-    display_mesh_radiance(mesh, &display, shaded ? shaded : B, radiance);
+    if (!display_mesh_radiance(mesh, &display, shaded ? shaded : B, radiance))
+        goto nomem;
     status = rad_tracer_create(RAD_TRACER_EMBREE, positions, display.vertex_count,
                                (const uint32_t(*)[3])display.triangles, display.triangle_count,
                                &tracer, error);

@@ -1,0 +1,240 @@
+/*
+ * test_alloc_failure.c - every allocation of a run may fail, and each failure is a clean
+ * RAD_ERR_NOMEM.
+ *
+ * For each case (a small dense render of the built-in Cornell box written as PNG, a small
+ * surface view-factor run written as CSV, an OBJ + MTL + PNG texture load, a glTF load,
+ * and a small hierarchical solve), the allocation hook of src/core/alloc.h fails the nth
+ * allocation for n = 1, 2, ... until the run succeeds without reaching it. Every failing
+ * run must return RAD_ERR_NOMEM with a message, and leave nothing allocated (the ASan
+ * build's leak checker sees every sweep) and no output file behind; a run that reaches the
+ * failure and still succeeds has swallowed it, which is a failure of this test too.
+ * Allocations inside Embree, Assimp, libpng, libjpeg, cJSON and OpenEXR are not hooked.
+ */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "testlib.h"
+
+typedef rad_status (*alloc_case_fn)(rad_error *error);
+
+static rad_status fail_nomem(rad_error *error)
+{
+    snprintf(error->message, sizeof(error->message), "out of memory");
+    return error->status = RAD_ERR_NOMEM;
+}
+
+/* A coarse Cornell box mesh and its scene, both owned by the caller on RAD_OK. */
+static rad_status coarse_cornell_box(rad_scene **scene, rad_mesh **mesh, rad_error *error)
+{
+    *mesh = NULL;
+    rad_status status = rad_scene_cornell_box(scene, error);
+    if (status != RAD_OK)
+        return status;
+    double patch_size = rad_mesh_default_patch_size(*scene, 60);
+    if (patch_size > 0)
+        status = rad_mesh_build(*scene, patch_size, mesh, error);
+    else
+        status = fail_nomem(error);
+    if (status != RAD_OK) {
+        rad_scene_destroy(*scene);
+        *scene = NULL;
+    }
+    return status;
+}
+
+/* (a) Cornell box -> dense Jacobi solve -> 16 x 12 render -> PNG. */
+static rad_status render_dense(rad_error *error)
+{
+    rad_scene *scene = NULL;
+    rad_mesh *mesh = NULL;
+    rad_rgb *B = NULL;
+    rad_image *image = NULL;
+    rad_status status = coarse_cornell_box(&scene, &mesh, error);
+    if (status == RAD_OK) {
+        B = calloc(mesh->patch_count, sizeof(*B)); /* the test's own: not counted */
+        if (!B)
+            status = fail_nomem(error);
+    }
+    if (status == RAD_OK) {
+        rad_scene_solve_options options = {.solver = RAD_SOLVER_JACOBI, .threads = 1};
+        status = rad_solve_scene(scene, mesh, &options, B, NULL, error);
+    }
+    if (status == RAD_OK)
+        status = rad_image_create(16, 12, &image, error);
+    if (status == RAD_OK) {
+        rad_camera camera = rad_scene_default_camera(scene);
+        rad_render_options options = {.threads = 1, .scene = scene};
+        status = rad_render(mesh, B, &camera, &options, image, error);
+    }
+    if (status == RAD_OK)
+        status = rad_image_write(image, test_path("render.png"), NULL, error);
+    rad_image_destroy(image);
+    free(B);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+    return status;
+}
+
+/* (d) Cornell box -> hierarchical solve. */
+static rad_status solve_hierarchical(rad_error *error)
+{
+    rad_scene *scene = NULL;
+    rad_mesh *mesh = NULL;
+    rad_rgb *B = NULL;
+    rad_status status = coarse_cornell_box(&scene, &mesh, error);
+    if (status == RAD_OK) {
+        B = calloc(mesh->patch_count, sizeof(*B)); /* the test's own: not counted */
+        if (!B)
+            status = fail_nomem(error);
+    }
+    if (status == RAD_OK) {
+        rad_scene_solve_options options = {.solver = RAD_SOLVER_HIERARCHICAL, .threads = 1};
+        status = rad_solve_scene(scene, mesh, &options, B, NULL, error);
+    }
+    free(B);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+    return status;
+}
+
+/* (b) the Cornell box's surface view factors -> CSV. */
+static rad_status viewfactors(rad_error *error)
+{
+    rad_scene *scene = NULL;
+    rad_viewfactor_matrix *matrix = NULL;
+    rad_status status = rad_scene_cornell_box(&scene, error);
+    if (status == RAD_OK) {
+        rad_viewfactor_options options = {.accuracy = 1e-2, .max_rays = 64, .threads = 1};
+        status = rad_viewfactor_matrix_compute(scene, &options, &matrix, NULL, error);
+    }
+    if (status == RAD_OK)
+        status = rad_viewfactor_matrix_write(scene, matrix, test_path("factors.csv"), NULL,
+                                             error);
+    rad_viewfactor_matrix_destroy(matrix);
+    rad_scene_destroy(scene);
+    return status;
+}
+
+static rad_status load_scene(const char *name, rad_error *error)
+{
+    rad_scene *scene = NULL;
+    rad_status status = rad_scene_load(test_path(name), NULL, &scene, error);
+    rad_scene_destroy(scene);
+    return status;
+}
+
+/* (c) an OBJ whose material library gives an albedo texture and an emitter. */
+static rad_status load_obj(rad_error *error) { return load_scene("textured.obj", error); }
+
+/* (c) a glTF of two triangles (a lit quad) with its buffer in a .bin file. */
+static rad_status load_gltf(rad_error *error) { return load_scene("quad.gltf", error); }
+
+static void write_obj_scene(void)
+{
+    unsigned char texels[4 * 4 * 3];
+    for (size_t k = 0; k < sizeof(texels); k++)
+        texels[k] = (unsigned char)(40 + 13 * k);
+    test_write_png("albedo.png", 4, 4, texels);
+    test_write_file("textured.mtl", "newmtl floor\nKd 0.8 0.8 0.8\nmap_Kd albedo.png\n"
+                                    "newmtl lamp\nKd 0 0 0\nKe 5 5 5\n");
+    test_write_file("textured.obj", "mtllib textured.mtl\n"
+                                    "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\n"
+                                    "v 0.4 0.9 0.4\nv 0.6 0.9 0.4\nv 0.6 0.9 0.6\n"
+                                    "v 0.4 0.9 0.6\n"
+                                    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                    "o floor\nusemtl floor\nf 1/1 4/4 3/3 2/2\n"
+                                    "o lamp\nusemtl lamp\nf 5 6 7 8\n");
+}
+
+static void write_gltf_scene(void)
+{
+    /* 4 positions (48 bytes) then 6 unsigned short indices (12 bytes) */
+    const float positions[12] = {0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 1};
+    const uint16_t indices[6] = {0, 2, 1, 0, 3, 2};
+    FILE *file = fopen(test_path("quad.bin"), "wb");
+    CHECK(file != NULL);
+    if (!file)
+        return;
+    CHECK(fwrite(positions, sizeof(positions), 1, file) == 1);
+    CHECK(fwrite(indices, sizeof(indices), 1, file) == 1);
+    CHECK(fclose(file) == 0);
+    test_write_file(
+        "quad.gltf",
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
+        "\"nodes\":[{\"mesh\":0}],"
+        "\"meshes\":[{\"name\":\"quad\",\"primitives\":[{\"attributes\":{\"POSITION\":0},"
+        "\"indices\":1,\"material\":0}]}],"
+        "\"materials\":[{\"name\":\"glow\",\"emissiveFactor\":[1,0.5,0.25],"
+        "\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1]}}],"
+        "\"buffers\":[{\"uri\":\"quad.bin\",\"byteLength\":60}],"
+        "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+        "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":"
+        "\"VEC3\",\"min\":[0,0,0],\"max\":[1,0,1]},"
+        "{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}");
+}
+
+/* Runs `run` with the nth allocation failing, n = 1, 2, ..., until it succeeds without
+ * reaching the failure; returns the allocations of the successful run. `output` (or NULL)
+ * is the file the case writes: no failing run may leave it, or any temporary, behind. */
+static uint64_t sweep(const char *name, alloc_case_fn run, const char *output)
+{
+    rad_error error;
+    rad_alloc_fail_nth(UINT64_MAX); /* counts, never fails */
+    memset(&error, 0, sizeof(error));
+    rad_status status = run(&error);
+    uint64_t allocations = rad_alloc_count();
+    rad_alloc_fail_nth(0);
+    CHECK(status == RAD_OK);
+    if (status != RAD_OK) {
+        fprintf(stderr, "%s: fails without an injected failure: %s\n", name, error.message);
+        return 0;
+    }
+    int failures_before = test_failures;
+    uint64_t n = 1;
+    for (; n <= allocations + 64; n++) {
+        if (output)
+            remove(test_path(output));
+        memset(&error, 0, sizeof(error));
+        rad_alloc_fail_nth(n);
+        status = run(&error);
+        bool injected = rad_alloc_failure_injected();
+        rad_alloc_fail_nth(0);
+        if (status == RAD_OK && !injected)
+            break; /* past the last allocation */
+        if (status == RAD_OK)
+            test_fail(__FILE__, __LINE__, "%s: allocation %llu failed and the run succeeded",
+                      name, (unsigned long long)n);
+        else if (status != RAD_ERR_NOMEM || !injected || !error.message[0])
+            test_fail(__FILE__, __LINE__, "%s: allocation %llu failed: %s%s (%s)", name,
+                      (unsigned long long)n, rad_status_name(status),
+                      injected ? "" : " without the injected failure", error.message);
+        else if (output && test_count_files(output) != 0)
+            test_fail(__FILE__, __LINE__, "%s: allocation %llu failed and left a file", name,
+                      (unsigned long long)n);
+        test_checks++;
+        if (test_failures - failures_before > 20)
+            break; /* enough to read */
+    }
+    CHECK(n <= allocations + 64);
+    printf("%s: %llu allocations; n = 1 .. %llu each fail with RAD_ERR_NOMEM\n", name,
+           (unsigned long long)allocations, (unsigned long long)(n - 1));
+    return allocations;
+}
+
+int main(void)
+{
+    test_tmpdir();
+    write_obj_scene();
+    write_gltf_scene();
+    CHECK(sweep("scene load (OBJ + MTL + PNG texture)", load_obj, NULL) > 0);
+    CHECK(sweep("scene load (glTF + .bin)", load_gltf, NULL) > 0);
+    CHECK(sweep("view factors (Cornell box, CSV)", viewfactors, "factors.csv") > 0);
+    CHECK(sweep("hierarchical solve (Cornell box)", solve_hierarchical, NULL) > 0);
+    CHECK(sweep("dense render (Cornell box, 16 x 12 PNG)", render_dense, "render.png") > 0);
+    return test_finish("test_alloc_failure");
+}
