@@ -119,6 +119,119 @@ static rad_status viewfactors(rad_error *error)
     return status;
 }
 
+/* (e) the closed Cornell box's view factors, closed as an enclosure, then script-F. */
+static rad_status enclosure_script_f(rad_error *error)
+{
+    rad_scene *scene = NULL;
+    rad_viewfactor_matrix *matrix = NULL, *script_f = NULL;
+    double *emissivity = NULL;
+    rad_status status = rad_scene_cornell_box(&scene, error);
+    if (status == RAD_OK) {
+        rad_viewfactor_options options = {.accuracy = 1e-2, .max_rays = 64, .threads = 1};
+        status = rad_viewfactor_matrix_compute(scene, &options, &matrix, NULL, error);
+    }
+    if (status == RAD_OK)
+        status = rad_viewfactor_matrix_close_enclosure(matrix, scene, NULL, error);
+    if (status == RAD_OK) {
+        emissivity = calloc(matrix->n, sizeof(*emissivity));
+        if (!emissivity)
+            status = fail_nomem(error);
+        for (uint32_t k = 0; emissivity && k < matrix->n; k++)
+            emissivity[k] = 0.9;
+    }
+    if (status == RAD_OK)
+        status = rad_viewfactor_matrix_script_f(matrix, emissivity, &script_f, error);
+    free(emissivity);
+    rad_viewfactor_matrix_destroy(script_f);
+    rad_viewfactor_matrix_destroy(matrix);
+    rad_scene_destroy(scene);
+    return status;
+}
+
+/* (f) Whitted and path-traced 8 x 6 images of the Cornell box written as HDR, PFM and EXR,
+ * read back and compared. */
+static rad_status trace_and_images(rad_error *error)
+{
+    static const char *const names[3] = {"traced.hdr", "traced.pfm", "traced.exr"};
+    rad_scene *scene = NULL;
+    rad_image *whitted = NULL, *traced = NULL, *deviation = NULL, *back = NULL;
+    rad_status status = rad_scene_cornell_box(&scene, error);
+    rad_camera camera = scene ? rad_scene_default_camera(scene) : (rad_camera){0};
+    if (status == RAD_OK)
+        status = rad_image_create(8, 6, &whitted, error);
+    if (status == RAD_OK)
+        status = rad_image_create(8, 6, &traced, error);
+    if (status == RAD_OK)
+        status = rad_image_create(8, 6, &deviation, error);
+    if (status == RAD_OK) {
+        rad_raytrace_options options = {.light_samples = 2, .samples_per_pixel = 1,
+                                        .threads = 1};
+        status = rad_raytrace(scene, &camera, &options, whitted, error);
+    }
+    if (status == RAD_OK) {
+        rad_pathtrace_options options = {.samples_per_pixel = 4, .max_depth = 3, .threads = 1};
+        status = rad_pathtrace(scene, &camera, &options, traced, deviation, NULL, error);
+    }
+    for (int k = 0; k < 3 && status == RAD_OK; k++) {
+        status = rad_image_write(k == 1 ? whitted : traced, test_path(names[k]), NULL, error);
+        if (status == RAD_OK)
+            status = rad_image_read(test_path(names[k]), &back, error);
+        if (status == RAD_OK) {
+            rad_image_difference difference;
+            status = rad_image_compare(back, traced, NULL, &difference, deviation, error);
+        }
+        rad_image_destroy(back);
+        back = NULL;
+    }
+    rad_image_destroy(deviation);
+    rad_image_destroy(traced);
+    rad_image_destroy(whitted);
+    rad_scene_destroy(scene);
+    return status;
+}
+
+/* The coarse Cornell box and a solution for it, made before the sweeps that use them. */
+static rad_scene *solved_scene;
+static rad_mesh *solved_mesh;
+static rad_rgb *solved_B;
+
+/* (g) the lit mesh as .ply, .glb and .obj, and the solution written, read and matched. */
+static rad_status lit_mesh_and_solution(rad_error *error)
+{
+    static const char *const names[3] = {"lit.ply", "lit.glb", "lit.obj"};
+    rad_status status = RAD_OK;
+    for (int k = 0; k < 3 && status == RAD_OK; k++)
+        status = rad_lit_mesh_write(solved_mesh, solved_B, test_path(names[k]), NULL, error);
+    rad_solution *solution = NULL;
+    if (status == RAD_OK)
+        status = rad_solution_write(solved_scene, solved_mesh, solved_B, test_path("saved.rad"),
+                                    error);
+    if (status == RAD_OK)
+        status = rad_solution_read(test_path("saved.rad"), &solution, error);
+    if (status == RAD_OK)
+        status = rad_solution_match(solution, solved_scene, solved_mesh, error);
+    rad_solution_destroy(solution);
+    return status;
+}
+
+/* (h) a View3D file with a mask: loaded, its view factors computed, the mask applied. */
+static rad_status vs3_masks(rad_error *error)
+{
+    const char *path = test_path("masked.vs3");
+    rad_scene *scene = NULL;
+    rad_viewfactor_matrix *matrix = NULL;
+    rad_status status = rad_scene_load_vs3(path, NULL, &scene, NULL, error);
+    if (status == RAD_OK) {
+        rad_viewfactor_options options = {.accuracy = 1e-2, .max_rays = 64, .threads = 1};
+        status = rad_viewfactor_matrix_compute(scene, &options, &matrix, NULL, error);
+    }
+    if (status == RAD_OK)
+        status = rad_viewfactor_matrix_apply_vs3_masks(path, scene, &matrix, error);
+    rad_viewfactor_matrix_destroy(matrix);
+    rad_scene_destroy(scene);
+    return status;
+}
+
 static rad_status load_scene(const char *name, rad_error *error)
 {
     rad_scene *scene = NULL;
@@ -231,10 +344,34 @@ int main(void)
     test_tmpdir();
     write_obj_scene();
     write_gltf_scene();
+    /* a 2 x 2 floor with a 1 x 1 mask on it, under a 2 x 2 ceiling */
+    test_write_file("masked.vs3", "F 3\nV 1 0 0 0\nV 2 2 0 0\nV 3 2 2 0\nV 4 0 2 0\n"
+                                  "V 5 0 0 1\nV 6 2 0 1\nV 7 2 2 1\nV 8 0 2 1\n"
+                                  "V 9 0.5 0.5 0\nV 10 1.5 0.5 0\nV 11 1.5 1.5 0\n"
+                                  "V 12 0.5 1.5 0\nS 1 1 2 3 4 0 0 0.9 floor\n"
+                                  "M 2 12 11 10 9 1 0 0.4 rug\nS 3 5 8 7 6 0 0 0.9 ceiling\n");
     CHECK(sweep("scene load (OBJ + MTL + PNG texture)", load_obj, NULL) > 0);
     CHECK(sweep("scene load (glTF + .bin)", load_gltf, NULL) > 0);
     CHECK(sweep("view factors (Cornell box, CSV)", viewfactors, "factors.csv") > 0);
     CHECK(sweep("hierarchical solve (Cornell box)", solve_hierarchical, NULL) > 0);
     CHECK(sweep("dense render (Cornell box, 16 x 12 PNG)", render_dense, "render.png") > 0);
+    CHECK(sweep("enclosure and script-F (Cornell box)", enclosure_script_f, NULL) > 0);
+    CHECK(sweep("Whitted and path tracing, HDR, PFM and EXR written and read", trace_and_images,
+                NULL) > 0);
+    CHECK(sweep("View3D file with a mask: load, view factors, mask", vs3_masks, NULL) > 0);
+    rad_error error = {0};
+    CHECK(coarse_cornell_box(&solved_scene, &solved_mesh, &error) == RAD_OK);
+    solved_B = solved_mesh ? calloc(solved_mesh->patch_count, sizeof(*solved_B)) : NULL;
+    CHECK(solved_B != NULL);
+    if (solved_B) {
+        rad_scene_solve_options options = {.solver = RAD_SOLVER_JACOBI, .threads = 1};
+        CHECK(rad_solve_scene(solved_scene, solved_mesh, &options, solved_B, NULL, &error) ==
+              RAD_OK);
+        CHECK(sweep("lit mesh (PLY, GLB, OBJ) and solution file", lit_mesh_and_solution,
+                    NULL) > 0);
+    }
+    free(solved_B);
+    rad_mesh_destroy(solved_mesh);
+    rad_scene_destroy(solved_scene);
     return test_finish("test_alloc_failure");
 }
