@@ -753,11 +753,16 @@ bool stats_write(cli_stats *stats, const char *path)
     return true;
 }
 
-/* The folder of path must exist and be writable, and path must not be a folder: checked
- * before hours of work. */
+/* The folder of path must exist, be a folder and be writable, and path must not be a
+ * folder: checked before hours of work. (Root writes into a read-only folder: access()
+ * says so.) */
 bool cli_output_writable(const char *path)
 {
     struct stat st;
+    if (!*path) {
+        cli_error("an output path is empty");
+        return false;
+    }
     if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
         cli_error("%s: cannot write: it is a folder", path);
         return false;
@@ -770,9 +775,17 @@ bool cli_output_writable(const char *path)
         snprintf(folder, sizeof(folder), "/");
     else
         snprintf(folder, sizeof(folder), "%.*s", (int)(slash - path), path);
-    if (access(folder, W_OK) != 0) {
-        cli_error("%s: cannot write: folder '%s' does not exist or is not writable", path,
-                  folder);
+    if (stat(folder, &st) != 0) {
+        cli_error("%s: cannot write: folder '%s' does not exist", path, folder);
+        return false;
+    }
+    if (!S_ISDIR(st.st_mode)) {
+        cli_error("%s: cannot write: '%s' is not a folder", path, folder);
+        return false;
+    }
+    if (access(folder, W_OK | X_OK) != 0) {
+        cli_error("%s: cannot write: folder '%s' is not writable (%s)", path, folder,
+                  strerror(errno));
         return false;
     }
     return true;
