@@ -842,7 +842,13 @@ typedef struct rad_scene_solve_options {
     uint32_t quadrature;       /* dense form factors: m x m split per patch; 0 = 1 */
     uint32_t visibility_rays;  /* most visibility segments per patch pair or link; 0 = 16 */
     double refine_threshold;   /* hierarchical: 0 = 0.25 */
-    uint64_t max_memory;       /* hierarchical: link store bytes; 0 = half the memory */
+    uint64_t max_memory;       /* bytes the solver's large buffers may use; 0 = no budget
+                                  (hierarchical: links up to half the memory). Dense: the
+                                  matrix (4 n^2 bytes, direct 12 n^2) must fit, else
+                                  RAD_ERR_NOMEM before any work (AUTO then chooses
+                                  hierarchical). Hierarchical: the trees (a bound, about
+                                  700 n bytes) must fit, else RAD_ERR_NOMEM; the links
+                                  get the rest (rad_hierarchy_options.max_memory) */
     uint64_t seed;
     int threads;               /* 0 = all cores */
     const volatile int *stop;  /* hierarchical: stops at the next sweep (report.interrupted) */

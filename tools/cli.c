@@ -359,6 +359,40 @@ rad_camera cli_view_camera(const cli_view *view, const rad_scene *scene)
     return camera;
 }
 
+uint64_t cli_image_bytes(const cli_view *view, const char *path, int images)
+{
+    uint64_t pixels = (uint64_t)view->width * view->height;
+    const char *dot = path ? strrchr(path, '.') : NULL;
+    bool png_auto = dot && strcasecmp(dot, ".png") == 0 && !view->write.fixed_exposure;
+    return pixels * (uint64_t)images * 3 * sizeof(float) + (png_auto ? pixels * sizeof(double) : 0);
+}
+
+/* A byte count for a message, in the units --max-memory takes (powers of 1024). */
+static void format_bytes(uint64_t bytes, char *text, size_t size)
+{
+    if (bytes < 1024)
+        snprintf(text, size, "%llu bytes", (unsigned long long)bytes);
+    else if (bytes < 1024u * 1024 * 1024)
+        snprintf(text, size, "%.1f MB", bytes / 1048576.0);
+    else
+        snprintf(text, size, "%.2f GB", bytes / 1073741824.0);
+}
+
+bool cli_memory_take(uint64_t *budget, uint64_t need, const char *what)
+{
+    if (*budget == 0)
+        return true;
+    if (need >= *budget) {
+        char needed[32], given[32];
+        format_bytes(need, needed, sizeof(needed));
+        format_bytes(*budget, given, sizeof(given));
+        cli_error("--max-memory: %s needs %s, more than the budget of %s", what, needed, given);
+        return false;
+    }
+    *budget -= need;
+    return true;
+}
+
 bool cli_image_output_ok(const char *path)
 {
     const char *dot = strrchr(path, '.');

@@ -134,9 +134,13 @@ enum {
     "  --refine-threshold X hierarchical: split a link while B x F x A exceeds X times\n"   \
     "                       the emitted power per patch (default "                     \
     CLI_STR(RAD_DEFAULT_REFINE_THRESHOLD) "; smaller = finer)\n"  \
-    "  --max-memory SIZE    hierarchical: bytes the links may use (K, M, G suffixes;\n"     \
-    "                       default half the machine's memory); refinement stops there\n"   \
-    "                       and the run says so\n"                                          \
+    "  --max-memory SIZE    bytes the run's large buffers may use (K, M, G suffixes): the\n" \
+    "                       image (render), then the dense matrix (4 n^2 bytes, direct\n"  \
+    "                       12 n^2) or the hierarchical trees and links; what cannot fit\n" \
+    "                       is refused before the work starts, the automatic choice\n"    \
+    "                       takes the hierarchical solver when the matrix does not fit,\n" \
+    "                       and refinement stops at the budget and says so (default:\n"   \
+    "                       links up to half the machine's memory)\n"                     \
     "  --tolerance X        relative residual, or unshot fraction for shoot, or change of\n" \
     "                       a sweep for hierarchical (default "                            \
     CLI_STR(RAD_DEFAULT_TOLERANCE) ")\n"                                                   \
@@ -234,6 +238,16 @@ bool cli_parse_view(const cli_args *args, cli_view *view);
 
 /* The scene's camera (or a framing default) with the command line's overrides. */
 rad_camera cli_view_camera(const cli_view *view, const rad_scene *scene);
+
+/* The bytes `images` images of the view's size hold (12 a pixel each), and, written to
+ * `path` as a PNG with automatic exposure, the luminance it sorts (8 a pixel): what
+ * --max-memory must hold for them from the start. */
+uint64_t cli_image_bytes(const cli_view *view, const char *path, int images);
+
+/* --max-memory: with a budget (*budget > 0), `need` bytes for `what` ("the 512 x 512
+ * image") come out of it; false, with the line "--max-memory: WHAT needs X, more than the
+ * budget of Y", when they do not fit. True at once without a budget. */
+bool cli_memory_take(uint64_t *budget, uint64_t need, const char *what);
 
 /* True for .png, .hdr and .pfm; prints the usage error otherwise. */
 bool cli_image_output_ok(const char *path);

@@ -96,6 +96,12 @@ int command_render(int argc, char **argv)
         return exit_code;
     if (!cli_solve_outputs_writable(&s.shared, &s.solve))
         return EXIT_ERROR;
+    char image_name[64];
+    snprintf(image_name, sizeof(image_name), "the %u x %u image", s.view.width, s.view.height);
+    if (!s.solve.solution_path &&
+        !cli_memory_take(&s.solve.options.max_memory, cli_image_bytes(&s.view, s.output, 1),
+                         image_name))
+        return EXIT_ERROR;
 
     rad_error error = {0};
     rad_status status;
