@@ -134,13 +134,9 @@ enum {
     "  --refine-threshold X hierarchical: split a link while B x F x A exceeds X times\n"   \
     "                       the emitted power per patch (default "                     \
     CLI_STR(RAD_DEFAULT_REFINE_THRESHOLD) "; smaller = finer)\n"  \
-    "  --max-memory SIZE    bytes the run's large buffers may use (K, M, G suffixes): the\n" \
-    "                       image (render), then the dense matrix (4 n^2 bytes, direct\n"  \
-    "                       12 n^2) or the hierarchical trees and links; what cannot fit\n" \
-    "                       is refused before the work starts, the automatic choice\n"    \
-    "                       takes the hierarchical solver when the matrix does not fit,\n" \
-    "                       and refinement stops at the budget and says so (default:\n"   \
-    "                       links up to half the machine's memory)\n"                     \
+    "  --max-memory SIZE    bytes for the image, the dense matrix (4 n^2) or the trees and\n" \
+    "                       links (K, M, G); refused up front when it cannot fit, else\n"  \
+    "                       refinement stops there, saying so (default: half the memory)\n" \
     "  --tolerance X        relative residual, or unshot fraction for shoot, or change of\n" \
     "                       a sweep for hierarchical (default "                            \
     CLI_STR(RAD_DEFAULT_TOLERANCE) ")\n"                                                   \
