@@ -13,6 +13,8 @@
  *     hierarchical and says why;
  *   - direct asked for, budget = image + 8 n^2: refused, 12 n^2;
  *   - the image alone over the budget: 1000 x 1000 PNG 20,000,000 bytes, PFM 12,000,000;
+ *   - the tracers: a 1000 x 1000 PNG over 15 MB, a path-traced PFM with its standard
+ *     error (24,000,000 bytes) over 20 MB; the PFM alone (12,000,000) runs in 12 MB;
  *   - hierarchical with 1 MB: its trees do not fit, refused.
  */
 #include <stdio.h>
@@ -116,6 +118,18 @@ int main(void)
     expect_refused("render -o out.png --exposure 0 --size 1000x1000 --max-memory 10M",
                    "radiosity: --max-memory: the 1000 x 1000 image needs 11.4 MB, more than the "
                    "budget of 10.0 MB\n");
+
+    /* the tracers: their images (the path tracer's standard error is one more) */
+    expect_refused("raytrace -o out.png --size 1000x1000 --max-memory 15M",
+                   "radiosity: --max-memory: the 1000 x 1000 image needs 19.1 MB, more than the "
+                   "budget of 15.0 MB\n");
+    expect_refused("pathtrace -o out.pfm --standard-error out-error.pfm --size 1000x1000 "
+                   "--max-memory 20M",
+                   "radiosity: --max-memory: the 1000 x 1000 image with its standard error "
+                   "needs 22.9 MB, more than the budget of 20.0 MB\n");
+    CHECK(run("pathtrace -o out.pfm --size 1000x1000 --spp 1 --max-depth 1 --max-memory 12M") ==
+          0);
+    remove(test_path("out.pfm"));
 
     /* hierarchical: the trees come first */
     snprintf(arguments, sizeof(arguments), "%s --solver hierarchical --max-memory 1M", common);

@@ -359,6 +359,31 @@ rad_camera cli_view_camera(const cli_view *view, const rad_scene *scene)
     return camera;
 }
 
+bool cli_parse_bytes(const char *name, const char *text, uint64_t *out)
+{
+    char *end = NULL;
+    double value = strtod(text, &end);
+    double scale = 1;
+    if (end && *end) {
+        if ((end[0] == 'K' || end[0] == 'k') && !end[1])
+            scale = 1024.0;
+        else if ((end[0] == 'M' || end[0] == 'm') && !end[1])
+            scale = 1024.0 * 1024;
+        else if ((end[0] == 'G' || end[0] == 'g') && !end[1])
+            scale = 1024.0 * 1024 * 1024;
+        else
+            end = NULL;
+    }
+    if (!end || end == text || !(value >= 1) || !(value * scale < 1.8e19)) {
+        cli_error("--%s: '%s' is not a size in bytes (a number, optionally followed by K, M "
+                  "or G)",
+                  name, text);
+        return false;
+    }
+    *out = (uint64_t)(value * scale);
+    return true;
+}
+
 uint64_t cli_image_bytes(const cli_view *view, const char *path, int images)
 {
     uint64_t pixels = (uint64_t)view->width * view->height;

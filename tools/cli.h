@@ -235,6 +235,10 @@ bool cli_parse_view(const cli_args *args, cli_view *view);
 /* The scene's camera (or a framing default) with the command line's overrides. */
 rad_camera cli_view_camera(const cli_view *view, const rad_scene *scene);
 
+/* Parses a byte count with an optional K, M or G suffix (powers of 1024), at least 1;
+ * prints "--NAME: 'TEXT' is not a size in bytes ..." otherwise. */
+bool cli_parse_bytes(const char *name, const char *text, uint64_t *out);
+
 /* The bytes `images` images of the view's size hold (12 a pixel each), and, written to
  * `path` as a PNG with automatic exposure, the luminance it sorts (8 a pixel): what
  * --max-memory must hold for them from the start. */
