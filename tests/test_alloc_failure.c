@@ -4,7 +4,10 @@
  *
  * For each case (a small dense render of the built-in Cornell box written as PNG, a small
  * surface view-factor run written as CSV, an OBJ + MTL + PNG texture load, a glTF load,
- * and a small hierarchical solve), the allocation hook of src/core/alloc.h fails the nth
+ * a small hierarchical solve; then enclosure and script-F, the tracers with HDR, PFM and
+ * EXR round trips, a textured render, the other dense solvers, two-thread runs, several
+ * files as one scene, a View3D mask, the lit mesh and the solution file), the allocation
+ * hook of src/core/alloc.h fails the nth
  * allocation for n = 1, 2, ... until the run succeeds without reaching it. Every failing
  * run must return RAD_ERR_NOMEM with a message, and leave nothing allocated (the ASan
  * build's leak checker sees every sweep) and no output file behind; a run that reaches the
@@ -75,6 +78,116 @@ static rad_status render_dense(rad_error *error)
     rad_image_destroy(image);
     free(B);
     rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+    return status;
+}
+
+/* A mesh of `scene` at about `patches` patches, solved by `solver` with `threads`, rendered
+ * 12 x 10 with the scene's textures (and mirrors when `specular`). */
+static rad_status solve_and_render(rad_scene *scene, uint32_t patches, rad_solver solver,
+                                   int threads, bool specular, rad_error *error)
+{
+    rad_mesh *mesh = NULL;
+    rad_rgb *B = NULL;
+    rad_image *image = NULL;
+    rad_patch_inputs *inputs = NULL;
+    rad_status status = RAD_OK;
+    double patch_size = rad_mesh_default_patch_size(scene, patches);
+    if (patch_size > 0)
+        status = rad_mesh_build(scene, patch_size, &mesh, error);
+    else
+        status = fail_nomem(error);
+    if (status == RAD_OK)
+        status = rad_patch_inputs_build(scene, mesh, &inputs, error);
+    if (status == RAD_OK) {
+        B = calloc(mesh->patch_count, sizeof(*B));
+        if (!B)
+            status = fail_nomem(error);
+    }
+    if (status == RAD_OK) {
+        rad_scene_solve_options options = {.solver = solver, .threads = threads,
+                                           .inputs = inputs};
+        status = rad_solve_scene(scene, mesh, &options, B, NULL, error);
+    }
+    if (status == RAD_OK)
+        status = rad_image_create(12, 10, &image, error);
+    if (status == RAD_OK) {
+        rad_camera camera = rad_scene_default_camera(scene);
+        rad_render_options options = {.threads = threads, .scene = scene, .inputs = inputs,
+                                      .materials = specular ? scene->materials : NULL};
+        status = rad_render(mesh, B, &camera, &options, image, error);
+    }
+    rad_image_destroy(image);
+    free(B);
+    rad_patch_inputs_destroy(inputs);
+    rad_mesh_destroy(mesh);
+    return status;
+}
+
+/* The textured OBJ: Gauss-Seidel, rendered with its texture; and path traced. */
+static rad_status textured_render(rad_error *error)
+{
+    rad_scene *scene = NULL;
+    rad_image *image = NULL;
+    rad_status status = rad_scene_load(test_path("textured.obj"), NULL, &scene, error);
+    if (status == RAD_OK)
+        status = solve_and_render(scene, 40, RAD_SOLVER_GAUSS_SEIDEL, 1, false, error);
+    if (status == RAD_OK)
+        status = rad_image_create(8, 6, &image, error);
+    if (status == RAD_OK) {
+        rad_camera camera = rad_scene_default_camera(scene);
+        rad_pathtrace_options options = {.samples_per_pixel = 2, .max_depth = 2, .threads = 1};
+        status = rad_pathtrace(scene, &camera, &options, image, NULL, NULL, error);
+    }
+    rad_image_destroy(image);
+    rad_scene_destroy(scene);
+    return status;
+}
+
+/* The Cornell box with a surface made a mirror-ish emitter (rad_scene_set_material), shot
+ * and rendered with mirrors, then solved directly: two threads. */
+static rad_status other_solvers(rad_error *error)
+{
+    rad_scene *scene = NULL;
+    rad_status status = rad_scene_cornell_box(&scene, error);
+    if (status == RAD_OK) {
+        rad_rgb albedo = {0.2, 0.3, 0.4};
+        status = rad_scene_set_material(scene, scene->surfaces[0].name, &albedo, NULL, error);
+    }
+    if (status == RAD_OK)
+        status = solve_and_render(scene, 50, RAD_SOLVER_SHOOT, 2, true, error);
+    if (status == RAD_OK)
+        status = solve_and_render(scene, 40, RAD_SOLVER_DIRECT, 2, false, error);
+    rad_scene_destroy(scene);
+    return status;
+}
+
+/* The Cornell box solved hierarchically with two threads and rendered. */
+static rad_status hierarchical_two_threads(rad_error *error)
+{
+    rad_scene *scene = NULL;
+    rad_status status = rad_scene_cornell_box(&scene, error);
+    if (status == RAD_OK)
+        status = solve_and_render(scene, 60, RAD_SOLVER_HIERARCHICAL, 2, false, error);
+    rad_scene_destroy(scene);
+    return status;
+}
+
+/* Several files (an STL, a PLY and the OBJ, one kept by its surfaces) as one scene, and
+ * their view factors. */
+static rad_status several_files(rad_error *error)
+{
+    rad_scene_file files[3] = {{test_path("slab.stl"), 0, false},
+                               {test_path("roof.ply"), 0, false},
+                               {test_path("textured.obj"), 0, true}};
+    rad_scene *scene = NULL;
+    rad_viewfactor_matrix *matrix = NULL;
+    rad_status status = rad_scene_load_files(files, 3, NULL, &scene, error);
+    if (status == RAD_OK) {
+        rad_viewfactor_options options = {.accuracy = 1e-2, .max_rays = 64, .threads = 2};
+        status = rad_viewfactor_matrix_compute(scene, &options, &matrix, NULL, error);
+    }
+    rad_viewfactor_matrix_destroy(matrix);
     rad_scene_destroy(scene);
     return status;
 }
@@ -334,8 +447,9 @@ static uint64_t sweep(const char *name, alloc_case_fn run, const char *output)
             break; /* enough to read */
     }
     CHECK(n <= allocations + 64);
-    printf("%s: %llu allocations; n = 1 .. %llu each fail with RAD_ERR_NOMEM\n", name,
-           (unsigned long long)allocations, (unsigned long long)(n - 1));
+    printf("%s: %llu allocations; n = 1 .. %llu swept, %d wrong\n", name,
+           (unsigned long long)allocations, (unsigned long long)(n - 1),
+           test_failures - failures_before);
     return allocations;
 }
 
@@ -344,6 +458,13 @@ int main(void)
     test_tmpdir();
     write_obj_scene();
     write_gltf_scene();
+    test_write_file("slab.stl", "solid slab\nfacet normal 0 1 0\nouter loop\n"
+                                 "vertex 0 -0.5 0\nvertex 0 -0.5 1\nvertex 1 -0.5 0\n"
+                                 "endloop\nendfacet\nendsolid slab\n");
+    test_write_file("roof.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                "property float y\nproperty float z\nelement face 1\n"
+                                "property list uchar int vertex_indices\nend_header\n"
+                                "0 2 0\n1 2 0\n0 2 1\n3 0 1 2\n");
     /* a 2 x 2 floor with a 1 x 1 mask on it, under a 2 x 2 ceiling */
     test_write_file("masked.vs3", "F 3\nV 1 0 0 0\nV 2 2 0 0\nV 3 2 2 0\nV 4 0 2 0\n"
                                   "V 5 0 0 1\nV 6 2 0 1\nV 7 2 2 1\nV 8 0 2 1\n"
@@ -358,6 +479,14 @@ int main(void)
     CHECK(sweep("enclosure and script-F (Cornell box)", enclosure_script_f, NULL) > 0);
     CHECK(sweep("Whitted and path tracing, HDR, PFM and EXR written and read", trace_and_images,
                 NULL) > 0);
+    CHECK(sweep("textured OBJ: Gauss-Seidel, textured render, path tracing", textured_render,
+                NULL) > 0);
+    CHECK(sweep("Cornell box: set_material, shooting with mirrors, direct, 2 threads",
+                other_solvers, NULL) > 0);
+    CHECK(sweep("Cornell box: hierarchical and render, 2 threads", hierarchical_two_threads,
+                NULL) > 0);
+    CHECK(sweep("STL + PLY + OBJ as one scene, view factors, 2 threads", several_files, NULL) >
+          0);
     CHECK(sweep("View3D file with a mask: load, view factors, mask", vs3_masks, NULL) > 0);
     rad_error error = {0};
     CHECK(coarse_cornell_box(&solved_scene, &solved_mesh, &error) == RAD_OK);

@@ -355,12 +355,12 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
                     tb.more_occluded && tb.more_kernel && tb.weight && tb.more_weight;
         refine_context local = *c;
         local.visibility_rays = extra_rays;
+        failed |= !have; /* whether or not this thread gets a chunk: the same answer for any
+                            schedule */
 #pragma omp for schedule(dynamic, 1)
         for (size_t k = 0; k < chunks; k++) {
-            if (!have) {
-                failed |= 1;
+            if (!have)
                 continue;
-            }
             size_t end = (k + 1) * CHUNK_LINKS < n ? (k + 1) * CHUNK_LINKS : n;
             chunk_live[k] = refine_chunk(&local, links, action, k * CHUNK_LINKS, end,
                                          out + chunk_start[k], &tb, &rays);
