@@ -51,9 +51,21 @@ static int render_and_signal(int signal_number, const char *output)
     posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, test_path("stderr.txt"),
                                      O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    /* the default dispositions, whatever this test inherited (a shell's background job
+     * ignores SIGINT) */
+    posix_spawnattr_t attributes;
+    posix_spawnattr_init(&attributes);
+    sigset_t defaults;
+    sigemptyset(&defaults);
+    sigaddset(&defaults, SIGTERM);
+    sigaddset(&defaults, SIGINT);
+    sigaddset(&defaults, SIGHUP);
+    posix_spawnattr_setsigdefault(&attributes, &defaults);
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGDEF);
     pid_t pid;
-    int spawned = posix_spawn(&pid, RAD_TOOL, &actions, NULL, argv, environ);
+    int spawned = posix_spawn(&pid, RAD_TOOL, &actions, &attributes, argv, environ);
     posix_spawn_file_actions_destroy(&actions);
+    posix_spawnattr_destroy(&attributes);
     CHECK(spawned == 0);
     if (spawned != 0) {
         close(watch);
