@@ -406,7 +406,8 @@ typedef struct rad_mesh {
     double patch_size; /* the longest-edge limit the mesh was built with */
 } rad_mesh;
 
-/* A patch size that gives roughly `target_patches` patches for the scene's area. */
+/* A patch size that gives roughly `target_patches` patches for the scene's area; 0 when
+ * out of memory. */
 double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patches);
 
 /* Splits every triangle (pairs of triangles forming a convex quadrilateral are merged
@@ -872,7 +873,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
 #define RAD_DENSE_MAX_PATCHES 4096
 
 /* The patch size for `solver` on this scene (rad_mesh_default_patch_size of the targets
- * above). */
+ * above; 0 when out of memory). */
 double rad_default_patch_size(const rad_scene *scene, rad_solver solver);
 
 typedef struct rad_scene_solve_options {
@@ -885,7 +886,13 @@ typedef struct rad_scene_solve_options {
     uint32_t quadrature;       /* dense form factors: m x m split per patch; 0 = 1 */
     uint32_t visibility_rays;  /* most visibility segments per patch pair or link; 0 = 16 */
     double refine_threshold;   /* hierarchical: 0 = 0.25 */
-    uint64_t max_memory;       /* hierarchical: link store bytes; 0 = half the memory */
+    uint64_t max_memory;       /* bytes the solver's large buffers may use; 0 = no budget
+                                  (hierarchical: links up to half the memory). Dense: the
+                                  matrix (4 n^2 bytes, direct 12 n^2) must fit, else
+                                  RAD_ERR_NOMEM before any work (AUTO then chooses
+                                  hierarchical). Hierarchical: the trees (a bound, about
+                                  700 n bytes) must fit, else RAD_ERR_NOMEM; the links
+                                  get the rest (rad_hierarchy_options.max_memory) */
     uint64_t seed;
     int threads;               /* 0 = all cores */
     const volatile int *stop;  /* hierarchical: stops at the next sweep (report.interrupted) */

@@ -359,6 +359,65 @@ rad_camera cli_view_camera(const cli_view *view, const rad_scene *scene)
     return camera;
 }
 
+bool cli_parse_bytes(const char *name, const char *text, uint64_t *out)
+{
+    char *end = NULL;
+    double value = strtod(text, &end);
+    double scale = 1;
+    if (end && *end) {
+        if ((end[0] == 'K' || end[0] == 'k') && !end[1])
+            scale = 1024.0;
+        else if ((end[0] == 'M' || end[0] == 'm') && !end[1])
+            scale = 1024.0 * 1024;
+        else if ((end[0] == 'G' || end[0] == 'g') && !end[1])
+            scale = 1024.0 * 1024 * 1024;
+        else
+            end = NULL;
+    }
+    if (!end || end == text || !(value >= 1) || !(value * scale < 1.8e19)) {
+        cli_error("--%s: '%s' is not a size in bytes (a number, optionally followed by K, M "
+                  "or G)",
+                  name, text);
+        return false;
+    }
+    *out = (uint64_t)(value * scale);
+    return true;
+}
+
+uint64_t cli_image_bytes(const cli_view *view, const char *path, int images)
+{
+    uint64_t pixels = (uint64_t)view->width * view->height;
+    const char *dot = path ? strrchr(path, '.') : NULL;
+    bool png_auto = dot && strcasecmp(dot, ".png") == 0 && !view->write.fixed_exposure;
+    return pixels * (uint64_t)images * 3 * sizeof(float) + (png_auto ? pixels * sizeof(double) : 0);
+}
+
+/* A byte count for a message, in the units --max-memory takes (powers of 1024). */
+static void format_bytes(uint64_t bytes, char *text, size_t size)
+{
+    if (bytes < 1024)
+        snprintf(text, size, "%llu bytes", (unsigned long long)bytes);
+    else if (bytes < 1024u * 1024 * 1024)
+        snprintf(text, size, "%.1f MB", bytes / 1048576.0);
+    else
+        snprintf(text, size, "%.2f GB", bytes / 1073741824.0);
+}
+
+bool cli_memory_take(uint64_t *budget, uint64_t need, const char *what)
+{
+    if (*budget == 0)
+        return true;
+    if (need >= *budget) {
+        char needed[32], given[32];
+        format_bytes(need, needed, sizeof(needed));
+        format_bytes(*budget, given, sizeof(given));
+        cli_error("--max-memory: %s needs %s, more than the budget of %s", what, needed, given);
+        return false;
+    }
+    *budget -= need;
+    return true;
+}
+
 bool cli_image_output_ok(const char *path)
 {
     const char *dot = strrchr(path, '.');
@@ -753,11 +812,16 @@ bool stats_write(cli_stats *stats, const char *path)
     return true;
 }
 
-/* The folder of path must exist and be writable, and path must not be a folder: checked
- * before hours of work. */
+/* The folder of path must exist, be a folder and be writable, and path must not be a
+ * folder: checked before hours of work. (Root writes into a read-only folder: access()
+ * says so.) */
 bool cli_output_writable(const char *path)
 {
     struct stat st;
+    if (!*path) {
+        cli_error("an output path is empty");
+        return false;
+    }
     if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
         cli_error("%s: cannot write: it is a folder", path);
         return false;
@@ -770,9 +834,17 @@ bool cli_output_writable(const char *path)
         snprintf(folder, sizeof(folder), "/");
     else
         snprintf(folder, sizeof(folder), "%.*s", (int)(slash - path), path);
-    if (access(folder, W_OK) != 0) {
-        cli_error("%s: cannot write: folder '%s' does not exist or is not writable", path,
-                  folder);
+    if (stat(folder, &st) != 0) {
+        cli_error("%s: cannot write: folder '%s' does not exist", path, folder);
+        return false;
+    }
+    if (!S_ISDIR(st.st_mode)) {
+        cli_error("%s: cannot write: '%s' is not a folder", path, folder);
+        return false;
+    }
+    if (access(folder, W_OK | X_OK) != 0) {
+        cli_error("%s: cannot write: folder '%s' is not writable (%s)", path, folder,
+                  strerror(errno));
         return false;
     }
     return true;

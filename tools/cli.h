@@ -11,6 +11,12 @@
 
 #include "radiosity.h"
 
+/* The library's allocation functions (src/core/alloc.h: zeroed, overflow-checked, NULL on
+ * failure, released with free()), so that the tool's own allocations pass the same
+ * failure hook as the library's. */
+void *rad_alloc_array(size_t count, size_t size);
+void *rad_resize_array(void *array, size_t count, size_t size);
+
 /* EXIT_INTERRUPTED (128 + SIGINT, what a shell reports for a run ended by Ctrl-C): a
  * hierarchical solve was stopped by Ctrl-C, and the outputs were written, complete, with
  * the solution so far. */
@@ -128,9 +134,9 @@ enum {
     "  --refine-threshold X hierarchical: split a link while B x F x A exceeds X times\n"   \
     "                       the emitted power per patch (default "                     \
     CLI_STR(RAD_DEFAULT_REFINE_THRESHOLD) "; smaller = finer)\n"  \
-    "  --max-memory SIZE    hierarchical: bytes the links may use (K, M, G suffixes;\n"     \
-    "                       default half the machine's memory); refinement stops there\n"   \
-    "                       and the run says so\n"                                          \
+    "  --max-memory SIZE    bytes for the image, the dense matrix (4 n^2) or the trees\n"  \
+    "                       and links (K, M, G): refused up front if it cannot fit, or\n" \
+    "                       links stop there, saying so (default: half of RAM)\n"          \
     "  --tolerance X        relative residual, or unshot fraction for shoot, or change of\n" \
     "                       a sweep for hierarchical (default "                            \
     CLI_STR(RAD_DEFAULT_TOLERANCE) ")\n"                                                   \
@@ -246,6 +252,20 @@ bool cli_parse_view(const cli_args *args, cli_view *view);
 
 /* The scene's camera (or a framing default) with the command line's overrides. */
 rad_camera cli_view_camera(const cli_view *view, const rad_scene *scene);
+
+/* Parses a byte count with an optional K, M or G suffix (powers of 1024), at least 1;
+ * prints "--NAME: 'TEXT' is not a size in bytes ..." otherwise. */
+bool cli_parse_bytes(const char *name, const char *text, uint64_t *out);
+
+/* The bytes `images` images of the view's size hold (12 a pixel each), and, written to
+ * `path` as a PNG with automatic exposure, the luminance it sorts (8 a pixel): what
+ * --max-memory must hold for them from the start. */
+uint64_t cli_image_bytes(const cli_view *view, const char *path, int images);
+
+/* --max-memory: with a budget (*budget > 0), `need` bytes for `what` ("the 512 x 512
+ * image") come out of it; false, with the line "--max-memory: WHAT needs X, more than the
+ * budget of Y", when they do not fit. True at once without a budget. */
+bool cli_memory_take(uint64_t *budget, uint64_t need, const char *what);
 
 /* True for .png, .hdr and .pfm; prints the usage error otherwise. */
 bool cli_image_output_ok(const char *path);

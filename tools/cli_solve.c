@@ -11,32 +11,6 @@
 
 #include "cli.h"
 
-/* Parses a byte count with an optional K, M or G suffix (powers of 1024). */
-static bool parse_bytes(const char *name, const char *text, uint64_t *out)
-{
-    char *end = NULL;
-    double value = strtod(text, &end);
-    double scale = 1;
-    if (end && *end) {
-        if ((end[0] == 'K' || end[0] == 'k') && !end[1])
-            scale = 1024.0;
-        else if ((end[0] == 'M' || end[0] == 'm') && !end[1])
-            scale = 1024.0 * 1024;
-        else if ((end[0] == 'G' || end[0] == 'g') && !end[1])
-            scale = 1024.0 * 1024 * 1024;
-        else
-            end = NULL;
-    }
-    if (!end || end == text || !(value >= 1) || !(value * scale < 1.8e19)) {
-        cli_error("--%s: '%s' is not a size in bytes (a number, optionally followed by K, M "
-                  "or G)",
-                  name, text);
-        return false;
-    }
-    *out = (uint64_t)(value * scale);
-    return true;
-}
-
 void cli_parse_two_sided(const cli_args *args, int option, cli_two_sided *out)
 {
     int cursor = 0;
@@ -87,7 +61,7 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
                             &o->refine_threshold))
         return false;
     if (args->value[OPT_MAX_MEMORY] &&
-        !parse_bytes("max-memory", args->value[OPT_MAX_MEMORY], &o->max_memory))
+        !cli_parse_bytes("max-memory", args->value[OPT_MAX_MEMORY], &o->max_memory))
         return false;
     o->quadrature = shared->formfactor.quadrature;
     o->visibility_rays = shared->formfactor.visibility_rays;
@@ -186,8 +160,12 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         }
         patch_size = solution->patch_size;
     }
-    if (!(patch_size > 0))
-        patch_size = rad_default_patch_size(out->scene, solve->options.solver);
+    if (!(patch_size > 0) &&
+        !((patch_size = rad_default_patch_size(out->scene, solve->options.solver)) > 0)) {
+        status = error->status = RAD_ERR_NOMEM;
+        snprintf(error->message, sizeof(error->message), "out of memory");
+        goto done;
+    }
     status = rad_mesh_build(out->scene, patch_size, &out->mesh, error);
     if (status != RAD_OK)
         goto done;
@@ -207,7 +185,7 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         out->from_file = true;
         goto done;
     }
-    out->B = calloc(out->mesh->patch_count ? out->mesh->patch_count : 1, sizeof(*out->B));
+    out->B = rad_alloc_array(out->mesh->patch_count, sizeof(*out->B));
     if (!out->B) {
         status = error->status = RAD_ERR_NOMEM;
         snprintf(error->message, sizeof(error->message), "out of memory");

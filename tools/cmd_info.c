@@ -50,7 +50,7 @@ static void say(report *r, const char *format, ...)
         return;
     if (r->length + (size_t)n + 1 > r->capacity) {
         size_t capacity = (r->length + (size_t)n + 1) * 2;
-        char *grown = realloc(r->text, capacity);
+        char *grown = rad_resize_array(r->text, capacity, 1);
         if (!grown) {
             r->failed = true;
             return;
@@ -126,10 +126,10 @@ static void describe(report *r, const rad_scene *scene)
 
     /* per material: triangles and area using it */
     uint32_t nm = scene->material_count;
-    double *material_area = calloc(nm ? nm : 1, sizeof(double));
-    double *radiating_area = calloc(nm ? nm : 1, sizeof(double)); /* two-sided: twice */
-    uint32_t *material_triangles = calloc(nm ? nm : 1, sizeof(uint32_t));
-    uint32_t *listed_for = calloc(nm ? nm : 1, sizeof(uint32_t)); /* surface + 1 */
+    double *material_area = rad_alloc_array(nm ? nm : 1, sizeof(double));
+    double *radiating_area = rad_alloc_array(nm ? nm : 1, sizeof(double)); /* two-sided: twice */
+    uint32_t *material_triangles = rad_alloc_array(nm ? nm : 1, sizeof(uint32_t));
+    uint32_t *listed_for = rad_alloc_array(nm ? nm : 1, sizeof(uint32_t)); /* surface + 1 */
     if (!material_area || !radiating_area || !material_triangles || !listed_for) {
         r->failed = true;
         free(material_area);

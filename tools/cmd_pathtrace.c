@@ -33,6 +33,7 @@ static const char usage[] =
     "  --standard-error FILE  also write each pixel's standard error of the mean, per\n"
     "                       channel (.hdr, .pfm or .exr)\n"
     CLI_TWO_SIDED_HELP
+    "  --max-memory SIZE    refuse at once images needing more bytes (K, M, G)\n"
     CLI_SCENE_HELP
     CLI_BASE_HELP("rays, times, mean radiance and peak memory");
 
@@ -42,6 +43,7 @@ static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS,
     CLI_VIEW_OPTIONS,
     CLI_SCENE_OPTIONS,
+    [OPT_MAX_MEMORY] = {"max-memory", 0, true},
     [OPT_MAX_DEPTH] = {"max-depth", 0, true},
     [OPT_STANDARD_ERROR] = {"standard-error", 0, true},
     [OPT_TWO_SIDED] = {"two-sided", 0, true},
@@ -53,6 +55,7 @@ typedef struct pathtrace_settings {
     cli_view view;
     rad_pathtrace_options trace;
     cli_two_sided two_sided;
+    uint64_t max_memory; /* --max-memory, 0 = none */
 } pathtrace_settings;
 
 static bool parse_settings(int argc, char **argv, pathtrace_settings *s, int *exit_code)
@@ -81,6 +84,9 @@ static bool parse_settings(int argc, char **argv, pathtrace_settings *s, int *ex
     }
     if (!cli_parse_count("max-depth", args.value[OPT_MAX_DEPTH], 0, 1u << 20,
                          &s->trace.max_depth))
+        return false;
+    if (args.value[OPT_MAX_MEMORY] &&
+        !cli_parse_bytes("max-memory", args.value[OPT_MAX_MEMORY], &s->max_memory))
         return false;
     s->trace.samples_per_pixel = s->view.samples_per_pixel; /* 0 = the library's default */
     CLI_SET_RUN_OPTIONS(s->trace, s->shared);
@@ -117,6 +123,13 @@ int command_pathtrace(int argc, char **argv)
         return exit_code;
     const char *output = s.shared.output;
     if (!cli_outputs_writable((const char *[]){output, s.shared.stats_path, s.error_path}, 3))
+        return EXIT_ERROR;
+    /* the image, and the standard error's when it is written or reported */
+    int images = s.error_path || s.shared.stats_path ? 2 : 1;
+    char image_name[80];
+    snprintf(image_name, sizeof(image_name), "the %u x %u image%s", s.view.width,
+             s.view.height, images == 2 ? " with its standard error" : "");
+    if (!cli_memory_take(&s.max_memory, cli_image_bytes(&s.view, output, images), image_name))
         return EXIT_ERROR;
 
     rad_error error = {0};

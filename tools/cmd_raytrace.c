@@ -32,6 +32,7 @@ static const char usage[] =
     "                       per shading point (default " CLI_STR(RAD_DEFAULT_LIGHT_SAMPLES) ")\n"
     "  --max-depth N        most mirror reflections followed (default "
     CLI_STR(RAD_DEFAULT_MAX_DEPTH) ")\n"
+    "  --max-memory SIZE    refuse at once an image needing more bytes (K, M, G)\n"
     CLI_CAMERA_HELP
     "  --spp N              samples per pixel, rounded to a square, stratified, box filter\n"
     "                       (default " CLI_STR(RAD_DEFAULT_RAYTRACE_SPP) "; 1 = through the pixel centre)\n"
@@ -48,6 +49,7 @@ static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS,
     CLI_VIEW_OPTIONS,
     CLI_SCENE_OPTIONS,
+    [OPT_MAX_MEMORY] = {"max-memory", 0, true},
     [OPT_LIGHT] = {"light", 0, true},
     [OPT_AMBIENT] = {"ambient", 0, true},
     [OPT_LIGHT_SAMPLES] = {"light-samples", 0, true},
@@ -66,6 +68,7 @@ typedef struct raytrace_settings {
     rad_point_light *lights; /* owned */
     cli_two_sided two_sided;
     rad_raytrace_options trace;
+    uint64_t max_memory; /* --max-memory, 0 = none */
 } raytrace_settings;
 
 /* Parses `count` comma-separated finite numbers from text up to `end` (exclusive). */
@@ -124,7 +127,7 @@ static bool parse_light(const char *text, rad_point_light *light)
 static bool collect_lights(const cli_args *args, raytrace_settings *s)
 {
     int count = cli_value_count(args, OPT_LIGHT), cursor = 0;
-    s->lights = calloc((size_t)(count > 0 ? count : 1), sizeof(*s->lights));
+    s->lights = rad_alloc_array((size_t)(count > 0 ? count : 1), sizeof(*s->lights));
     if (!s->lights) {
         cli_error("out of memory");
         return false;
@@ -154,6 +157,9 @@ static bool parse_settings(int argc, char **argv, raytrace_settings *s, int *exi
         !cli_parse_count("max-depth", args.value[OPT_MAX_DEPTH], 1, MAX_DEPTH,
                          &s->trace.max_depth))
         return false;
+    if (args.value[OPT_MAX_MEMORY] &&
+        !cli_parse_bytes("max-memory", args.value[OPT_MAX_MEMORY], &s->max_memory))
+        return false;
     s->trace.samples_per_pixel = s->view.samples_per_pixel; /* 0 = the library's default */
     CLI_SET_RUN_OPTIONS(s->trace, s->shared);
     *exit_code = EXIT_OK;
@@ -168,7 +174,11 @@ int command_raytrace(int argc, char **argv)
         free(s.lights);
         return exit_code;
     }
-    if (!cli_outputs_writable((const char *[]){s.shared.output, s.shared.stats_path}, 2)) {
+    char image_name[64];
+    snprintf(image_name, sizeof(image_name), "the %u x %u image", s.view.width, s.view.height);
+    if (!cli_outputs_writable((const char *[]){s.shared.output, s.shared.stats_path}, 2) ||
+        !cli_memory_take(&s.max_memory, cli_image_bytes(&s.view, s.shared.output, 1),
+                         image_name)) {
         free(s.lights);
         return EXIT_ERROR;
     }

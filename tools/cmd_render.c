@@ -24,8 +24,7 @@ static const char usage[] =
     "                       most 256; pixels on an edge get 64 more)\n"
     "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"
     "  --exr-float          .exr: 32-bit float channels instead of half\n"
-    "  --specular           the two-pass method: surfaces with Ks > 0 (MTL) also show\n"
-    "                       mirror reflections of the radiosity-lit scene\n"
+    "  --specular           the two-pass method: Ks > 0 surfaces mirror the lit scene\n"
     "  --max-depth N        mirror reflections followed with --specular (default 5)\n"
     CLI_TWO_SIDED_HELP
     CLI_SOLVE_HELP;
@@ -98,6 +97,12 @@ int command_render(int argc, char **argv)
     if (!parse_settings(argc, argv, &s, &exit_code))
         return exit_code;
     if (!cli_solve_outputs_writable(&s.shared, &s.solve))
+        return EXIT_ERROR;
+    char image_name[64];
+    snprintf(image_name, sizeof(image_name), "the %u x %u image", s.view.width, s.view.height);
+    if (!s.solve.solution_path &&
+        !cli_memory_take(&s.solve.options.max_memory, cli_image_bytes(&s.view, s.output, 1),
+                         image_name))
         return EXIT_ERROR;
 
     rad_error error = {0};

@@ -213,7 +213,7 @@ int command_viewfactors(int argc, char **argv)
                 enclosure.row_deviation_after, enclosure.reciprocity_after);
     }
     if (write.script_f) {
-        emissivity = calloc(S ? S : 1, sizeof(*emissivity));
+        emissivity = rad_alloc_array(S ? S : 1, sizeof(*emissivity));
         if (!emissivity) {
             snprintf(error.message, sizeof(error.message), "%s: out of memory for %zu surfaces",
                      scene->source, S);

@@ -105,7 +105,10 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
         goto done;
     }
     display_mesh_positions(mesh, &shown, position);
-    display_mesh_radiance(mesh, &shown, B, radiance);
+    if (!display_mesh_radiance(mesh, &shown, B, radiance)) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for %u vertices", path, n);
+        goto done;
+    }
     vertex_normals(mesh, normal);
     for (uint32_t k = 0; k < shown.extra_count; k++) { /* along their edge, as the values */
         const display_extra *x = &shown.extras[k];

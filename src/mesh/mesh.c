@@ -451,7 +451,7 @@ double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patch
     double fallback = sqrt(rad_scene_area(scene) / target_patches);
     mesh_plan plan;
     if (plan_build(scene, &plan, NULL) != RAD_OK)
-        return fallback;
+        return 0; /* out of memory */
     /* the count falls as the size grows: bisect (in log space) for the size whose count is
      * closest to the target */
     rad_vec3 lo_corner, hi_corner;
@@ -491,7 +491,7 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
     if (status != RAD_OK)
         return status;
     mesh_output result = {&plan.in, {0}, NULL, 0, 0};
-    rad_mesh *mesh = calloc(1, sizeof(*mesh));
+    rad_mesh *mesh = rad_alloc_array(1, sizeof(*mesh));
     if (!mesh || !rad_weld_init(&result.weld, 16))
         goto nomem;
 

@@ -91,7 +91,7 @@ rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occlu
                         "%zu patches need a %.1f GB form-factor matrix and this machine has "
                         "%.1f GB: use a larger --patch-size",
                         n, bytes / 1e9, (double)physical / 1e9);
-    rad_formfactors *result = calloc(1, sizeof(*result));
+    rad_formfactors *result = rad_alloc_array(1, sizeof(*result));
     float *F = rad_alloc_array(n * n, sizeof(*F));
     if (!result || !F) {
         free(result);

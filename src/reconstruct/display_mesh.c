@@ -743,14 +743,14 @@ void display_mesh_positions(const rad_mesh *mesh, const display_mesh *display,
         positions[mesh->vertex_count + k] = mesh->vertices[display->extras[k].at];
 }
 
-void display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, const rad_rgb *B,
+bool display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, const rad_rgb *B,
                            rad_rgb *vertex_radiance)
 {
-    double *weight = calloc(mesh->vertex_count ? mesh->vertex_count : 1, sizeof(*weight));
+    double *weight = rad_alloc_array(mesh->vertex_count, sizeof(*weight));
     memset(vertex_radiance, 0,
            (display ? display->vertex_count : mesh->vertex_count) * sizeof(*vertex_radiance));
     if (!weight)
-        return; /* callers check nothing here: black is the graceful failure */
+        return false;
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
         const rad_patch *patch = &mesh->patches[p];
         for (uint32_t k = 0; k < patch->vertex_count; k++) {
@@ -769,7 +769,7 @@ void display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, co
     }
     free(weight);
     if (!display)
-        return;
+        return true;
     for (uint32_t i = 0; i < display->tvertex_count; i++) {
         const display_tvertex *tv = &display->tvertices[i];
         vertex_radiance[tv->vertex] =
@@ -780,6 +780,7 @@ void display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, co
         vertex_radiance[mesh->vertex_count + k] =
             rgb_lerp(vertex_radiance[x->from], vertex_radiance[x->to], x->t);
     }
+    return true;
 }
 
 void display_mesh_free(display_mesh *display)

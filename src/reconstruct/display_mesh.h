@@ -56,8 +56,8 @@ rad_status display_mesh_build(const rad_mesh *mesh, bool triangles, display_mesh
 /* The displayed radiance at every vertex (display->vertex_count of them): the
  * area-weighted mean of B / pi over the patches sharing it, then the T-vertex
  * constraints, then the added vertices. `display` may be NULL (the mesh's vertices, means
- * only). */
-void display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, const rad_rgb *B,
+ * only). False when out of memory (the values are then all 0). */
+bool display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, const rad_rgb *B,
                            rad_rgb *vertex_radiance);
 
 /* The positions of all display->vertex_count vertices. */

@@ -13,8 +13,9 @@ void rad_reconstruct_vertices(const rad_mesh *mesh, const rad_rgb *B, rad_rgb *v
 {
     display_mesh display;
     bool found = display_mesh_build(mesh, false, &display, NULL) == RAD_OK;
-    /* out of memory for the T-vertices: the area-weighted means alone */
-    display_mesh_radiance(mesh, found ? &display : NULL, B, vertex_radiance);
+    /* out of memory for the T-vertices: the area-weighted means alone; out of memory for
+     * those too: black */
+    (void)display_mesh_radiance(mesh, found ? &display : NULL, B, vertex_radiance);
     if (found)
         display_mesh_free(&display);
 }

@@ -293,7 +293,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     status = textures_begin(options, mesh, B, &lookup, &inputs, &built_inputs, &shaded, error);
     if (status != RAD_OK)
         goto done;
-    display_mesh_radiance(mesh, &display, shaded ? shaded : B, radiance);
+    if (!display_mesh_radiance(mesh, &display, shaded ? shaded : B, radiance))
+        goto nomem;
     /* the tracer sees the front patches: the twins come after them (rad_mesh), and so do
      * their display triangles, which are in patch order */
     uint32_t traced = display.triangle_count;

@@ -44,7 +44,7 @@ static rad_status read_whole(const char *path, unsigned char **data, size_t *siz
         return rad_fail(error, RAD_ERR_IO, "%s: cannot read", path);
     }
     *size = (size_t)st.st_size;
-    *data = malloc(*size + 1);
+    *data = rad_alloc_array(*size + 1, 1);
     if (!*data) {
         fclose(file);
         return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", path);

@@ -202,7 +202,7 @@ static const gltf_material *gltf_material_of(const import_state *state, unsigned
  * same sRGB decoding for every role). */
 static uint32_t take_texture(import_state *state, const struct aiMaterial *m,
                              enum aiTextureType type, const rad_material *material,
-                             const char *role)
+                             const char *role, rad_error *error)
 {
     struct aiString texture;
     unsigned uv_set = 0;
@@ -255,6 +255,10 @@ static uint32_t take_texture(import_state *state, const struct aiMaterial *m,
         }
         status = texture_load_file(key, &decoded, &why);
     }
+    if (status == RAD_ERR_NOMEM) {
+        *error = why;
+        return 0;
+    }
     if (status != RAD_OK) {
         rad_warn(log, user, "%s: material '%s': texture '%s': %s; its %s is the material's "
                  "colour",
@@ -264,7 +268,11 @@ static uint32_t take_texture(import_state *state, const struct aiMaterial *m,
     uint32_t index = scene_builder_texture(state->builder, &decoded);
     if (!state->cache)
         state->cache = rad_alloc_array(TEXTURE_CACHE, sizeof(*state->cache));
-    if (index && state->cache && state->cache_count < TEXTURE_CACHE) {
+    if (!index || !state->cache) {
+        rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", state->path);
+        return 0;
+    }
+    if (state->cache_count < TEXTURE_CACHE) {
         snprintf(state->cache[state->cache_count].key, sizeof(state->cache[0].key), "%s", key);
         state->cache[state->cache_count++].index = index;
     }
@@ -276,11 +284,20 @@ static uint32_t take_texture(import_state *state, const struct aiMaterial *m,
  * verified with Assimp 5.2 for both formats). An emission texture multiplies the emission
  * factor, so with a zero factor (MTL Ke missing, glTF emissiveFactor missing) it shows
  * nothing: a warning says so. */
-static void take_textures(import_state *state, const struct aiMaterial *m, rad_material *material)
+static rad_status take_textures(import_state *state, const struct aiMaterial *m,
+                                rad_material *material, rad_error *error)
 {
-    material->albedo_texture = take_texture(state, m, aiTextureType_DIFFUSE, material, "albedo");
-    material->emission_texture =
-        take_texture(state, m, aiTextureType_EMISSIVE, material, "emission");
+    rad_error lack = {0}; /* RAD_ERR_NOMEM, else every problem is a warning */
+    material->albedo_texture =
+        take_texture(state, m, aiTextureType_DIFFUSE, material, "albedo", &lack);
+    if (lack.status == RAD_OK)
+        material->emission_texture =
+            take_texture(state, m, aiTextureType_EMISSIVE, material, "emission", &lack);
+    if (lack.status != RAD_OK) {
+        if (error)
+            *error = lack;
+        return lack.status;
+    }
     const rad_rgb *e = &material->emission;
     if (material->emission_texture && !(e->r > 0 || e->g > 0 || e->b > 0))
         rad_warn(state->options ? state->options->log : NULL,
@@ -288,6 +305,7 @@ static void take_textures(import_state *state, const struct aiMaterial *m, rad_m
                  "%s: material '%s': an emission texture but an emission factor of 0 (MTL Ke, "
                  "glTF emissiveFactor): it emits nothing",
                  state->path, material->name);
+    return RAD_OK;
 }
 
 static rad_status map_material(import_state *state, unsigned index, uint32_t *out,
@@ -366,8 +384,11 @@ static rad_status map_material(import_state *state, unsigned index, uint32_t *ou
                          "tracer (raytrace) and render --specular show its specular part",
                          state->path, material.name);
         }
-        if (!is_default)
-            take_textures(state, m, &material);
+        if (!is_default) {
+            rad_status status = take_textures(state, m, &material, error);
+            if (status != RAD_OK)
+                return status;
+        }
         state->textured[index] = material.albedo_texture != 0 || material.emission_texture != 0;
         state->material_map[index] = scene_builder_material(state->builder, &material);
         if (state->material_map[index] == UINT32_MAX)

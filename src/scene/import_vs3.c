@@ -689,7 +689,7 @@ static rad_status add_polygon(vs3_reader *r, scene_builder *builder, size_t inde
 {
     const vs3_polygon *p = &r->polygon[index];
     size_t capacity = 1, count = 1;
-    vs3_piece *pieces = malloc(sizeof(*pieces));
+    vs3_piece *pieces = rad_alloc_array(1, sizeof(*pieces));
     rad_status status = RAD_OK;
     if (!pieces)
         return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", r->path);

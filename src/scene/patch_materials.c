@@ -40,7 +40,7 @@ rad_status patch_material_lookup_create(const rad_scene *scene, patch_material_l
         count += material_textured(scene, scene->triangles[t].material);
     if (count == 0)
         return RAD_OK;
-    patch_material_lookup *l = calloc(1, sizeof(*l));
+    patch_material_lookup *l = rad_alloc_array(1, sizeof(*l));
     uint32_t(*triangles)[3] = rad_alloc_array(count, sizeof(*triangles));
     if (!l || !triangles || !(l->triangle_of = rad_alloc_array(count, sizeof(uint32_t)))) {
         free(triangles);

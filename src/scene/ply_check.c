@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/alloc.h"
 #include "core/error.h"
 
 enum { PLY_MAX_ELEMENTS = 16, PLY_MAX_PROPERTIES = 64 };
@@ -199,7 +200,7 @@ static rad_status check_body(const char *path, FILE *file, ply_format format,
 
 rad_status ply_check(const char *path, FILE *file, rad_error *error)
 {
-    ply_element *element_list = calloc(PLY_MAX_ELEMENTS, sizeof(*element_list));
+    ply_element *element_list = rad_alloc_array(PLY_MAX_ELEMENTS, sizeof(*element_list));
     if (!element_list)
         return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", path);
     char line_text[1024];

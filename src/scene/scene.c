@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/alloc.h"
 #include "core/error.h"
 #include "core/vec3.h"
 #include "radiosity.h"
@@ -119,8 +120,8 @@ static uint32_t copy_material(rad_scene *scene, uint32_t m)
 {
     if (scene->material_count >= UINT32_MAX - 1)
         return UINT32_MAX;
-    rad_material *grown = realloc(scene->materials,
-                                  (scene->material_count + 1) * sizeof(*scene->materials));
+    rad_material *grown = rad_resize_array(scene->materials, scene->material_count + 1,
+                                           sizeof(*scene->materials));
     if (!grown)
         return UINT32_MAX;
     scene->materials = grown;
@@ -263,7 +264,7 @@ rad_status rad_scene_set_material(rad_scene *scene, const char *name, const rad_
         /* each material of this surface: changed in place when no other surface uses it,
          * else replaced by a changed copy for this surface's triangles */
         uint32_t count = scene->material_count;
-        uint8_t *use = calloc(count ? count : 1, 1); /* bit 1: used here, bit 2: elsewhere */
+        uint8_t *use = rad_alloc_array(count, 1); /* bit 1: used here, bit 2: elsewhere */
         if (!use)
             return rad_fail(error, RAD_ERR_NOMEM, "out of memory");
         for (uint32_t t = 0; t < scene->triangle_count; t++)

@@ -49,7 +49,7 @@ struct scene_builder {
 rad_status scene_builder_create(const char *source, const rad_load_options *options,
                                 scene_builder **out, rad_error *error)
 {
-    scene_builder *b = calloc(1, sizeof(*b));
+    scene_builder *b = rad_alloc_array(1, sizeof(*b));
     if (!b)
         return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", source);
     snprintf(b->source, sizeof(b->source), "%s", source);
@@ -319,7 +319,7 @@ rad_status scene_builder_finish(scene_builder *b, rad_scene **out, rad_error *er
         check_material(b, &b->materials[m]);
 
     skipped = rad_alloc_array(b->surface_count, sizeof(*skipped));
-    scene = calloc(1, sizeof(*scene));
+    scene = rad_alloc_array(1, sizeof(*scene));
     if (!skipped || !scene || !rad_weld_init(&weld, (uint32_t)(b->triangle_count < UINT32_MAX / 4 ? b->triangle_count : UINT32_MAX / 4)))
         goto nomem;
 

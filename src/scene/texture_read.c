@@ -62,7 +62,7 @@ static rad_status decode_png(const char *name, const unsigned char *data, size_t
         return rad_fail(error, RAD_ERR_PARSE, "%s: PNG of %ux%u pixels", name, image.width,
                         image.height);
     }
-    unsigned char *pixels = malloc(PNG_IMAGE_SIZE(image));
+    unsigned char *pixels = rad_alloc_array(PNG_IMAGE_SIZE(image), 1);
     if (!pixels) {
         png_image_free(&image);
         return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", name);
@@ -123,7 +123,7 @@ static rad_status decode_jpeg(const char *name, const unsigned char *data, size_
         jpeg_destroy_decompress(&info);
         return rad_fail(error, RAD_ERR_PARSE, "%s: JPEG of %ux%u pixels", name, width, height);
     }
-    pixels = malloc((size_t)width * height * 3);
+    pixels = rad_alloc_array((size_t)width * height, 3);
     if (!pixels) {
         jpeg_destroy_decompress(&info);
         return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", name);
@@ -164,7 +164,7 @@ rad_status texture_load_file(const char *path, rad_texture *out, rad_error *erro
         return rad_fail(error, RAD_ERR_IO, "%s: cannot read: not a file or empty", path);
     }
     size_t size = (size_t)st.st_size;
-    unsigned char *data = malloc(size);
+    unsigned char *data = rad_alloc_array(size, 1);
     if (!data) {
         fclose(file);
         return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", path);

@@ -28,7 +28,7 @@ rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
 {
     *out = NULL;
     uint32_t n = mesh->patch_count;
-    rad_patch_inputs *in = calloc(1, sizeof(*in));
+    rad_patch_inputs *in = rad_alloc_array(1, sizeof(*in));
     if (in) {
         in->n = n;
         in->area = rad_alloc_array(n, sizeof(*in->area));

@@ -17,12 +17,20 @@
 
 #include "core/error.h"
 #include "core/memory.h"
+#include "solve/hierarchical/hierarchy.h"
 
 /* The automatic choice keeps the dense matrix to this share of the machine's memory (the
  * form-factor computation itself refuses above 3/4). */
 #define AUTO_DENSE_MEMORY_SHARE 0.5
 
 static double seconds_now(void) { return omp_get_wtime(); }
+
+/* The dense solvers' matrices: F in floats, and the direct solver's LU copy in doubles. */
+static double dense_matrix_bytes(uint32_t patches, rad_solver solver)
+{
+    double entries = (double)patches * patches;
+    return entries * (sizeof(float) + (solver == RAD_SOLVER_DIRECT ? sizeof(double) : 0));
+}
 
 double rad_default_patch_size(const rad_scene *scene, rad_solver solver)
 {
@@ -51,6 +59,11 @@ rad_solver rad_solve_scene_choice(const rad_mesh *mesh, const rad_scene_solve_op
     if (patches > RAD_DENSE_MAX_PATCHES) {
         snprintf(reason, size, "%u patches > %d: no dense matrix", patches,
                  RAD_DENSE_MAX_PATCHES);
+        return RAD_SOLVER_HIERARCHICAL;
+    }
+    if (o->max_memory && matrix_bytes > (double)o->max_memory) {
+        snprintf(reason, size, "the %.1f MB matrix would not fit --max-memory (%.1f MB)",
+                 matrix_bytes / 1048576.0, (double)o->max_memory / 1048576.0);
         return RAD_SOLVER_HIERARCHICAL;
     }
     if (physical && matrix_bytes > AUTO_DENSE_MEMORY_SHARE * (double)physical) {
@@ -137,8 +150,22 @@ static rad_status solve_hierarchy(const rad_scene *scene, const rad_mesh *mesh, 
                                   const rad_scene_solve_options *o, rad_rgb *B,
                                   rad_scene_solve_report *r, rad_error *error)
 {
+    uint64_t link_budget = o->max_memory;
+    if (o->max_memory) {
+        /* the budget holds the trees first: at most 2 n - 1 elements over the planes and
+         * n - 1 clusters above them, with their values, and the per-patch arrays */
+        uint64_t n = mesh->patch_count;
+        uint64_t trees = 3 * n * (sizeof(hnode) + 3 * sizeof(rad_rgb) + sizeof(size_t)) +
+                         n * (sizeof(rad_rgb) + sizeof(float) + sizeof(uint32_t) + sizeof(double));
+        if (trees >= o->max_memory)
+            return rad_fail(error, RAD_ERR_NOMEM,
+                            "--max-memory: the element and cluster trees of %u patches need up "
+                            "to %.1f MB, more than the budget of %.1f MB",
+                            mesh->patch_count, trees / 1048576.0, o->max_memory / 1048576.0);
+        link_budget = o->max_memory - trees;
+    }
     rad_hierarchy_options h = {o->refine_threshold, o->visibility_rays, o->tolerance,
-                               o->max_iterations,   o->max_memory,      o->seed,
+                               o->max_iterations,   link_budget,        o->seed,
                                o->threads,          o->stop,            o->progress,
                                o->progress_user};
     double t0 = seconds_now();
@@ -190,6 +217,16 @@ rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
     r.patches = mesh->patch_count;
     r.solver_chosen = o.solver == RAD_SOLVER_AUTO;
     r.solver = rad_solve_scene_choice(mesh, &o, r.reason, sizeof(r.reason));
+    double dense_bytes = dense_matrix_bytes(mesh->patch_count, r.solver);
+    if (o.max_memory && r.solver != RAD_SOLVER_HIERARCHICAL &&
+        dense_bytes > (double)o.max_memory)
+        return rad_fail(error, RAD_ERR_NOMEM,
+                        "--max-memory: the %s solver's matrix for %u patches needs %.1f MB (%s), "
+                        "more than the budget of %.1f MB: use a larger --patch-size, the "
+                        "hierarchical solver or a larger budget",
+                        rad_solver_name(r.solver), mesh->patch_count, dense_bytes / 1048576.0,
+                        r.solver == RAD_SOLVER_DIRECT ? "12 n^2 bytes" : "4 n^2 bytes",
+                        (double)o.max_memory / 1048576.0);
     if (!rad_scene_has_emitter(scene))
         rad_warn(o.log, o.log_user,
                  "%s: no surface emits light (no material with non-zero Ke): the result "

@@ -11,7 +11,7 @@ rad_status rad_viewfactor_matrix_create(uint32_t n, uint64_t nonzeros,
                                         rad_viewfactor_matrix **out, rad_error *error)
 {
     *out = NULL;
-    rad_viewfactor_matrix *m = calloc(1, sizeof(*m));
+    rad_viewfactor_matrix *m = rad_alloc_array(1, sizeof(*m));
     if (!m || nonzeros > SIZE_MAX)
         goto nomem;
     m->n = n;

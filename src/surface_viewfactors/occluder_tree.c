@@ -109,7 +109,7 @@ rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_
                                occluder_tree **out, rad_error *error)
 {
     *out = NULL;
-    occluder_tree *tree = calloc(1, sizeof(*tree));
+    occluder_tree *tree = rad_alloc_array(1, sizeof(*tree));
     uint32_t count = scene->triangle_count;
     rad_vec3 *centres = rad_alloc_array(count ? count : 1, sizeof(rad_vec3));
     if (tree) {

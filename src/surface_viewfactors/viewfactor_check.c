@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "core/alloc.h"
 #include "core/vec3.h"
 
 typedef struct edge_key {
@@ -27,7 +28,7 @@ static bool scene_is_closed(const rad_scene *scene)
             count += 3 * (size_t)scene->surfaces[s].triangle_count;
     if (count == 0)
         return false;
-    edge_key *edges = malloc(count * sizeof(*edges));
+    edge_key *edges = rad_alloc_array(count, sizeof(*edges));
     if (!edges)
         return false;
     size_t n = 0;

@@ -167,7 +167,7 @@ static bool row_push(pending_row *r, uint32_t column, double transfer, double bo
 {
     if (r->count == r->capacity) {
         uint32_t capacity = r->capacity ? 2 * r->capacity : 8;
-        row_entry *grown = realloc(r->entries, capacity * sizeof(*grown));
+        row_entry *grown = rad_resize_array(r->entries, capacity, sizeof(*grown));
         if (!grown)
             return false;
         r->entries = grown;
@@ -217,7 +217,7 @@ static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_work
 
 static rad_viewfactor_matrix *assemble(const vf_geometry *g, pending_row *rows, uint32_t n)
 {
-    rad_viewfactor_matrix *m = calloc(1, sizeof(*m));
+    rad_viewfactor_matrix *m = rad_alloc_array(1, sizeof(*m));
     if (!m)
         return NULL;
     m->n = n;
@@ -304,7 +304,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
     uint32_t n = scene->surface_count;
     if (status == RAD_OK) {
-        rows = calloc(n ? n : 1, sizeof(pending_row));
+        rows = rad_alloc_array(n ? n : 1, sizeof(pending_row));
         if (!rows)
             status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u rows", n);
     }

@@ -17,6 +17,7 @@
 #include <omp.h>
 #include <stdlib.h>
 
+#include "core/alloc.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
 #include "solve/hierarchical/final_gather.h"
@@ -45,7 +46,7 @@ static bool reserve(gather_buffers *b, size_t pending, size_t rays)
 {
     if (pending > b->pending_capacity) {
         size_t capacity = pending + pending / 2;
-        shadowed *p = realloc(b->pending, capacity * sizeof(*p));
+        shadowed *p = rad_resize_array(b->pending, capacity, sizeof(*p));
         if (!p)
             return false;
         b->pending = p;
@@ -53,23 +54,23 @@ static bool reserve(gather_buffers *b, size_t pending, size_t rays)
     }
     if (rays > b->ray_capacity) {
         size_t capacity = rays + rays / 2;
-        rad_ray *r = realloc(b->rays, capacity * sizeof(*r));
+        rad_ray *r = rad_resize_array(b->rays, capacity, sizeof(*r));
         if (!r)
             return false;
         b->rays = r;
-        uint8_t *o = realloc(b->occluded, capacity);
+        uint8_t *o = rad_resize_array(b->occluded, capacity, 1);
         if (!o)
             return false;
         b->occluded = o;
-        uint8_t *blocked = realloc(b->blocked, capacity);
+        uint8_t *blocked = rad_resize_array(b->blocked, capacity, 1);
         if (!blocked)
             return false;
         b->blocked = blocked;
-        double *k = realloc(b->kernel, capacity * sizeof(*k));
+        double *k = rad_resize_array(b->kernel, capacity, sizeof(*k));
         if (!k)
             return false;
         b->kernel = k;
-        float *w = realloc(b->weight, capacity * sizeof(*w));
+        float *w = rad_resize_array(b->weight, capacity, sizeof(*w));
         if (!w)
             return false;
         b->weight = w;

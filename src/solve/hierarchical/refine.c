@@ -247,11 +247,11 @@ static int grow_store(link_store *store, size_t needed)
         capacity = needed;
     if ((uint64_t)capacity * 2 * sizeof(hlink) > store->max_bytes)
         capacity = needed;
-    hlink *a = realloc(store->links, capacity * sizeof(hlink));
+    hlink *a = rad_resize_array(store->links, capacity, sizeof(hlink));
     if (!a)
         return 0;
     store->links = a;
-    hlink *b = realloc(store->spare, capacity * sizeof(hlink));
+    hlink *b = rad_resize_array(store->spare, capacity, sizeof(hlink));
     if (!b)
         return 0;
     store->spare = b;
@@ -360,12 +360,12 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
                     tb.weight && tb.more_weight;
         refine_context local = *c;
         local.visibility_rays = extra_rays;
+        failed |= !have; /* whether or not this thread gets a chunk: the same answer for any
+                            schedule */
 #pragma omp for schedule(dynamic, 1)
         for (size_t k = 0; k < chunks; k++) {
-            if (!have) {
-                failed |= 1;
+            if (!have)
                 continue;
-            }
             size_t end = (k + 1) * CHUNK_LINKS < n ? (k + 1) * CHUNK_LINKS : n;
             chunk_live[k] = refine_chunk(&local, links, action, k * CHUNK_LINKS, end,
                                          out + chunk_start[k], &tb, &rays);

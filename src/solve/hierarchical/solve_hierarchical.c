@@ -265,8 +265,8 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             return rad_fail(error, RAD_ERR_NOMEM, "--max-memory: %llu bytes cannot hold a link",
                             (unsigned long long)budget);
         }
-        s.store.links = malloc(sizeof(hlink));
-        s.store.spare = malloc(sizeof(hlink));
+        s.store.links = rad_alloc_array(1, sizeof(hlink));
+        s.store.spare = rad_alloc_array(1, sizeof(hlink));
         if (!s.store.links || !s.store.spare) {
             hsolver_free(&s);
             return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the links");
