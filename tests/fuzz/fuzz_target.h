@@ -18,15 +18,16 @@
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 /* Writes data to `name` (replacing it) in this process's temporary folder, made on first
- * use under $TMPDIR or /tmp and removed at exit with the files in it (at most 8 names).
- * Returns the file's path, valid until the next call. Aborts on an I/O error: that is the
- * machine, not the parser. */
+ * use under $TMPDIR (else /dev/shm, else /tmp) and removed at exit with the files in it
+ * (at most 8 names). Returns the file's path, valid until the next call. Aborts on an I/O
+ * error: that is the machine, not the parser. */
 const char *fuzz_write_file(const char *name, const uint8_t *data, size_t size);
 
 /* Load options whose warnings go nowhere (a fuzzer's log is for its own lines). */
 const rad_load_options *fuzz_quiet_options(void);
 
-/* Aborts unless status is RAD_OK, or error holds one line starting with path. */
+/* Aborts unless status is RAD_OK, or error holds one line starting with path. With the
+ * environment variable RAD_FUZZ_VERBOSE set, prints the message (or "loaded") first. */
 void fuzz_check_refusal(rad_status status, const rad_error *error, const char *path);
 
 /* Aborts unless scene keeps radiosity.h's promises for a loaded scene. */
