@@ -18,6 +18,7 @@ typedef enum ply_format { PLY_ASCII, PLY_LITTLE, PLY_BIG } ply_format;
 typedef struct ply_property {
     int size;       /* bytes of a scalar, or of the list's items */
     int count_size; /* bytes of a list's count; 0 = a scalar */
+    bool corners;   /* a face's vertex_indices (vertex_index): Assimp 5.2 aborts on an empty one */
 } ply_property;
 
 typedef struct ply_element {
@@ -93,6 +94,9 @@ static rad_status check_body(const char *path, FILE *file, ply_format format,
                                             path, line, element->name, row, token);
                     } else
                         items = 0;
+                    if (!ended && property->corners && items == 0)
+                        return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: face %llu has no vertices",
+                                        path, line, row);
                     for (unsigned long long k = 0; k < items && !ended; k++)
                         ended = !next_token(file, token, sizeof(token), &line);
                 } else {
@@ -101,6 +105,9 @@ static rad_status check_body(const char *path, FILE *file, ply_format format,
                         ended = fread(bytes, 1, (size_t)property->count_size, file) !=
                                 (size_t)property->count_size;
                         items = ended ? 0 : binary_count(bytes, property->count_size, format);
+                        if (!ended && property->corners && items == 0)
+                            return rad_fail(error, RAD_ERR_PARSE, "%s: face %llu has no vertices",
+                                            path, row);
                     }
                     /* skip the items, then read their last byte: fseek passes the end */
                     ended = ended || items > (unsigned long long)LONG_MAX / 8 ||
@@ -131,8 +138,8 @@ rad_status ply_check(const char *path, FILE *file, rad_error *error)
     rad_status status = RAD_OK;
     while (status == RAD_OK && fgets(line_text, sizeof(line_text), file)) {
         line++;
-        char word[64] = "", a[64] = "", b[64] = "", c[64] = "";
-        int n = sscanf(line_text, "%63s %63s %63s %63s", word, a, b, c);
+        char word[64] = "", a[64] = "", b[64] = "", c[64] = "", d[64] = "";
+        int n = sscanf(line_text, "%63s %63s %63s %63s %63s", word, a, b, c, d);
         if (n < 1 || strcmp(word, "ply") == 0 || strcmp(word, "comment") == 0 ||
             strcmp(word, "obj_info") == 0)
             continue;
@@ -172,7 +179,10 @@ rad_status ply_check(const char *path, FILE *file, rad_error *error)
             if (!e || e->property_count == PLY_MAX_PROPERTIES || !size || (list && !count_size))
                 status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: bad property line", path, line);
             else
-                e->properties[e->property_count++] = (ply_property){size, count_size};
+                e->properties[e->property_count++] = (ply_property){
+                    size, count_size,
+                    list && strcmp(e->name, "face") == 0 &&
+                        (strcmp(d, "vertex_indices") == 0 || strcmp(d, "vertex_index") == 0)};
         }
     }
     if (status == RAD_OK && (!has_format || !ended))
