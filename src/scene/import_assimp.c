@@ -23,6 +23,7 @@
 #include <ctype.h>
 #include <errno.h>
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -126,7 +127,8 @@ static rad_status check_obj_face(const char *path, unsigned long number, const c
         long long index = strtoll(cursor, &end, 10);
         if (end == cursor)
             return RAD_OK; /* malformed: Assimp reports it */
-        if (index == 0 || (index < 0 && (unsigned long long)-index > vertices))
+        if (index == 0 || (index < 0 && (index == LLONG_MIN ||
+                                         (unsigned long long)-index > vertices)))
             return rad_fail(error, RAD_ERR_PARSE,
                             "%s:%lu: face vertex %lld: %s", path, number, index,
                             index == 0 ? "OBJ indices start at 1"
