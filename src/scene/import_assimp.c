@@ -143,6 +143,10 @@ static rad_status check_obj_face(const char *path, unsigned long number, const c
     }
 }
 
+/* Assimp 5.2 fails the whole OBJ ("File is too small", and leaks) when a material library
+ * has 1 to 7 bytes; "newmtl a" is the shortest library that defines a material. */
+enum { OBJ_SMALLEST_LIBRARY = 8 };
+
 /* OBJ checks Assimp does not make (or makes without a line number): material libraries
  * exist, vertex coordinates finite, face indices name vertices of the file. */
 static rad_status check_obj(const char *path, FILE *file, rad_error *error)
@@ -182,6 +186,13 @@ static rad_status check_obj(const char *path, FILE *file, rad_error *error)
             if (!S_ISREG(st.st_mode))
                 return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s' is not a file",
                                 path, number, name);
+            if (st.st_size > 0 && st.st_size < OBJ_SMALLEST_LIBRARY)
+                return rad_fail(error, RAD_ERR_PARSE,
+                                "%s:%lu: material library '%s' has %lld bytes, too few for a "
+                                "material (Assimp 5.2 refuses a file of 1 to %d bytes): empty it "
+                                "or remove the mtllib line",
+                                path, number, name, (long long)st.st_size,
+                                OBJ_SMALLEST_LIBRARY - 1);
         } else if (p[0] == 'v' && (p[1] == ' ' || p[1] == '\t')) {
             char *cursor = p + 2;
             for (int k = 0; k < 3; k++) {
