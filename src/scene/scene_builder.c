@@ -258,7 +258,7 @@ static void check_material(scene_builder *b, rad_material *m)
     for (int c = 0; c < 3; c++) {
         clamped |= clamp_unit(albedo[c]);
         clamped_specular |= clamp_unit(specular[c]);
-        if (!(*emission[c] >= 0)) {
+        if (!(*emission[c] >= 0) || !isfinite(*emission[c])) {
             *emission[c] = 0;
             negative = true;
         }
