@@ -176,7 +176,10 @@ rad_status ply_check(const char *path, FILE *file, rad_error *error)
             ply_element *e = element_count ? &element_list[element_count - 1] : NULL;
             bool list = strcmp(a, "list") == 0;
             int size = type_size(list ? c : a), count_size = list ? type_size(b) : 0;
-            if (!e || e->property_count == PLY_MAX_PROPERTIES || !size || (list && !count_size))
+            /* a property without a name makes Assimp 5.2 abort in its triangulation */
+            bool named = n >= (list ? 5 : 3);
+            if (!e || e->property_count == PLY_MAX_PROPERTIES || !size || (list && !count_size) ||
+                !named)
                 status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: bad property line", path, line);
             else
                 e->properties[e->property_count++] = (ply_property){
