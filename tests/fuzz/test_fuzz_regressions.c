@@ -1,0 +1,79 @@
+/*
+ * test_fuzz_regressions.c - every input the fuzz targets found a crash, leak or broken
+ * contract with (tests/fuzz/regressions/, also in the targets' seed corpora), through the
+ * command line: `radiosity info FILE` exits 1 with one line "radiosity: FILE...: message"
+ * on stderr, or (the one input that is valid) loads with a warning and no non-finite
+ * number in what it prints.
+ */
+#include <ctype.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "testlib.h"
+
+static int count_lines(const char *text)
+{
+    int lines = 0;
+    for (; *text; text++)
+        lines += *text == '\n';
+    return lines;
+}
+
+/* True when text holds "inf" or "nan" as a word (a number printed with %g), not inside a
+ * name such as "mtl_infinite". */
+static bool prints_non_finite(const char *text)
+{
+    for (const char *p = text; *p; p++)
+        if ((strncmp(p, "inf", 3) == 0 || strncmp(p, "nan", 3) == 0) &&
+            (p == text || (!isalnum((unsigned char)p[-1]) && p[-1] != '_')) &&
+            !isalnum((unsigned char)p[3]) && p[3] != '_')
+            return true;
+    return false;
+}
+
+/* `radiosity info regressions/NAME` is refused: exit 1, one line naming the file (and
+ * `fragment` from the message). */
+static void expect_refused(const char *name, const char *fragment)
+{
+    char arguments[4096], named[1024];
+    snprintf(arguments, sizeof(arguments), "info '%s/%s'", RAD_FUZZ_REGRESSIONS, name);
+    snprintf(named, sizeof(named), "radiosity: %s/%s", RAD_FUZZ_REGRESSIONS, name);
+    int code = test_run_tool(arguments);
+    const char *err = test_read_text(test_path("stderr.txt"));
+    if (code != 1 || count_lines(err) != 1 || strncmp(err, named, strlen(named)) != 0 ||
+        !strstr(err, fragment))
+        fprintf(stderr, "[%s] exit %d, stderr: %s\n", name, code, err);
+    CHECK(code == 1);
+    CHECK(count_lines(err) == 1);
+    CHECK(strncmp(err, named, strlen(named)) == 0);
+    CHECK(strstr(err, fragment) != NULL);
+}
+
+int main(void)
+{
+    /* Assimp aborted (ai_assert in its triangulation) */
+    expect_refused("ply_empty_face.ply", "face 0 has no vertices");
+    expect_refused("ply_unnamed_property.ply", ":5: bad property line");
+    /* signed overflow negating the index -2^63 */
+    expect_refused("obj_index_min.obj", "obj_index_min.obj:7: ");
+    /* Assimp failed the OBJ ("File is too small") and leaked */
+    expect_refused("mtl_tiny.obj", ":1: material library 'mtl_tiny.mtl' has 1 bytes");
+    /* the message quoted a newline from the input */
+    expect_refused("gltf_uri_newline.gltf", "buffer 0: file 'dat{},?' not found");
+    expect_refused("stl_tail_control.stl", "truncated: an ASCII STL ends with 'endsolid'");
+
+    /* Ke 1 inf 1e308 (beyond float: inf in Assimp): a warning, the emission 0 */
+    char arguments[4096];
+    snprintf(arguments, sizeof(arguments), "info '%s/mtl_infinite.obj'", RAD_FUZZ_REGRESSIONS);
+    int code = test_run_tool(arguments);
+    const char *err = test_read_text(test_path("stderr.txt"));
+    const char *out = test_read_text(test_path("stdout.txt"));
+    if (code != 0 || strstr(out, "emission (1, 0, 0)") == NULL || prints_non_finite(out))
+        fprintf(stderr, "[mtl_infinite.obj] exit %d, stderr: %s\nstdout: %s\n", code, err, out);
+    CHECK(code == 0);
+    CHECK(strstr(out, "material 'lamp': negative or invalid emission set to 0") != NULL);
+    CHECK(strstr(out, "emission (1, 0, 0)") != NULL);
+    CHECK(!prints_non_finite(out));
+    CHECK(prints_non_finite("radiance (inf, 0, 0)")); /* the scan itself */
+    return test_finish("test_fuzz_regressions");
+}
