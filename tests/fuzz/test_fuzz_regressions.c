@@ -1,9 +1,10 @@
 /*
- * test_fuzz_regressions.c - every input the fuzz targets found a crash, leak or broken
- * contract with (tests/fuzz/regressions/, also in the targets' seed corpora), through the
+ * test_fuzz_regressions.c - every input the fuzz targets (or the wild corpus) found a
+ * crash, leak, broken contract or wrong refusal with (tests/fuzz/regressions/, also in the
+ * targets' seed corpora), through the
  * command line: `radiosity info FILE` exits 1 with one line "radiosity: FILE...: message"
- * on stderr (no control character in it), or (the one input that is valid) loads with a warning and no non-finite
- * number in what it prints.
+ * on stderr (no control character in it), or (the inputs that are valid) loads, with a
+ * warning where a value was dropped and no non-finite number in what it prints.
  */
 #include <ctype.h>
 #include <stdio.h>
@@ -54,6 +55,23 @@ static void expect_refused(const char *name, const char *fragment)
     CHECK(strstr(err, fragment) != NULL);
 }
 
+/* `radiosity info regressions/NAME` loads: exit 0, `fragment` in what it prints, and no
+ * non-finite number. */
+static void expect_loads(const char *name, const char *fragment)
+{
+    char arguments[4096];
+    snprintf(arguments, sizeof(arguments), "info '%s/%s'", RAD_FUZZ_REGRESSIONS, name);
+    int code = test_run_tool(arguments);
+    const char *out = test_read_text(test_path("stdout.txt"));
+    bool found = strstr(out, fragment) != NULL, finite = !prints_non_finite(out);
+    if (code != 0 || !found || !finite)
+        fprintf(stderr, "[%s] exit %d, stderr: %s\nstdout: %s\n", name, code,
+                test_read_text(test_path("stderr.txt")), out);
+    CHECK(code == 0);
+    CHECK(found);
+    CHECK(finite);
+}
+
 int main(void)
 {
     /* Assimp aborted (ai_assert in its triangulation) */
@@ -81,5 +99,12 @@ int main(void)
     CHECK(!prints_non_finite(out));
     CHECK(prints_non_finite("radiance (inf, 0, 0)")); /* the scans themselves */
     CHECK(!one_clean_line("radiosity: a.stl: ends with 'x\r'\n"));
+    /* found by the wild corpus (tests/wild): ASCII STL files refused as damaged binary
+     * ones (a UTF-8 solid name), or as truncated (a last line longer than 255 bytes, CR
+     * line endings); an emission beyond single precision printed as inf */
+    expect_loads("stl_name_utf8.stl", "triangles: 2");
+    expect_loads("stl_name_long.stl", "triangles: 2");
+    expect_loads("stl_ascii_cr.stl", "triangles: 2");
+    expect_loads("gltf_strength_huge.gltf", "negative or invalid emission set to 0");
     return test_finish("test_fuzz_regressions");
 }
