@@ -159,11 +159,20 @@ static rad_status check_obj(const char *path, FILE *file, rad_error *error)
     char line[8192];
     unsigned long number = 0, vertices = 0, largest_line = 0;
     long long largest = 0;
+    bool continued = false; /* this piece continues a line longer than `line` */
     while (fgets(line, sizeof(line), file)) {
+        bool line_start = !continued;
+        continued = !strchr(line, '\n');
         number++;
         char *p = line;
         while (*p == ' ' || *p == '\t')
             p++;
+        size_t word = strcspn(p, " \t\r\n");
+        if (line_start && p != line && isalpha((unsigned char)*p)) /* Assimp 5.2 skips it */
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s:%lu: an indented '%.*s' line, which Assimp 5.2 would skip: "
+                            "remove the indentation",
+                            path, number, (int)(word < 40 ? word : 40), p);
         if (p[0] == 'f' && (p[1] == ' ' || p[1] == '\t')) {
             rad_status status = check_obj_face(path, number, p + 2, vertices, &largest,
                                                &largest_line, error);
