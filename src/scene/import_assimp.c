@@ -146,6 +146,39 @@ static rad_status check_obj_face(const char *path, unsigned long number, const c
     }
 }
 
+/* MTL: Assimp 5.2 crashes on a texture statement (map_Kd, bump, ...) or one starting with
+ * 'a' before the first newmtl, having no material to put it in; any statement there is
+ * refused (it belongs to no material). `library` is the file, `name` as the OBJ says it. */
+static rad_status check_mtl_start(const char *path, unsigned long number, const char *name,
+                                  const char *library, rad_error *error)
+{
+    FILE *file = fopen(library, "rb");
+    if (!file)
+        return RAD_OK; /* stat saw it: Assimp says why it cannot open it */
+    char line[8192];
+    unsigned long mtl_line = 0;
+    rad_status status = RAD_OK;
+    while (status == RAD_OK && fgets(line, sizeof(line), file)) {
+        mtl_line++;
+        char *p = line;
+        if (mtl_line == 1 && strncmp(p, "\xef\xbb\xbf", 3) == 0)
+            p += 3; /* a UTF-8 byte order mark */
+        while (isspace((unsigned char)*p))
+            p++;
+        size_t word = strcspn(p, " \t\r\n");
+        if (!*p || *p == '#')
+            continue;
+        if (word == 6 && strncmp(p, "newmtl", 6) == 0)
+            break;
+        status = rad_fail(error, RAD_ERR_PARSE,
+                          "%s:%lu: material library '%s', line %lu: '%.*s' before the first "
+                          "newmtl belongs to no material",
+                          path, number, name, mtl_line, (int)(word < 40 ? word : 40), p);
+    }
+    fclose(file);
+    return status;
+}
+
 /* Assimp 5.2 fails the whole OBJ ("File is too small", and leaks) when a material library
  * has 1 to 7 bytes; "newmtl a" is the shortest library that defines a material. */
 enum { OBJ_SMALLEST_LIBRARY = 8 };
@@ -205,6 +238,9 @@ static rad_status check_obj(const char *path, FILE *file, rad_error *error)
                                 "or remove the mtllib line",
                                 path, number, name, (long long)st.st_size,
                                 OBJ_SMALLEST_LIBRARY - 1);
+            rad_status status = check_mtl_start(path, number, name, library, error);
+            if (status != RAD_OK)
+                return status;
         } else if (p[0] == 'v' && (p[1] == ' ' || p[1] == '\t')) {
             char *cursor = p + 2;
             for (int k = 0; k < 3; k++) {
