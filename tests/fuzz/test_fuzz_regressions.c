@@ -81,6 +81,9 @@ int main(void)
     expect_refused("obj_index_min.obj", "obj_index_min.obj:7: ");
     /* Assimp failed the OBJ ("File is too small") and leaked */
     expect_refused("mtl_tiny.obj", ":1: material library 'mtl_tiny.mtl' has 1 bytes");
+    /* Assimp crashed (SEGV) on a statement before the first newmtl */
+    expect_refused("mtl_before_newmtl.obj",
+                   ":1: material library 'mtl_before_newmtl.mtl', line 1: '[ewmtl' before");
     /* the message quoted a newline from the input */
     expect_refused("gltf_uri_newline.gltf", "buffer 0: file 'dat{},?' not found");
     expect_refused("stl_tail_control.stl", "truncated: an ASCII STL ends with 'endsolid'");
