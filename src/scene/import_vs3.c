@@ -31,6 +31,10 @@
  * applied) corners; this bounds it (a wall with a dozen windows fits). */
 enum { VS3_PIECE_CORNERS = 64 };
 
+/* Vertex and surface numbers index arrays: a number above this (far beyond what a
+ * view-factor computation can take) would make the reader allocate gigabytes. */
+enum { VS3_MOST_NUMBER = 10000000 };
+
 typedef enum vs3_kind { VS3_SURFACE, VS3_OBSTRUCTION, VS3_MASK, VS3_NULL } vs3_kind;
 
 typedef struct vs3_polygon {
@@ -193,6 +197,9 @@ static rad_status parse_vertex(vs3_reader *r, char **token, int count, unsigned 
     if (count > 5)
         return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: unexpected '%s' after the vertex",
                         r->path, line, token[5]);
+    if (number > VS3_MOST_NUMBER)
+        return rad_fail(error, RAD_ERR_UNSUPPORTED, "%s:%lu: vertex number %u is above %d",
+                        r->path, line, number, VS3_MOST_NUMBER);
     size_t old = r->vertex_capacity;
     if (number >= old) {
         size_t capacity = old;
@@ -234,6 +241,9 @@ static rad_status parse_surface(vs3_reader *r, vs3_kind kind, char **token, int 
     if (count > 10)
         return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: unexpected '%s' after the surface name",
                         r->path, line, token[10]);
+    if (p.number > VS3_MOST_NUMBER)
+        return rad_fail(error, RAD_ERR_UNSUPPORTED, "%s:%lu: surface number %u is above %d",
+                        r->path, line, p.number, VS3_MOST_NUMBER);
     if (!(p.emissivity > 0 && p.emissivity <= 1))
         return rad_fail(error, RAD_ERR_PARSE,
                         "%s:%lu: surface %u: emissivity %g is outside (0,1]", r->path, line,
