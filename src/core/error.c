@@ -20,6 +20,15 @@ const char *rad_status_name(rad_status status)
     return "unknown status";
 }
 
+/* A message is one line: control characters (of the input a message quotes: a name, a
+ * token, a file's last bytes) become '?'. */
+static void one_line(char *text)
+{
+    for (; *text; text++)
+        if ((unsigned char)*text < 0x20 || *text == 0x7f)
+            *text = '?';
+}
+
 rad_status rad_fail(rad_error *error, rad_status status, const char *format, ...)
 {
     if (error) {
@@ -28,6 +37,7 @@ rad_status rad_fail(rad_error *error, rad_status status, const char *format, ...
         error->status = status;
         vsnprintf(error->message, sizeof(error->message), format, args);
         va_end(args);
+        one_line(error->message);
     }
     return status;
 }
@@ -41,5 +51,6 @@ void rad_warn(rad_log_fn log, void *user, const char *format, ...)
     va_start(args, format);
     vsnprintf(line, sizeof(line), format, args);
     va_end(args);
+    one_line(line);
     log(user, line);
 }

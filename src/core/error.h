@@ -16,11 +16,12 @@
 #define RAD_PRINTF(fmt, args)
 #endif
 
-/* Sets error (when not NULL) and returns status. */
+/* Sets error (when not NULL) and returns status. The message is one line: control
+ * characters in it (from quoted input) become '?'. */
 rad_status rad_fail(rad_error *error, rad_status status, const char *format, ...)
     RAD_PRINTF(3, 4);
 
-/* Sends one formatted warning to the log callback (when not NULL). */
+/* Sends one formatted warning to the log callback (when not NULL), one line as above. */
 void rad_warn(rad_log_fn log, void *user, const char *format, ...) RAD_PRINTF(3, 4);
 
 #endif

@@ -28,6 +28,7 @@
 #include <assimp/scene.h>
 #include <ctype.h>
 #include <errno.h>
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -80,7 +81,7 @@ static rad_status check_stl(const char *path, FILE *file, rad_error *error)
     long size = ftell(file);
     bool text = true;
     for (size_t k = 0; k < got; k++)
-        text = text && (isprint(head[k]) || isspace(head[k]));
+        text = text && (isprint(head[k]) || isspace(head[k]) || head[k] >= 0x80); /* UTF-8 */
     if (got == sizeof(head)) {
         unsigned long count = (unsigned long)head[80] | (unsigned long)head[81] << 8 |
                               (unsigned long)head[82] << 16 | (unsigned long)head[83] << 24;
@@ -105,8 +106,11 @@ static rad_status check_stl(const char *path, FILE *file, rad_error *error)
     while (n > 0 && isspace((unsigned char)tail[n - 1]))
         n--;
     tail[n] = 0;
-    char *last = strrchr(tail, '\n');
-    last = last ? last + 1 : tail;
+    char *last = tail + n; /* the start of the last line, ended by LF, CRLF or CR */
+    while (last > tail && last[-1] != '\n' && last[-1] != '\r')
+        last--;
+    if (last == tail && from > 0)
+        return RAD_OK; /* a last line longer than the tail (a long solid name): not checked */
     while (isspace((unsigned char)*last))
         last++;
     if (strncasecmp(last, "endsolid", 8) != 0)

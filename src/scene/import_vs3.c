@@ -230,6 +230,9 @@ static rad_status parse_vertex(vs3_reader *r, char **token, int count, unsigned 
     if (count > 5)
         return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: unexpected '%s' after the vertex",
                         r->path, line, token[5]);
+    if (number > VS3_LARGEST_NUMBER)
+        return rad_fail(error, RAD_ERR_UNSUPPORTED, "%s:%lu: vertex number %u is above %d",
+                        r->path, line, number, VS3_LARGEST_NUMBER);
     size_t old = r->vertex_capacity;
     if (number >= old) {
         size_t capacity = old;
@@ -285,6 +288,9 @@ static rad_status parse_surface(vs3_reader *r, vs3_kind kind, char **token, int 
     if (count > 10)
         return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: unexpected '%s' after the surface name",
                         r->path, line, token[10]);
+    if (p.number > VS3_LARGEST_NUMBER)
+        return rad_fail(error, RAD_ERR_UNSUPPORTED, "%s:%lu: surface number %u is above %d",
+                        r->path, line, p.number, VS3_LARGEST_NUMBER);
     if (!(p.emissivity > 0 && p.emissivity <= 1))
         return rad_fail(error, RAD_ERR_PARSE,
                         "%s:%lu: surface %u: emissivity %g is outside (0,1]", r->path, line,

@@ -67,13 +67,16 @@ static bool append_text(obj_check *c, const char *text, size_t n)
     return true;
 }
 
-/* The next line of `file` into *line (grown as needed); false at the end. */
-static bool read_line(FILE *file, char **line, size_t *capacity)
+/* The next line of `file` into *line (grown as needed); false at the end, or out of
+ * memory (then *out_of_memory is set). */
+static bool read_line(FILE *file, char **line, size_t *capacity, bool *out_of_memory)
 {
     size_t length = 0;
     for (;;) {
-        if (!rad_grow_array((void **)line, capacity, length + 4096, 1))
+        if (!rad_grow_array((void **)line, capacity, length + 4096, 1)) {
+            *out_of_memory = true;
             return false;
+        }
         if (!fgets(*line + length, (int)(*capacity - length), file))
             return length > 0;
         length += strlen(*line + length);
@@ -213,6 +216,9 @@ static rad_status check_obj_numbers(obj_check *c, const char *keyword, const cha
 /* One material library `name` of an mtllib line, written to the copy as the path Assimp
  * opens: the file beside the OBJ (or at its absolute path); else, as Blender and Assimp
  * do, a file of its base name beside the OBJ, with a warning. */
+/* The shortest material library Assimp 5.2 reads (see add_obj_library). */
+enum { OBJ_SMALLEST_LIBRARY = 8 };
+
 static rad_status add_obj_library(obj_check *c, const char *name, rad_error *error)
 {
     char library[8192 + 4096];
@@ -243,19 +249,46 @@ static rad_status add_obj_library(obj_check *c, const char *name, rad_error *err
     if (!file)
         return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s': cannot open: %s",
                         c->path, c->line, name, strerror(errno));
+    /* Assimp 5.2 fails the whole OBJ ("File is too small", and leaks) on a library of 1
+     * to 7 bytes: "newmtl a" is the shortest that defines a material */
+    if (fstat(fileno(file), &st) == 0 && st.st_size > 0 && st.st_size < OBJ_SMALLEST_LIBRARY) {
+        fclose(file);
+        return rad_fail(error, RAD_ERR_PARSE,
+                        "%s:%lu: material library '%s' has %lld bytes, too few for a material "
+                        "(Assimp 5.2 refuses a file of 1 to %d bytes): empty it or remove the "
+                        "mtllib line",
+                        c->path, c->line, name, (long long)st.st_size, OBJ_SMALLEST_LIBRARY - 1);
+    }
     char *line = NULL;
     size_t capacity = 0;
-    bool ok = true;
-    while (ok && read_line(file, &line, &capacity)) {
+    bool ok = true, in_material = false;
+    unsigned long mtl_line = 0;
+    rad_status status = RAD_OK;
+    bool out_of_memory = false;
+    while (ok && status == RAD_OK && read_line(file, &line, &capacity, &out_of_memory)) {
         char *p = line;
-        while (*p == ' ' || *p == '\t')
+        if (++mtl_line == 1 && strncmp(p, "\xef\xbb\xbf", 3) == 0)
+            p += 3; /* a UTF-8 byte order mark */
+        while (isspace((unsigned char)*p))
             p++;
-        if (strncmp(p, "newmtl", 6) == 0 && isspace((unsigned char)p[6]))
+        size_t word = strcspn(p, " \t\r\n");
+        if (strncmp(p, "newmtl", 6) == 0 && isspace((unsigned char)p[6])) {
+            in_material = true;
             ok = names_add(&c->materials_defined, rest_of_line(p + 6), 0);
+        } else if (!in_material && *p && *p != '#') {
+            /* Assimp 5.2 crashes on some statements before the first newmtl (a texture,
+             * one starting with 'a'): they belong to no material, so all are refused */
+            status = rad_fail(error, RAD_ERR_PARSE,
+                              "%s:%lu: material library '%s', line %lu: '%.*s' before the "
+                              "first newmtl belongs to no material",
+                              c->path, c->line, name, mtl_line, (int)(word < 40 ? word : 40), p);
+        }
     }
     free(line);
     fclose(file);
-    return ok ? RAD_OK : rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
+    if (status != RAD_OK)
+        return status;
+    return ok && !out_of_memory ? RAD_OK : rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
 }
 
 /* An mtllib line's libraries: the whole rest of the line when it names a file (a name
@@ -302,7 +335,8 @@ rad_status obj_check_read(const char *path, const rad_load_options *options, FIL
         int list, least;
     } data[] = {{"v", OBJ_VERTEX, 3}, {"vt", OBJ_UV, 2}, {"vn", OBJ_NORMAL, 3}};
     unsigned long continued = 0; /* lines joined to the one before by a trailing '\\' */
-    while (status == RAD_OK && read_line(file, &line, &capacity)) {
+    bool out_of_memory = false;
+    while (status == RAD_OK && read_line(file, &line, &capacity, &out_of_memory)) {
         c->line += 1 + continued;
         continued = 0;
         for (;;) { /* a '\\' at the end continues the line on the next (Assimp joins them) */
@@ -315,9 +349,11 @@ rad_status obj_check_read(const char *path, const rad_load_options *options, FIL
             line[n] = 0;
             char *more = NULL;
             size_t more_capacity = 0;
-            bool read = read_line(file, &more, &more_capacity);
-            if (read && !rad_grow_array((void **)&line, &capacity, n + strlen(more) + 1, 1))
+            bool read = read_line(file, &more, &more_capacity, &out_of_memory);
+            if (read && !rad_grow_array((void **)&line, &capacity, n + strlen(more) + 1, 1)) {
                 read = false;
+                out_of_memory = true;
+            }
             if (read)
                 strcpy(line + n, more);
             free(more);
@@ -328,6 +364,11 @@ rad_status obj_check_read(const char *path, const rad_load_options *options, FIL
         char *p = line;
         while (*p == ' ' || *p == '\t')
             p++;
+        if (p != line && isalpha((unsigned char)*p)) { /* Assimp 5.2 skips indented lines */
+            memmove(line, p, strlen(p) + 1);
+            p = line;
+            c->copy_differs = true;
+        }
         size_t word = strcspn(p, " \t\r\n");
         bool handled = false;
         for (size_t k = 0; k < sizeof(data) / sizeof(data[0]) && !handled; k++)
@@ -362,6 +403,8 @@ rad_status obj_check_read(const char *path, const rad_load_options *options, FIL
             status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
     }
     free(line);
+    if (status == RAD_OK && out_of_memory)
+        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", c->path);
     /* materials used but defined by no library (Assimp 5.2 makes them up, grey 0.6): the
      * default albedo, as faces without a material, and a warning at their first use */
     char *entry = c->materials_used.text ? c->materials_used.text + 1 : NULL;

@@ -146,6 +146,9 @@ static rad_status check_body(const char *path, FILE *file, ply_format format,
                                             path, line, element->name, row, token);
                     } else
                         items = 0;
+                    if (!ended && property->vertex_indices && items == 0)
+                        return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: face %llu has no vertices",
+                                        path, line, row);
                     for (unsigned long long k = 0; k < items && !ended; k++) {
                         ended = !next_token(file, token, sizeof(token), &line);
                         if (!ended && property->vertex_indices) {
@@ -161,6 +164,9 @@ static rad_status check_body(const char *path, FILE *file, ply_format format,
                         ended = fread(bytes, 1, (size_t)property->count_size, file) !=
                                 (size_t)property->count_size;
                         items = ended ? 0 : binary_count(bytes, property->count_size, format);
+                        if (!ended && property->vertex_indices && items == 0)
+                            return rad_fail(error, RAD_ERR_PARSE, "%s: face %llu has no vertices",
+                                            path, row);
                     }
                     if (property->vertex_indices && !property->item_float) {
                         /* read each index (a face has a handful) */
@@ -255,7 +261,10 @@ rad_status ply_check(const char *path, FILE *file, rad_error *error)
             bool list = strcmp(a, "list") == 0;
             const char *type = list ? c : a, *name = list ? d : b;
             int size = type_size(type), count_size = list ? type_size(b) : 0;
-            if (!e || e->property_count == PLY_MAX_PROPERTIES || !size || (list && !count_size))
+            /* a property without a name makes Assimp 5.2 abort in its triangulation */
+            bool named = n >= (list ? 5 : 3);
+            if (!e || e->property_count == PLY_MAX_PROPERTIES || !size || (list && !count_size) ||
+                !named)
                 status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: bad property line", path, line);
             else if (list && type_is_float(b))
                 status = rad_fail(error, RAD_ERR_PARSE,

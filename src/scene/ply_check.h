@@ -1,7 +1,8 @@
 /*
  * ply_check.h - a PLY check Assimp does not make: the body holds every row the header
- * declares (ASCII or binary, lists included). Assimp 5.2 reads short files past their data
- * and aborts or crashes in its triangulation; this check refuses them first.
+ * declares (ASCII or binary, lists included), and no face has an empty vertex list.
+ * Assimp 5.2 reads short files past their data and aborts or crashes in its
+ * triangulation, and aborts on an empty face; this check refuses them first.
  */
 #ifndef RAD_SCENE_PLY_CHECK_H
 #define RAD_SCENE_PLY_CHECK_H

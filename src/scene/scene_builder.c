@@ -7,6 +7,7 @@
  */
 #include "scene/scene_builder.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -258,7 +259,7 @@ static void check_material(scene_builder *b, rad_material *m)
     for (int c = 0; c < 3; c++) {
         clamped |= clamp_unit(albedo[c]);
         clamped_specular |= clamp_unit(specular[c]);
-        if (!(*emission[c] >= 0)) {
+        if (!(*emission[c] >= 0 && *emission[c] <= FLT_MAX)) { /* powers stay finite */
             *emission[c] = 0;
             negative = true;
         }
