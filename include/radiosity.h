@@ -768,8 +768,8 @@ typedef struct rad_solve_report {
  * non-positive area, an albedo outside [0,1], a negative exitance, a row whose rho_i x
  * sum_j F_ij exceeds 1 + RAD_ROW_SUM_SLACK (it creates energy: no solver converges), an
  * iteration that diverges or stops being finite anyway (report->patch names the patch) or
- * the hierarchical solver (it needs the mesh: rad_solve_hierarchical); the direct solver refuses more than
- * RAD_DIRECT_MAX_PATCHES patches (RAD_ERR_UNSUPPORTED) and a singular system
+ * the hierarchical solver (it needs the mesh: rad_solve_hierarchical); the direct solver
+ * refuses more than RAD_DIRECT_MAX_PATCHES patches (RAD_ERR_UNSUPPORTED) and a singular system
  * (RAD_ERR_INVALID), and reports iterations 0. Shooting derives F_ji from F_ij by
  * reciprocity, so its residual levels off near float precision (about 1e-7). With the
  * ambient term on, `residual` measures B including it. */
