@@ -142,8 +142,9 @@ int main(void)
     strcat(ply, "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
     test_write_file("short-vertices.ply", ply);
     expect_error("PLY short of vertices", "render short-vertices.ply -o out.png",
-                 "short-vertices.ply: truncated: the header declares 30 rows of element "
-                 "'vertex', the file holds 4"); /* 13 numbers: the face's "3 0 1" is a 4th */
+                 "short-vertices.ply:13: row 3 of element 'vertex' does not end its line "
+                 "(one row per line; or the file holds fewer rows than its header "
+                 "declares)"); /* the face's "3 0 1" read as a 4th vertex leaves "2" */
     snprintf(ply, sizeof(ply), PLY_HEADER, "ascii", 3, 5);
     strcat(ply, "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
     test_write_file("short-faces.ply", ply);

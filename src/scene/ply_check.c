@@ -78,11 +78,39 @@ static bool next_token(FILE *file, char *token, size_t size, unsigned long *line
     size_t n = 0;
     for (; c != EOF && !isspace(c); c = getc(file))
         if (n + 1 < size)
-            token[n++] = (char)c;
+            token[n++] = c ? (char)c : '?'; /* a NUL byte makes the token no number */
     token[n] = 0;
     if (c == '\n')
         ungetc(c, file);
     return true;
+}
+
+/* An ASCII value of its property's type: a whole number (optionally signed) or a real
+ * one, written whole (Assimp 5.2 reads a prefix of "0-" or "25z" and can then abort). */
+static bool is_number(const char *token, bool real)
+{
+    char *end;
+    errno = 0;
+    if (real)
+        (void)strtod(token, &end);
+    else
+        (void)strtoll(token, &end, 10);
+    return end != token && *end == 0;
+}
+
+/* After an ASCII row: only blanks (and a '\r') up to the end of the line or the file.
+ * Assimp 5.2 reads rows line by line, and aborts on a row that runs over into the next
+ * line or shares one with it (found by fuzz_ply). */
+static bool row_ends_line(FILE *file)
+{
+    int c;
+    while ((c = getc(file)) == ' ' || c == '\t' || c == '\r')
+        ;
+    if (c == '\n') {
+        ungetc(c, file); /* next_token counts it */
+        return true;
+    }
+    return c == EOF;
 }
 
 /* A face's vertex index (`text` as written, or `value` read from a binary file) names one
@@ -128,7 +156,11 @@ static rad_status check_body(const char *path, FILE *file, ply_format format,
             vertices = elements[e].rows;
     for (int e = 0; e < element_count; e++) {
         const ply_element *element = &elements[e];
-        for (unsigned long long row = 0; row < element->rows; row++)
+        if (element->property_count == 0 && element->rows > 0) /* Assimp 5.2 spins on them */
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s: element '%s' declares %llu rows but no properties", path,
+                            element->name, element->rows);
+        for (unsigned long long row = 0; row < element->rows; row++) {
             for (int p = 0; p < element->property_count; p++) {
                 const ply_property *property = &element->properties[p];
                 unsigned long long items = 1;
@@ -144,13 +176,23 @@ static rad_status check_body(const char *path, FILE *file, ply_format format,
                             return rad_fail(error, RAD_ERR_PARSE,
                                             "%s:%lu: %s %llu: list length '%s' is not a count",
                                             path, line, element->name, row, token);
-                    } else
+                    } else {
                         items = 0;
+                        if (!ended && !is_number(token, property->item_float))
+                            return rad_fail(error, RAD_ERR_PARSE,
+                                            "%s:%lu: %s %llu: '%s' is not a number", path, line,
+                                            element->name, row, token);
+                    }
                     if (!ended && property->vertex_indices && items == 0)
                         return rad_fail(error, RAD_ERR_PARSE, "%s:%lu: face %llu has no vertices",
                                         path, line, row);
                     for (unsigned long long k = 0; k < items && !ended; k++) {
                         ended = !next_token(file, token, sizeof(token), &line);
+                        if (!ended && !property->vertex_indices &&
+                            !is_number(token, property->item_float))
+                            return rad_fail(error, RAD_ERR_PARSE,
+                                            "%s:%lu: %s %llu: '%s' is not a number", path, line,
+                                            element->name, row, token);
                         if (!ended && property->vertex_indices) {
                             rad_status status = check_vertex_index(path, line, token, 0, row,
                                                                    vertices, error);
@@ -200,6 +242,15 @@ static rad_status check_body(const char *path, FILE *file, ply_format format,
                                     "the file holds %llu",
                                     path, element->rows, element->name, row);
             }
+            /* Assimp 5.2 reads an ASCII body line by line (it aborted on rows run together
+             * by a form feed; found by fuzz_ply) */
+            if (format == PLY_ASCII && element->property_count > 0 && !row_ends_line(file))
+                return rad_fail(error, RAD_ERR_PARSE,
+                                "%s:%lu: row %llu of element '%s' does not end its line (one "
+                                "row per line; or the file holds fewer rows than its header "
+                                "declares)",
+                                path, line, row, element->name);
+        }
     }
     return RAD_OK;
 }
@@ -217,11 +268,31 @@ rad_status ply_check(const char *path, FILE *file, rad_error *error)
     rad_status status = RAD_OK;
     while (status == RAD_OK && fgets(line_text, sizeof(line_text), file)) {
         line++;
+        bool whole = strchr(line_text, '\n') != NULL || feof(file);
+        if (!whole) { /* the rest of a long line: only comments may be that long */
+            int ch;
+            while ((ch = fgetc(file)) != EOF && ch != '\n')
+                ;
+        }
         char word[64] = "", a[64] = "", b[64] = "", c[64] = "", d[64] = "";
         int n = sscanf(line_text, "%63s %63s %63s %63s %63s", word, a, b, c, d);
-        if (n < 1 || strcmp(word, "ply") == 0 || strcmp(word, "comment") == 0 ||
+        if ((n < 1 && whole) || strcmp(word, "ply") == 0 || strcmp(word, "comment") == 0 ||
             strcmp(word, "obj_info") == 0)
             continue;
+        if (!whole) { /* fgets stopped short: a NUL byte, or a line too long */
+            status = rad_fail(error, RAD_ERR_PARSE,
+                              "%s:%lu: header line holds a NUL byte or is longer than %zu bytes",
+                              path, line, sizeof(line_text) - 2);
+            break;
+        }
+        /* the header has these keywords only; Assimp 5.2 skips others and can corrupt its
+         * heap on what follows (found by fuzz_ply) */
+        if (strcmp(word, "end_header") != 0 && strcmp(word, "format") != 0 &&
+            strcmp(word, "element") != 0 && strcmp(word, "property") != 0) {
+            status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: unknown header line '%.40s'", path,
+                              line, word);
+            break;
+        }
         if (strcmp(word, "end_header") == 0) {
             ended = true;
             break;
@@ -237,6 +308,9 @@ rad_status ply_check(const char *path, FILE *file, rad_error *error)
             else
                 status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: unknown PLY format '%s'", path,
                                   line, a);
+            if (status == RAD_OK && strcmp(b, "1.0") != 0)
+                status = rad_fail(error, RAD_ERR_PARSE, "%s:%lu: PLY version '%s' (1.0 expected)",
+                                  path, line, b);
         } else if (strcmp(word, "element") == 0) {
             char *end;
             errno = 0;
@@ -281,6 +355,12 @@ rad_status ply_check(const char *path, FILE *file, rad_error *error)
     if (status == RAD_OK && (!has_format || !ended))
         status = rad_fail(error, RAD_ERR_PARSE, "%s: not a PLY file (no %s)", path,
                           has_format ? "end_header" : "format line");
+    bool has_vertices = false;
+    for (int e = 0; e < element_count; e++)
+        has_vertices = has_vertices || (strcmp(element_list[e].name, "vertex") == 0 &&
+                                        element_list[e].rows > 0);
+    if (status == RAD_OK && !has_vertices) /* Assimp 5.2 crashed on one (found by fuzz_ply) */
+        status = rad_fail(error, RAD_ERR_PARSE, "%s: no vertex element with rows", path);
     if (status == RAD_OK)
         status = check_body(path, file, format, element_list, element_count, line + 1, error);
     free(element_list);

@@ -77,6 +77,19 @@ int main(void)
     /* Assimp aborted (ai_assert in its triangulation) */
     expect_refused("ply_empty_face.ply", "face 0 has no vertices");
     expect_refused("ply_unnamed_property.ply", ":5: bad property line");
+    /* Assimp 5.2 corrupted its heap after skipping a header line it did not know */
+    expect_refused("ply_unknown_header_word.ply", ":4: unknown header line 'pro3'");
+    /* Assimp 5.2 aborted after a header line that began with NUL bytes */
+    expect_refused("ply_nul_header_line.ply", ":6: header line holds a NUL byte");
+    /* Assimp 5.2 aborted on an ASCII row whose line ended in a form feed, not a newline */
+    expect_refused("ply_rows_run_together.ply", "row 2 of element 'vertex' does not end its line");
+    /* Assimp 5.2 aborted on ASCII values "0-" and "25" + NUL */
+    expect_refused("ply_bad_number.ply", ":15: vertex 0: '0-' is not a number");
+    /* 4294967295 rows without properties: minutes in the pre-check, then Assimp spun */
+    expect_refused("ply_rows_without_properties.ply",
+                   "element 'face' declares 4294967295 rows but no properties");
+    /* no element at all: Assimp 5.2 crashed (SEGV) */
+    expect_refused("ply_no_elements.ply", ":2: PLY version '1.0ledices'");
     /* signed overflow negating the index -2^63 */
     expect_refused("obj_index_min.obj", "obj_index_min.obj:3: ");
     /* Assimp failed the OBJ ("File is too small") and leaked */
