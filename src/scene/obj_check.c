@@ -249,6 +249,20 @@ static rad_status add_obj_library(obj_check *c, const char *name, rad_error *err
     if (!file)
         return rad_fail(error, RAD_ERR_IO, "%s:%lu: material library '%s': cannot open: %s",
                         c->path, c->line, name, strerror(errno));
+    /* a NUL byte hides what follows it on its line from the checks below, and Assimp 5.2
+     * crashed on a texture statement hidden that way (found by fuzz_mtl) */
+    char chunk[4096];
+    size_t got;
+    bool has_nul = false;
+    while (!has_nul && (got = fread(chunk, 1, sizeof(chunk), file)) > 0)
+        has_nul = memchr(chunk, 0, got) != NULL;
+    if (has_nul) {
+        fclose(file);
+        return rad_fail(error, RAD_ERR_PARSE,
+                        "%s:%lu: material library '%s' holds a NUL byte: not a text file",
+                        c->path, c->line, name);
+    }
+    rewind(file);
     /* Assimp 5.2 fails the whole OBJ ("File is too small", and leaks) on a library of 1
      * to 7 bytes: "newmtl a" is the shortest that defines a material */
     if (fstat(fileno(file), &st) == 0 && st.st_size > 0 && st.st_size < OBJ_SMALLEST_LIBRARY) {

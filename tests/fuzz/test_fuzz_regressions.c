@@ -94,6 +94,9 @@ int main(void)
     expect_refused("obj_index_min.obj", "obj_index_min.obj:3: ");
     /* Assimp failed the OBJ ("File is too small") and leaked */
     expect_refused("mtl_tiny.obj", ":1: material library 'mtl_tiny.mtl' has 1 bytes");
+    /* Assimp crashed (SEGV) on a texture statement hidden behind NUL bytes */
+    expect_refused("mtl_nul_bytes.obj",
+                   ":1: material library 'mtl_nul_bytes.mtl' holds a NUL byte: not a text file");
     /* Assimp crashed (SEGV) on a statement before the first newmtl */
     expect_refused("mtl_before_newmtl.obj",
                    ":1: material library 'mtl_before_newmtl.mtl', line 1: '[ewmtl' before");
