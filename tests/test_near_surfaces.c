@@ -166,6 +166,25 @@ static bool solve(const rad_scene *scene, const rad_mesh *mesh, rad_solver solve
     return status == RAD_OK;
 }
 
+/* The mesh's form factors with the scene's triangles as occluders (exits on failure). */
+static rad_formfactors *formfactors_of(const rad_scene *scene, const rad_mesh *mesh,
+                                       rad_formfactor_report *report)
+{
+    rad_tracer *tracer = NULL;
+    rad_formfactors *ff = NULL;
+    rad_error error = {0};
+    rad_status status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &tracer, &error);
+    if (status == RAD_OK)
+        status = rad_formfactors_compute(mesh, tracer, NULL, &ff, report, &error);
+    rad_tracer_destroy(tracer);
+    if (status != RAD_OK) {
+        fprintf(stderr, "form factors: %s\n", error.message);
+        CHECK(false);
+        exit(1);
+    }
+    return ff;
+}
+
 static void check_box_in_box(double gap)
 {
     rad_scene *scene = load(write_box_in_box(gap));
@@ -175,11 +194,8 @@ static void check_box_in_box(double gap)
     uint32_t n = mesh->patch_count;
 
     /* rows of F: a closed scene, so every row sums to 1 */
-    rad_tracer *tracer = NULL;
-    CHECK(rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &tracer, &error) == RAD_OK);
-    rad_formfactors *ff = NULL;
     rad_formfactor_report ff_report;
-    CHECK(rad_formfactors_compute(mesh, tracer, NULL, &ff, &ff_report, &error) == RAD_OK);
+    rad_formfactors *ff = formfactors_of(scene, mesh, &ff_report);
     double lowest = INFINITY, highest = 0;
     for (uint32_t i = 0; i < n; i++) {
         double row = 0;
@@ -195,7 +211,6 @@ static void check_box_in_box(double gap)
     CHECK(ff_report.largest_row_sum <= 1 + 1e-3); /* not only trimmed: right */
     CHECK(lowest >= 1 - 2e-3);
     rad_formfactors_destroy(ff);
-    rad_tracer_destroy(tracer);
 
     int inner_top = surface_index(scene, "inner_top");
     int room_floor = surface_index(scene, "room_bottom");
@@ -282,11 +297,8 @@ static void check_interpenetrating(void)
     rad_error error = {0};
     CHECK(rad_mesh_build(scene, 0.1, &mesh, &error) == RAD_OK);
     uint32_t n = mesh->patch_count;
-    rad_tracer *tracer = NULL;
-    CHECK(rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &tracer, &error) == RAD_OK);
-    rad_formfactors *ff = NULL;
     rad_formfactor_report ff_report;
-    CHECK(rad_formfactors_compute(mesh, tracer, NULL, &ff, &ff_report, &error) == RAD_OK);
+    rad_formfactors *ff = formfactors_of(scene, mesh, &ff_report);
     int ceiling = surface_index(scene, "room_top");
     double smallest = INFINITY, highest = 0, ceiling_low = INFINITY, ceiling_high = 0;
     for (uint32_t i = 0; i < n; i++) {
@@ -310,7 +322,6 @@ static void check_interpenetrating(void)
     CHECK(highest <= 1 + RAD_ROW_SUM_SLACK);
     CHECK(fabs(ceiling_low - 1) <= RAD_ROW_SUM_SLACK && fabs(ceiling_high - 1) <= RAD_ROW_SUM_SLACK);
     rad_formfactors_destroy(ff);
-    rad_tracer_destroy(tracer);
 
     const char *shown[] = {"room_bottom", "room_left", "sunk_top", "cross_top", "cross_left"};
     int below = surface_index(scene, "sunk_bottom");
