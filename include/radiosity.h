@@ -222,6 +222,11 @@ typedef struct rad_scene {
                            Assimp having applied its <unit> and <up_axis>; FBX:
                            UnitScaleFactor / 100), else 0. This library never rescales */
     char source[512];  /* file the scene came from, or "(built-in Cornell box)" */
+    struct rad_light *lights; /* light sources besides emissive surfaces (rad_light), from
+                                 the file (glTF KHR_lights_punctual, Assimp's lights) or
+                                 added with rad_scene_add_light */
+    uint32_t light_count;
+    rad_vec3 north;     /* unit, perpendicular to up; zero = the default (rad_scene_north) */
 } rad_scene;
 
 typedef struct rad_load_options {
@@ -366,6 +371,132 @@ rad_camera rad_scene_default_camera(const rad_scene *scene);
  * finite). */
 rad_status rad_scene_set_material(rad_scene *scene, const char *name, const rad_rgb *albedo,
                                   const rad_rgb *emission, rad_error *error);
+
+/* ------------------------------------------------------------------------------------ */
+/* Light sources besides emissive surfaces: point, spot, sun, sky, environment, luminaire */
+
+/* Units. A light given in photometric units (intensity in candela, illuminance in lux,
+ * luminance in cd/m^2) makes every radiance of the answer a luminance in cd/m^2 and every
+ * irradiance an illuminance in lux (per RGB channel: a white light is equal in all three);
+ * given in W/sr, W/m^2 and W/(m^2 sr) it gives W/(m^2 sr) and W/m^2. Emitted radiance of a
+ * surface (Ke) is in the same unit as a luminance. Distances to point-like lights are
+ * converted to metres with rad_scene.unit_metres (1 when 0), so a 100 cd lamp 2 m above
+ * a floor gives 25 lux there whether the scene is in metres or millimetres. */
+
+typedef enum rad_light_type {
+    RAD_LIGHT_POINT = 1,   /* isotropic: intensity I (cd) in every direction */
+    RAD_LIGHT_SPOT,        /* I inside inner_degrees of `direction`, 0 outside outer_degrees,
+                              between them glTF's smooth falloff (KHR_lights_punctual:
+                              t = clamp((cos a - cos outer) / (cos inner - cos outer), 0, 1),
+                              I t^2) */
+    RAD_LIGHT_DIRECTIONAL, /* the sun: illuminance E_n (lux) on a plane facing it, arriving
+                              along `direction` from a disk of angular_diameter_degrees */
+    RAD_LIGHT_SKY,         /* a sky dome over the upper hemisphere of rad_scene.up: the
+                              luminance distribution `sky`, scaled by `intensity` (the
+                              zenith luminance, cd/m^2); nothing below the horizon */
+    RAD_LIGHT_ENVIRONMENT, /* an equirectangular radiance map (`environment`) at infinity,
+                              times `intensity` */
+    RAD_LIGHT_LUMINAIRE    /* a photometric web (`photometry`, IES LM-63) at `position`,
+                              its nadir (vertical angle 0) along `direction`, horizontal
+                              angle 0 along `reference`; times `intensity` (1,1,1 = as the
+                              file says) */
+} rad_light_type;
+
+typedef enum rad_sky_model {
+    RAD_SKY_UNIFORM = 1,  /* L = L_z everywhere above the horizon: E_horizontal = pi L_z */
+    RAD_SKY_CIE_OVERCAST, /* CIE standard overcast (Moon and Spencer): L = L_z (1 + 2 sin h)
+                             / 3, h the elevation: E_horizontal = 7 pi L_z / 9 */
+    RAD_SKY_CIE_CLEAR     /* CIE standard clear sky (CIE S 011 type 12), its sun along the
+                             light's `direction` (the sun's own light is a separate
+                             RAD_LIGHT_DIRECTIONAL) */
+} rad_sky_model;
+
+/* A photometric web read from an IES LM-63 file (rad_photometry_read). Candela values are
+ * absolute (the file's multiplier and ballast factors applied). */
+typedef struct rad_photometry {
+    char source[512];            /* the file */
+    uint32_t photometric_type;   /* 1 = type C (the usual), 2 = type B, 3 = type A */
+    uint32_t vertical_count;     /* angles as the file lists them, ascending, degrees */
+    uint32_t horizontal_count;
+    double *vertical_degrees;
+    double *horizontal_degrees;
+    double *candela;             /* [h * vertical_count + v] */
+    double lumens;               /* the flux of the web, integrated over the sphere (lm) */
+} rad_photometry;
+
+/* Reads an IES LM-63 file (1986, 1991, 1995, 2002 and 2019 headers; TILT=NONE or INCLUDE
+ * or a TILT file beside it is ignored with a warning through `log`), every symmetric
+ * variant of the horizontal angles (a single 0: symmetric about the axis; 0..90 quadrant;
+ * 0..180 bilateral; 90..270; 0..360). RAD_ERR_PARSE naming the file and line for a short
+ * table, angles that are not ascending or out of range, a bad header or count, a negative
+ * candela value. */
+rad_status rad_photometry_read(const char *path, rad_log_fn log, void *log_user,
+                               rad_photometry **out, rad_error *error);
+void rad_photometry_destroy(rad_photometry *photometry);
+
+/* Candela toward (vertical angle, horizontal angle), degrees, photometric type C
+ * conventions (vertical 0 = nadir, 180 = zenith; horizontal counter-clockwise seen from
+ * above); bilinear in the table, the symmetric variants unfolded; 0 outside the table's
+ * vertical range. */
+double rad_photometry_candela(const rad_photometry *photometry, double vertical_degrees,
+                              double horizontal_degrees);
+
+typedef struct rad_light {
+    rad_light_type type;
+    char name[128];            /* what the file or the command line calls it */
+    rad_vec3 position;         /* point, spot, luminaire: scene units */
+    rad_vec3 direction;        /* unit. spot: its axis; luminaire: its nadir; directional
+                                  and the clear sky's sun: the way the light travels (from
+                                  the sun down to the scene) */
+    rad_vec3 reference;        /* luminaire: horizontal angle 0 (perpendicular to direction;
+                                  zero: chosen from the scene's axes) */
+    rad_rgb intensity;         /* point, spot: I (cd); directional: E_n (lux); sky: zenith
+                                  luminance (cd/m^2); environment, luminaire: a factor */
+    double inner_degrees;      /* spot: half-angles from the axis, 0 <= inner <= outer <= 90 */
+    double outer_degrees;
+    double angular_diameter_degrees; /* directional: the disk seen (the sun: 0.53); 0 = a
+                                        point at infinity, hard shadows */
+    rad_sky_model sky;         /* RAD_LIGHT_SKY */
+    double rotate_degrees;     /* environment: turned about rad_scene.up */
+    rad_photometry *photometry; /* luminaire: owned by the scene once added */
+    struct rad_image *environment; /* environment: owned by the scene once added */
+} rad_light;
+
+/* Adds a copy of `light` to the scene (rad_scene.lights); on success the scene owns its
+ * photometry and environment (freed by rad_scene_destroy), on failure the caller keeps
+ * them. RAD_ERR_INVALID with a message naming the light for: a type out of range, a
+ * non-finite value, a negative intensity, a zero direction where one is needed, spot
+ * angles outside 0 <= inner <= outer <= 90, an angular diameter outside [0, 20), a
+ * luminaire without photometry, an environment map that is missing or not 2:1. */
+rad_status rad_scene_add_light(rad_scene *scene, const rad_light *light, rad_error *error);
+
+/* "point", "spot", "sun", "sky", "environment", "luminaire". Never NULL. */
+const char *rad_light_type_name(rad_light_type type);
+
+/* The scene's north (unit, perpendicular to rad_scene.up): -z for a y-up scene, +y for a
+ * z-up one, unless rad_scene.north was set. East is north x up. */
+rad_vec3 rad_scene_north(const rad_scene *scene);
+
+/* Where the sun is: latitude and longitude in degrees (north and east positive), the
+ * local date and time and the time zone's offset from UTC in hours (east positive), by
+ * NOAA's solar position algorithm (Meeus), refraction included. Azimuth in degrees
+ * clockwise from north, elevation above the horizon. RAD_ERR_INVALID for a date or time
+ * out of range. */
+typedef struct rad_place_time {
+    double latitude, longitude;
+    int year, month, day;
+    double hour;               /* local time, e.g. 13.5 for half past one */
+    double utc_offset_hours;
+} rad_place_time;
+
+rad_status rad_sun_position(const rad_place_time *when, double *azimuth_degrees,
+                            double *elevation_degrees, rad_error *error);
+
+/* The sky's luminance relative to its zenith (L / L_z) toward a direction `elevation`
+ * radians above the horizon, `gamma` radians from the sun, the sun `sun_elevation`
+ * radians high (used by RAD_SKY_CIE_CLEAR only); 0 below the horizon. */
+double rad_sky_relative_luminance(rad_sky_model sky, double elevation, double gamma,
+                                  double sun_elevation);
 
 /* ------------------------------------------------------------------------------------ */
 /* Mesh: the scene split into patches                                                    */

@@ -18,6 +18,7 @@
 #include "core/error.h"
 #include "core/vec3.h"
 #include "radiosity.h"
+#include "lights/scene_lights.h"
 #include "scene/material_at.h"
 
 void rad_scene_destroy(rad_scene *scene)
@@ -32,6 +33,7 @@ void rad_scene_destroy(rad_scene *scene)
         free(scene->textures[t].rgb);
     free(scene->textures);
     free(scene->uv);
+    scene_lights_free(scene);
     free(scene);
 }
 
