@@ -847,12 +847,20 @@ bool rad_solver_from_name(const char *name, rad_solver *solver);
  * built in one place (rad_patch_inputs_build): area A_i; albedo rho_i, the material's, or
  * for a textured material the mean of albedo x texel over the patch; exitance
  * E_i = pi L_e, the material's emitted radiance (times the mean of its emissive texture
- * over the patch). */
+ * over the patch); the direct irradiance H_i of the scene's light sources (rad_light: the
+ * mean over the patch, shadows included); and the source term every solver uses,
+ * S_i = E_i + rho_i H_i: the light sources enter the solution here, as its first bounce,
+ * and B = S + diag(rho) F B. */
 typedef struct rad_patch_inputs {
     uint32_t n;        /* mesh->patch_count */
     double *area;      /* A_i */
     rad_rgb *albedo;   /* rho_i, in [0,1] */
     rad_rgb *exitance; /* E_i, >= 0 */
+    rad_rgb *direct;   /* H_i, >= 0 (0 without light sources) */
+    rad_rgb *direct_sharp; /* the part of H_i from point, spot, luminaire and sun lights,
+                              which the renderers recompute at each pixel for exact
+                              shadows */
+    rad_rgb *source;   /* S_i = E_i + rho_i H_i */
 } rad_patch_inputs;
 
 rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
@@ -865,7 +873,8 @@ typedef struct rad_system {
     const float *F;          /* n x n row-major, F_ij */
     const double *area;      /* A_i */
     const rad_rgb *albedo;   /* rho_i */
-    const rad_rgb *exitance; /* E_i */
+    const rad_rgb *exitance; /* the source term: E_i, plus rho_i H_i with light sources
+                                (rad_patch_inputs.source) */
 } rad_system;
 
 /* The system of `inputs` and `formfactors` (NULL: F = NULL), pointing into both: nothing

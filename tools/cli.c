@@ -285,6 +285,8 @@ bool cli_parse_shared(const cli_args *args, cli_shared *shared)
             return false;
         override_count++;
     }
+    if (!cli_parse_lights(args))
+        return false;
     quiet = args->value[OPT_QUIET] != NULL;
     unsigned long value;
     memset(shared, 0, sizeof(*shared));
@@ -437,6 +439,8 @@ bool cli_begin(const char *command, const char *usage, int argc, char **argv,
         return false;
     if (args->value[OPT_HELP]) {
         fputs(usage, stdout);
+        if (options[OPT_POINT].name)
+            fputs(CLI_LIGHT_HELP, stdout);
         *exit_code = EXIT_OK;
         return false;
     }
@@ -549,6 +553,13 @@ rad_status cli_load_scene_logged(const char *path, rad_log_fn log, void *log_use
             snprintf(message, sizeof(message), "%s", error->message);
             snprintf(error->message, sizeof(error->message), "--%s: %.900s",
                      o->is_emission ? "emit" : "albedo", message);
+            rad_scene_destroy(*scene);
+            *scene = NULL;
+        }
+    }
+    if (status == RAD_OK) {
+        status = cli_apply_lights(*scene, log, log_user, error);
+        if (status != RAD_OK) {
             rad_scene_destroy(*scene);
             *scene = NULL;
         }

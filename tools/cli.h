@@ -69,6 +69,8 @@ enum {
     OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_SOLUTION,        /* SOLVE */
     OPT_SAVE_SOLUTION, OPT_REFINE_THRESHOLD, OPT_MAX_MEMORY,
     OPT_EMIT, OPT_ALBEDO,                                               /* SCENE */
+    OPT_POINT, OPT_SPOT, OPT_SUN, OPT_TIME, OPT_SKY, OPT_LUMINAIRE, OPT_ENVIRONMENT,
+    OPT_ENVIRONMENT_ROTATE, OPT_UNIT, OPT_NORTH,
     OPT_OWN
 };
 
@@ -172,7 +174,32 @@ enum {
     "elsewhere too, RADIOSITY_PROGRESS=0 never.\n"
 
 #define CLI_SCENE_OPTIONS                                                                  \
-    [OPT_EMIT] = {"emit", 0, true}, [OPT_ALBEDO] = {"albedo", 0, true}
+    [OPT_EMIT] = {"emit", 0, true}, [OPT_ALBEDO] = {"albedo", 0, true},                    \
+    [OPT_POINT] = {"point", 0, true}, [OPT_SPOT] = {"spot", 0, true},                      \
+    [OPT_SUN] = {"sun", 0, true}, [OPT_TIME] = {"time", 0, true},                          \
+    [OPT_SKY] = {"sky", 0, true}, [OPT_LUMINAIRE] = {"luminaire", 0, true},                \
+    [OPT_ENVIRONMENT] = {"environment", 0, true},                                          \
+    [OPT_ENVIRONMENT_ROTATE] = {"environment-rotate", 0, true},                            \
+    [OPT_UNIT] = {"unit", 0, true}, [OPT_NORTH] = {"north", 0, true}
+
+/* The help of the light-source options (printed after a command's own help when its
+ * table has the SCENE group: the text would not fit in one string literal). */
+#define CLI_LIGHT_HELP                                                                     \
+    "\n"                                                                                   \
+    "Light sources besides emissive surfaces (repeatable; in candela and lux, radiance\n"    \
+    "comes out as luminance in cd/m^2 and irradiance as illuminance in lux):\n"            \
+    "  --point X,Y,Z:CD[:R,G,B]          a point light of CD candela (times R,G,B)\n"      \
+    "  --spot X,Y,Z:DX,DY,DZ:CD:IN:OUT[:R,G,B]  a spot along DX,DY,DZ: CD inside IN\n"     \
+    "                       degrees of its axis, none past OUT (half-angles), glTF falloff\n" \
+    "  --sun X,Y,Z[:LUX[:DIAM]]          the sun toward X,Y,Z: LUX on a plane facing it\n" \
+    "                       (default 100000), a disk DIAM degrees across (default 0.53)\n" \
+    "  --sun LAT,LON[:LUX[:DIAM]] --time YYYY-MM-DDTHH:MM[+HH:MM]  the sun's place at\n"    \
+    "                       that local time (NOAA's algorithm); below the horizon: none\n"  \
+    "  --sky uniform|cie-overcast|cie-clear[:LZ]  a sky of zenith luminance LZ cd/m^2\n"    \
+    "                       (default: 10000 lux on open ground); cie-clear needs --sun\n"   \
+    "  --unit m|cm|mm|in|ft  the scene's length unit, for the inverse-square law (default:\n" \
+    "                       the file's, glTF metres; else metres)\n"                        \
+    "  --north X,Y,Z        the scene's north (default -z for y up, +y for z up)\n"
 
 /* The help lines of the SCENE group. */
 #define CLI_SCENE_HELP                                                                     \
@@ -286,6 +313,12 @@ rad_status cli_load_scene(const char *path, rad_scene **scene, rad_error *error)
 /* The same with the loader's warnings sent to `log` instead. */
 rad_status cli_load_scene_logged(const char *path, rad_log_fn log, void *log_user,
                                  rad_scene **scene, rad_error *error);
+
+/* The light-source options (cli_lights.c): checked with the shared options (false after
+ * printing what is wrong), then added to a loaded scene by cli_load_scene. */
+bool cli_parse_lights(const cli_args *args);
+rad_status cli_apply_lights(rad_scene *scene, rad_log_fn log, void *log_user,
+                            rad_error *error);
 
 /* Value parsers: print "radiosity: --NAME: ..." and return false on a bad value. */
 bool cli_parse_double(const char *name, const char *text, double *out);

@@ -15,3 +15,13 @@ void rad_photometry_destroy(rad_photometry *photometry)
     free(photometry->candela);
     free(photometry);
 }
+
+/* PLACEHOLDER until the IES reader lands. */
+double rad_photometry_candela(const rad_photometry *photometry, double vertical_degrees,
+                              double horizontal_degrees)
+{
+    (void)photometry;
+    (void)vertical_degrees;
+    (void)horizontal_degrees;
+    return 0;
+}

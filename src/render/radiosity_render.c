@@ -31,6 +31,7 @@
 #include "core/rgb.h"
 #include "core/tolerance.h"
 #include "core/vec3.h"
+#include "lights/direct_light.h"
 #include "render/camera.h"
 #include "render/progress.h"
 #include "reconstruct/display_mesh.h"
@@ -40,6 +41,8 @@
 #define MAX_STRATA 16u
 #define EDGE_CONTRAST 0.1        /* relative luminance spread that makes an edge */
 #define EDGE_STREAM 0x5EED0EDCEull /* keeps edge samples' random numbers apart */
+#define LIGHT_STREAM 0x5EED11647ull /* the same for shadow rays toward light sources */
+#define LIGHT_BATCH 65536u         /* shadow rays traced together, at most */
 
 /* One thread's rays of one image row, compacted bounce by bounce. */
 typedef struct row_work {
@@ -50,6 +53,13 @@ typedef struct row_work {
     rad_rgb *sum;     /* radiance gathered per sample: first samples, then edge samples */
     uint8_t *edge;    /* per pixel of the row: gets edge samples */
     double *level;    /* per pixel of the row: mean luminance of its first samples */
+    uint32_t row;     /* the image row being rendered (random numbers) */
+    /* shadow rays toward the sharp light sources from the hits of a bounce */
+    rad_ray *light_rays;
+    rad_rgb *light_value;   /* radiance the ray adds to its sample when unblocked */
+    uint32_t *light_sample;
+    uint8_t *light_blocked;
+    uint32_t light_count, light_capacity;
 } row_work;
 
 typedef struct shading {
@@ -64,7 +74,12 @@ typedef struct shading {
     float t_near;
     double leave;                   /* how far mirror rays start off a surface (scene units) */
     const patch_material_lookup *textures; /* NULL: no textured surface */
-    const rad_patch_inputs *inputs; /* per patch: the means the solve used (with textures) */
+    const rad_patch_inputs *inputs; /* per patch: the means the solve used (with textures
+                                       or light sources) */
+    const light_set *lights;        /* NULL: no light sources besides emitters */
+    const rad_tracer *tracer;       /* for shadow rays */
+    uint32_t strata;                /* first samples per pixel, k^2 */
+    uint64_t seed;
 } shading;
 
 static double mean_luminance(const rad_rgb *samples, unsigned count)
@@ -95,7 +110,7 @@ static bool is_edge(const rad_rgb *samples, unsigned count, double mean)
  * at the point times the interpolated irradiance (/ pi). Where the probe finds no scene
  * triangle, the patch's means stand in: E_i / pi and rho_i. */
 static rad_rgb textured_radiance(const shading *sh, const rad_ray *ray, const rad_hit *hit,
-                                 uint32_t patch_index, rad_rgb irradiance)
+                                 uint32_t patch_index, rad_rgb irradiance, rad_rgb *albedo_at)
 {
     const rad_patch *patch = &sh->mesh->patches[patch_index];
     rad_vec3 point = v3(ray->origin[0] + (double)hit->t * ray->direction[0],
@@ -104,6 +119,7 @@ static rad_rgb textured_radiance(const shading *sh, const rad_ray *ray, const ra
     rad_rgb albedo = sh->inputs->albedo[patch_index];
     rad_rgb emission = rgb_scale(sh->inputs->exitance[patch_index], 1.0 / RAD_PI);
     patch_material_at(sh->textures, point, patch->normal, 2 * patch->bulge, &albedo, &emission);
+    *albedo_at = albedo;
     return rgb_add(emission, rgb_mul(albedo, irradiance));
 }
 
@@ -138,6 +154,38 @@ static uint32_t twin_triangle(const shading *sh, uint32_t twin, rad_vec3 point, 
     return best;
 }
 
+/* Traces the pending shadow rays and adds the light of those that got through. */
+static void flush_lights(const shading *sh, row_work *w)
+{
+    if (w->light_count == 0)
+        return;
+    rad_tracer_occluded(sh->tracer, w->light_rays, w->light_count, w->light_blocked);
+    for (uint32_t k = 0; k < w->light_count; k++)
+        if (!w->light_blocked[k])
+            rgb_add_to(&w->sum[w->light_sample[k]], w->light_value[k]);
+    w->light_count = 0;
+}
+
+/* Queues the shadow rays of the sharp light sources (point, spot, luminaire, sun) from a
+ * hit: each adds weight x albedo / pi x its irradiance to the sample when unblocked. */
+static void queue_lights(const shading *sh, row_work *w, uint32_t sample, rad_vec3 point,
+                         const rad_patch *patch, rad_rgb factor)
+{
+    if (w->light_count + sh->lights->sharp_count > w->light_capacity)
+        flush_lights(sh, w);
+    rad_rng rng = rad_rng_seed(sh->seed ^ LIGHT_STREAM, w->row, sample);
+    uint32_t count = light_set_rays(sh->lights, LIGHTS_SHARP, point, patch->normal,
+                                    2 * patch->bulge + sh->lights->leave, sample % sh->strata,
+                                    sh->strata, 0, &rng, &w->light_rays[w->light_count],
+                                    &w->light_value[w->light_count]);
+    for (uint32_t k = 0; k < count; k++) {
+        uint32_t q = w->light_count + k;
+        w->light_value[q] = rgb_mul(w->light_value[q], factor);
+        w->light_sample[q] = sample;
+    }
+    w->light_count += count;
+}
+
 /* Adds each hit's interpolated radiance (times the ray's weight) to its sample and, when
  * mirrors are allowed, writes the mirror rays of specular hits to the front of the arrays.
  * Returns how many rays are left for the next bounce. */
@@ -146,8 +194,16 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
     uint32_t next = 0;
     for (uint32_t r = 0; r < count; r++) {
         const rad_hit *hit = &w->hits[r];
-        if (hit->triangle == RAD_NO_HIT)
+        if (hit->triangle == RAD_NO_HIT) {
+            /* the sky (or environment) behind open geometry */
+            if (sh->lights && sh->lights->has_sky) {
+                const rad_ray *ray = &w->rays[r];
+                rad_vec3 d = v3_normalize(v3(ray->direction[0], ray->direction[1], ray->direction[2]));
+                rgb_add_to(&w->sum[w->sample[r]],
+                           rgb_mul(w->weight[r], light_set_sky_radiance(sh->lights, d)));
+            }
             continue;
+        }
         uint32_t triangle = hit->triangle;
         double hit_u = hit->u, hit_v = hit->v;
         uint32_t patch_index = sh->patch_of[triangle];
@@ -170,9 +226,19 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
         rad_rgb weight = w->weight[r];
         rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit_u - hit_v),
                                        rgb_add(rgb_scale(L[v[1]], hit_u), rgb_scale(L[v[2]], hit_v)));
+        rad_rgb albedo = sh->inputs ? sh->inputs->albedo[patch_index] : (rad_rgb){0, 0, 0};
         if (patch_material_textured(sh->textures, sh->mesh->patches[patch_index].material))
-            interpolated = textured_radiance(sh, &w->rays[r], hit, patch_index, interpolated);
+            interpolated =
+                textured_radiance(sh, &w->rays[r], hit, patch_index, interpolated, &albedo);
         rgb_add_to(&w->sum[w->sample[r]], rgb_mul(weight, interpolated));
+        if (sh->lights && sh->lights->sharp_count > 0 && !rgb_is_zero(albedo)) {
+            const rad_ray *ray = &w->rays[r];
+            rad_vec3 point = v3(ray->origin[0] + (double)hit->t * ray->direction[0],
+                                ray->origin[1] + (double)hit->t * ray->direction[1],
+                                ray->origin[2] + (double)hit->t * ray->direction[2]);
+            queue_lights(sh, w, w->sample[r], point, &sh->mesh->patches[patch_index],
+                         rgb_scale(rgb_mul(weight, albedo), 1.0 / RAD_PI));
+        }
         if (!mirrors || !sh->materials)
             continue;
         const rad_patch *patch = &sh->mesh->patches[patch_index];
@@ -202,16 +268,20 @@ static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work 
     for (unsigned depth = 0; count > 0; depth++) {
         rad_tracer_intersect(tracer, w->rays, count, w->hits);
         count = shade_hits(sh, w, count, depth < max_depth);
+        flush_lights(sh, w);
     }
 }
 
-/* With textures: the lookup, the patch inputs (the caller's, else built here into *built)
- * and the per-patch values to reconstruct: (B - E) / rho on textured patches (0 where rho
- * is 0), B elsewhere. All NULL when there is no scene or no textured triangle. */
-static rad_status textures_begin(const rad_render_options *options, const rad_mesh *mesh,
-                                 const rad_rgb *B, patch_material_lookup **lookup,
-                                 const rad_patch_inputs **inputs, rad_patch_inputs **built,
-                                 rad_rgb **shaded, rad_error *error)
+/* With textures or light sources: the texture lookup (NULL without textures), the patch
+ * inputs (the caller's, else built here into *built) and the per-patch values to
+ * reconstruct, without the direct light of the sharp sources (point, spot, luminaire, sun:
+ * H_sharp), which is added at each hit instead: on textured patches the irradiance
+ * (B - E) / rho - H_sharp (0 where rho is 0), elsewhere the exitance B - rho H_sharp. All
+ * NULL when there is no scene or neither textures nor light sources. */
+static rad_status inputs_begin(const rad_render_options *options, const rad_mesh *mesh,
+                               const rad_rgb *B, patch_material_lookup **lookup,
+                               const rad_patch_inputs **inputs, rad_patch_inputs **built,
+                               rad_rgb **shaded, rad_error *error)
 {
     *lookup = NULL;
     *inputs = NULL;
@@ -222,10 +292,12 @@ static rad_status textures_begin(const rad_render_options *options, const rad_me
         return rad_fail(error, RAD_ERR_INVALID,
                         "render: the patch inputs are for %u patches, the mesh has %u",
                         options->inputs->n, mesh->patch_count);
-    if (!scene || scene->texture_count == 0)
+    if (!scene || (scene->texture_count == 0 && scene->light_count == 0))
         return RAD_OK;
-    rad_status status = patch_material_lookup_create(scene, lookup, error);
-    if (status != RAD_OK || !*lookup)
+    rad_status status = RAD_OK;
+    if (scene->texture_count > 0)
+        status = patch_material_lookup_create(scene, lookup, error);
+    if (status != RAD_OK || (!*lookup && scene->light_count == 0))
         return status;
     if (!options->inputs) {
         status = rad_patch_inputs_build(scene, mesh, built, error);
@@ -237,15 +309,16 @@ static rad_status textures_begin(const rad_render_options *options, const rad_me
     if (!*shaded)
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for textures");
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        const double *b = &B[p].r, *e = &(*inputs)->exitance[p].r;
+        const double *rho = &(*inputs)->albedo[p].r, *h = &(*inputs)->direct_sharp[p].r;
+        double *out = &(*shaded)[p].r;
         if (!patch_material_textured(*lookup, mesh->patches[p].material)) {
-            (*shaded)[p] = B[p];
+            for (int c = 0; c < 3; c++)
+                out[c] = fmax(b[c] - rho[c] * h[c], 0);
             continue;
         }
-        const double *b = &B[p].r, *e = &(*inputs)->exitance[p].r;
-        const double *rho = &(*inputs)->albedo[p].r;
-        double *out = &(*shaded)[p].r;
         for (int c = 0; c < 3; c++)
-            out[c] = rho[c] > 0 ? (b[c] - e[c]) / rho[c] : 0;
+            out[c] = rho[c] > 0 ? fmax((b[c] - e[c]) / rho[c] - h[c], 0) : 0;
     }
     return RAD_OK;
 }
@@ -282,6 +355,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     rad_patch_inputs *built_inputs = NULL;
     rad_rgb *shaded = NULL;
     uint32_t *first_triangle = NULL;
+    light_set lights;
+    const light_set *lights_ptr = NULL;
     status = display_mesh_build(mesh, true, &display, error);
     if (status != RAD_OK)
         goto done;
@@ -290,9 +365,13 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     if (!radiance || !positions)
         goto nomem;
     display_mesh_positions(mesh, &display, positions);
-    status = textures_begin(options, mesh, B, &lookup, &inputs, &built_inputs, &shaded, error);
+    status = inputs_begin(options, mesh, B, &lookup, &inputs, &built_inputs, &shaded, error);
     if (status != RAD_OK)
         goto done;
+    if (options->scene && options->scene->light_count > 0) {
+        light_set_init(&lights, options->scene);
+        lights_ptr = &lights;
+    }
     if (!display_mesh_radiance(mesh, &display, shaded ? shaded : B, radiance))
         goto nomem;
     /* the tracer sees the front patches: the twins come after them (rad_mesh), and so do
@@ -346,13 +425,24 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         w->level = rad_alloc_array(W, sizeof(*w->level));
         if (!w->rays || !w->hits || !w->weight || !w->sample || !w->sum || !w->edge || !w->level)
             goto nomem;
+        if (lights_ptr && lights.sharp_count > 0) {
+            w->light_capacity = LIGHT_BATCH > lights.sharp_count ? LIGHT_BATCH : lights.sharp_count;
+            w->light_rays = rad_alloc_array(w->light_capacity, sizeof(*w->light_rays));
+            w->light_value = rad_alloc_array(w->light_capacity, sizeof(*w->light_value));
+            w->light_sample = rad_alloc_array(w->light_capacity, sizeof(*w->light_sample));
+            w->light_blocked = rad_alloc_array(w->light_capacity, sizeof(*w->light_blocked));
+            if (!w->light_rays || !w->light_value || !w->light_sample || !w->light_blocked)
+                goto nomem;
+        }
     }
     shading shade = {mesh,      (const uint32_t(*)[3])display.triangles,
                      display.patch_of, first_triangle,
                      radiance,  positions,
                      options->materials,
                      t_near,    leave,
-                     lookup,    inputs};
+                     lookup,    inputs,
+                     lights_ptr, tracer,
+                     k * k,     options->seed};
 
     render_progress progress =
         render_progress_start(options->progress, options->progress_user, "render", H);
@@ -360,6 +450,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     for (uint32_t y = 0; y < H; y++) {
         int thread = omp_get_thread_num();
         row_work *w = &work[thread];
+        w->row = y;
         for (uint32_t x = 0; x < W; x++) {
             rad_rng rng = rad_rng_seed(options->seed, y, x);
             for (unsigned s = 0; s < k * k; s++) {
@@ -435,6 +526,10 @@ done:
             free(work[th].sum);
             free(work[th].edge);
             free(work[th].level);
+            free(work[th].light_rays);
+            free(work[th].light_value);
+            free(work[th].light_sample);
+            free(work[th].light_blocked);
         }
     free(work);
     rad_tracer_destroy(tracer);

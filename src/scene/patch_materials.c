@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
+#include "mesh/patch_point.h"
 #include "scene/material_at.h"
 
 /* Points per patch edge for the averages (8 x 8 per patch). */
@@ -115,23 +116,6 @@ bool patch_material_at(const patch_material_lookup *l, rad_vec3 point, rad_vec3 
     probe(&ray, point, normal, fmax(reach, l->reach));
     rad_tracer_intersect(l->tracer, &ray, 1, &hit);
     return material_of_hit(l, &hit, albedo, emission);
-}
-
-/* Point (s, t) in [0,1]^2 of a patch: bilinear on a quad; on a triangle, the unit square
- * folded onto it. */
-static rad_vec3 patch_point(const rad_mesh *mesh, const rad_patch *p, double s, double t)
-{
-    const rad_vec3 *v = mesh->vertices;
-    if (p->vertex_count == 4)
-        return v3_add(v3_add(v3_scale(v[p->vertex[0]], (1 - s) * (1 - t)),
-                             v3_scale(v[p->vertex[1]], s * (1 - t))),
-                      v3_add(v3_scale(v[p->vertex[2]], s * t), v3_scale(v[p->vertex[3]], (1 - s) * t)));
-    if (s + t > 1) {
-        s = 1 - s;
-        t = 1 - t;
-    }
-    return v3_add(v3_scale(v[p->vertex[0]], 1 - s - t),
-                  v3_add(v3_scale(v[p->vertex[1]], s), v3_scale(v[p->vertex[2]], t)));
 }
 
 /* The means over the patch's 8 x 8 points of the textured albedo and emission; false when

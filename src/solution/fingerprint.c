@@ -2,8 +2,9 @@
  * fingerprint.c - rad_solution_fingerprint: a hash of everything a radiosity solution
  * depends on, so a solution file is never applied to another scene or meshing.
  *
- * What is hashed: the scene's positions and triangles, each patch's albedo and exitance
- * as rad_patch_inputs_build hands them to every solver (so however materials come to patches,
+ * What is hashed: the scene's positions and triangles, each patch's albedo and source term
+ * (exitance plus the reflected direct light of light sources) as rad_patch_inputs_build
+ * hands them to every solver (so however materials and lights come to patches,
  * the fingerprint follows), the patch size, and the mesh's counts and patch vertices. Not
  * hashed: names, the file's path, cameras and specular terms, which do not change B. The
  * mesh's computed coordinates are left out on purpose: they follow from the hashed inputs,
@@ -42,7 +43,7 @@ rad_status rad_solution_fingerprint(const rad_scene *scene, const rad_mesh *mesh
         h = hash_u32(h, patch->vertex_count);
         for (uint32_t k = 0; k < patch->vertex_count; k++)
             h = hash_u32(h, patch->vertex[k]);
-        const rad_rgb *rho = &inputs->albedo[p], *E = &inputs->exitance[p];
+        const rad_rgb *rho = &inputs->albedo[p], *E = &inputs->source[p];
         h = hash_f64(h, rho->r);
         h = hash_f64(h, rho->g);
         h = hash_f64(h, rho->b);

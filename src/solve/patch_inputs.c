@@ -4,14 +4,18 @@
  *
  * Exitance E_i = pi * L_e (the material's emitted radiance, METHOD.md section 3); albedo
  * rho_i the material's; for a textured material both are averages over the patch
- * (rad_patch_materials).
+ * (rad_patch_materials). The scene's light sources add their direct irradiance H_i
+ * (lights/patch_direct.c), and the source term S_i = E_i + rho_i H_i is what the solvers
+ * take.
  */
 #include <stdint.h>
 #include <stdlib.h>
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/rgb.h"
 #include "core/vec3.h"
+#include "lights/patch_direct.h"
 
 void rad_patch_inputs_destroy(rad_patch_inputs *inputs)
 {
@@ -20,6 +24,9 @@ void rad_patch_inputs_destroy(rad_patch_inputs *inputs)
     free(inputs->area);
     free(inputs->albedo);
     free(inputs->exitance);
+    free(inputs->direct);
+    free(inputs->direct_sharp);
+    free(inputs->source);
     free(inputs);
 }
 
@@ -34,8 +41,12 @@ rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
         in->area = rad_alloc_array(n, sizeof(*in->area));
         in->albedo = rad_alloc_array(n, sizeof(*in->albedo));
         in->exitance = rad_alloc_array(n, sizeof(*in->exitance));
+        in->direct = rad_alloc_array(n, sizeof(*in->direct));
+        in->direct_sharp = rad_alloc_array(n, sizeof(*in->direct_sharp));
+        in->source = rad_alloc_array(n, sizeof(*in->source));
     }
-    if (!in || !in->area || !in->albedo || !in->exitance) {
+    if (!in || !in->area || !in->albedo || !in->exitance || !in->direct || !in->direct_sharp ||
+        !in->source) {
         rad_patch_inputs_destroy(in);
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u patches", n);
     }
@@ -50,6 +61,14 @@ rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
     for (uint32_t i = 0; i < n; i++)
         in->exitance[i] = (rad_rgb){RAD_PI * in->exitance[i].r, RAD_PI * in->exitance[i].g,
                                     RAD_PI * in->exitance[i].b};
+    /* the light sources' direct light, the first bounce of every solver */
+    status = patch_direct_light(scene, mesh, in->direct, in->direct_sharp, error);
+    if (status != RAD_OK) {
+        rad_patch_inputs_destroy(in);
+        return status;
+    }
+    for (uint32_t i = 0; i < n; i++)
+        in->source[i] = rgb_add(in->exitance[i], rgb_mul(in->albedo[i], in->direct[i]));
     *out = in;
     return RAD_OK;
 }
@@ -57,5 +76,5 @@ rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
 rad_system rad_system_of(const rad_patch_inputs *inputs, const rad_formfactors *formfactors)
 {
     return (rad_system){inputs->n, formfactors ? formfactors->F : NULL, inputs->area,
-                        inputs->albedo, inputs->exitance};
+                        inputs->albedo, inputs->source};
 }

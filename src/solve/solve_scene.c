@@ -227,10 +227,11 @@ rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
                         rad_solver_name(r.solver), mesh->patch_count, dense_bytes / 1048576.0,
                         r.solver == RAD_SOLVER_DIRECT ? "12 n^2 bytes" : "4 n^2 bytes",
                         (double)o.max_memory / 1048576.0);
-    if (!rad_scene_has_emitter(scene))
+    if (!rad_scene_has_emitter(scene) && scene->light_count == 0)
         rad_warn(o.log, o.log_user,
-                 "%s: no surface emits light (no material with non-zero Ke): the result "
-                 "will be black (--emit NAME=R,G,B makes a surface a light)",
+                 "%s: no light: no surface emits (no material with non-zero Ke) and the "
+                 "scene has no light source: the result will be black (--emit NAME=R,G,B "
+                 "makes a surface a light; --point, --spot, --sun, --sky add sources)",
                  scene->source);
 
     rad_patch_inputs *built = NULL;
@@ -254,10 +255,10 @@ rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
                      ? solve_hierarchy(scene, mesh, inputs, occluders, &o, B, &r, error)
                      : solve_dense(scene, mesh, inputs, occluders, &o, r.solver, B, &r, error);
     rad_tracer_destroy(occluders);
-    /* every value finite and at least the patch's own exitance (what comes in is >= 0) */
+    /* every value finite and at least the patch's own source term (what comes in is >= 0) */
     for (uint32_t i = 0; status == RAD_OK && i < mesh->patch_count; i++) {
         rad_rgb *b = &B[i];
-        const rad_rgb *e = &inputs->exitance[i];
+        const rad_rgb *e = &inputs->source[i];
         if (!(isfinite(b->r) && isfinite(b->g) && isfinite(b->b)))
             status = rad_fail(error, RAD_ERR_INTERNAL,
                               "%s: surface '%s' (patch %u): the %s solution is not finite (a "

@@ -231,7 +231,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     if (!hier_tree_build(mesh, &s.tree))
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory building the element tree");
     uint32_t nodes = s.tree.node_count;
-    s.emission = inputs->exitance;
+    s.emission = inputs->source; /* E + rho H: the light sources' first bounce */
     s.albedo = inputs->albedo;
     s.patch_B = rad_alloc_array(n, sizeof(rad_rgb));
     s.brightness = rad_alloc_array(n, sizeof(float));
