@@ -192,14 +192,15 @@ uint32_t light_set_rays(const light_set *set, unsigned which, rad_vec3 x, rad_ve
     if ((which & LIGHTS_SOFT) && set->has_sky && sky_rays > 0) {
         rad_vec3 a, b;
         frame_of(n, &a, &b);
-        uint32_t k = grid_side(sky_rays);
-        /* the first k^2 directions stratified, the rest uniform; a random turn per call
-         * keeps the strata of different samples apart */
-        double turn = 2 * RAD_PI * rad_rng_uniform(rng);
-        (void)sample;
+        /* one direction: stratum `sample` of the caller's samples; several: stratified
+         * among themselves (the first k^2), with a random turn per call */
+        uint32_t k = sky_rays == 1 ? grid_side(sample_count) : grid_side(sky_rays);
+        double turn = sky_rays == 1 ? 0 : 2 * RAD_PI * rad_rng_uniform(rng);
         for (uint32_t j = 0; j < sky_rays; j++) {
             double u1, u2;
-            if (j < k * k)
+            if (sky_rays == 1 && sample < k * k)
+                stratum(sample, k, rng, &u1, &u2);
+            else if (sky_rays > 1 && j < k * k)
                 stratum(j, k, rng, &u1, &u2);
             else {
                 u1 = rad_rng_uniform(rng);

@@ -1,8 +1,9 @@
 /*
  * patch_direct.c - the direct light of the scene's light sources on each patch: the mean
  * irradiance over PATCH_LIGHT_POINTS^2 stratified jittered points of the patch, each with
- * one shadow ray per point-like source or sun and PATCH_SKY_RAYS directions toward the
- * sky, traced against the scene's own triangles. Random numbers come from (patch, point),
+ * one shadow ray per point-like source or sun and one direction toward the sky, the
+ * directions stratified over the hemisphere across the points (a stratum per point, in
+ * an order unrelated to the points' places), traced against the scene's own triangles. Random numbers come from (patch, point),
  * so the result is the same for any thread count.
  */
 #include <math.h>
@@ -18,8 +19,7 @@
 #include "lights/patch_direct.h"
 #include "mesh/patch_point.h"
 
-#define PATCH_LIGHT_POINTS 4u /* per side: 16 points per patch */
-#define PATCH_SKY_RAYS 4u     /* per point: 64 sky directions per patch */
+#define PATCH_LIGHT_POINTS 8u /* per side: 64 points per patch, one sky direction each */
 #define PATCH_LIGHT_STREAM 0x11647ull
 
 typedef struct thread_buffers {
@@ -44,7 +44,7 @@ rad_status patch_direct_light(const rad_scene *scene, const rad_mesh *mesh, rad_
     light_set set;
     light_set_init(&set, scene);
     const uint32_t points = PATCH_LIGHT_POINTS * PATCH_LIGHT_POINTS;
-    uint32_t per_point = light_set_capacity(&set, LIGHTS_SHARP | LIGHTS_SOFT, PATCH_SKY_RAYS);
+    uint32_t per_point = light_set_capacity(&set, LIGHTS_SHARP | LIGHTS_SOFT, 1);
     size_t capacity = (size_t)points * per_point;
     rad_tracer *tracer = NULL;
     rad_status status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &tracer, error);
@@ -78,8 +78,10 @@ rad_status patch_direct_light(const rad_scene *scene, const rad_mesh *mesh, rad_
                 for (uint32_t k = 0; k < sharp; k++)
                     b->sharp[count + k] = 1;
                 count += sharp;
-                uint32_t soft = light_set_rays(&set, LIGHTS_SOFT, x, patch->normal, leave, q,
-                                               points, PATCH_SKY_RAYS, &rng, &b->rays[count],
+                /* 37 is prime to the point count (a power of 4): a permutation of strata */
+                uint32_t direction = (q * 37u + 11u) % points;
+                uint32_t soft = light_set_rays(&set, LIGHTS_SOFT, x, patch->normal, leave,
+                                               direction, points, 1, &rng, &b->rays[count],
                                                &b->irradiance[count]);
                 for (uint32_t k = 0; k < soft; k++)
                     b->sharp[count + k] = 0;
