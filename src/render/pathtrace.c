@@ -5,8 +5,10 @@
  * two-sided: RAD_SURFACE_TWO_SIDED, both sides alike) surfaces with albedo Kd and emitted
  * radiance Ke, the same model radiosity solves, each times its texture's texel at the point
  * (scene/material_at.h: albedo at every path vertex, emission seen by every ray and at
- * every light sample). What it is not: a general renderer (no specular, no environment
- * light).
+ * every light sample), lit by emissive surfaces and by the scene's light sources (rad_light:
+ * point, spot, luminaire and sun by next-event estimation, one shadow ray each per
+ * vertex; sky and environment seen by the rays that leave the scene). What it is not: a
+ * general renderer (no specular).
  *
  * The one idea needed to read it: the image is cut into TILE x TILE tiles, and each tile is
  * traced as a sequence of WAVES. A wave holds SAMPLES_PER_WAVE samples of every pixel of
@@ -36,6 +38,7 @@
 #include "core/tolerance.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
+#include "lights/direct_light.h"
 #include "render/camera.h"
 #include "render/emitters.h"
 #include "render/progress.h"
@@ -106,6 +109,8 @@ typedef struct pt_context {
     uint64_t seed;
     double offset;           /* ray offset in scene units */
     float camera_near;       /* t_near of camera rays */
+    const light_set *lights; /* the scene's light sources besides emitters */
+    uint32_t shadow_capacity; /* shadow rays per bounce of a wave, at most */
 } pt_context;
 
 /* Plain comparisons: fmax is a library call unless NaNs are ruled out, and none occur. */
@@ -226,11 +231,19 @@ static uint32_t extend_paths(const pt_context *c, pt_workspace *w, uint32_t live
         const rad_hit hit = w->hits[k];
         uint32_t p = w->active[k];
         pt_path *path = &w->paths[p];
-        if (hit.triangle == RAD_NO_HIT ||
-            (!hit.front && !triangle_two_sided(scene, hit.triangle)))
-            continue; /* escaped, or met a one-sided surface's back: nothing comes back */
         rad_vec3 d = v3((double)w->rays[k].direction[0], (double)w->rays[k].direction[1],
                         (double)w->rays[k].direction[2]);
+        if (hit.triangle == RAD_NO_HIT) {
+            /* escaped: the sky's radiance, whole (the sky is never sampled by next-event
+             * estimation, so BSDF sampling is its only estimator) */
+            if (c->lights->has_sky)
+                rgb_add_to(&path->radiance,
+                           rgb_mul(path->throughput,
+                                   light_set_sky_radiance(c->lights, v3_normalize(d))));
+            continue;
+        }
+        if (!hit.front && !triangle_two_sided(scene, hit.triangle))
+            continue; /* met a one-sided surface's back: nothing comes back */
         /* a two-sided surface's back is a front facing the ray, with the same material */
         rad_vec3 n = c->normals[hit.triangle];
         if (!hit.front)
@@ -259,6 +272,19 @@ static uint32_t extend_paths(const pt_context *c, pt_workspace *w, uint32_t live
         rad_vec3 o = v3_add(x, v3_scale(n, c->offset));
         if (c->emitters->count)
             shadows += (uint32_t)queue_light_sample(c, w, shadows, p, x, n, o, albedo);
+        if (c->lights->sharp_count) {
+            /* every point, spot, luminaire and sun light, each by one shadow ray: Kd / pi
+             * times its irradiance at x (the sun's disk sampled by the path's numbers) */
+            uint32_t count = light_set_rays(c->lights, LIGHTS_SHARP, x, n, c->offset, 0, 1, 0,
+                                            &path->rng, &w->shadow_rays[shadows],
+                                            &w->shadow_value[shadows]);
+            rad_rgb factor = rgb_scale(rgb_mul(path->throughput, albedo), 1.0 / RAD_PI);
+            for (uint32_t q = shadows; q < shadows + count; q++) {
+                w->shadow_value[q] = rgb_mul(w->shadow_value[q], factor);
+                w->shadow_path[q] = p;
+            }
+            shadows += count;
+        }
 
         double cos_theta;
         rad_vec3 wo = cosine_direction(n, &path->rng, &cos_theta);
@@ -363,17 +389,17 @@ static void workspace_free(pt_workspace *w)
     free(w->m2);
 }
 
-static int workspace_alloc(pt_workspace *w)
+static int workspace_alloc(pt_workspace *w, uint32_t shadow_capacity)
 {
     memset(w, 0, sizeof(*w));
     w->paths = rad_alloc_array(WAVE_PATHS, sizeof(*w->paths));
     w->active = rad_alloc_array(WAVE_PATHS, sizeof(*w->active));
     w->rays = rad_alloc_array(WAVE_PATHS, sizeof(*w->rays));
     w->hits = rad_alloc_array(WAVE_PATHS, sizeof(*w->hits));
-    w->shadow_rays = rad_alloc_array(WAVE_PATHS, sizeof(*w->shadow_rays));
-    w->shadow_path = rad_alloc_array(WAVE_PATHS, sizeof(*w->shadow_path));
-    w->shadow_value = rad_alloc_array(WAVE_PATHS, sizeof(*w->shadow_value));
-    w->occluded = rad_alloc_array(WAVE_PATHS, sizeof(*w->occluded));
+    w->shadow_rays = rad_alloc_array(shadow_capacity, sizeof(*w->shadow_rays));
+    w->shadow_path = rad_alloc_array(shadow_capacity, sizeof(*w->shadow_path));
+    w->shadow_value = rad_alloc_array(shadow_capacity, sizeof(*w->shadow_value));
+    w->occluded = rad_alloc_array(shadow_capacity, sizeof(*w->occluded));
     w->mean = rad_alloc_array(TILE * TILE * 3, sizeof(*w->mean));
     w->m2 = rad_alloc_array(TILE * TILE * 3, sizeof(*w->m2));
     return w->paths && w->active && w->rays && w->hits && w->shadow_rays && w->shadow_path &&
@@ -446,8 +472,13 @@ rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
     workspaces = rad_alloc_array((size_t)threads, sizeof(*workspaces));
     if (!normals || !workspaces)
         goto nomem;
+    light_set lights;
+    light_set_init(&lights, scene);
+    c.lights = &lights;
+    /* per path and bounce: one emitter sample and one ray per sharp light */
+    c.shadow_capacity = WAVE_PATHS * (1 + lights.sharp_count);
     for (int t = 0; t < threads; t++)
-        if (!workspace_alloc(&workspaces[t]))
+        if (!workspace_alloc(&workspaces[t], c.shadow_capacity))
             goto nomem;
     for (uint32_t t = 0; t < scene->triangle_count; t++) {
         const uint32_t *v = scene->triangles[t].vertex;

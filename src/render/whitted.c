@@ -55,6 +55,7 @@
 #include "core/tolerance.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
+#include "lights/direct_light.h"
 #include "render/camera.h"
 #include "render/emitters.h"
 #include "render/progress.h"
@@ -111,6 +112,8 @@ typedef struct rt_context {
     uint32_t width, height;
     float camera_near;            /* t_near of camera rays */
     double offset;                /* secondary-ray gap, scene units */
+    light_set scene_lights;       /* the scene's light sources besides emitters */
+    uint32_t sky_samples;         /* directions toward a sky per shading point */
 } rt_context;
 
 /* One thread's buffers, allocated before the rows start. */
@@ -207,11 +210,35 @@ static void shade_direct(const rt_context *ctx, rt_workspace *ws, const rad_mate
             queue_shadow(ctx, ws, from, light->position, 0, sample, add);
     }
 
+    uint64_t in_pixel = (ws->packet_first + sample) % ((uint64_t)ctx->strata * ctx->strata);
+    rad_rng rng = rad_rng_seed(ctx->seed + STREAM_LIGHT, pixel, (in_pixel << 32) | depth);
+    const light_set *lights = &ctx->scene_lights;
+    if (lights->count) {
+        /* the scene's light sources: (K_D + K_S <V,R>^n) / pi times each one's irradiance,
+         * one shadow ray per point, spot, luminaire or sun, sky_samples toward a sky */
+        uint32_t room = light_set_capacity(lights, LIGHTS_SHARP | LIGHTS_SOFT, ctx->sky_samples);
+        if (ws->shadow_count > 0 && ws->shadow_count + room > SHADOW_BATCH)
+            flush_shadows(ctx, ws); /* the buffers hold SHADOW_BATCH + room */
+        uint32_t first = ws->shadow_count;
+        uint32_t count = light_set_rays(lights, LIGHTS_SHARP | LIGHTS_SOFT, p, N, ctx->offset,
+                                        (uint32_t)in_pixel, ctx->strata * ctx->strata,
+                                        ctx->sky_samples, &rng, &ws->shadow_rays[first],
+                                        &ws->shadow_add[first]);
+        for (uint32_t q = first; q < first + count; q++) {
+            const rad_ray *ray = &ws->shadow_rays[q];
+            rad_vec3 L = v3_normalize(v3(ray->direction[0], ray->direction[1], ray->direction[2]));
+            double NL = v3_dot(N, L);
+            double lobe = specular && NL > 0 ? phong_lobe(N, L, NL, V, m->shininess) : 0;
+            rad_rgb brdf = rgb_scale(rgb_add(albedo, rgb_scale(m->specular, lobe)), 1 / RAD_PI);
+            ws->shadow_add[q] = rgb_mul(rgb_mul(weight, brdf), ws->shadow_add[q]);
+            ws->shadow_sample[q] = sample;
+        }
+        ws->shadow_count += count;
+    }
+
     uint32_t n = ctx->light_samples;
     if (n == 0)
         return;
-    uint64_t in_pixel = (ws->packet_first + sample) % ((uint64_t)ctx->strata * ctx->strata);
-    rad_rng rng = rad_rng_seed(ctx->seed + STREAM_LIGHT, pixel, (in_pixel << 32) | depth);
     /* Triangle choice stratified: u0 in stratum i, so each triangle gets a contiguous block
      * of samples; inside a block, the point is the block's j-th Halton point (bases 2, 3),
      * shifted by one random offset per shading point (Cranley-Patterson), so each sample
@@ -264,6 +291,14 @@ static void trace_packet(const rt_context *ctx, rt_workspace *ws, uint32_t count
         uint32_t alive = 0;
         for (uint32_t i = 0; i < count; i++) {
             const rad_hit *hit = &ws->hits[i];
+            if (hit->triangle == RAD_NO_HIT && ctx->scene_lights.has_sky) {
+                /* the sky (or environment) behind open geometry */
+                rt_path *gone = &ws->paths[i];
+                ws->radiance[gone->sample] = rgb_add(
+                    ws->radiance[gone->sample],
+                    rgb_mul(gone->weight, light_set_sky_radiance(&ctx->scene_lights, gone->direction)));
+                continue;
+            }
             if (hit->triangle == RAD_NO_HIT ||
                 (!hit->front && !triangle_two_sided(scene, hit->triangle)))
                 continue; /* black: a miss, or the back of a one-sided surface */
@@ -358,17 +393,17 @@ static void workspace_free(rt_workspace *ws)
     free(ws->pixel_sum);
 }
 
-static bool workspace_alloc(rt_workspace *ws, uint32_t width)
+static bool workspace_alloc(rt_workspace *ws, uint32_t width, uint32_t shadow_capacity)
 {
     memset(ws, 0, sizeof(*ws));
     ws->paths = rad_alloc_array(PACKET_SAMPLES, sizeof(*ws->paths));
     ws->rays = rad_alloc_array(PACKET_SAMPLES, sizeof(*ws->rays));
     ws->hits = rad_alloc_array(PACKET_SAMPLES, sizeof(*ws->hits));
     ws->radiance = rad_alloc_array(PACKET_SAMPLES, sizeof(*ws->radiance));
-    ws->shadow_rays = rad_alloc_array(SHADOW_BATCH, sizeof(*ws->shadow_rays));
-    ws->shadow_occluded = rad_alloc_array(SHADOW_BATCH, sizeof(*ws->shadow_occluded));
-    ws->shadow_add = rad_alloc_array(SHADOW_BATCH, sizeof(*ws->shadow_add));
-    ws->shadow_sample = rad_alloc_array(SHADOW_BATCH, sizeof(*ws->shadow_sample));
+    ws->shadow_rays = rad_alloc_array(shadow_capacity, sizeof(*ws->shadow_rays));
+    ws->shadow_occluded = rad_alloc_array(shadow_capacity, sizeof(*ws->shadow_occluded));
+    ws->shadow_add = rad_alloc_array(shadow_capacity, sizeof(*ws->shadow_add));
+    ws->shadow_sample = rad_alloc_array(shadow_capacity, sizeof(*ws->shadow_sample));
     ws->pixel_sum = rad_alloc_array(width, sizeof(*ws->pixel_sum));
     return ws->paths && ws->rays && ws->hits && ws->radiance && ws->shadow_rays &&
            ws->shadow_occluded && ws->shadow_add && ws->shadow_sample &&
@@ -426,6 +461,8 @@ rad_status rad_raytrace(const rad_scene *scene, const rad_camera *camera,
     ctx.lights = options->lights;
     ctx.light_count = options->light_count;
     ctx.ambient = options->ambient;
+    light_set_init(&ctx.scene_lights, scene);
+    ctx.sky_samples = options->light_samples ? options->light_samples : RAD_DEFAULT_LIGHT_SAMPLES;
     ctx.seed = options->seed;
     int threads = options->threads > 0 ? options->threads : omp_get_max_threads();
 
@@ -464,8 +501,11 @@ rad_status rad_raytrace(const rad_scene *scene, const rad_camera *camera,
                  c = scene->positions[v[2]];
         normal[t] = v3_normalize(v3_cross(v3_sub(b, a), v3_sub(c, a)));
     }
+    /* a batch, and room for one shading point's light-source rays past it */
+    uint32_t room = light_set_capacity(&ctx.scene_lights, LIGHTS_SHARP | LIGHTS_SOFT,
+                                       ctx.sky_samples);
     for (; workspaces_made < threads; workspaces_made++)
-        if (!workspace_alloc(&workspaces[workspaces_made], ctx.width)) {
+        if (!workspace_alloc(&workspaces[workspaces_made], ctx.width, SHADOW_BATCH + room)) {
             workspaces_made++; /* so that its partial buffers are freed too */
             goto nomem;
         }
