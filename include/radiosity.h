@@ -1172,6 +1172,42 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                       rad_error *error);
 
 /* ------------------------------------------------------------------------------------ */
+/* Illuminance at points: work planes and measuring points                               */
+
+#define RAD_DEFAULT_GATHER_RAYS 1024 /* rad_illuminance_options.gather_rays */
+
+typedef struct rad_illuminance_options {
+    uint32_t gather_rays;      /* directions over the hemisphere for the light from surfaces
+                                  and the sky, stratified, cosine-weighted; 0 = 1024 */
+    uint64_t seed;
+    int threads;
+} rad_illuminance_options;
+
+/* The irradiance (illuminance in lux with photometric lights) at each point, on the
+ * side its unit normal faces: the sharp light sources (point, spot, luminaire, sun) by
+ * exact shadow rays, then a final gather over the hemisphere: a ray that hits a patch
+ * brings its radiance (B / pi interpolated from the vertices, emitters included), a ray
+ * that leaves the scene the sky's. `E` receives `count` values. */
+rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
+                           const rad_vec3 *points, const rad_vec3 *normals, uint32_t count,
+                           const rad_illuminance_options *options, rad_rgb *E,
+                           rad_error *error);
+
+/* A horizontal calculation grid (normals up) `height` above the floor: points `spacing`
+ * apart over the scene's extent across rad_scene.up, half a spacing in from its edges, at
+ * the lowest scene point plus `height`, kept where the first surface straight below is
+ * the front of an upward-facing surface (the floor, not the outside of the building or
+ * the inside of a wall). *points is the caller's (free()); RAD_ERR_INVALID for a height
+ * or spacing that is not positive and finite, or more than 10^7 points; *count may be 0. */
+rad_status rad_work_plane(const rad_scene *scene, double height, double spacing,
+                          rad_vec3 **points, uint32_t *count, rad_error *error);
+
+/* The illuminance on an unobstructed horizontal plane under the scene's sky and
+ * environment lights alone (their sum, lux): the reference of the daylight factor. 0
+ * when there is none. */
+double rad_sky_horizontal_illuminance(const rad_scene *scene);
+
+/* ------------------------------------------------------------------------------------ */
 /* Ray tracing (Whitted, Phong model) and path tracing                                   */
 
 /* A point light of the classic Phong model: no distance falloff (METHOD.md section 1). */

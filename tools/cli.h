@@ -462,5 +462,6 @@ int command_raytrace(int argc, char **argv);
 int command_pathtrace(int argc, char **argv);
 int command_compare(int argc, char **argv);
 int command_info(int argc, char **argv);
+int command_illuminance(int argc, char **argv);
 
 #endif

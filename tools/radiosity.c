@@ -18,6 +18,8 @@ static const char usage[] =
     "  viewfactors SCENE         the surface-to-surface view-factor matrix as CSV\n"
     "  raytrace SCENE -o OUT     Whitted ray tracing with the Phong model\n"
     "  pathtrace SCENE -o OUT    a Monte-Carlo path tracer: the reference for radiosity\n"
+    "  illuminance [SCENE] --plane H -o OUT.csv  illuminance (lux) on a work plane, or\n"
+    "                            at --points FILE: E_min, E_avg, E_max, uniformity\n"
     "  compare A B [-o DIFF]     differences between two HDR images (.pfm, .hdr, .exr)\n"
     "  info [SCENE]              what was read: surfaces, materials, emitters, camera\n"
     "  help [COMMAND]            this text, or a command's\n"
@@ -34,6 +36,7 @@ static const command commands[] = {
     {"viewfactors", command_viewfactors},
     {"raytrace", command_raytrace}, {"pathtrace", command_pathtrace},
     {"compare", command_compare},   {"info", command_info},
+    {"illuminance", command_illuminance},
 };
 
 static const command *find_command(const char *name)

@@ -229,9 +229,9 @@ rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
                         (double)o.max_memory / 1048576.0);
     if (!rad_scene_has_emitter(scene) && scene->light_count == 0)
         rad_warn(o.log, o.log_user,
-                 "%s: no light: no surface emits (no material with non-zero Ke) and the "
-                 "scene has no light source: the result will be black (--emit NAME=R,G,B "
-                 "makes a surface a light; --point, --spot, --sun, --sky add sources)",
+                 "%s: no surface emits light (no material with non-zero Ke) and no light "
+                 "source is given: the result will be black (--emit NAME=R,G,B makes a "
+                 "surface a light; --point, --spot, --sun, --sky add sources)",
                  scene->source);
 
     rad_patch_inputs *built = NULL;

@@ -1,0 +1,171 @@
+/*
+ * illuminance.c - irradiance (illuminance) at given points from a radiosity solution:
+ * exact shadow rays toward the sharp light sources, then a final gather. Gather rays are
+ * cosine-weighted and stratified over the point's hemisphere (an estimate of
+ * E = integral L cos dw = pi x the mean radiance of the rays), each bringing the radiance
+ * interpolated at the display triangle it hits (B / pi at the vertices, as the renderer
+ * shows it; a two-sided patch's back its twin's B / pi) or the sky's when it leaves the
+ * scene. Random numbers come from (seed, point), so the values are the same for any
+ * thread count.
+ */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/random.h"
+#include "core/rgb.h"
+#include "core/vec3.h"
+#include "lights/direct_light.h"
+#include "reconstruct/display_mesh.h"
+#include "trace/ray.h"
+
+#define GATHER_STREAM 0x6A7E2ull
+
+typedef struct point_buffers {
+    rad_ray *rays;
+    rad_rgb *value;
+    uint8_t *blocked;
+    rad_hit *hits;
+} point_buffers;
+
+rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
+                           const rad_vec3 *points, const rad_vec3 *normals, uint32_t count,
+                           const rad_illuminance_options *options, rad_rgb *E,
+                           rad_error *error)
+{
+    rad_illuminance_options defaults = {0};
+    if (!options)
+        options = &defaults;
+    if (options->threads < 0)
+        return rad_fail(error, RAD_ERR_INVALID, "illuminance: thread count %d is negative",
+                        options->threads);
+    for (uint32_t i = 0; i < count; i++)
+        if (!v3_is_finite(points[i]) || !(v3_length(normals[i]) > 0) ||
+            !v3_is_finite(normals[i]))
+            return rad_fail(error, RAD_ERR_INVALID,
+                            "illuminance: point %u has a non-finite position or a zero normal",
+                            i);
+    uint32_t gather = options->gather_rays ? options->gather_rays : RAD_DEFAULT_GATHER_RAYS;
+    int threads = options->threads > 0 ? options->threads : omp_get_max_threads();
+    light_set lights;
+    light_set_init(&lights, scene);
+
+    display_mesh display = {0};
+    rad_rgb *radiance = NULL;
+    rad_vec3 *positions = NULL;
+    rad_tracer *surfaces = NULL, *occluders = NULL;
+    point_buffers *buffers = NULL;
+    uint32_t sharp = light_set_capacity(&lights, LIGHTS_SHARP, 0);
+    uint32_t capacity = sharp > gather ? sharp : gather;
+    rad_status status = display_mesh_build(mesh, true, &display, error);
+    if (status != RAD_OK)
+        goto done;
+    radiance = rad_alloc_array(display.vertex_count, sizeof(*radiance));
+    positions = rad_alloc_array(display.vertex_count, sizeof(*positions));
+    buffers = rad_alloc_array((size_t)threads, sizeof(*buffers));
+    if (!radiance || !positions || !buffers)
+        goto nomem;
+    for (int t = 0; t < threads; t++) {
+        point_buffers *b = &buffers[t];
+        b->rays = rad_alloc_array(capacity, sizeof(*b->rays));
+        b->value = rad_alloc_array(capacity, sizeof(*b->value));
+        b->blocked = rad_alloc_array(capacity, sizeof(*b->blocked));
+        b->hits = rad_alloc_array(gather, sizeof(*b->hits));
+        if (!b->rays || !b->value || !b->blocked || !b->hits)
+            goto nomem;
+    }
+    display_mesh_positions(mesh, &display, positions);
+    if (!display_mesh_radiance(mesh, &display, B, radiance))
+        goto nomem;
+    /* the front patches' triangles (twins come after them, and so do their display
+     * triangles); a hit on the back of a two-sided patch takes its twin's B */
+    uint32_t traced = display.triangle_count;
+    while (traced > 0 && mesh->patches[display.patch_of[traced - 1]].twin != 0 &&
+           mesh->patches[display.patch_of[traced - 1]].twin - 1 < display.patch_of[traced - 1])
+        traced--;
+    status = rad_tracer_create(RAD_TRACER_EMBREE, positions, display.vertex_count,
+                               (const uint32_t(*)[3])display.triangles, traced, &surfaces,
+                               error);
+    if (status == RAD_OK)
+        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &occluders, error);
+    if (status != RAD_OK)
+        goto done;
+
+#pragma omp parallel for schedule(dynamic, 16) num_threads(threads)
+    for (int64_t i = 0; i < (int64_t)count; i++) {
+        point_buffers *b = &buffers[omp_get_thread_num()];
+        rad_vec3 x = points[i], n = v3_normalize(normals[i]);
+        rad_rng rng = rad_rng_seed(options->seed ^ GATHER_STREAM, (uint64_t)i, 0);
+        rad_rgb sum = {0, 0, 0};
+        /* the sharp sources, exactly */
+        uint32_t k = light_set_rays(&lights, LIGHTS_SHARP, x, n, lights.leave, 0, 1, 0, &rng,
+                                    b->rays, b->value);
+        rad_tracer_occluded(occluders, b->rays, k, b->blocked);
+        for (uint32_t q = 0; q < k; q++)
+            if (!b->blocked[q])
+                rgb_add_to(&sum, b->value[q]);
+        /* the gather: cosine-weighted directions, stratified over a grid */
+        rad_vec3 helper = fabs(n.x) < 0.6 ? v3(1, 0, 0) : fabs(n.y) < 0.6 ? v3(0, 1, 0) : v3(0, 0, 1);
+        rad_vec3 a = v3_normalize(v3_cross(helper, n)), c = v3_cross(n, a);
+        uint32_t side = (uint32_t)floor(sqrt((double)gather));
+        rad_vec3 origin = v3_add(x, v3_scale(n, lights.leave));
+        for (uint32_t j = 0; j < gather; j++) {
+            double u1 = rad_rng_uniform(&rng), u2 = rad_rng_uniform(&rng);
+            if (j < side * side) {
+                u1 = ((j % side) + u1) / side;
+                u2 = ((j / side) + u2) / side;
+            }
+            double r = sqrt(u1), phi = 2 * RAD_PI * u2;
+            rad_vec3 w = v3_add(v3_scale(n, sqrt(fmax(0, 1 - u1))),
+                                v3_add(v3_scale(a, r * cos(phi)), v3_scale(c, r * sin(phi))));
+            ray_set(&b->rays[j], origin, w, 0, INFINITY);
+        }
+        rad_tracer_intersect(surfaces, b->rays, gather, b->hits);
+        rad_rgb gathered = {0, 0, 0};
+        for (uint32_t j = 0; j < gather; j++) {
+            const rad_hit *hit = &b->hits[j];
+            if (hit->triangle == RAD_NO_HIT) {
+                if (lights.has_sky) {
+                    const rad_ray *ray = &b->rays[j];
+                    rgb_add_to(&gathered,
+                               light_set_sky_radiance(&lights, v3(ray->direction[0],
+                                                                  ray->direction[1],
+                                                                  ray->direction[2])));
+                }
+                continue;
+            }
+            if (!hit->front) {
+                uint32_t twin = mesh->patches[display.patch_of[hit->triangle]].twin;
+                if (twin)
+                    rgb_add_to(&gathered, rgb_scale(B[twin - 1], 1 / RAD_PI));
+                continue;
+            }
+            const uint32_t *v = display.triangles[hit->triangle];
+            double u = hit->u, vv = hit->v;
+            rgb_add_to(&gathered, rgb_add(rgb_scale(radiance[v[0]], 1 - u - vv),
+                                          rgb_add(rgb_scale(radiance[v[1]], u),
+                                                  rgb_scale(radiance[v[2]], vv))));
+        }
+        E[i] = rgb_add(sum, rgb_scale(gathered, RAD_PI / gather));
+    }
+    goto done;
+nomem:
+    status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for illuminance at %u points", count);
+done:
+    if (buffers)
+        for (int t = 0; t < threads; t++) {
+            free(buffers[t].rays);
+            free(buffers[t].value);
+            free(buffers[t].blocked);
+            free(buffers[t].hits);
+        }
+    free(buffers);
+    rad_tracer_destroy(surfaces);
+    rad_tracer_destroy(occluders);
+    display_mesh_free(&display);
+    free(radiance);
+    free(positions);
+    return status;
+}
