@@ -479,9 +479,13 @@ rad_vec3 rad_scene_north(const rad_scene *scene);
 
 /* Where the sun is: latitude and longitude in degrees (north and east positive), the
  * local date and time and the time zone's offset from UTC in hours (east positive), by
- * NOAA's solar position algorithm (Meeus), refraction included. Azimuth in degrees
- * clockwise from north, elevation above the horizon. RAD_ERR_INVALID for a date or time
- * out of range. */
+ * NOAA's solar position algorithm (its Solar Calculator spreadsheet, after Meeus; about
+ * 0.01 degree for 1900..2100), its standard-atmosphere refraction added to the elevation.
+ * Azimuth in degrees clockwise from north, in [0, 360); elevation in degrees above the
+ * horizon. Either output may be NULL. RAD_ERR_INVALID, naming the field and its value,
+ * for a latitude outside [-90, 90], a longitude outside [-180, 180], a year outside
+ * 1900..2200, a month outside 1..12, a day the month lacks (leap years counted), an hour
+ * outside [0, 24], an offset outside [-14, 14], or a NULL `when`. */
 typedef struct rad_place_time {
     double latitude, longitude;
     int year, month, day;
@@ -494,7 +498,9 @@ rad_status rad_sun_position(const rad_place_time *when, double *azimuth_degrees,
 
 /* The sky's luminance relative to its zenith (L / L_z) toward a direction `elevation`
  * radians above the horizon, `gamma` radians from the sun, the sun `sun_elevation`
- * radians high (used by RAD_SKY_CIE_CLEAR only); 0 below the horizon. */
+ * radians high (gamma and the sun used by RAD_SKY_CIE_CLEAR only: CIE S 011 type 12,
+ * a = -1, b = -0.32, c = 10, d = -3, e = 0.45; a sun below the horizon is taken as it
+ * stands). 0 below the horizon, for a NaN angle and for an unknown model. */
 double rad_sky_relative_luminance(rad_sky_model sky, double elevation, double gamma,
                                   double sun_elevation);
 
