@@ -504,6 +504,12 @@ rad_status rad_sun_position(const rad_place_time *when, double *azimuth_degrees,
 double rad_sky_relative_luminance(rad_sky_model sky, double elevation, double gamma,
                                   double sun_elevation);
 
+/* The illuminance of an unobstructed horizontal plane under a sky of zenith luminance 1
+ * (the integral of L / L_z sin h over the upper hemisphere): pi for the uniform sky,
+ * 7 pi / 9 for the CIE overcast one, by quadrature for the clear sky with its sun
+ * `sun_elevation` radians high. */
+double rad_sky_horizontal_factor(rad_sky_model sky, double sun_elevation);
+
 /* ------------------------------------------------------------------------------------ */
 /* Mesh: the scene split into patches                                                    */
 

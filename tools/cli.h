@@ -197,6 +197,9 @@ enum {
     "                       that local time (NOAA's algorithm); below the horizon: none\n"  \
     "  --sky uniform|cie-overcast|cie-clear[:LZ]  a sky of zenith luminance LZ cd/m^2\n"    \
     "                       (default: 10000 lux on open ground); cie-clear needs --sun\n"   \
+    "  --environment FILE[:SCALE]  an equirectangular radiance map (.hdr, .exr, .pfm; 2:1,\n" \
+    "                       its centre looking north, top the zenith) around the scene\n"   \
+    "  --environment-rotate DEG  turn it about the up axis (clockwise from above)\n"      \
     "  --unit m|cm|mm|in|ft  the scene's length unit, for the inverse-square law (default:\n" \
     "                       the file's, glTF metres; else metres)\n"                        \
     "  --north X,Y,Z        the scene's north (default -z for y up, +y for z up)\n"

@@ -214,6 +214,19 @@ static bool build_light(const light_spec *spec, rad_light *light, bool *place, d
             return false;
         break;
     }
+    case OPT_ENVIRONMENT:
+        light->type = RAD_LIGHT_ENVIRONMENT;
+        intensity = 1;
+        if (n < 1 || n > 2 || f[0][0] == '\0') {
+            cli_error("--environment: '%s' is not FILE.hdr|.exr|.pfm[:SCALE]", spec->text);
+            return false;
+        }
+        if (n > 1 && !parse_number(option, f[1], "scale", &intensity))
+            return false;
+        if (rotate_text && !parse_number("environment-rotate", rotate_text, "degrees",
+                                         &light->rotate_degrees))
+            return false;
+        break;
     default:
         cli_error("--%s: not available yet", option);
         return false;
@@ -403,10 +416,39 @@ rad_status cli_apply_lights(rad_scene *scene, rad_log_fn log, void *log_user,
                 }
                 if (light.intensity.r < 0) {
                     /* the zenith luminance that gives DEFAULT_SKY_LUX on open ground */
-                    double factor = light.sky == RAD_SKY_UNIFORM ? PI : 7 * PI / 9;
-                    double lz = DEFAULT_SKY_LUX / factor;
+                    double sun_elevation = 0;
+                    if (light.sky == RAD_SKY_CIE_CLEAR) {
+                        double d = -(sun_travel.x * up.x + sun_travel.y * up.y + sun_travel.z * up.z) /
+                                   sqrt(sun_travel.x * sun_travel.x + sun_travel.y * sun_travel.y +
+                                        sun_travel.z * sun_travel.z);
+                        sun_elevation = asin(fmin(fmax(d, -1), 1));
+                    }
+                    double lz = DEFAULT_SKY_LUX / rad_sky_horizontal_factor(light.sky, sun_elevation);
                     light.intensity = (rad_rgb){lz, lz, lz};
                 }
+            }
+            if (light.type == RAD_LIGHT_ENVIRONMENT) {
+                char copy[1024], *f[MAX_FIELDS];
+                split_fields(specs[k].text, copy, sizeof(copy), f);
+                rad_image *map = NULL;
+                rad_status status = rad_image_read(f[0], &map, error);
+                if (status != RAD_OK)
+                    return blame(status, "environment", error);
+                if (map->width != 2 * map->height) {
+                    fail(error, RAD_ERR_INVALID,
+                         "--environment: %s is %ux%u: an equirectangular map is twice as wide "
+                         "as high",
+                         f[0], map->width, map->height);
+                    rad_image_destroy(map);
+                    return RAD_ERR_INVALID;
+                }
+                light.environment = map;
+                status = rad_scene_add_light(scene, &light, error);
+                if (status != RAD_OK) {
+                    rad_image_destroy(map);
+                    return blame(status, "environment", error);
+                }
+                continue;
             }
             rad_status status = rad_scene_add_light(scene, &light, error);
             if (status != RAD_OK)

@@ -19,6 +19,8 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "lights/direct_light.h"
+#include "lights/environment_map.h"
+#include "lights/sky_model.h"
 #include "trace/ray.h"
 
 static bool is_sharp(rad_light_type type)
@@ -126,6 +128,11 @@ static rad_rgb sky_radiance(const light_set *set, const rad_light *light, rad_ve
         }
         return rgb_scale(light->intensity,
                          rad_sky_relative_luminance(light->sky, elevation, gamma, sun_elevation));
+    }
+    if (light->type == RAD_LIGHT_ENVIRONMENT) {
+        double azimuth, elevation;
+        sky_angles(w, set->up, set->north, light->rotate_degrees, &azimuth, &elevation);
+        return rgb_mul(light->intensity, environment_radiance(light->environment, azimuth, elevation));
     }
     return (rad_rgb){0, 0, 0};
 }

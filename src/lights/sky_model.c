@@ -188,3 +188,8 @@ rad_vec3 sky_direction(double azimuth, double elevation, rad_vec3 up, rad_vec3 n
                          v3_scale(east, horizontal * sin(azimuth))),
                   v3_scale(up, sin(elevation)));
 }
+
+double rad_sky_horizontal_factor(rad_sky_model sky, double sun_elevation)
+{
+    return sky_horizontal_illuminance_factor(sky, sun_elevation);
+}
