@@ -103,6 +103,13 @@ static const char *axis_name(rad_vec3 up)
     return "oblique";
 }
 
+/* A component of a unit vector as shown with 6 digits: float noise below that (a
+ * rotation by 90 degrees in single precision leaves 4e-8) and -0 shown as 0. */
+static double shown(double v)
+{
+    return fabs(v) < 5e-7 ? 0 : v;
+}
+
 /* One line per light: type, name, where it is and where it points (as the type has
  * them), its intensity in its unit, a spot's cone half-angles. */
 static void describe_lights(report *r, const rad_scene *scene)
@@ -121,11 +128,11 @@ static void describe_lights(report *r, const rad_scene *scene)
                                                                              : " (factor)";
         say(r, "  %-11s %-24s", rad_light_type_name(type), light->name);
         if (placed)
-            say(r, "  position (%.6g, %.6g, %.6g)", light->position.x, light->position.y,
-                light->position.z);
+            say(r, "  position (%.6g, %.6g, %.6g)", light->position.x + 0.0,
+                light->position.y + 0.0, light->position.z + 0.0); /* + 0.0: no -0 */
         if (directed)
-            say(r, "  direction (%.6g, %.6g, %.6g)", light->direction.x, light->direction.y,
-                light->direction.z);
+            say(r, "  direction (%.6g, %.6g, %.6g)", shown(light->direction.x),
+                shown(light->direction.y), shown(light->direction.z));
         say(r, "  intensity (%.6g, %.6g, %.6g)%s", light->intensity.r, light->intensity.g,
             light->intensity.b, unit);
         if (type == RAD_LIGHT_SPOT)
