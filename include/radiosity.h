@@ -248,9 +248,14 @@ typedef struct rad_load_options {
  * unreadable is a warning (the value is then the factor alone), and so is an emission
  * texture under an emission factor of 0 (it shows nothing). A surface is a mesh's name (OBJ o/g, glTF mesh, STL solid), else its
  * node's, else the file's name without extension. The first glTF camera becomes the
- * scene's camera. A glTF material's doubleSided makes every surface using it
- * RAD_SURFACE_TWO_SIDED. A material with a specular colour (MTL Ks) but a black diffuse one
- * is a warning: radiosity sees it black. Degenerate triangles are skipped with a warning;
+ * scene's camera. Lights become rad_scene.lights: glTF KHR_lights_punctual (read from the
+ * JSON: each node of the default scene holding one, at its world transform, along its -Z;
+ * color x intensity; a malformed light is an error), and Assimp's point, spot and
+ * directional lights for other formats (their colour taken as cd or lux, a warning says
+ * so; area and ambient lights skipped with a warning). A glTF material's doubleSided
+ * makes every surface using it RAD_SURFACE_TWO_SIDED. A material with a specular colour
+ * (MTL Ks) but a black diffuse one is a warning: radiosity sees it black. Degenerate
+ * triangles are skipped with a warning;
  * non-finite coordinates, a missing material library or glTF buffer, a truncated .glb, an
  * index out of range, unreadable or empty files are errors. A View3D input file is read by
  * rad_scene_load_vs3 below (*.vs3, or View3D content). */

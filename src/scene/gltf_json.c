@@ -6,11 +6,17 @@
  * the file: a .glb shorter than its header says, a buffer whose file is missing or short,
  * and references (accessor, buffer view, buffer, material, mesh, node) beyond their arrays
  * or byte ranges beyond their buffers, which Assimp 5.2 does not all check.
+ *
+ * Lights (KHR_lights_punctual) are read here rather than from Assimp's aiLight: Assimp
+ * 5.2 stores glTF's cone half-angles where aiLight means full angles, and places the light
+ * by its node name only. Each node of the default scene that holds a light gives one,
+ * placed by the product of the node transforms from its root, in double precision.
  */
 #include "scene/gltf_json.h"
 
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,6 +25,7 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/vec3.h"
 
 enum {
     GLB_MAGIC = 0x46546C67u, /* "glTF" */
@@ -417,6 +424,282 @@ done:
     return status;
 }
 
+/* ---- KHR_lights_punctual (the Khronos extension's README: types, defaults, -Z axis) ---- */
+
+typedef struct matrix4 {
+    double m[4][4]; /* [row][column], acting on column vectors */
+} matrix4;
+
+static matrix4 matrix_identity(void)
+{
+    matrix4 r;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            r.m[i][j] = i == j;
+    return r;
+}
+
+static matrix4 matrix_product(const matrix4 *a, const matrix4 *b)
+{
+    matrix4 r;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            r.m[i][j] = a->m[i][0] * b->m[0][j] + a->m[i][1] * b->m[1][j] +
+                        a->m[i][2] * b->m[2][j] + a->m[i][3] * b->m[3][j];
+    return r;
+}
+
+/* A node's local transform (glTF 2.0, "Transformations"): `matrix`, 16 numbers in
+ * column-major order, else T * R * S from translation, rotation (a unit quaternion
+ * x, y, z, w; normalised here) and scale. false when `matrix` is not 16 numbers. */
+static bool node_matrix(const cJSON *node, matrix4 *out)
+{
+    double(*m)[4] = out->m;
+    const cJSON *matrix = cJSON_GetObjectItemCaseSensitive(node, "matrix");
+    if (matrix) {
+        if (!cJSON_IsArray(matrix) || cJSON_GetArraySize(matrix) != 16)
+            return false;
+        for (int k = 0; k < 16; k++) {
+            const cJSON *item = cJSON_GetArrayItem(matrix, k);
+            if (!cJSON_IsNumber(item))
+                return false;
+            m[k % 4][k / 4] = item->valuedouble;
+        }
+        return true;
+    }
+    double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+    read_vector(node, "translation", t, 3);
+    read_vector(node, "rotation", q, 4);
+    read_vector(node, "scale", s, 3);
+    double length = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (length > 0)
+        for (int k = 0; k < 4; k++)
+            q[k] /= length;
+    double x = q[0], y = q[1], z = q[2], w = q[3];
+    /* the rotation matrix of a unit quaternion */
+    double r[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+                      {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+                      {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++)
+            m[i][j] = r[i][j] * s[j];
+        m[i][3] = t[i];
+        m[3][i] = 0;
+    }
+    m[3][3] = 1;
+    return true;
+}
+
+/* Light `index` of the extension's array, checked, without position and direction: type,
+ * intensity = color x intensity, cone half-angles in degrees, its own name (or ""). */
+static rad_status read_light(const char *path, const cJSON *object, int index, rad_light *out,
+                             bool *ranged, rad_error *error)
+{
+    memset(out, 0, sizeof(*out));
+    const cJSON *type = cJSON_GetObjectItemCaseSensitive(object, "type");
+    const char *name = cJSON_IsString(type) ? type->valuestring : "";
+    if (strcmp(name, "point") == 0)
+        out->type = RAD_LIGHT_POINT;
+    else if (strcmp(name, "spot") == 0)
+        out->type = RAD_LIGHT_SPOT;
+    else if (strcmp(name, "directional") == 0)
+        out->type = RAD_LIGHT_DIRECTIONAL;
+    else
+        return rad_fail(error, RAD_ERR_PARSE,
+                        "%s: extensions.KHR_lights_punctual.lights[%d].type '%.40s' is not "
+                        "point, spot or directional",
+                        path, index, name);
+    const cJSON *intensity = cJSON_GetObjectItemCaseSensitive(object, "intensity");
+    double value = cJSON_IsNumber(intensity) ? intensity->valuedouble : 1;
+    if ((intensity && !cJSON_IsNumber(intensity)) || !(value >= 0) || !isfinite(value))
+        return rad_fail(error, RAD_ERR_PARSE,
+                        "%s: extensions.KHR_lights_punctual.lights[%d].intensity must be a "
+                        "finite number >= 0",
+                        path, index);
+    double color[3] = {1, 1, 1};
+    read_vector(object, "color", color, 3);
+    if (!(color[0] >= 0 && color[1] >= 0 && color[2] >= 0) || !isfinite(color[0]) ||
+        !isfinite(color[1]) || !isfinite(color[2]))
+        return rad_fail(error, RAD_ERR_PARSE,
+                        "%s: extensions.KHR_lights_punctual.lights[%d].color must be finite "
+                        "and not negative",
+                        path, index);
+    out->intensity = (rad_rgb){color[0] * value, color[1] * value, color[2] * value};
+    if (out->type == RAD_LIGHT_SPOT) {
+        const cJSON *spot = cJSON_GetObjectItemCaseSensitive(object, "spot");
+        double inner = number_or(spot, "innerConeAngle", 0);
+        double outer = number_or(spot, "outerConeAngle", RAD_PI / 4);
+        if (!(inner >= 0 && inner <= outer && outer > 0 && outer <= RAD_PI / 2))
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s: extensions.KHR_lights_punctual.lights[%d].spot: cone angles "
+                            "inner %g and outer %g rad must satisfy 0 <= inner <= outer <= pi/2 "
+                            "and outer > 0",
+                            path, index, inner, outer);
+        out->inner_degrees = inner * 180 / RAD_PI;
+        out->outer_degrees = outer * 180 / RAD_PI;
+    }
+    const cJSON *light_name = cJSON_GetObjectItemCaseSensitive(object, "name");
+    if (cJSON_IsString(light_name))
+        snprintf(out->name, sizeof(out->name), "%s", light_name->valuestring);
+    *ranged = cJSON_GetObjectItemCaseSensitive(object, "range") != NULL;
+    return RAD_OK;
+}
+
+typedef struct light_walk {
+    const cJSON *nodes;
+    const char *path;
+    int node_count;
+    const rad_light *defined; /* the extension's lights, read_light's part */
+    int defined_count;
+    const uint8_t *defined_ranged;
+    uint8_t *seen;
+    gltf_info *info;
+} light_walk;
+
+static const cJSON *node_light(const cJSON *node)
+{
+    const cJSON *extensions = cJSON_GetObjectItemCaseSensitive(node, "extensions");
+    return cJSON_GetObjectItemCaseSensitive(
+        cJSON_GetObjectItemCaseSensitive(extensions, "KHR_lights_punctual"), "light");
+}
+
+/* The light `index` held by `node`, placed by the node's world transform. */
+static rad_status place_light(light_walk *w, int node, int index, const matrix4 *world,
+                              rad_error *error)
+{
+    const double(*m)[4] = world->m;
+    rad_light light = w->defined[index];
+    const cJSON *object = cJSON_GetArrayItem(w->nodes, node);
+    const cJSON *node_name = cJSON_GetObjectItemCaseSensitive(object, "name");
+    if (!light.name[0] && cJSON_IsString(node_name))
+        snprintf(light.name, sizeof(light.name), "%s", node_name->valuestring);
+    if (!light.name[0])
+        snprintf(light.name, sizeof(light.name), "light %d", index);
+    light.position = (rad_vec3){m[0][3], m[1][3], m[2][3]};
+    rad_vec3 axis = {-m[0][2], -m[1][2], -m[2][2]}; /* the transformed -Z */
+    double length = sqrt(axis.x * axis.x + axis.y * axis.y + axis.z * axis.z);
+    bool directed = light.type != RAD_LIGHT_POINT;
+    if (!(isfinite(light.position.x) && isfinite(light.position.y) &&
+          isfinite(light.position.z)) ||
+        (directed && !(length > 0 && isfinite(length))))
+        return rad_fail(error, RAD_ERR_PARSE,
+                        "%s: nodes[%d] (light '%s'): its transform gives no finite %s", w->path,
+                        node, light.name, directed ? "position and direction" : "position");
+    if (length > 0 && isfinite(length))
+        light.direction = (rad_vec3){axis.x / length, axis.y / length, axis.z / length};
+    rad_light *grown = rad_resize_array(w->info->lights, (size_t)w->info->light_count + 1,
+                                        sizeof(*grown));
+    if (!grown)
+        return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", w->path);
+    w->info->lights = grown;
+    w->info->lights[w->info->light_count++] = light;
+    if (w->defined_ranged[index] && w->info->ranged_light_count++ == 0)
+        snprintf(w->info->ranged_light_name, sizeof(w->info->ranged_light_name), "%s",
+                 light.name);
+    return RAD_OK;
+}
+
+static rad_status place_node_lights(light_walk *w, int node, const matrix4 *parent,
+                                    unsigned depth, rad_error *error)
+{
+    if (w->seen[node])
+        return RAD_OK;
+    if (depth > 256)
+        return rad_fail(error, RAD_ERR_PARSE, "%s: node tree deeper than 256", w->path);
+    w->seen[node] = 1;
+    const cJSON *object = cJSON_GetArrayItem(w->nodes, node);
+    matrix4 local;
+    if (!node_matrix(object, &local))
+        return rad_fail(error, RAD_ERR_PARSE, "%s: nodes[%d].matrix is not 16 numbers", w->path,
+                        node);
+    matrix4 world = matrix_product(parent, &local);
+    const cJSON *light = node_light(object);
+    if (light) {
+        rad_status status = place_light(w, node, (int)light->valuedouble, &world, error);
+        if (status != RAD_OK)
+            return status;
+    }
+    const cJSON *child;
+    cJSON_ArrayForEach(child, cJSON_GetObjectItemCaseSensitive(object, "children"))
+    {
+        if (!cJSON_IsNumber(child) || child->valuedouble < 0 || child->valuedouble >= w->node_count)
+            return rad_fail(error, RAD_ERR_PARSE, "%s: node %d names a child out of range",
+                            w->path, node);
+        rad_status status = place_node_lights(w, (int)child->valuedouble, &world,
+                                                depth + 1, error);
+        if (status != RAD_OK)
+            return status;
+    }
+    return RAD_OK;
+}
+
+/* The extension's lights, checked, and every node's reference to one; then the lights of
+ * the default scene's nodes, placed. */
+static rad_status read_lights(const char *path, const cJSON *root, gltf_info *info,
+                              rad_error *error)
+{
+    const cJSON *extension = cJSON_GetObjectItemCaseSensitive(
+        cJSON_GetObjectItemCaseSensitive(root, "extensions"), "KHR_lights_punctual");
+    const cJSON *lights = cJSON_GetObjectItemCaseSensitive(extension, "lights");
+    const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(root, "nodes");
+    int light_count = cJSON_IsArray(lights) ? cJSON_GetArraySize(lights) : 0;
+    int node_count = array_size(root, "nodes");
+    bool referenced = false;
+    for (int n = 0; n < node_count; n++) {
+        const cJSON *light = node_light(cJSON_GetArrayItem(nodes, n));
+        if (!light)
+            continue;
+        if (!cJSON_IsNumber(light) || light->valuedouble < 0 ||
+            light->valuedouble >= light_count ||
+            light->valuedouble != (double)(int)light->valuedouble)
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s: nodes[%d].extensions.KHR_lights_punctual.light is not an index "
+                            "into the %d lights of extensions.KHR_lights_punctual.lights",
+                            path, n, light_count);
+        referenced = true;
+    }
+    if (light_count == 0)
+        return RAD_OK;
+    light_walk w = {nodes, path, node_count, NULL, light_count, NULL, NULL, info};
+    rad_light *defined = rad_alloc_array((size_t)light_count, sizeof(*defined));
+    uint8_t *ranged = rad_alloc_array((size_t)light_count, 1);
+    w.seen = rad_alloc_array((size_t)node_count + 1, 1);
+    rad_status status = RAD_OK;
+    if (!defined || !ranged || !w.seen)
+        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory", path);
+    for (int l = 0; l < light_count && status == RAD_OK; l++) {
+        bool has_range = false;
+        status = read_light(path, cJSON_GetArrayItem(lights, l), l, &defined[l], &has_range,
+                            error);
+        ranged[l] = has_range;
+    }
+    w.defined = defined;
+    w.defined_ranged = ranged;
+    /* the default scene's roots (walk() has checked them) */
+    int scene = index_member(root, "scene", array_size(root, "scenes"));
+    const cJSON *roots = cJSON_GetObjectItemCaseSensitive(
+        cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(root, "scenes"), scene < 0 ? 0 : scene),
+        "nodes");
+    matrix4 identity = matrix_identity();
+    const cJSON *node;
+    if (!referenced || status != RAD_OK)
+        roots = NULL;
+    cJSON_ArrayForEach(node, roots)
+    {
+        if (!cJSON_IsNumber(node) || node->valuedouble < 0 || node->valuedouble >= node_count) {
+            status = rad_fail(error, RAD_ERR_PARSE, "%s: a scene names a node out of range", path);
+            break;
+        }
+        status = place_node_lights(&w, (int)node->valuedouble, &identity, 0, error);
+        if (status != RAD_OK)
+            break;
+    }
+    free(defined);
+    free(ranged);
+    free(w.seen);
+    return status;
+}
+
 rad_status gltf_info_read(const char *path, gltf_info *out, rad_error *error)
 {
     memset(out, 0, sizeof(*out));
@@ -455,6 +738,8 @@ rad_status gltf_info_read(const char *path, gltf_info *out, rad_error *error)
         status = read_materials(path, root, out, error);
     if (status == RAD_OK)
         status = walk(path, root, out, error);
+    if (status == RAD_OK)
+        status = read_lights(path, root, out, error);
     cJSON_Delete(root);
     free(data);
     if (status != RAD_OK)
@@ -466,5 +751,6 @@ void gltf_info_free(gltf_info *info)
 {
     free(info->materials);
     free(info->assimp_order);
+    free(info->lights);
     memset(info, 0, sizeof(*info));
 }

@@ -19,7 +19,8 @@
  * primitives without one) gets RAD_DEFAULT_ALBEDO; albedo
  * and emission textures are decoded once each and triangles of textured materials keep
  * their texture coordinates; (4) takes the first glTF camera, and the up axis and unit
- * from the file's metadata.
+ * from the file's metadata; (5) adds the file's lights: glTF's KHR_lights_punctual as
+ * gltf_json.c read them, other formats' from Assimp's aiLight.
  * View3D input files are recognised here and handed to import_vs3.c.
  */
 #include <assimp/cimport.h>
@@ -555,6 +556,105 @@ static void take_gltf_camera(const struct aiScene *ai, scene_builder *builder)
     scene_builder_set_camera(builder, &camera);
 }
 
+/* Adds one light read from the file; a light the scene refuses is the file's fault. */
+static rad_status add_file_light(const import_state *state, rad_scene *scene,
+                                 const rad_light *light, rad_error *error)
+{
+    rad_error why = {0};
+    rad_status status = rad_scene_add_light(scene, light, &why);
+    if (status == RAD_ERR_NOMEM)
+        return rad_fail(error, status, "%s: out of memory for its lights", state->path);
+    if (status != RAD_OK)
+        return rad_fail(error, RAD_ERR_PARSE, "%s: %s", state->path, why.message);
+    return RAD_OK;
+}
+
+/* glTF: the KHR_lights_punctual lights gltf_json.c read and placed (Assimp 5.2's aiLight
+ * for glTF keeps the cone half-angles where aiLight means full angles). */
+static rad_status add_gltf_lights(const import_state *state, rad_scene *scene, rad_error *error)
+{
+    const gltf_info *g = state->gltf;
+    if (g->ranged_light_count)
+        rad_warn(state->options ? state->options->log : NULL,
+                 state->options ? state->options->log_user : NULL,
+                 "%s: light '%s'%s gives a range, which is ignored: lights fall off by the "
+                 "inverse-square law without a cut-off",
+                 state->path, g->ranged_light_name,
+                 g->ranged_light_count > 1 ? " (and others)" : "");
+    for (uint32_t l = 0; l < g->light_count; l++) {
+        rad_status status = add_file_light(state, scene, &g->lights[l], error);
+        if (status != RAD_OK)
+            return status;
+    }
+    return RAD_OK;
+}
+
+/* Other formats: Assimp's lights (Collada, FBX, ...). An aiLight is named after the node
+ * that holds it, its mPosition and mDirection in that node's space; Assimp's cone angles
+ * are full angles (Collada's falloff_angle; its outer cone is falloff_angle plus
+ * penumbra_angle, or Assimp's guess from falloff_exponent), halved here. These formats'
+ * light values are not photometric: the colour is taken as candela or lux, as given. */
+static rad_status add_assimp_lights(const import_state *state, rad_scene *scene,
+                                    rad_error *error)
+{
+    rad_log_fn log = state->options ? state->options->log : NULL;
+    void *user = state->options ? state->options->log_user : NULL;
+    const struct aiScene *ai = state->ai;
+    unsigned taken = 0;
+    for (unsigned k = 0; k < ai->mNumLights; k++) {
+        const struct aiLight *a = ai->mLights[k];
+        rad_light light = {0};
+        snprintf(light.name, sizeof(light.name), "%.*s", (int)sizeof(light.name) - 1,
+                 a->mName.data);
+        switch (a->mType) {
+        case aiLightSource_POINT: light.type = RAD_LIGHT_POINT; break;
+        case aiLightSource_SPOT: light.type = RAD_LIGHT_SPOT; break;
+        case aiLightSource_DIRECTIONAL: light.type = RAD_LIGHT_DIRECTIONAL; break;
+        default:
+            rad_warn(log, user, "%s: light '%s' is an %s light, which is not read", state->path,
+                     light.name,
+                     a->mType == aiLightSource_AREA      ? "area"
+                     : a->mType == aiLightSource_AMBIENT ? "ambient"
+                                                         : "unknown");
+            continue;
+        }
+        struct aiMatrix4x4 to_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        struct aiMatrix4x4 identity = to_world;
+        if (!ai->mRootNode || !find_node(ai->mRootNode, a->mName.data, &identity, 0, &to_world))
+            rad_warn(log, user, "%s: light '%s': no node of that name; its position and "
+                     "direction are taken as given",
+                     state->path, light.name);
+        struct aiVector3D ahead = {a->mPosition.x + a->mDirection.x,
+                                   a->mPosition.y + a->mDirection.y,
+                                   a->mPosition.z + a->mDirection.z};
+        light.position = transform(&to_world, a->mPosition);
+        light.direction = v3_sub(transform(&to_world, ahead), light.position);
+        light.intensity = (rad_rgb){a->mColorDiffuse.r, a->mColorDiffuse.g, a->mColorDiffuse.b};
+        if (light.type == RAD_LIGHT_SPOT) {
+            light.inner_degrees = a->mAngleInnerCone / 2 * 180 / RAD_PI;
+            light.outer_degrees = a->mAngleOuterCone / 2 * 180 / RAD_PI;
+            if (light.outer_degrees > 90) {
+                rad_warn(log, user, "%s: spot light '%s': its cone (half-angle %.4g degrees) "
+                         "is wider than a hemisphere; 90 degrees taken",
+                         state->path, light.name, light.outer_degrees);
+                light.outer_degrees = 90;
+            }
+            if (light.inner_degrees > light.outer_degrees)
+                light.inner_degrees = light.outer_degrees;
+        }
+        rad_status status = add_file_light(state, scene, &light, error);
+        if (status != RAD_OK)
+            return status;
+        taken++;
+    }
+    if (taken)
+        rad_warn(log, user, "%s: %u light%s: this format's light values are not photometric; "
+                 "each colour is taken as candela (point, spot) or lux (sun) as given "
+                 "(--point, --spot and --sun give exact photometric values)",
+                 state->path, taken, taken > 1 ? "s" : "");
+    return RAD_OK;
+}
+
 /* A numeric metadata value. */
 static bool metadata_number(const struct aiScene *ai, const char *key, double *out)
 {
@@ -764,6 +864,14 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
     take_frame(ai, is_gltf || has_extension(path, ".dae"), builder);
     status = scene_builder_finish(builder, out, error);
     builder = NULL;
+    if (status == RAD_OK) {
+        status = is_gltf ? add_gltf_lights(&state, *out, error)
+                         : add_assimp_lights(&state, *out, error);
+        if (status != RAD_OK) {
+            rad_scene_destroy(*out);
+            *out = NULL;
+        }
+    }
 done:
     scene_builder_destroy(builder);
     free(state.material_map);
