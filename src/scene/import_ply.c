@@ -330,7 +330,11 @@ static rad_status read_face(ply_reader *r, const ply_property *property,
     for (unsigned long long k = 0; k < items; k++) {
         ply_value value;
         uint64_t index = 0;
-        status = read_value(r, property->type, r->face, row, &value, error);
+        /* an ASCII index is parsed whole by vertex_index, for its own message */
+        if (r->header->format == PLY_ASCII)
+            status = next_token(r, value.text) ? RAD_OK : truncated(r, r->face, row, error);
+        else
+            status = read_value(r, property->type, r->face, row, &value, error);
         if (status == RAD_OK)
             status = vertex_index(r, property, &value, row, &index, error);
         if (status != RAD_OK)
