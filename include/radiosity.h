@@ -238,8 +238,11 @@ typedef struct rad_load_options {
  * element, OBJ faces before any usemtl, glTF primitives without a material. */
 #define RAD_DEFAULT_ALBEDO 0.5
 
-/* Reads a scene file through Assimp: OBJ + MTL, glTF 2.0 (.gltf, .glb), PLY, STL, FBX,
- * Collada, 3DS and the other formats Assimp reads. Materials map onto METHOD.md's units:
+/* Reads a scene file through Assimp: OBJ + MTL, glTF 2.0 (.gltf, .glb), STL, FBX,
+ * Collada, 3DS and the other formats Assimp reads; PLY (by extension, or content starting
+ * "ply" and a line end) is read by the project itself: vertex x y z, faces fanned into
+ * triangles, one surface named after the file, the first row of a material element as
+ * its material (diffuse_* albedo, specular_*, specular_power), per-vertex colours unused. Materials map onto METHOD.md's units:
  * MTL Kd and glTF baseColorFactor are the albedo; MTL Ke, and glTF emissiveFactor times
  * KHR_materials_emissive_strength (read from the file's JSON: Assimp 5.2 drops it), the
  * emitted radiance; MTL map_Kd / glTF baseColorTexture and MTL map_Ke / glTF

@@ -14,14 +14,15 @@
  * Assimp mesh name (OBJ `o`/`g`, glTF mesh, STL solid), else its node's name, else the
  * file's name without folder and extension; (3) maps materials onto METHOD.md's units:
  * Kd / glTF baseColorFactor = albedo, Ke / glTF emissiveFactor x emissiveStrength =
- * emitted radiance; a format's "no material" (STL, PLY without a material element, OBJ
+ * emitted radiance; a format's "no material" (STL, OBJ
  * faces before any usemtl or under a usemtl no library defines (a warning), glTF
  * primitives without one) gets RAD_DEFAULT_ALBEDO; albedo
  * and emission textures are decoded once each and triangles of textured materials keep
  * their texture coordinates; (4) takes the first glTF camera, and the up axis and unit
  * from the file's metadata; (5) adds the file's lights: glTF's KHR_lights_punctual as
  * gltf_json.c read them, other formats' from Assimp's aiLight.
- * View3D input files are recognised here and handed to import_vs3.c.
+ * View3D input files are recognised here and handed to import_vs3.c, PLY files (by
+ * extension or content) to import_ply.c: Assimp never reads PLY.
  */
 #include <assimp/cimport.h>
 #include <assimp/material.h>
@@ -43,7 +44,7 @@
 #include "core/vec3.h"
 #include "scene/gltf_json.h"
 #include "scene/obj_check.h"
-#include "scene/ply_check.h"
+#include "scene/import_ply.h"
 #include "scene/scene_builder.h"
 #include "scene/texture.h"
 
@@ -136,7 +137,6 @@ typedef struct import_state {
     uint32_t *material_map; /* Assimp material index -> builder index, UINT32_MAX = not yet */
     const char *path;
     const gltf_info *gltf;  /* our reading of a glTF file, else NULL */
-    bool ply_without_materials;
     char stem[128];         /* the file's name without folder and extension */
     const rad_load_options *options;
     uint8_t *textured;      /* Assimp material index -> it has a texture (albedo or emission) */
@@ -327,13 +327,12 @@ static rad_status map_material(import_state *state, unsigned index, uint32_t *ou
         const gltf_material *gltf = state->gltf ? gltf_material_of(state, index, m, name.data)
                                                 : NULL;
         /* Assimp's stand-in when the file has no material: "DefaultMaterial" (OBJ, STL,
-         * Collada; 3DS adds "_N"), the unnamed one it appends after glTF's own, PLY's only
-         * one */
+         * Collada; 3DS adds "_N"), the unnamed one it appends after glTF's own */
         bool gltf_default = state->gltf && !gltf && name.data[0] == 0 &&
                             index + 1 == state->ai->mNumMaterials;
         bool is_default = strncmp(name.data, AI_DEFAULT_MATERIAL_NAME,
                                   strlen(AI_DEFAULT_MATERIAL_NAME)) == 0 ||
-                          gltf_default || state->ply_without_materials;
+                          gltf_default;
         /* an OBJ's usemtl that no library defines: no material, under its own name */
         bool undefined = state->obj_undefined && obj_names_has(state->obj_undefined, name.data);
         rad_material material = {0};
@@ -498,19 +497,6 @@ static rad_status add_node(import_state *state, const struct aiNode *node,
             return status;
     }
     return RAD_OK;
-}
-
-/* PLY: true when the header declares no material element (Assimp then invents one). */
-static bool ply_has_materials(FILE *file)
-{
-    char line[1024];
-    while (fgets(line, sizeof(line), file)) {
-        if (strncmp(line, "element material", 16) == 0 && isspace((unsigned char)line[16]))
-            return true;
-        if (strncmp(line, "end_header", 10) == 0)
-            break;
-    }
-    return false;
 }
 
 static bool find_node(const struct aiNode *node, const char *name, const struct aiMatrix4x4 *parent,
@@ -788,8 +774,13 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
         return rad_scene_load_vs3(path, options, out, NULL, error);
     }
     rewind(file);
+    if (has_extension(path, ".ply") || ply_stream_is_ply(file)) { /* Assimp never reads PLY */
+        fclose(file);
+        return ply_scene_load(path, options, out, error);
+    }
+    rewind(file);
     rad_status status = RAD_OK;
-    import_state state = {NULL, NULL, NULL, path, NULL, false, "", options, NULL, NULL, 0, NULL};
+    import_state state = {NULL, NULL, NULL, path, NULL, "", options, NULL, NULL, 0, NULL};
     gltf_info gltf = {0};
     bool is_gltf = has_extension(path, ".gltf") || has_extension(path, ".glb");
     obj_check obj = {0};
@@ -797,11 +788,6 @@ rad_status rad_scene_load(const char *path, const rad_load_options *options, rad
         status = obj_check_read(path, options, file, &obj, error);
     else if (has_extension(path, ".stl"))
         status = check_stl(path, file, error);
-    else if (has_extension(path, ".ply")) {
-        state.ply_without_materials = !ply_has_materials(file);
-        rewind(file);
-        status = ply_check(path, file, error);
-    }
     fclose(file);
     if (status == RAD_OK && is_gltf) {
         status = gltf_info_read(path, &gltf, error);

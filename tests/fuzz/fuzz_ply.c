@@ -1,13 +1,12 @@
 /*
- * fuzz_ply.c - libFuzzer target: the PLY pre-check (ply_check.c) on the input in memory
- * (fmemopen); an input it accepts then goes through the whole load (rad_scene_load, which
- * hands it to Assimp), since the check exists to keep Assimp from reading past a file's
- * data: what it lets through must load or be refused cleanly.
+ * fuzz_ply.c - libFuzzer target: the project's PLY reader (import_ply.c, with the header
+ * parser ply_header.c) on the input in memory (fmemopen), the whole load up to a finished
+ * scene; rad_scene_load hands every PLY file to this reader, so nothing else reads one.
  */
 #include <stdio.h>
 
 #include "fuzz_target.h"
-#include "scene/ply_check.h"
+#include "scene/import_ply.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -17,15 +16,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (!file)
         return 0;
     rad_error error = {0};
-    rad_status status = ply_check("input.ply", file, &error);
+    rad_scene *scene = NULL;
+    rad_status status = ply_scene_read("input.ply", file, fuzz_quiet_options(), &scene, &error);
     fclose(file);
     fuzz_check_refusal(status, &error, "input.ply");
-    if (status != RAD_OK)
-        return 0;
-    const char *path = fuzz_write_file("input.ply", data, size);
-    rad_scene *scene = NULL;
-    status = rad_scene_load(path, fuzz_quiet_options(), &scene, &error);
-    fuzz_check_refusal(status, &error, path);
     if (status == RAD_OK)
         fuzz_check_scene(scene);
     rad_scene_destroy(scene);

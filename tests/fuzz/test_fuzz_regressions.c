@@ -90,6 +90,11 @@ int main(void)
                    "element 'face' declares 4294967295 rows but no properties");
     /* no element at all: Assimp 5.2 crashed (SEGV) */
     expect_refused("ply_no_elements.ply", ":2: PLY version '1.0ledices'");
+    /* Assimp 5.2 aborted on these CRLF files (an LF CR line end; found by fuzz_ply, kept
+     * open until the project read PLY itself): the row after an empty material element
+     * is one more than the header declares */
+    expect_refused("ply_ci_finding.ply", ":19: '0.5' after the last row the header declares");
+    expect_refused("ply_cr_line_start.ply", ":19: '0.5' after the last row the header declares");
     /* signed overflow negating the index -2^63 */
     expect_refused("obj_index_min.obj", "obj_index_min.obj:3: ");
     /* Assimp failed the OBJ ("File is too small") and leaked */
