@@ -1217,7 +1217,8 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
  * apart over the scene's extent across rad_scene.up, half a spacing in from its edges, at
  * the lowest scene point plus `height`, kept where the first surface straight below is
  * the front of an upward-facing surface (the floor, not the outside of the building or
- * the inside of a wall). *points is the caller's (free()); RAD_ERR_INVALID for a height
+ * the inside of a wall) and the first straight above is a front or nothing (not inside a
+ * closed object: a block, a cupboard). *points is the caller's (free()); RAD_ERR_INVALID for a height
  * or spacing that is not positive and finite, or more than 10^7 points; *count may be 0. */
 rad_status rad_work_plane(const rad_scene *scene, double height, double spacing,
                           rad_vec3 **points, uint32_t *count, rad_error *error);

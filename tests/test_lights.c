@@ -135,6 +135,24 @@ static void test_point_light_floor(void)
     }
     printf("point light, rendered pixels: worst relative error %.2e\n", pixel_worst);
     CHECK(pixel_worst < 0.01);
+
+    /* the same through rad_illuminance at points of the floor, and its work plane */
+    rad_vec3 at[8], up[8];
+    rad_rgb E[8];
+    for (int k = 0; k < 8; k++) {
+        at[k] = (rad_vec3){0.7 * k, 0, 0.3 * k};
+        up[k] = (rad_vec3){0, 1, 0};
+    }
+    rad_illuminance_options measure = {.gather_rays = 64, .threads = 2};
+    CHECK(rad_illuminance(scene, mesh, B, at, up, 8, &measure, E, &error) == RAD_OK);
+    for (int k = 0; k < 8; k++)
+        CHECK_NEAR(E[k].g, point_illuminance(at[k].x, at[k].z, &source), 0.001);
+    rad_vec3 *grid = NULL;
+    uint32_t grid_count = 0;
+    CHECK(rad_work_plane(scene, 0.75, 0.5, &grid, &grid_count, &error) == RAD_OK);
+    CHECK(grid_count == 40 * 40);
+    CHECK(grid_count > 0 && fabs(grid[0].y - 0.75) < 1e-12 && fabs(grid[0].x + 9.75) < 1e-9);
+    free(grid);
     rad_image_destroy(image);
     free(B);
     rad_patch_inputs_destroy(inputs);

@@ -76,6 +76,16 @@ rad_status rad_work_plane(const rad_scene *scene, double height, double spacing,
                 continue;
             grid[kept++] = grid[k];
         }
+        /* and not inside furniture or a wall: straight up it sees a front (a ceiling, the
+         * underside of a table) or the open sky, never the back of a surface */
+        for (uint32_t k = 0; k < kept; k++)
+            ray_set(&rays[k], grid[k], up, 0, INFINITY);
+        rad_tracer_intersect(tracer, rays, kept, hits);
+        uint32_t inside = 0;
+        for (uint32_t k = 0; k < kept; k++)
+            if (hits[k].triangle == RAD_NO_HIT || hits[k].front)
+                grid[inside++] = grid[k];
+        kept = inside;
         *count = kept;
         *points = grid;
         grid = NULL;
