@@ -1139,6 +1139,21 @@ rad_status rad_image_write(const rad_image *image, const char *path,
  * is the top. */
 rad_status rad_image_read(const char *path, rad_image **out, rad_error *error);
 
+typedef struct rad_false_colour_options {
+    double low, high; /* the scale's ends (the quantity's unit); both 0 = automatic: 0 (or,
+                         logarithmic, the 1st percentile) to the 99th percentile */
+    bool logarithmic; /* a logarithmic scale (low > 0) */
+    const char *unit; /* written above the legend, e.g. "lx"; NULL = none */
+} rad_false_colour_options;
+
+/* The luminance of each pixel of `values` in false colour, blue (low) through cyan, green
+ * and yellow to red (high), with a legend bar of the scale, its values and unit on a band
+ * added on the right (96 pixels). The result (*out, the caller's) holds linear RGB in
+ * [0,1]: written as PNG with a fixed exposure of 0 it shows the scale's colours. */
+rad_status rad_image_false_colour(const rad_image *values,
+                                  const rad_false_colour_options *options, rad_image **out,
+                                  rad_error *error);
+
 /* ------------------------------------------------------------------------------------ */
 /* Rendering                                                                             */
 
@@ -1171,6 +1186,11 @@ typedef struct rad_render_options {
      * builds them from `scene` itself when it has a textured material (the same values:
      * the build is deterministic). Read only for textured surfaces of `scene`. */
     const rad_patch_inputs *inputs;
+    /* Pixels hold the irradiance arriving at the surface seen (illuminance in lux with
+     * photometric lights) instead of its radiance: (B_i - E_i) / rho_i reconstructed, the
+     * sharp light sources added per pixel as for radiance; a black patch shows its direct
+     * light alone; misses and mirrors show nothing. Needs `scene`. */
+    bool irradiance;
 } rad_render_options;
 
 /* Radiance at every mesh vertex: the area-weighted average of B/pi over the patches that

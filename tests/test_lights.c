@@ -136,6 +136,19 @@ static void test_point_light_floor(void)
     printf("point light, rendered pixels: worst relative error %.2e\n", pixel_worst);
     CHECK(pixel_worst < 0.01);
 
+    /* an illuminance image: pixels hold E itself at the ground point */
+    render.irradiance = true;
+    CHECK(rad_render(mesh, B, &camera, &render, image, &error) == RAD_OK);
+    double lux_worst = 0;
+    for (int j = 0; j <= 30; j += 3) {
+        double x = 10 * tan_half * 2.0 * j / 65, expected = point_illuminance(x, 0, &source);
+        lux_worst = fmax(lux_worst, fabs(test_pixel(image, (uint32_t)(32 + j), 32)[1] - expected) /
+                                        expected);
+    }
+    printf("point light, illuminance image: worst relative error %.2e\n", lux_worst);
+    CHECK(lux_worst < 0.01);
+    render.irradiance = false;
+
     /* the same through rad_illuminance at points of the floor, and its work plane */
     rad_vec3 at[8], up[8];
     rad_rgb E[8];
@@ -431,8 +444,34 @@ static void test_bad_lights(void)
     CHECK(strstr(test_read_text(test_path("stdout.txt")), "below the horizon") != NULL);
 }
 
+/* The false-colour scale: its ends, its legend band, a refused scale. */
+static void test_false_colour(void)
+{
+    rad_image *values = test_new_image(100, 50);
+    for (uint32_t y = 0; y < 50; y++)
+        for (uint32_t x = 0; x < 100; x++)
+            test_set_pixel(values, x, y, x * 10.0, x * 10.0, x * 10.0);
+    rad_false_colour_options options = {.low = 0, .high = 990, .unit = "lx"};
+    rad_image *out = NULL;
+    rad_error error;
+    CHECK(rad_image_false_colour(values, &options, &out, &error) == RAD_OK);
+    CHECK(out->width == 196 && out->height == 50);
+    const float *low = test_pixel(out, 0, 25), *high = test_pixel(out, 99, 25),
+                *middle = test_pixel(out, 50, 25);
+    CHECK(low[2] > low[0] && low[2] > low[1]);   /* blue at the low end */
+    CHECK(high[0] > high[1] && high[0] > high[2]); /* red at the high end */
+    CHECK(middle[1] > middle[2]);                 /* green-yellow in the middle */
+    rad_image_destroy(out);
+    options.low = 5;
+    options.high = 1;
+    CHECK(rad_image_false_colour(values, &options, &out, &error) == RAD_ERR_INVALID);
+    CHECK(out == NULL);
+    rad_image_destroy(values);
+}
+
 int main(void)
 {
+    test_false_colour();
     test_point_light_floor();
     test_spot_cone();
     test_sun();

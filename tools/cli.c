@@ -439,8 +439,10 @@ bool cli_begin(const char *command, const char *usage, int argc, char **argv,
         return false;
     if (args->value[OPT_HELP]) {
         fputs(usage, stdout);
-        if (options[OPT_POINT].name)
+        if (options[OPT_POINT].name) {
+            fputs("\nScene:\n" CLI_SCENE_HELP, stdout);
             fputs(CLI_LIGHT_HELP, stdout);
+        }
         *exit_code = EXIT_OK;
         return false;
     }

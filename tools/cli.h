@@ -156,7 +156,6 @@ enum {
     "                       first, all N only where those 4 disagree)\n"                   \
     "  --quadrature M       M x M points per patch for the analytic form factor (default " \
     CLI_STR(RAD_DEFAULT_QUADRATURE) ")\n"                                                 \
-    CLI_SCENE_HELP                                                                         \
     "  --threads N          worker threads (default: all cores)\n"                          \
     "  --seed N             seed of every random choice (default 1)\n"                      \
     "  --stats FILE.json    write counts, times, residuals and peak memory\n"               \
@@ -182,8 +181,9 @@ enum {
     [OPT_ENVIRONMENT_ROTATE] = {"environment-rotate", 0, true},                            \
     [OPT_UNIT] = {"unit", 0, true}, [OPT_NORTH] = {"north", 0, true}
 
-/* The help of the light-source options (printed after a command's own help when its
- * table has the SCENE group: the text would not fit in one string literal). */
+/* The help of the SCENE group's options, --emit and --albedo (CLI_SCENE_HELP) and the
+ * light sources (CLI_LIGHT_HELP), printed after a command's own help when its table has
+ * the group (the texts would not fit in one string literal with a command's own). */
 #define CLI_LIGHT_HELP                                                                     \
     "\n"                                                                                   \
     "Light sources besides emissive surfaces (repeatable; in candela and lux, radiance\n"    \

@@ -22,7 +22,6 @@ static const char usage[] =
     "The --emit, --albedo and --two-sided options show their effect. Exit status 1 when\n"
     "the scene cannot be read.\n"
     "\n"
-    CLI_SCENE_HELP
     CLI_TWO_SIDED_HELP
     "  -o FILE              write the report to FILE instead of stdout\n"
     "  --stats FILE.json    load time, counts and peak memory\n"

@@ -34,7 +34,6 @@ static const char usage[] =
     "                       channel (.hdr, .pfm or .exr)\n"
     CLI_TWO_SIDED_HELP
     "  --max-memory SIZE    refuse at once images needing more bytes (K, M, G)\n"
-    CLI_SCENE_HELP
     CLI_BASE_HELP("rays, times, mean radiance and peak memory");
 
 enum { OPT_MAX_DEPTH = OPT_OWN, OPT_STANDARD_ERROR, OPT_TWO_SIDED, OPT_COUNT };

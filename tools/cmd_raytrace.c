@@ -39,7 +39,6 @@ static const char usage[] =
     CLI_IMAGE_FILE_HELP
     "Run:\n"
     CLI_TWO_SIDED_HELP
-    CLI_SCENE_HELP
     CLI_BASE_HELP("counts, times and peak memory");
 
 enum { OPT_LIGHT = OPT_OWN, OPT_AMBIENT, OPT_LIGHT_SAMPLES, OPT_MAX_DEPTH, OPT_TWO_SIDED,

@@ -5,6 +5,8 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
+#include <stdio.h>
 
 #include "cli.h"
 
@@ -26,10 +28,15 @@ static const char usage[] =
     "  --exr-float          .exr: 32-bit float channels instead of half\n"
     "  --specular           the two-pass method: Ks > 0 surfaces mirror the lit scene\n"
     "  --max-depth N        mirror reflections followed with --specular (default 5)\n"
+    "  --quantity illuminance  pixels: illuminance (lux) at the surface seen, not radiance\n"
+    "  --false-colour       PNG in false colour with a legend; --scale LOW,HIGH, --log\n"
     CLI_TWO_SIDED_HELP
     CLI_SOLVE_HELP;
 
-enum { OPT_SPECULAR = OPT_OWN, OPT_MAX_DEPTH, OPT_TWO_SIDED, OPT_COUNT };
+enum {
+    OPT_SPECULAR = OPT_OWN, OPT_MAX_DEPTH, OPT_TWO_SIDED, OPT_QUANTITY, OPT_FALSE_COLOUR,
+    OPT_SCALE, OPT_LOG, OPT_COUNT
+};
 
 static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS,
@@ -40,6 +47,10 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_SPECULAR] = {"specular", 0, false},
     [OPT_MAX_DEPTH] = {"max-depth", 0, true},
     [OPT_TWO_SIDED] = {"two-sided", 0, true},
+    [OPT_QUANTITY] = {"quantity", 0, true},
+    [OPT_FALSE_COLOUR] = {"false-colour", 0, false},
+    [OPT_SCALE] = {"scale", 0, true},
+    [OPT_LOG] = {"log", 0, false},
 };
 
 #define RENDER_MAX_SPP 256u
@@ -51,6 +62,8 @@ typedef struct render_settings {
     cli_solve solve;
     rad_render_options render;
     bool specular; /* the two-pass method */
+    bool false_colour;
+    rad_false_colour_options colours;
 } render_settings;
 
 static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_code)
@@ -70,6 +83,45 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
         return false;
     }
     s->specular = args.value[OPT_SPECULAR] != NULL;
+    const char *quantity = args.value[OPT_QUANTITY];
+    if (quantity && strcmp(quantity, "illuminance") != 0 && strcmp(quantity, "irradiance") != 0 &&
+        strcmp(quantity, "radiance") != 0 && strcmp(quantity, "luminance") != 0) {
+        cli_error("--quantity: '%s' is not radiance (or luminance) or illuminance (or "
+                  "irradiance)",
+                  quantity);
+        return false;
+    }
+    s->render.irradiance =
+        quantity && (strcmp(quantity, "illuminance") == 0 || strcmp(quantity, "irradiance") == 0);
+    s->false_colour = args.value[OPT_FALSE_COLOUR] != NULL;
+    s->colours.logarithmic = args.value[OPT_LOG] != NULL;
+    s->colours.unit = s->render.irradiance ? "lx" : "cd/m^2";
+    if (args.value[OPT_SCALE]) {
+        double lo, hi;
+        char tail;
+        if (sscanf(args.value[OPT_SCALE], "%lf,%lf%c", &lo, &hi, &tail) != 2 || !(lo >= 0) ||
+            !(hi > lo) || !isfinite(hi)) {
+            cli_error("--scale: '%s' is not LOW,HIGH with 0 <= LOW < HIGH", args.value[OPT_SCALE]);
+            return false;
+        }
+        s->colours.low = lo;
+        s->colours.high = hi;
+    }
+    if ((args.value[OPT_SCALE] || args.value[OPT_LOG]) && !s->false_colour) {
+        cli_error("--scale and --log go with --false-colour");
+        return false;
+    }
+    if (s->false_colour) {
+        const char *dot = strrchr(s->output, '.');
+        if (!dot || strcasecmp(dot, ".png") != 0) {
+            cli_error("--false-colour: write a .png (the colours are the picture)");
+            return false;
+        }
+        if (s->specular) {
+            cli_error("--false-colour: not with --specular");
+            return false;
+        }
+    }
     if (args.value[OPT_MAX_DEPTH]) {
         unsigned long value;
         if (!cli_parse_uint("max-depth", args.value[OPT_MAX_DEPTH], 64, &value))
@@ -127,7 +179,7 @@ int command_render(int argc, char **argv)
     if (status != RAD_OK)
         goto fail;
     t_render = rad_clock_seconds();
-    if (rad_scene_has_emitter(solved.scene)) {
+    if (rad_scene_has_emitter(solved.scene) || solved.scene->light_count > 0) {
         /* lit surfaces, a black image: the camera sees only backs (surfaces are one-sided),
          * as the default view from outside a closed room does */
         size_t lit = 0, values = (size_t)image->width * image->height * 3;
@@ -139,7 +191,16 @@ int command_render(int argc, char **argv)
                      "inside with --eye and --target)",
                      solved.scene->source, camera.eye.x, camera.eye.y, camera.eye.z);
     }
-    status = rad_image_write(image, s.output, &s.view.write, &error);
+    if (s.false_colour) {
+        rad_image *coloured = NULL;
+        status = rad_image_false_colour(image, &s.colours, &coloured, &error);
+        if (status == RAD_OK) {
+            rad_image_write_options exact = {.fixed_exposure = true, .exposure = 0};
+            status = rad_image_write(coloured, s.output, &exact, &error);
+        }
+        rad_image_destroy(coloured);
+    } else
+        status = rad_image_write(image, s.output, &s.view.write, &error);
     if (status != RAD_OK)
         goto fail;
     t_write = rad_clock_seconds();

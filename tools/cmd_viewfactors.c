@@ -43,7 +43,6 @@ static const char usage[] =
     CLI_STR(RAD_DEFAULT_ACCURACY) ")\n"
     "  --max-rays N         visibility rays per sampled polygon pair at most\n"
     "                       (default " CLI_STR(RAD_DEFAULT_MAX_RAYS) ")\n"
-    CLI_SCENE_HELP
     CLI_BASE_HELP("counts, times, invariants and error bounds");
 
 enum {

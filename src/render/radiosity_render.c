@@ -80,6 +80,7 @@ typedef struct shading {
     const rad_tracer *tracer;       /* for shadow rays */
     uint32_t strata;                /* first samples per pixel, k^2 */
     uint64_t seed;
+    bool irradiance;                /* pixels hold the irradiance arriving at the surface */
 } shading;
 
 static double mean_luminance(const rad_rgb *samples, unsigned count)
@@ -196,7 +197,7 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
         const rad_hit *hit = &w->hits[r];
         if (hit->triangle == RAD_NO_HIT) {
             /* the sky (or environment) behind open geometry */
-            if (sh->lights && sh->lights->has_sky) {
+            if (sh->lights && sh->lights->has_sky && !sh->irradiance) {
                 const rad_ray *ray = &w->rays[r];
                 rad_vec3 d = v3_normalize(v3(ray->direction[0], ray->direction[1], ray->direction[2]));
                 rgb_add_to(&w->sum[w->sample[r]],
@@ -227,7 +228,11 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
         rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit_u - hit_v),
                                        rgb_add(rgb_scale(L[v[1]], hit_u), rgb_scale(L[v[2]], hit_v)));
         rad_rgb albedo = sh->inputs ? sh->inputs->albedo[patch_index] : (rad_rgb){0, 0, 0};
-        if (patch_material_textured(sh->textures, sh->mesh->patches[patch_index].material))
+        if (sh->irradiance) {
+            /* the vertices hold irradiance / pi; the sharp sources come below, whole */
+            interpolated = rgb_scale(interpolated, RAD_PI);
+            albedo = (rad_rgb){RAD_PI, RAD_PI, RAD_PI};
+        } else if (patch_material_textured(sh->textures, sh->mesh->patches[patch_index].material))
             interpolated =
                 textured_radiance(sh, &w->rays[r], hit, patch_index, interpolated, &albedo);
         rgb_add_to(&w->sum[w->sample[r]], rgb_mul(weight, interpolated));
@@ -239,7 +244,7 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
             queue_lights(sh, w, w->sample[r], point, &sh->mesh->patches[patch_index],
                          rgb_scale(rgb_mul(weight, albedo), 1.0 / RAD_PI));
         }
-        if (!mirrors || !sh->materials)
+        if (!mirrors || !sh->materials || sh->irradiance)
             continue;
         const rad_patch *patch = &sh->mesh->patches[patch_index];
         rad_rgb ks = sh->materials[patch->material].specular;
@@ -292,12 +297,15 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
         return rad_fail(error, RAD_ERR_INVALID,
                         "render: the patch inputs are for %u patches, the mesh has %u",
                         options->inputs->n, mesh->patch_count);
-    if (!scene || (scene->texture_count == 0 && scene->light_count == 0))
+    if (options->irradiance && !scene)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "render: an irradiance image needs the scene (options.scene)");
+    if (!scene || (scene->texture_count == 0 && scene->light_count == 0 && !options->irradiance))
         return RAD_OK;
     rad_status status = RAD_OK;
     if (scene->texture_count > 0)
         status = patch_material_lookup_create(scene, lookup, error);
-    if (status != RAD_OK || (!*lookup && scene->light_count == 0))
+    if (status != RAD_OK || (!*lookup && scene->light_count == 0 && !options->irradiance))
         return status;
     if (!options->inputs) {
         status = rad_patch_inputs_build(scene, mesh, built, error);
@@ -312,6 +320,13 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
         const double *b = &B[p].r, *e = &(*inputs)->exitance[p].r;
         const double *rho = &(*inputs)->albedo[p].r, *h = &(*inputs)->direct_sharp[p].r;
         double *out = &(*shaded)[p].r;
+        if (options->irradiance) {
+            /* (B - E) / rho is the irradiance; a black patch shows its direct light only */
+            const double *all = &(*inputs)->direct[p].r;
+            for (int c = 0; c < 3; c++)
+                out[c] = fmax((rho[c] > 0 ? (b[c] - e[c]) / rho[c] : all[c]) - h[c], 0);
+            continue;
+        }
         if (!patch_material_textured(*lookup, mesh->patches[p].material)) {
             for (int c = 0; c < 3; c++)
                 out[c] = fmax(b[c] - rho[c] * h[c], 0);
@@ -442,7 +457,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                      t_near,    leave,
                      lookup,    inputs,
                      lights_ptr, tracer,
-                     k * k,     options->seed};
+                     k * k,     options->seed,
+                     options->irradiance};
 
     render_progress progress =
         render_progress_start(options->progress, options->progress_user, "render", H);
