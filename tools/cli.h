@@ -197,6 +197,8 @@ enum {
     "                       that local time (NOAA's algorithm); below the horizon: none\n"  \
     "  --sky uniform|cie-overcast|cie-clear[:LZ]  a sky of zenith luminance LZ cd/m^2\n"    \
     "                       (default: 10000 lux on open ground); cie-clear needs --sun\n"   \
+    "  --luminaire FILE.ies:X,Y,Z[:AX,AY,AZ[:FACTOR]]  an IES LM-63 photometric web at\n" \
+    "                       X,Y,Z, its nadir along AX,AY,AZ (default: down), times FACTOR\n" \
     "  --environment FILE[:SCALE]  an equirectangular radiance map (.hdr, .exr, .pfm; 2:1,\n" \
     "                       its centre looking north, top the zenith) around the scene\n"   \
     "  --environment-rotate DEG  turn it about the up axis (clockwise from above)\n"      \

@@ -214,6 +214,19 @@ static bool build_light(const light_spec *spec, rad_light *light, bool *place, d
             return false;
         break;
     }
+    case OPT_LUMINAIRE:
+        light->type = RAD_LIGHT_LUMINAIRE;
+        intensity = 1;
+        if (n < 2 || n > 4 || f[0][0] == '\0') {
+            cli_error("--luminaire: '%s' is not FILE.ies:X,Y,Z[:AIMX,AIMY,AIMZ[:FACTOR]]",
+                      spec->text);
+            return false;
+        }
+        if (!parse_vector(option, f[1], "a position", &light->position) ||
+            (n > 2 && f[2][0] && !parse_vector(option, f[2], "an aim (the nadir)", &light->direction)) ||
+            (n > 3 && !parse_number(option, f[3], "factor", &intensity)))
+            return false;
+        break;
     case OPT_ENVIRONMENT:
         light->type = RAD_LIGHT_ENVIRONMENT;
         intensity = 1;
@@ -426,6 +439,23 @@ rad_status cli_apply_lights(rad_scene *scene, rad_log_fn log, void *log_user,
                     double lz = DEFAULT_SKY_LUX / rad_sky_horizontal_factor(light.sky, sun_elevation);
                     light.intensity = (rad_rgb){lz, lz, lz};
                 }
+            }
+            if (light.type == RAD_LIGHT_LUMINAIRE) {
+                char copy[1024], *f[MAX_FIELDS];
+                split_fields(specs[k].text, copy, sizeof(copy), f);
+                if (light.direction.x == 0 && light.direction.y == 0 && light.direction.z == 0)
+                    light.direction = (rad_vec3){-up.x, -up.y, -up.z}; /* aimed straight down */
+                rad_photometry *web = NULL;
+                rad_status status = rad_photometry_read(f[0], log, log_user, &web, error);
+                if (status != RAD_OK)
+                    return blame(status, "luminaire", error);
+                light.photometry = web;
+                status = rad_scene_add_light(scene, &light, error);
+                if (status != RAD_OK) {
+                    rad_photometry_destroy(web);
+                    return blame(status, "luminaire", error);
+                }
+                continue;
             }
             if (light.type == RAD_LIGHT_ENVIRONMENT) {
                 char copy[1024], *f[MAX_FIELDS];
