@@ -138,9 +138,10 @@ int command_pathtrace(int argc, char **argv)
     rad_status status = cli_image_run_begin(&run, s.scene_path, &s.view, &error);
     if (status == RAD_OK)
         status = cli_apply_two_sided(&s.two_sided, run.scene, &error);
-    if (status == RAD_OK && !rad_scene_has_emitter(run.scene))
-        cli_warn("%s: no surface emits light (no material with non-zero Ke): the image will "
-                 "be black (--emit NAME=R,G,B makes a surface a light)",
+    if (status == RAD_OK && !rad_scene_has_emitter(run.scene) && run.scene->light_count == 0)
+        cli_warn("%s: no surface emits light (no material with non-zero Ke) and no light "
+                 "source is given: the image will be black (--emit NAME=R,G,B makes a surface "
+                 "a light; --point, --spot, --sun, --sky add sources)",
                  run.scene->source);
     if (status == RAD_OK && (s.error_path || s.shared.stats_path))
         status = rad_image_create(s.view.width, s.view.height, &standard_error, &error);

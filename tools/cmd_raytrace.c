@@ -187,10 +187,11 @@ int command_raytrace(int argc, char **argv)
     rad_status status = cli_image_run_begin(&run, s.scene_path, &s.view, &error);
     if (status == RAD_OK)
         status = cli_apply_two_sided(&s.two_sided, run.scene, &error);
-    bool emitters = status == RAD_OK && rad_scene_has_emitter(run.scene);
+    bool emitters = status == RAD_OK &&
+                    (rad_scene_has_emitter(run.scene) || run.scene->light_count > 0);
     bool ambient = s.trace.ambient.r > 0 || s.trace.ambient.g > 0 || s.trace.ambient.b > 0;
     if (status == RAD_OK && !emitters && s.trace.light_count == 0)
-        cli_warn("%s: no light: no --light given and no surface emits (Ke)%s", run.scene->source,
+        cli_warn("%s: no light: no --light given, no surface emits (Ke) and no light source%s", run.scene->source,
                  ambient ? ": only the ambient term lights the image" : ": the image will be black");
     if (status == RAD_OK)
         status = rad_raytrace(run.scene, &run.camera, &s.trace, run.image, &error);

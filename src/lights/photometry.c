@@ -2,6 +2,7 @@
  * photometry.c - a photometric web (IES LM-63): freeing it. The reader and the candela
  * look-up come with the IES reader.
  */
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "radiosity.h"
@@ -24,4 +25,19 @@ double rad_photometry_candela(const rad_photometry *photometry, double vertical_
     (void)vertical_degrees;
     (void)horizontal_degrees;
     return 0;
+}
+
+/* PLACEHOLDER until the IES reader lands. */
+rad_status rad_photometry_read(const char *path, rad_log_fn log, void *log_user,
+                               rad_photometry **out, rad_error *error)
+{
+    (void)log;
+    (void)log_user;
+    *out = NULL;
+    if (error) {
+        error->status = RAD_ERR_UNSUPPORTED;
+        snprintf(error->message, sizeof(error->message), "%s: IES files cannot be read yet",
+                 path);
+    }
+    return RAD_ERR_UNSUPPORTED;
 }
