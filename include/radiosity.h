@@ -111,6 +111,7 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 #define RAD_DEFAULT_MAX_RAYS 1024       /* rad_viewfactor_options.max_rays */
 #define RAD_DEFAULT_EMISSIVITY 0.9      /* rad_surface.emissivity when the file gives none */
 #define RAD_DEFAULT_RENDER_SPP 16       /* rad_render_options.samples_per_pixel */
+#define RAD_DEFAULT_DIRECT_SAMPLES 4    /* rad_render_options.direct_samples */
 #define RAD_DEFAULT_EDGE_SAMPLES 64     /* rad_render_options.edge_samples */
 #define RAD_DEFAULT_MAX_DEPTH 5         /* max_depth of rad_render_options (mirror
                                            reflections) and rad_raytrace_options */
@@ -1191,6 +1192,14 @@ typedef struct rad_render_options {
      * sharp light sources added per pixel as for radiance; a black patch shows its direct
      * light alone; misses and mirrors show nothing. Needs `scene`. */
     bool irradiance;
+    /* The direct light of emissive surfaces is computed at every pixel sample by
+     * `direct_samples` shadow rays to points of the emitters (stratified over the pixel's
+     * samples; exact soft shadows), and the rest (their light reflected once or more, the
+     * sky) taken from the solution with their patch means (16 x 8 samples per patch) taken
+     * out first. Needs `scene`; 0 = RAD_DEFAULT_DIRECT_SAMPLES. */
+    uint32_t direct_samples;
+    bool direct_from_solution; /* instead: the emitters' direct light interpolated from the
+                                  solution like the rest (the classic radiosity image) */
 } rad_render_options;
 
 /* Radiance at every mesh vertex: the area-weighted average of B/pi over the patches that
@@ -1336,6 +1345,16 @@ typedef struct rad_image_difference {
     uint32_t block_count;        /* whole blocks compared */
     uint32_t blocks_within;      /* how many of them are within block_tolerance */
     double blocks_within_tolerance; /* that fraction (0 when there is no whole block) */
+    /* The accuracy measures of a render against a converged reference, on luminance
+     * Y = 0.2126 R + 0.7152 G + 0.0722 B: */
+    double block_relative_rmse;  /* the RMS over whole blocks of |Y_a - Y_b| / Y_b, the
+                                    blocks' mean luminances, Y_b floored at 1e-3 of the
+                                    image's mean */
+    double pixel_relative_rmse;  /* sqrt(mean over pixels of (Y_a - Y_b)^2) / mean(Y_b),
+                                    leaving out the light sources seen directly: pixels
+                                    whose reference luminance exceeds 20 times the image's
+                                    median, and 2 pixels around them */
+    uint32_t pixels_left_out;    /* how many pixels that left out */
 } rad_image_difference;
 
 /* Compares a against b (the reference). The images must have the same size

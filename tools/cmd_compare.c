@@ -19,6 +19,10 @@ static const char usage[] =
     "  rmse                     root mean square of A - B over pixels and channels\n"
     "  mean_relative_error      mean of |A - B|_1 / |B|_1 over the pixels where B is not\n"
     "                           black (|v|_1 = |r| + |g| + |b|)\n"
+    "  block_relative_rmse      RMS over blocks of |Y_A - Y_B| / Y_B, block mean luminances\n"
+    "                           (Y_B floored at 1e-3 of its image mean)\n"
+    "  pixel_relative_rmse      sqrt(mean (Y_A - Y_B)^2) / mean Y_B, leaving out lights seen\n"
+    "                           directly (Y_B over 20 x its median) and 2 pixels around them\n"
     "  mean_a, mean_b           mean radiance per channel: R G B\n"
     "  worst_block              X,Y (top-left pixel) and relative difference of the block\n"
     "                           whose mean differs most: |mean_A - mean_B|_1 / |mean_B|_1\n"
@@ -72,6 +76,9 @@ static void print_report(const rad_image *a, const rad_image_difference *d, uint
     printf("size: %ux%u\n", (unsigned)a->width, (unsigned)a->height);
     printf("rmse: %.6g\n", d->rmse);
     printf("mean_relative_error: %.6g\n", d->mean_relative_error);
+    printf("block_relative_rmse: %.6g\n", d->block_relative_rmse);
+    printf("pixel_relative_rmse: %.6g (%u pixels of lights left out)\n", d->pixel_relative_rmse,
+           (unsigned)d->pixels_left_out);
     printf("mean_a: %.6g %.6g %.6g\n", d->mean_a.r, d->mean_a.g, d->mean_a.b);
     printf("mean_b: %.6g %.6g %.6g\n", d->mean_b.r, d->mean_b.g, d->mean_b.b);
     printf("worst_block: %u,%u %.6g\n", (unsigned)d->worst_block_x, (unsigned)d->worst_block_y,

@@ -45,4 +45,13 @@ static inline double rad_rng_uniform(rad_rng *rng)
     return (double)(rad_rng_next(rng) >> 11) * (1.0 / 9007199254740992.0);
 }
 
+/* Radical inverse of j in base b: a coordinate of the Halton sequence, in [0, 1). */
+static inline double rad_radical_inverse(uint32_t j, uint32_t b)
+{
+    double inverse = 1.0 / b, scale = inverse, value = 0;
+    for (; j > 0; j /= b, scale *= inverse)
+        value += (j % b) * scale;
+    return value;
+}
+
 #endif

@@ -20,16 +20,21 @@
  */
 #include <inttypes.h>
 #include <math.h>
+#include <stdbool.h>
+#include <stdlib.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
 
+#include "core/alloc.h"
 #include "core/error.h"
 
 /* The false colour divides by max(|b|_1, this) (radiance, sum of three channels): far below
  * any radiance a float image holds in practice, so a black reference pixel shows blue where
  * a is black as well and red wherever a is not. */
 #define COMPARE_SMALLEST_REFERENCE 1e-30
+/* A reference pixel this many times brighter than the median shows a light source. */
+#define COMPARE_LIGHT_OVER_MEDIAN 20.0
 
 /* The false-colour ramp: blue, cyan, green, yellow, red at relative difference 0, 1/4,
  * 1/2, 3/4 and 1 (and above), linear in between. Corners are 0 or 1 exactly, so a PNG
@@ -89,6 +94,31 @@ static double block_relative(const double *sum_a, const double *sum_b)
     if (ref > 0)
         return diff / ref;
     return diff > 0 ? HUGE_VAL : 0.0;
+}
+
+static double luminance3(const float *p)
+{
+    return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+}
+
+static int compare_luminance(const void *x, const void *y)
+{
+    double a = *(const double *)x, b = *(const double *)y;
+    return (a > b) - (a < b);
+}
+
+/* The median luminance of an image; false when out of memory. */
+static bool median_luminance(const rad_image *image, size_t pixels, double *median)
+{
+    double *values = rad_alloc_array(pixels ? pixels : 1, sizeof(*values));
+    if (!values)
+        return false;
+    for (size_t i = 0; i < pixels; i++)
+        values[i] = luminance3(image->rgb + 3 * i);
+    qsort(values, pixels, sizeof(*values), compare_luminance);
+    *median = pixels ? values[pixels / 2] : 0;
+    free(values);
+    return true;
 }
 
 rad_status rad_image_compare(const rad_image *a, const rad_image *b,
@@ -175,6 +205,61 @@ rad_status rad_image_compare(const rad_image *a, const rad_image *b,
             }
         }
     const uint32_t block_count = blocks_x * blocks_y; /* <= pixels / block^2 */
+
+    /* The render-accuracy measures on luminance (the definitions, in the header). */
+    {
+        double mean_y = 0;
+        for (size_t i = 0; i < pixels; i++)
+            mean_y += luminance3(b->rgb + 3 * i);
+        mean_y /= (double)pixels;
+        double floor_y = 1e-3 * mean_y, sum_sq = 0;
+        for (uint32_t by = 0; by < blocks_y; by++)
+            for (uint32_t bx = 0; bx < blocks_x; bx++) {
+                double ya = 0, yb = 0;
+                for (size_t y = (size_t)by * block; y < (size_t)(by + 1) * block; y++)
+                    for (size_t x = (size_t)bx * block; x < (size_t)(bx + 1) * block; x++) {
+                        ya += luminance3(a->rgb + 3 * (y * width + x));
+                        yb += luminance3(b->rgb + 3 * (y * width + x));
+                    }
+                ya /= (double)block * block;
+                yb /= (double)block * block;
+                double d = fabs(ya - yb) / fmax(yb, floor_y);
+                sum_sq += d * d;
+            }
+        difference->block_relative_rmse =
+            blocks_x > 0 && blocks_y > 0 ? sqrt(sum_sq / ((double)blocks_x * blocks_y)) : 0;
+        /* the light seen directly: far above the median, and 2 pixels around it */
+        double median;
+        if (!median_luminance(b, pixels, &median))
+            return rad_fail(error, RAD_ERR_NOMEM, "out of memory comparing %" PRIu32 "x%" PRIu32
+                            " images", width, height);
+        double pixel_sq = 0, kept_sum = 0;
+        size_t kept = 0, left_out = 0;
+        for (uint32_t y = 0; y < height; y++)
+            for (uint32_t x = 0; x < width; x++) {
+                bool near_light = false;
+                for (int dy = -2; dy <= 2 && !near_light; dy++)
+                    for (int dx = -2; dx <= 2 && !near_light; dx++) {
+                        int64_t xx = (int64_t)x + dx, yy = (int64_t)y + dy;
+                        if (xx < 0 || yy < 0 || xx >= width || yy >= height)
+                            continue;
+                        near_light = luminance3(b->rgb + 3 * ((size_t)yy * width + (size_t)xx)) >
+                                     COMPARE_LIGHT_OVER_MEDIAN * median;
+                    }
+                if (near_light) {
+                    left_out++;
+                    continue;
+                }
+                size_t i = (size_t)y * width + x;
+                double ya = luminance3(a->rgb + 3 * i), yb = luminance3(b->rgb + 3 * i);
+                pixel_sq += (ya - yb) * (ya - yb);
+                kept_sum += yb;
+                kept++;
+            }
+        difference->pixel_relative_rmse =
+            kept && kept_sum > 0 ? sqrt(pixel_sq / (double)kept) / (kept_sum / (double)kept) : 0;
+        difference->pixels_left_out = (uint32_t)left_out;
+    }
 
     /* Pass 2: the picture, now that every pixel is known to be finite. Each pixel is read
      * before it is written, so false_colour may even be a or b. */

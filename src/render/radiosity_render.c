@@ -33,6 +33,8 @@
 #include "core/vec3.h"
 #include "lights/direct_light.h"
 #include "render/camera.h"
+#include "render/emitter_light.h"
+#include "render/emitters.h"
 #include "render/progress.h"
 #include "reconstruct/display_mesh.h"
 #include "scene/patch_materials.h"
@@ -43,6 +45,7 @@
 #define EDGE_STREAM 0x5EED0EDCEull /* keeps edge samples' random numbers apart */
 #define LIGHT_STREAM 0x5EED11647ull /* the same for shadow rays toward light sources */
 #define LIGHT_BATCH 65536u         /* shadow rays traced together, at most */
+#define EMITTER_STREAM 0x5EEDE3177ull /* the per-pixel shifts of the emitters' samples */
 
 /* One thread's rays of one image row, compacted bounce by bounce. */
 typedef struct row_work {
@@ -54,6 +57,7 @@ typedef struct row_work {
     uint8_t *edge;    /* per pixel of the row: gets edge samples */
     double *level;    /* per pixel of the row: mean luminance of its first samples */
     uint32_t row;     /* the image row being rendered (random numbers) */
+    uint32_t *edge_pixel; /* the pixels of the row that get edge samples, in order */
     /* shadow rays toward the sharp light sources from the hits of a bounce */
     rad_ray *light_rays;
     rad_rgb *light_value;   /* radiance the ray adds to its sample when unblocked */
@@ -81,6 +85,12 @@ typedef struct shading {
     uint32_t strata;                /* first samples per pixel, k^2 */
     uint64_t seed;
     bool irradiance;                /* pixels hold the irradiance arriving at the surface */
+    const emitter_set *emitters;    /* NULL: the emitters' direct light comes from the
+                                       solution, interpolated, not per pixel */
+    const rad_scene *scene;
+    uint32_t emitter_samples;       /* per pixel sample */
+    size_t per_row;                 /* first samples of a row: W k^2 */
+    uint32_t edge_strata;           /* edge samples of an edge pixel */
 } shading;
 
 static double mean_luminance(const rad_rgb *samples, unsigned count)
@@ -167,22 +177,48 @@ static void flush_lights(const shading *sh, row_work *w)
     w->light_count = 0;
 }
 
-/* Queues the shadow rays of the sharp light sources (point, spot, luminaire, sun) from a
- * hit: each adds weight x albedo / pi x its irradiance to the sample when unblocked. */
-static void queue_lights(const shading *sh, row_work *w, uint32_t sample, rad_vec3 point,
+/* Queues the shadow rays of the sharp light sources (point, spot, luminaire, sun) and of
+ * the emitters from a hit: each adds weight x albedo / pi x its irradiance to the sample
+ * when unblocked. The emitters' samples of one pixel are stratified together: sample
+ * `slot` is the pixel's index-th, and takes the index-th share of the triangle choice and
+ * the Halton points after the previous samples', with the pixel's own shift. */
+static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3 point,
                          const rad_patch *patch, rad_rgb factor)
 {
-    if (w->light_count + sh->lights->sharp_count > w->light_capacity)
+    uint32_t room = (sh->lights ? sh->lights->sharp_count : 0) + sh->emitter_samples;
+    if (w->light_count + room > w->light_capacity)
         flush_lights(sh, w);
-    rad_rng rng = rad_rng_seed(sh->seed ^ LIGHT_STREAM, w->row, sample);
-    uint32_t count = light_set_rays(sh->lights, LIGHTS_SHARP, point, patch->normal,
-                                    2 * patch->bulge + sh->lights->leave, sample % sh->strata,
-                                    sh->strata, 0, &rng, &w->light_rays[w->light_count],
-                                    &w->light_value[w->light_count]);
+    rad_rng rng = rad_rng_seed(sh->seed ^ LIGHT_STREAM, w->row, slot);
+    double leave = 2 * patch->bulge + sh->leave;
+    uint32_t count = 0, index;
+    uint32_t pixel;
+    if (slot < sh->per_row) {
+        pixel = slot / sh->strata;
+        index = slot % sh->strata;
+    } else {
+        pixel = w->edge_pixel[(slot - sh->per_row) / sh->edge_strata];
+        index = sh->strata + (uint32_t)((slot - sh->per_row) % sh->edge_strata);
+    }
+    if (sh->lights && sh->lights->sharp_count)
+        count = light_set_rays(sh->lights, LIGHTS_SHARP, point, patch->normal, leave,
+                               index % sh->strata, sh->strata, 0, &rng,
+                               &w->light_rays[w->light_count], &w->light_value[w->light_count]);
+    if (sh->emitters) {
+        rad_rng per_pixel = rad_rng_seed(sh->seed ^ EMITTER_STREAM, w->row, pixel);
+        double turn = rad_rng_uniform(&per_pixel), shift1 = rad_rng_uniform(&per_pixel),
+               shift2 = rad_rng_uniform(&per_pixel);
+        uint32_t total = sh->strata + sh->edge_strata;
+        turn += (double)index / (sh->emitter_samples * (double)total);
+        count += emitter_light_rays(sh->emitters, sh->scene, point, patch->normal, leave,
+                                    sh->emitter_samples, turn - floor(turn),
+                                    index * sh->emitter_samples, shift1, shift2, &rng,
+                                    &w->light_rays[w->light_count + count],
+                                    &w->light_value[w->light_count + count]);
+    }
     for (uint32_t k = 0; k < count; k++) {
         uint32_t q = w->light_count + k;
         w->light_value[q] = rgb_mul(w->light_value[q], factor);
-        w->light_sample[q] = sample;
+        w->light_sample[q] = slot;
     }
     w->light_count += count;
 }
@@ -236,7 +272,8 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
             interpolated =
                 textured_radiance(sh, &w->rays[r], hit, patch_index, interpolated, &albedo);
         rgb_add_to(&w->sum[w->sample[r]], rgb_mul(weight, interpolated));
-        if (sh->lights && sh->lights->sharp_count > 0 && !rgb_is_zero(albedo)) {
+        if (((sh->lights && sh->lights->sharp_count > 0) || sh->emitters) &&
+            !rgb_is_zero(albedo)) {
             const rad_ray *ray = &w->rays[r];
             rad_vec3 point = v3(ray->origin[0] + (double)hit->t * ray->direction[0],
                                 ray->origin[1] + (double)hit->t * ray->direction[1],
@@ -284,7 +321,8 @@ static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work 
  * (B - E) / rho - H_sharp (0 where rho is 0), elsewhere the exitance B - rho H_sharp. All
  * NULL when there is no scene or neither textures nor light sources. */
 static rad_status inputs_begin(const rad_render_options *options, const rad_mesh *mesh,
-                               const rad_rgb *B, patch_material_lookup **lookup,
+                               const rad_rgb *B, const rad_rgb *emitter_direct,
+                               patch_material_lookup **lookup,
                                const rad_patch_inputs **inputs, rad_patch_inputs **built,
                                rad_rgb **shaded, rad_error *error)
 {
@@ -300,12 +338,14 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
     if (options->irradiance && !scene)
         return rad_fail(error, RAD_ERR_INVALID,
                         "render: an irradiance image needs the scene (options.scene)");
-    if (!scene || (scene->texture_count == 0 && scene->light_count == 0 && !options->irradiance))
+    if (!scene || (scene->texture_count == 0 && scene->light_count == 0 && !options->irradiance &&
+                   !emitter_direct))
         return RAD_OK;
     rad_status status = RAD_OK;
     if (scene->texture_count > 0)
         status = patch_material_lookup_create(scene, lookup, error);
-    if (status != RAD_OK || (!*lookup && scene->light_count == 0 && !options->irradiance))
+    if (status != RAD_OK ||
+        (!*lookup && scene->light_count == 0 && !options->irradiance && !emitter_direct))
         return status;
     if (!options->inputs) {
         status = rad_patch_inputs_build(scene, mesh, built, error);
@@ -318,7 +358,12 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for textures");
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
         const double *b = &B[p].r, *e = &(*inputs)->exitance[p].r;
-        const double *rho = &(*inputs)->albedo[p].r, *h = &(*inputs)->direct_sharp[p].r;
+        const double *rho = &(*inputs)->albedo[p].r;
+        /* what the hits add themselves: the sharp sources', and the emitters' */
+        rad_rgb sharp = (*inputs)->direct_sharp[p];
+        if (emitter_direct)
+            sharp = rgb_add(sharp, emitter_direct[p]);
+        const double *h = &sharp.r;
         double *out = &(*shaded)[p].r;
         if (options->irradiance) {
             /* (B - E) / rho is the irradiance; a black patch shows its direct light only */
@@ -372,6 +417,10 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     uint32_t *first_triangle = NULL;
     light_set lights;
     const light_set *lights_ptr = NULL;
+    emitter_set emitters = {0};
+    const emitter_set *emitters_ptr = NULL;
+    rad_tracer *scene_tracer = NULL;
+    rad_rgb *emitter_direct = NULL;
     status = display_mesh_build(mesh, true, &display, error);
     if (status != RAD_OK)
         goto done;
@@ -380,7 +429,37 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     if (!radiance || !positions)
         goto nomem;
     display_mesh_positions(mesh, &display, positions);
-    status = inputs_begin(options, mesh, B, &lookup, &inputs, &built_inputs, &shaded, error);
+    rad_vec3 lo, hi;
+    v3_bounds(mesh->vertices, mesh->vertex_count, &lo, &hi);
+    double diagonal = mesh->vertex_count ? v3_length(v3_sub(hi, lo)) : 1;
+    double largest = fmax(fmax(fmax(fabs(lo.x), fabs(hi.x)), fmax(fabs(lo.y), fabs(hi.y))),
+                          fmax(fabs(lo.z), fabs(hi.z)));
+    /* hit points are float: their error grows with the distance from the origin */
+    double leave = RAD_SURFACE_LEAVE_DIAGONAL * diagonal + RAD_SURFACE_LEAVE_COORDINATE * largest;
+    uint32_t emitter_samples =
+        options->direct_samples ? options->direct_samples : RAD_DEFAULT_DIRECT_SAMPLES;
+
+    /* the emitters' direct light at every pixel sample, and its patch means to take out of
+     * the solution first */
+    if (options->scene && !options->direct_from_solution && rad_scene_has_emitter(options->scene)) {
+        status = emitters_build(options->scene, &emitters, error);
+        if (status == RAD_OK)
+            status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, options->scene,
+                                                 &scene_tracer, error);
+        if (status != RAD_OK)
+            goto done;
+        emitter_direct = rad_alloc_array(mesh->patch_count, sizeof(*emitter_direct));
+        if (!emitter_direct)
+            goto nomem;
+        status = emitter_patch_direct(&emitters, options->scene, mesh, scene_tracer,
+                                      leave, options->seed, threads,
+                                      emitter_direct, error);
+        if (status != RAD_OK)
+            goto done;
+        emitters_ptr = &emitters;
+    }
+    status = inputs_begin(options, mesh, B, emitter_direct, &lookup, &inputs, &built_inputs,
+                          &shaded, error);
     if (status != RAD_OK)
         goto done;
     if (options->scene && options->scene->light_count > 0) {
@@ -410,14 +489,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     if (status != RAD_OK)
         goto done;
 
-    rad_vec3 lo, hi;
-    v3_bounds(mesh->vertices, mesh->vertex_count, &lo, &hi);
-    double diagonal = mesh->vertex_count ? v3_length(v3_sub(hi, lo)) : 1;
     float t_near = (float)(RAD_CAMERA_NEAR * diagonal);
-    double largest = fmax(fmax(fmax(fabs(lo.x), fabs(hi.x)), fmax(fabs(lo.y), fabs(hi.y))),
-                          fmax(fabs(lo.z), fabs(hi.z)));
-    /* hit points are float: their error grows with the distance from the origin */
-    double leave = RAD_SURFACE_LEAVE_DIAGONAL * diagonal + RAD_SURFACE_LEAVE_COORDINATE * largest;
 
     size_t per_row = (size_t)W * k * k;
     unsigned edge_k = (unsigned)lround(sqrt((double)(options->edge_samples ? options->edge_samples
@@ -440,8 +512,12 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         w->level = rad_alloc_array(W, sizeof(*w->level));
         if (!w->rays || !w->hits || !w->weight || !w->sample || !w->sum || !w->edge || !w->level)
             goto nomem;
-        if (lights_ptr && lights.sharp_count > 0) {
-            w->light_capacity = LIGHT_BATCH > lights.sharp_count ? LIGHT_BATCH : lights.sharp_count;
+        w->edge_pixel = rad_alloc_array(W, sizeof(*w->edge_pixel));
+        if (!w->edge_pixel)
+            goto nomem;
+        uint32_t room = (lights_ptr ? lights.sharp_count : 0) + (emitters_ptr ? emitter_samples : 0);
+        if (room > 0) {
+            w->light_capacity = LIGHT_BATCH > room ? LIGHT_BATCH : room;
             w->light_rays = rad_alloc_array(w->light_capacity, sizeof(*w->light_rays));
             w->light_value = rad_alloc_array(w->light_capacity, sizeof(*w->light_value));
             w->light_sample = rad_alloc_array(w->light_capacity, sizeof(*w->light_sample));
@@ -458,7 +534,10 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                      lookup,    inputs,
                      lights_ptr, tracer,
                      k * k,     options->seed,
-                     options->irradiance};
+                     options->irradiance,
+                     emitters_ptr, options->scene,
+                     emitter_samples, per_row,
+                     edge_k * edge_k};
 
     render_progress progress =
         render_progress_start(options->progress, options->progress_user, "render", H);
@@ -495,6 +574,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                          (x + 1 < W && is_step(w->level[x], w->level[x + 1]));
             if (!w->edge[x])
                 continue;
+            w->edge_pixel[extra / (edge_k * edge_k)] = x;
             rad_rng rng = rad_rng_seed(options->seed ^ EDGE_STREAM, y, x);
             for (unsigned s = 0; s < edge_k * edge_k; s++) {
                 double px = x + ((s % edge_k) + rad_rng_uniform(&rng)) / edge_k;
@@ -542,6 +622,7 @@ done:
             free(work[th].sum);
             free(work[th].edge);
             free(work[th].level);
+            free(work[th].edge_pixel);
             free(work[th].light_rays);
             free(work[th].light_value);
             free(work[th].light_sample);
@@ -549,6 +630,9 @@ done:
         }
     free(work);
     rad_tracer_destroy(tracer);
+    rad_tracer_destroy(scene_tracer);
+    emitters_free(&emitters);
+    free(emitter_direct);
     display_mesh_free(&display);
     free(radiance);
     free(positions);

@@ -172,15 +172,6 @@ static double phong_lobe(rad_vec3 N, rad_vec3 L, double NL, rad_vec3 V, double n
     return c > 0 ? pow(c, n) : 0;
 }
 
-/* Radical inverse of j in base b: the Halton sequence's coordinate. */
-static double radical_inverse(uint32_t j, uint32_t b)
-{
-    double inverse = 1.0 / b, scale = inverse, value = 0;
-    for (; j > 0; j /= b, scale *= inverse)
-        value += (j % b) * scale;
-    return value;
-}
-
 static double wrap(double u) { return u < 1 ? u : u - 1; }
 
 /* Queues the direct light at point p (front normal N, viewer direction V) of the surface
@@ -248,8 +239,8 @@ static void shade_direct(const rt_context *ctx, rt_workspace *ws, const rad_mate
     for (uint32_t i = 0; i < n; i++, j++) {
         double u0 = (i + rad_rng_uniform(&rng)) / n;
         emitter_sample es;
-        emitters_sample(ctx->emitters, ctx->scene, u0, wrap(radical_inverse(j, 2) + shift1),
-                        wrap(radical_inverse(j, 3) + shift2), &es);
+        emitters_sample(ctx->emitters, ctx->scene, u0, wrap(rad_radical_inverse(j, 2) + shift1),
+                        wrap(rad_radical_inverse(j, 3) + shift2), &es);
         if (es.triangle != block_triangle) { /* a new block: start its sequence */
             block_triangle = es.triangle;
             j = 0;

@@ -1,0 +1,41 @@
+/*
+ * emitter_light.h - the direct light of emissive surfaces at a point, as shadow-ray pairs
+ * (internal): what the radiosity render adds at each pixel sample for exact soft shadows,
+ * and the same averaged over each patch, which it takes out of the solution first.
+ *
+ * Like the light sources' (lights/direct_light.h), a query returns pairs (shadow segment,
+ * irradiance at x if the segment is unblocked); the caller traces them in a batch. Each
+ * sample is a point on the emitters (emitters.h: a triangle by power, a point uniformly on
+ * it) and carries L_e cos_x cos_e / (r^2 pdf_area) / count, so the pairs of one query sum
+ * to an unbiased estimate of the irradiance from every emitter.
+ */
+#ifndef RAD_RENDER_EMITTER_LIGHT_H
+#define RAD_RENDER_EMITTER_LIGHT_H
+
+#include "core/random.h"
+#include "render/emitters.h"
+#include "radiosity.h"
+
+/* `count` samples for the point x (unit normal n; segments leave from x + n * leave and
+ * stop `leave` off the light), each of the whole light, so the query alone is unbiased:
+ * the triangle choice u0 stratified over the `count` samples and turned by `turn` in
+ * [0,1), the point on the triangle the Halton points first, first + 1, ... shifted by
+ * (shift1, shift2) (a caller taking several queries for one pixel gives them consecutive
+ * `first` and different turns, so together they cover the light evenly). Returns how
+ * many pairs could carry light (the light in front of the surface and the surface in
+ * front of the light). */
+uint32_t emitter_light_rays(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
+                            rad_vec3 n, double leave, uint32_t count, double turn,
+                            uint32_t first, double shift1, double shift2, rad_rng *rng,
+                            rad_ray *rays, rad_rgb *irradiance);
+
+/* Per patch, the mean over the patch of the emitters' direct irradiance (shadows
+ * included): PATCH_EMITTER_POINTS^2 points, PATCH_EMITTER_SAMPLES samples each, traced
+ * against `occluders` (the scene's triangles, or the patches). Deterministic per seed for
+ * any thread count. */
+rad_status emitter_patch_direct(const emitter_set *set, const rad_scene *scene,
+                                const rad_mesh *mesh, const rad_tracer *occluders,
+                                double leave, uint64_t seed, int threads, rad_rgb *direct,
+                                rad_error *error);
+
+#endif
