@@ -13,7 +13,14 @@
  *     POSITION min/max equal to the data, unit normals, colours in [0,1];
  *   - physics: in the furnace (every face Kd 0.5, Ke 1) every vertex radiance is
  *     Le / (1 - rho) = 2 within 0.5 %;
- *   - creases: vertices at one position on two walls keep different radiances.
+ *   - creases: vertices at one position on two walls keep different radiances;
+ *   - illuminance (the CLI passes the patch inputs): in the furnace every vertex has
+ *     pi x 2 (the radiance 2 arriving from the whole hemisphere) within 0.5 %; in the
+ *     Cornell box the per-patch irradiance (B - E) / rho computed here from the patch
+ *     inputs, through rad_reconstruct_vertices, times pi; a floor under a point light
+ *     (library calls) against E = I h / (h^2 + r^2)^(3/2), and radiance = rho / pi x
+ *     illuminance on its grey floor; files written without inputs hold no illuminance
+ *     and keep today's exact layout; a wrong patch count and non-finite inputs refused.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -23,6 +30,7 @@
 
 #include "testlib.h"
 
+#define PI 3.14159265358979323846
 #define CORNELL_PATCH_SIZE 100.0
 #define FLOAT_RELATIVE 1e-6 /* a double stored as float, or printed with 9 digits */
 
@@ -31,6 +39,9 @@ typedef struct reference {
     rad_scene *scene;
     rad_mesh *mesh;
     rad_rgb *radiance; /* per mesh vertex */
+    rad_rgb *illuminance; /* per mesh vertex: the irradiance from the patch inputs */
+    rad_patch_inputs *inputs;
+    rad_rgb *B;
     uint32_t (*triangles)[3];
     uint32_t triangle_count;
     double scale; /* the automatic exposure, recomputed here */
@@ -69,9 +80,33 @@ static void compute_reference(const char *scene_path, double patch_size, referen
         fprintf(stderr, "reference: %s\n", error.message);
         exit(1);
     }
+    if (rad_patch_inputs_build(ref->scene, ref->mesh, &ref->inputs, &error) != RAD_OK) {
+        fprintf(stderr, "reference inputs: %s\n", error.message);
+        exit(1);
+    }
     uint32_t n = ref->mesh->vertex_count;
     ref->radiance = calloc(n, sizeof(*ref->radiance));
     rad_reconstruct_vertices(ref->mesh, B, ref->radiance);
+    /* the light arriving at each patch: B = E + rho x (incident), per channel */
+    rad_rgb *irradiance = calloc(ref->mesh->patch_count, sizeof(*irradiance));
+    for (uint32_t p = 0; p < ref->mesh->patch_count; p++) {
+        const double b[3] = {B[p].r, B[p].g, B[p].b};
+        const rad_rgb *in_E = &ref->inputs->exitance[p], *in_rho = &ref->inputs->albedo[p],
+                      *in_H = &ref->inputs->direct[p];
+        const double e[3] = {in_E->r, in_E->g, in_E->b}, rho[3] = {in_rho->r, in_rho->g, in_rho->b},
+                     h[3] = {in_H->r, in_H->g, in_H->b};
+        double out[3];
+        for (int k = 0; k < 3; k++)
+            out[k] = rho[k] > 0 ? fmax((b[k] - e[k]) / rho[k], 0) : h[k];
+        irradiance[p] = (rad_rgb){out[0], out[1], out[2]};
+    }
+    ref->illuminance = calloc(n, sizeof(*ref->illuminance));
+    rad_reconstruct_vertices(ref->mesh, irradiance, ref->illuminance);
+    for (uint32_t v = 0; v < n; v++) /* rad_reconstruct_vertices gives value / pi */
+        ref->illuminance[v] = (rad_rgb){PI * ref->illuminance[v].r,
+                                        PI * ref->illuminance[v].g,
+                                        PI * ref->illuminance[v].b};
+    free(irradiance);
     ref->triangles = calloc(2 * (size_t)ref->mesh->patch_count, sizeof(*ref->triangles));
     for (uint32_t p = 0; p < ref->mesh->patch_count; p++) {
         const rad_patch *patch = &ref->mesh->patches[p];
@@ -95,12 +130,15 @@ static void compute_reference(const char *scene_path, double patch_size, referen
         quantile += (position - (double)below) * (lit[below + 1] - lit[below]);
     ref->scale = 0.9 / quantile;
     free(lit);
-    free(B);
+    ref->B = B;
 }
 
 static void free_reference(reference *ref)
 {
     free(ref->radiance);
+    free(ref->illuminance);
+    free(ref->B);
+    rad_patch_inputs_destroy(ref->inputs);
     free(ref->triangles);
     rad_mesh_destroy(ref->mesh);
     rad_scene_destroy(ref->scene);
@@ -164,8 +202,9 @@ static const uint8_t *accessor_data(const cJSON *json, int index, const uint8_t 
     return bin + offset;
 }
 
-/* Reads x.glb back by hand and checks it against the reference and the glTF rules. */
-static void check_glb(const char *name, const reference *ref)
+/* Reads x.glb back by hand and checks it against the reference and the glTF rules;
+ * `illuminance`: whether it must have _ILLUMINANCE (the reference's), or must not. */
+static void check_glb(const char *name, const reference *ref, bool illuminance)
 {
     size_t size = 0;
     uint8_t *bytes = test_read_bytes(test_path(name), &size);
@@ -217,10 +256,22 @@ static void check_glb(const char *name, const reference *ref)
     const uint8_t *radiance = accessor_data(json, json_int(attributes, "_RADIANCE"), bin,
                                             bin_length, &count, 5126, "VEC3");
     CHECK(count == n);
+    const uint8_t *illuminance_data = NULL;
+    CHECK((cJSON_GetObjectItem(attributes, "_ILLUMINANCE") != NULL) == illuminance);
+    if (illuminance) {
+        illuminance_data = accessor_data(json, json_int(attributes, "_ILLUMINANCE"), bin,
+                                         bin_length, &count, 5126, "VEC3");
+        CHECK(count == n && illuminance_data != NULL);
+        /* five vertex views and the indices: the buffer holds all of them, nothing else */
+        CHECK(bin_length == 5 * 12 * n + 12 * ref->triangle_count);
+    } else {
+        CHECK(bin_length == 4 * 12 * n + 12 * ref->triangle_count);
+    }
     const uint8_t *indices = accessor_data(json, json_int(primitive, "indices"), bin,
                                            bin_length, &count, 5125, "SCALAR");
     CHECK(count == 3 * ref->triangle_count);
-    if (!position || !normal || !colour || !radiance || !indices || count != 3 * ref->triangle_count) {
+    if (!position || !normal || !colour || !radiance || !indices ||
+        count != 3 * ref->triangle_count || (illuminance && !illuminance_data)) {
         cJSON_Delete(json);
         free(bytes);
         return;
@@ -229,13 +280,15 @@ static void check_glb(const char *name, const reference *ref)
     /* POSITION: the mesh's vertices, and min/max exactly those of the data */
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     uint32_t bad_position = 0, bad_normal = 0, bad_colour = 0, bad_radiance = 0;
+    uint32_t bad_illuminance = 0;
     for (uint32_t v = 0; v < n; v++) {
-        float p[3], nn[3], c[3], L[3];
+        float p[3], nn[3], c[3], L[3], E[3];
         for (int k = 0; k < 3; k++) {
             p[k] = get_f32(position + 12 * v + 4 * k);
             nn[k] = get_f32(normal + 12 * v + 4 * k);
             c[k] = get_f32(colour + 12 * v + 4 * k);
             L[k] = get_f32(radiance + 12 * v + 4 * k);
+            E[k] = illuminance ? get_f32(illuminance_data + 12 * v + 4 * k) : 0;
             lo[k] = fminf(lo[k], p[k]);
             hi[k] = fmaxf(hi[k], p[k]);
         }
@@ -245,14 +298,17 @@ static void check_glb(const char *name, const reference *ref)
                                 (double)nn[2] * nn[2]) - 1) > 1e-6;
         rad_rgb Lr = ref->radiance[v];
         bad_radiance += !same_rgb(L, Lr);
+        bad_illuminance += illuminance && !same_rgb(E, ref->illuminance[v]);
         rad_rgb d = {display(Lr.r, ref->scale), display(Lr.g, ref->scale),
                      display(Lr.b, ref->scale)};
         bad_colour += !same_rgb(c, d) || c[0] < 0 || c[0] > 1 || c[1] < 0 || c[1] > 1 ||
                       c[2] < 0 || c[2] > 1;
     }
     printf("%s: %u vertices, %u triangles; mismatches: position %u, normal %u, colour %u, "
-           "radiance %u\n",
-           name, n, ref->triangle_count, bad_position, bad_normal, bad_colour, bad_radiance);
+           "radiance %u, illuminance %u%s\n",
+           name, n, ref->triangle_count, bad_position, bad_normal, bad_colour, bad_radiance,
+           bad_illuminance, illuminance ? "" : " (none written)");
+    CHECK(bad_illuminance == 0);
     CHECK(bad_position == 0);
     CHECK(bad_normal == 0);
     CHECK(bad_colour == 0);
@@ -318,8 +374,9 @@ static void check_geometry_through_assimp(const char *name, const reference *ref
     rad_scene_destroy(scene);
 }
 
-/* A PLY as this writer makes it: the header line by line, then the binary records. */
-static void check_ply(const char *name, const reference *ref, bool furnace)
+/* A PLY as this writer makes it: the header line by line, then the binary records;
+ * `illuminance`: whether the records end with the reference's illuminance, or have none. */
+static void check_ply(const char *name, const reference *ref, bool furnace, bool illuminance)
 {
     size_t size = 0;
     uint8_t *bytes = test_read_bytes(test_path(name), &size);
@@ -340,19 +397,27 @@ static void check_ply(const char *name, const reference *ref, bool furnace)
              "property float nx\nproperty float ny\nproperty float nz\n"
              "property uchar red\nproperty uchar green\nproperty uchar blue\n"
              "property float radiance_r\nproperty float radiance_g\nproperty float radiance_b\n"
+             "%s"
              "element face %u\nproperty list uchar int vertex_indices\n",
-             ref->mesh->vertex_count, ref->triangle_count);
+             ref->mesh->vertex_count,
+             illuminance ? "property float illuminance_r\nproperty float illuminance_g\n"
+                           "property float illuminance_b\n"
+                         : "",
+             ref->triangle_count);
     CHECK(strncmp((const char *)bytes, "ply\nformat binary_little_endian 1.0\n", 36) == 0);
     CHECK(strstr((const char *)bytes, expected_elements) != NULL);
     uint32_t n = ref->mesh->vertex_count;
-    size_t vertex_bytes = 39, face_bytes = 13;
+    size_t vertex_bytes = illuminance ? 51 : 39, face_bytes = 13;
+    CHECK((strstr((const char *)bytes, "illuminance") != NULL) == illuminance);
     CHECK(size == header + n * vertex_bytes + ref->triangle_count * face_bytes);
     if (size != header + n * vertex_bytes + ref->triangle_count * face_bytes) {
         free(bytes);
         return;
     }
     uint32_t bad_position = 0, bad_colour = 0, bad_radiance = 0, bad_face = 0, off_furnace = 0;
+    uint32_t bad_illuminance = 0, off_furnace_illuminance = 0;
     double worst = 0; /* largest |L - 2| / 2 in the furnace */
+    double worst_illuminance = 0; /* largest |E - 2 pi| / (2 pi) in the furnace */
     for (uint32_t v = 0; v < n; v++) {
         const uint8_t *r = bytes + header + v * vertex_bytes;
         rad_vec3 q = ref->mesh->vertices[v];
@@ -361,6 +426,16 @@ static void check_ply(const char *name, const reference *ref, bool furnace)
         rad_rgb L = ref->radiance[v];
         float stored[3] = {get_f32(r + 27), get_f32(r + 31), get_f32(r + 35)};
         bad_radiance += !same_rgb(stored, L);
+        if (illuminance) {
+            float E[3] = {get_f32(r + 39), get_f32(r + 43), get_f32(r + 47)};
+            bad_illuminance += !same_rgb(E, ref->illuminance[v]);
+            /* (B - E) / rho turns B's error dB into dB / (B - E) relative: here B - E = B / 2,
+             * so twice B's relative error, and twice its 0.5 % bound */
+            for (int k = 0; k < 3; k++) {
+                off_furnace_illuminance += furnace && fabs(E[k] - 2 * PI) > 0.01 * 2 * PI;
+                worst_illuminance = fmax(worst_illuminance, fabs(E[k] - 2 * PI) / (2 * PI));
+            }
+        }
         double channel[3] = {L.r, L.g, L.b};
         for (int k = 0; k < 3; k++) {
             int expected = (int)lround(255 * srgb(display(channel[k], ref->scale)));
@@ -375,24 +450,29 @@ static void check_ply(const char *name, const reference *ref, bool furnace)
         for (int k = 0; k < 3; k++)
             bad_face += get_u32(f + 1 + 4 * k) != ref->triangles[t][k];
     }
-    printf("%s: %u vertices; mismatches: position %u, colour %u, radiance %u, face %u%s\n",
-           name, n, bad_position, bad_colour, bad_radiance, bad_face,
-           furnace ? "" : " (not the furnace)");
+    printf("%s: %u vertices; mismatches: position %u, colour %u, radiance %u, illuminance "
+           "%u%s, face %u%s\n",
+           name, n, bad_position, bad_colour, bad_radiance, bad_illuminance,
+           illuminance ? "" : " (none written)", bad_face, furnace ? "" : " (not the furnace)");
+    CHECK(bad_illuminance == 0);
     CHECK(bad_position == 0);
     CHECK(bad_colour == 0);
     CHECK(bad_radiance == 0);
     CHECK(bad_face == 0);
     if (furnace) {
-        printf("%s: %u channels off Le / (1 - rho) = 2 by over 0.5 %%; largest deviation "
-               "%.2e relative\n",
-               name, off_furnace, worst);
+        printf("%s: %u channels off Le / (1 - rho) = 2 by over 0.5 %%, %u illuminance "
+               "channels off pi x 2 by over 1 %%; largest deviation %.2e relative "
+               "(illuminance %.2e)\n",
+               name, off_furnace, off_furnace_illuminance, worst, worst_illuminance);
+        CHECK(off_furnace_illuminance == 0);
         CHECK(off_furnace == 0);
     }
     free(bytes);
 }
 
-/* The OBJ: `v x y z r g b`, then `#radiance R G B` per vertex in the same order. */
-static void check_obj(const char *name, const reference *ref, double scale)
+/* The OBJ: `v x y z r g b`, then `#radiance R G B` per vertex in the same order, each
+ * followed by `#illuminance R G B` when `illuminance` (the reference's), else none. */
+static void check_obj(const char *name, const reference *ref, double scale, bool illuminance)
 {
     FILE *f = fopen(test_path(name), "r");
     CHECK(f != NULL);
@@ -400,7 +480,8 @@ static void check_obj(const char *name, const reference *ref, double scale)
         return;
     char line[512];
     uint32_t v = 0, radiance_lines = 0, faces = 0, bad_colour = 0, bad_radiance = 0;
-    bool described = false;
+    uint32_t illuminance_lines = 0, bad_illuminance = 0;
+    bool described = false, after_radiance = false;
     while (fgets(line, sizeof(line), f)) {
         double x, y, z, r, g, b;
         if (strncmp(line, "# v x y z r g b:", 16) == 0)
@@ -419,13 +500,28 @@ static void check_obj(const char *name, const reference *ref, double scale)
                 bad_radiance += !same_rgb(stored, ref->radiance[radiance_lines]);
             }
             radiance_lines++;
+            after_radiance = true;
+            continue;
+        } else if (sscanf(line, "#illuminance %lf %lf %lf", &r, &g, &b) == 3) {
+            /* right after its vertex's #radiance line */
+            bad_illuminance += !after_radiance || illuminance_lines + 1 != radiance_lines;
+            if (illuminance_lines < ref->mesh->vertex_count) {
+                float stored[3] = {(float)r, (float)g, (float)b};
+                bad_illuminance += !same_rgb(stored, ref->illuminance[illuminance_lines]);
+            }
+            illuminance_lines++;
         } else if (line[0] == 'f' && line[1] == ' ') {
             faces++;
         }
+        after_radiance = false;
     }
     fclose(f);
-    printf("%s: %u v lines, %u #radiance lines, %u faces; mismatches: colour %u, radiance %u\n",
-           name, v, radiance_lines, faces, bad_colour, bad_radiance);
+    printf("%s: %u v lines, %u #radiance lines, %u #illuminance lines, %u faces; mismatches: "
+           "colour %u, radiance %u, illuminance %u\n",
+           name, v, radiance_lines, illuminance_lines, faces, bad_colour, bad_radiance,
+           bad_illuminance);
+    CHECK(illuminance_lines == (illuminance ? ref->mesh->vertex_count : 0));
+    CHECK(bad_illuminance == 0);
     CHECK(described);
     CHECK(v == ref->mesh->vertex_count);
     CHECK(radiance_lines == ref->mesh->vertex_count);
@@ -451,11 +547,11 @@ int main(void)
     run_ok("solve -o cornell.glb --patch-size 100");
     run_ok("solve -o cornell.ply --patch-size 100");
     run_ok("solve -o cornell.obj --patch-size 100");
-    check_glb("cornell.glb", &cornell);
+    check_glb("cornell.glb", &cornell, true);
     check_geometry_through_assimp("cornell.glb", &cornell, 0);
-    check_ply("cornell.ply", &cornell, false);
+    check_ply("cornell.ply", &cornell, false, true);
     check_geometry_through_assimp("cornell.ply", &cornell, 0);
-    check_obj("cornell.obj", &cornell, cornell.scale);
+    check_obj("cornell.obj", &cornell, cornell.scale, true);
     /* 9 significant digits of coordinates up to 560 mm */
     check_geometry_through_assimp("cornell.obj", &cornell, 1e-6 * 560);
     free_reference(&cornell);
@@ -465,9 +561,9 @@ int main(void)
     reference furnace;
     compute_reference(test_path("furnace.obj"), 0.125, &furnace);
     run_ok("solve furnace.obj -o furnace.ply --patch-size 0.125");
-    check_ply("furnace.ply", &furnace, true);
+    check_ply("furnace.ply", &furnace, true, true);
     run_ok("solve furnace.obj -o furnace.obj.obj --patch-size 0.125 --exposure -3");
-    check_obj("furnace.obj.obj", &furnace, 0.125); /* 2^-3 */
+    check_obj("furnace.obj.obj", &furnace, 0.125, true); /* 2^-3 */
     free_reference(&furnace);
 
     /* refusals: a usage error, no file left */
