@@ -530,6 +530,350 @@ static void check_obj(const char *name, const reference *ref, double scale, bool
     CHECK(bad_radiance == 0);
 }
 
+/* ---- illuminance through the library: files read back by name, not by this writer's layout */
+
+/* The vertex element's three float properties `names` of a binary PLY (any property
+ * order, float/uchar/int types), malloc'd as count x 3 floats; NULL when one is missing. */
+static float *ply_vertex_floats(const char *name, const char *const names[3], uint32_t *count)
+{
+    *count = 0;
+    size_t size = 0;
+    uint8_t *bytes = test_read_bytes(test_path(name), &size);
+    const char *end = bytes ? strstr((const char *)bytes, "end_header\n") : NULL;
+    if (!end) {
+        free(bytes);
+        return NULL;
+    }
+    size_t header = (size_t)(end - (const char *)bytes) + strlen("end_header\n");
+    size_t record = 0, offset[3] = {SIZE_MAX, SIZE_MAX, SIZE_MAX};
+    uint32_t vertices = 0;
+    bool in_vertex = false;
+    for (const char *line = (const char *)bytes; line < end;) {
+        const char *next = strchr(line, '\n');
+        char text[128] = {0}, type[32], property[64];
+        memcpy(text, line, (size_t)(next - line) < sizeof(text) - 1 ? (size_t)(next - line)
+                                                                    : sizeof(text) - 1);
+        unsigned u;
+        if (sscanf(text, "element vertex %u", &u) == 1) {
+            in_vertex = true;
+            vertices = u;
+        } else if (strncmp(text, "element ", 8) == 0) {
+            in_vertex = false;
+        } else if (in_vertex && sscanf(text, "property %31s %63s", type, property) == 2) {
+            for (int k = 0; k < 3; k++)
+                if (strcmp(property, names[k]) == 0 && strcmp(type, "float") == 0)
+                    offset[k] = record;
+            record += strcmp(type, "uchar") == 0 ? 1 : 4;
+        }
+        line = next + 1;
+    }
+    float *values = NULL;
+    if (offset[0] != SIZE_MAX && offset[1] != SIZE_MAX && offset[2] != SIZE_MAX &&
+        header + (size_t)vertices * record <= size) {
+        values = calloc(3 * (size_t)vertices + 1, sizeof(*values));
+        for (uint32_t v = 0; v < vertices; v++)
+            for (int k = 0; k < 3; k++)
+                values[3 * v + k] = get_f32(bytes + header + v * record + offset[k]);
+        *count = vertices;
+    }
+    free(bytes);
+    return values;
+}
+
+/* A float VEC3 attribute of a .glb's first primitive, malloc'd; NULL when it has none. */
+static float *glb_attribute(const char *name, const char *attribute, uint32_t *count)
+{
+    *count = 0;
+    size_t size = 0;
+    uint8_t *bytes = test_read_bytes(test_path(name), &size);
+    if (!bytes || size < 28) {
+        free(bytes);
+        return NULL;
+    }
+    uint32_t json_length = get_u32(bytes + 12);
+    const uint8_t *bin_header = bytes + 20 + json_length;
+    cJSON *json = 20 + (size_t)json_length + 8 <= size
+                      ? cJSON_ParseWithLength((const char *)bytes + 20, json_length)
+                      : NULL;
+    float *values = NULL;
+    const cJSON *attributes = cJSON_GetObjectItem(
+        cJSON_GetArrayItem(
+            cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(json, "meshes"), 0),
+                                "primitives"),
+            0),
+        "attributes");
+    if (cJSON_GetObjectItem(attributes, attribute)) {
+        uint32_t n = 0;
+        const uint8_t *data = accessor_data(json, json_int(attributes, attribute), bin_header + 8,
+                                            get_u32(bin_header), &n, 5126, "VEC3");
+        if (data) {
+            values = calloc(3 * (size_t)n + 1, sizeof(*values));
+            for (size_t k = 0; k < 3 * (size_t)n; k++)
+                values[k] = get_f32(data + 4 * k);
+            *count = n;
+        }
+    }
+    cJSON_Delete(json);
+    free(bytes);
+    return values;
+}
+
+/* The numbers of every OBJ comment line `TAG R G B` (tag with its '#'), malloc'd. */
+static float *obj_comments(const char *name, const char *tag, uint32_t *count)
+{
+    *count = 0;
+    FILE *f = fopen(test_path(name), "r");
+    if (!f)
+        return NULL;
+    size_t capacity = 1024;
+    float *values = calloc(3 * capacity, sizeof(*values));
+    char line[512];
+    float r, g, b;
+    size_t tag_length = strlen(tag);
+    while (fgets(line, sizeof(line), f))
+        if (strncmp(line, tag, tag_length) == 0 && line[tag_length] == ' ' &&
+            sscanf(line + tag_length, "%f %f %f", &r, &g, &b) == 3) {
+            if (*count == capacity) {
+                capacity *= 2;
+                values = realloc(values, 3 * capacity * sizeof(*values));
+            }
+            values[3 * *count] = r, values[3 * *count + 1] = g, values[3 * *count + 2] = b;
+            (*count)++;
+        }
+    fclose(f);
+    return values;
+}
+
+#define FLOOR_HALF 3.0        /* the floor: [-3, 3] x [-3, 3] at y = 0, facing +y */
+#define FLOOR_PATCH 0.1       /* 60 x 60 square patches */
+#define FLOOR_INNER 2.0       /* vertices checked: |x|, |z| <= 2, a metre from every edge */
+#define LAMP_HEIGHT 2.0       /* a 100 cd point light at (0, 2, 0) */
+#define LAMP_CANDELA 100.0
+#define FLOOR_ALBEDO 0.5      /* the default material: grey */
+/* A vertex holds the area-weighted mean of its four patches' mean irradiance, i.e. the mean
+ * of E over the square of side 2a (a = FLOOR_PATCH) around it: E + a^2/6 lap E + O(a^4).
+ * For E = I h / (h^2 + r^2)^(3/2), lap E / E = (9 r^2 - 6 h^2) / (h^2 + r^2)^2, largest in
+ * size at r = 0: -6 / h^2, so the vertex is low by a^2 / h^2 = 0.25 % at most; each
+ * patch's H itself is an 8 x 8 point mean (under 0.1 % here). 2 % leaves room for both and
+ * still fails for any wrong factor (pi, rho, a missing bounce weight). */
+#define FLOOR_BOUND 0.02
+
+/* E = I h / (h^2 + r^2)^(3/2) below the lamp. */
+static double floor_illuminance(rad_vec3 p)
+{
+    double r2 = p.x * p.x + p.z * p.z;
+    return LAMP_CANDELA * LAMP_HEIGHT / pow(LAMP_HEIGHT * LAMP_HEIGHT + r2, 1.5);
+}
+
+/* Checks a floor file's vertex values: illuminance against the closed form inside, and
+ * radiance = rho / pi x illuminance at every vertex; returns the worst relative error. */
+static double check_floor_values(const char *label, const rad_mesh *mesh, const float *radiance,
+                                 uint32_t radiance_count, const float *illuminance,
+                                 uint32_t illuminance_count)
+{
+    CHECK(radiance != NULL && illuminance != NULL);
+    CHECK(radiance_count == mesh->vertex_count && illuminance_count == mesh->vertex_count);
+    if (!radiance || !illuminance || radiance_count != mesh->vertex_count ||
+        illuminance_count != mesh->vertex_count)
+        return HUGE_VAL;
+    double worst = 0, worst_ratio = 0;
+    uint32_t checked = 0;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        rad_vec3 p = mesh->vertices[v];
+        for (int k = 0; k < 3; k++) {
+            double E = illuminance[3 * v + k], L = radiance[3 * v + k];
+            double expected_L = FLOOR_ALBEDO / PI * E;
+            worst_ratio = fmax(worst_ratio, fabs(L - expected_L) / fmax(expected_L, 1e-30));
+            if (fabs(p.x) <= FLOOR_INNER && fabs(p.z) <= FLOOR_INNER)
+                worst = fmax(worst, fabs(E - floor_illuminance(p)) / floor_illuminance(p));
+        }
+        checked += fabs(p.x) <= FLOOR_INNER && fabs(p.z) <= FLOOR_INNER;
+    }
+    printf("%s: %u inner vertices, illuminance worst %.2e relative to I h / (h^2 + r^2)^1.5; "
+           "radiance vs rho / pi x illuminance worst %.2e relative\n",
+           label, checked, worst, worst_ratio);
+    CHECK(checked >= 41 * 41);
+    CHECK(worst < FLOOR_BOUND);
+    CHECK(worst_ratio < FLOAT_RELATIVE);
+    return worst;
+}
+
+static void write_ok(const rad_mesh *mesh, const rad_rgb *B, const char *name,
+                     const rad_lit_mesh_options *options)
+{
+    rad_error error = {0};
+    rad_status status = rad_lit_mesh_write(mesh, B, test_path(name), options, &error);
+    CHECK(status == RAD_OK);
+    if (status != RAD_OK)
+        fprintf(stderr, "%s: %s\n", name, error.message);
+}
+
+/* A lone floor under a point light, written with the patch inputs in all three formats. */
+static void test_floor_under_point_light(void)
+{
+    char text[256];
+    snprintf(text, sizeof(text), "o floor\nv %g 0 %g\nv %g 0 %g\nv %g 0 %g\nv %g 0 %g\nf 1 2 3 4\n",
+             -FLOOR_HALF, FLOOR_HALF, FLOOR_HALF, FLOOR_HALF, FLOOR_HALF, -FLOOR_HALF,
+             -FLOOR_HALF, -FLOOR_HALF);
+    rad_scene *scene = NULL;
+    rad_mesh *mesh = NULL;
+    rad_patch_inputs *inputs = NULL;
+    rad_error error = {0};
+    rad_light lamp = {.type = RAD_LIGHT_POINT, .position = {0, LAMP_HEIGHT, 0},
+                      .intensity = {LAMP_CANDELA, LAMP_CANDELA, LAMP_CANDELA}};
+    rad_status status = rad_scene_load(test_write_file("floor.obj", text), NULL, &scene, &error);
+    if (status == RAD_OK)
+        status = rad_scene_add_light(scene, &lamp, &error);
+    if (status == RAD_OK)
+        status = rad_mesh_build(scene, FLOOR_PATCH, &mesh, &error);
+    if (status == RAD_OK)
+        status = rad_patch_inputs_build(scene, mesh, &inputs, &error);
+    rad_rgb *B = calloc(mesh ? mesh->patch_count : 1, sizeof(*B));
+    rad_scene_solve_options solve = {.solver = RAD_SOLVER_JACOBI, .threads = 2, .inputs = inputs};
+    if (status == RAD_OK)
+        status = rad_solve_scene(scene, mesh, &solve, B, NULL, &error);
+    CHECK(status == RAD_OK);
+    if (status != RAD_OK) {
+        fprintf(stderr, "floor: %s\n", error.message);
+        exit(1);
+    }
+    uint32_t grey = 0;
+    for (uint32_t p = 0; p < mesh->patch_count; p++)
+        grey += inputs->albedo[p].r == FLOOR_ALBEDO && inputs->albedo[p].g == FLOOR_ALBEDO &&
+                inputs->albedo[p].b == FLOOR_ALBEDO;
+    CHECK(grey == mesh->patch_count);
+    printf("floor: %u patches, %u vertices\n", mesh->patch_count, mesh->vertex_count);
+
+    rad_lit_mesh_options options = {.inputs = inputs};
+    write_ok(mesh, B, "floor.ply", &options);
+    write_ok(mesh, B, "floor.glb", &options);
+    write_ok(mesh, B, "floor.obj.obj", &options);
+    static const char *const radiance_names[3] = {"radiance_r", "radiance_g", "radiance_b"};
+    static const char *const illuminance_names[3] = {"illuminance_r", "illuminance_g",
+                                                     "illuminance_b"};
+    uint32_t nL, nE;
+    float *L = ply_vertex_floats("floor.ply", radiance_names, &nL);
+    float *E = ply_vertex_floats("floor.ply", illuminance_names, &nE);
+    check_floor_values("floor.ply", mesh, L, nL, E, nE);
+    free(L);
+    free(E);
+    L = glb_attribute("floor.glb", "_RADIANCE", &nL);
+    E = glb_attribute("floor.glb", "_ILLUMINANCE", &nE);
+    check_floor_values("floor.glb", mesh, L, nL, E, nE);
+    free(L);
+    free(E);
+    L = obj_comments("floor.obj.obj", "#radiance", &nL);
+    E = obj_comments("floor.obj.obj", "#illuminance", &nE);
+    check_floor_values("floor.obj", mesh, L, nL, E, nE);
+    free(L);
+    free(E);
+
+    /* a black floor reflects nothing (B = 0): its vertices show the lamp's direct light
+     * alone, which on a lone floor is all the light there is */
+    rad_rgb *black = calloc(mesh->patch_count, sizeof(*black));
+    rad_patch_inputs dark = *inputs;
+    dark.albedo = black;
+    rad_lit_mesh_options dark_options = {.inputs = &dark};
+    write_ok(mesh, black, "black.ply", &dark_options);
+    E = ply_vertex_floats("black.ply", illuminance_names, &nE);
+    CHECK(E != NULL && nE == mesh->vertex_count);
+    double worst_black = 0;
+    for (uint32_t v = 0; E && v < nE && v < mesh->vertex_count; v++)
+        if (fabs(mesh->vertices[v].x) <= FLOOR_INNER && fabs(mesh->vertices[v].z) <= FLOOR_INNER)
+            worst_black = fmax(worst_black, fabs(E[3 * v + 1] - floor_illuminance(mesh->vertices[v])) /
+                                                floor_illuminance(mesh->vertices[v]));
+    printf("black.ply: illuminance (H alone) worst %.2e relative to the closed form\n",
+           worst_black);
+    CHECK(worst_black < FLOOR_BOUND);
+    free(E);
+
+    /* without inputs: no illuminance in any format */
+    write_ok(mesh, B, "plain.ply", NULL);
+    write_ok(mesh, B, "plain.glb", &(rad_lit_mesh_options){0});
+    write_ok(mesh, B, "plain.obj", NULL);
+    E = ply_vertex_floats("plain.ply", illuminance_names, &nE);
+    CHECK(E == NULL);
+    free(E);
+    E = glb_attribute("plain.glb", "_ILLUMINANCE", &nE);
+    CHECK(E == NULL);
+    free(E);
+    E = obj_comments("plain.obj", "#illuminance", &nE);
+    CHECK(nE == 0);
+    free(E);
+    CHECK(!strstr(test_read_text(test_path("plain.obj")), "illuminance"));
+
+    free(black);
+    free(B);
+    rad_patch_inputs_destroy(inputs);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+}
+
+/* The Cornell box through the library without inputs: today's exact files; with inputs
+ * of the wrong size, or non-finite ones, refused and nothing written. */
+static void test_library_cornell(const reference *ref)
+{
+    write_ok(ref->mesh, ref->B, "plain_cornell.ply", NULL);
+    write_ok(ref->mesh, ref->B, "plain_cornell.glb", NULL);
+    write_ok(ref->mesh, ref->B, "plain_cornell.obj", NULL);
+    check_ply("plain_cornell.ply", ref, false, false);
+    check_glb("plain_cornell.glb", ref, false);
+    check_obj("plain_cornell.obj", ref, ref->scale, false);
+    rad_lit_mesh_options with = {.inputs = ref->inputs};
+    write_ok(ref->mesh, ref->B, "with_cornell.ply", &with);
+    check_ply("with_cornell.ply", ref, false, true);
+
+    const char *names[3] = {"refused.ply", "refused.glb", "refused.obj"};
+    uint32_t n = ref->mesh->patch_count, k = n / 3;
+    rad_rgb *albedo = calloc(n, sizeof(*albedo)), *exitance = calloc(n, sizeof(*exitance)),
+            *direct = calloc(n, sizeof(*direct));
+    for (int f = 0; f < 3; f++) {
+        const char *path = test_path(names[f]);
+        rad_error error = {0};
+        char expected[64];
+        /* a patch count other than the mesh's */
+        rad_patch_inputs wrong = *ref->inputs;
+        wrong.n = n - 1;
+        rad_lit_mesh_options options = {.inputs = &wrong};
+        CHECK(rad_lit_mesh_write(ref->mesh, ref->B, path, &options, &error) == RAD_ERR_INVALID);
+        snprintf(expected, sizeof(expected), "have %u patches, the mesh %u", n - 1, n);
+        printf("%s\n", error.message);
+        CHECK(strstr(error.message, path) != NULL && strstr(error.message, expected) != NULL);
+        CHECK(!test_file_exists(path));
+
+        /* a NaN exitance on a patch that reflects: its irradiance is not finite */
+        memcpy(albedo, ref->inputs->albedo, n * sizeof(*albedo));
+        memcpy(exitance, ref->inputs->exitance, n * sizeof(*exitance));
+        memcpy(direct, ref->inputs->direct, n * sizeof(*direct));
+        CHECK(albedo[k].g > 0);
+        exitance[k].g = NAN;
+        rad_patch_inputs bad = *ref->inputs;
+        bad.albedo = albedo, bad.exitance = exitance, bad.direct = direct;
+        options.inputs = &bad;
+        memset(&error, 0, sizeof(error));
+        CHECK(rad_lit_mesh_write(ref->mesh, ref->B, path, &options, &error) == RAD_ERR_INVALID);
+        snprintf(expected, sizeof(expected), "patch %u has an irradiance", k);
+        printf("%s\n", error.message);
+        CHECK(strstr(error.message, path) != NULL && strstr(error.message, expected) != NULL);
+        CHECK(!test_file_exists(path));
+        /* a black patch whose direct light is infinite */
+        exitance[k].g = ref->inputs->exitance[k].g;
+        albedo[k].b = 0;
+        direct[k].b = INFINITY;
+        memset(&error, 0, sizeof(error));
+        CHECK(rad_lit_mesh_write(ref->mesh, ref->B, path, &options, &error) == RAD_ERR_INVALID);
+        CHECK(strstr(error.message, expected) != NULL);
+        CHECK(!test_file_exists(path));
+        /* and a finite one is written */
+        direct[k].b = 1;
+        CHECK(rad_lit_mesh_write(ref->mesh, ref->B, path, &options, &error) == RAD_OK);
+        CHECK(test_file_exists(path));
+    }
+    free(albedo);
+    free(exitance);
+    free(direct);
+}
+
 static void run_ok(const char *arguments)
 {
     int code = test_run_tool(arguments);
@@ -554,6 +898,7 @@ int main(void)
     check_obj("cornell.obj", &cornell, cornell.scale, true);
     /* 9 significant digits of coordinates up to 560 mm */
     check_geometry_through_assimp("cornell.obj", &cornell, 1e-6 * 560);
+    test_library_cornell(&cornell);
     free_reference(&cornell);
 
     /* the furnace: radiance 2 everywhere; a uniform mesh exposes to 0.9 exactly */
@@ -565,6 +910,8 @@ int main(void)
     run_ok("solve furnace.obj -o furnace.obj.obj --patch-size 0.125 --exposure -3");
     check_obj("furnace.obj.obj", &furnace, 0.125, true); /* 2^-3 */
     free_reference(&furnace);
+
+    test_floor_under_point_light();
 
     /* refusals: a usage error, no file left */
     CHECK(test_run_tool("solve -o out.stl") == 2);
