@@ -1390,23 +1390,39 @@ rad_status rad_image_compare(const rad_image *a, const rad_image *b,
 typedef struct rad_lit_mesh_options {
     bool fixed_exposure; /* false = automatic (above), true = use `exposure` */
     double exposure;     /* the display colour is radiance * 2^exposure */
+    const rad_patch_inputs *inputs; /* NULL, or the patch inputs B was solved with
+                                  (rad_patch_inputs_build of this scene and mesh; n must be
+                                  mesh->patch_count): every vertex then also carries its
+                                  irradiance, see rad_lit_mesh_write */
 } rad_lit_mesh_options;
 
 /* Writes the mesh lit by B (per-patch exitance) by the extension of path:
  *   .ply  binary little-endian PLY. Vertex: float x y z, float nx ny nz, uchar red green
  *         blue (the display colour, sRGB-encoded), float radiance_r radiance_g radiance_b
- *         (linear); face: list uchar int vertex_indices. Comments give the exposure.
+ *         (linear), with inputs then float illuminance_r illuminance_g illuminance_b;
+ *         face: list uchar int vertex_indices. Comments give the exposure.
  *   .glb  binary glTF 2.0, one mesh of triangles with POSITION, NORMAL, COLOR_0 (the
  *         display colour as float RGB, linear as glTF requires: viewers apply the sRGB
  *         curve themselves), _RADIANCE (float RGB linear radiance, an application
- *         attribute) and an unlit material (KHR_materials_unlit), so viewers show the
- *         colours as they are, not shaded again.
+ *         attribute), with inputs _ILLUMINANCE (float VEC3, likewise), and an unlit
+ *         material (KHR_materials_unlit), so viewers show the colours as they are, not
+ *         shaded again.
  *   .obj  `v x y z r g b` (the display colour, sRGB-encoded, in [0,1]: the vertex-colour
  *         extension MeshLab and Blender read), `vn`, triangles `f a//a b//b c//c`; the
  *         linear radiance is a comment line `#radiance R G B` per vertex, in vertex order,
- *         after the `v` lines, so the file stays one plain OBJ for every reader.
- * options NULL = automatic exposure. Atomic like rad_image_write. RAD_ERR_INVALID for an
- * unknown extension or a non-finite exposure. */
+ *         after the `v` lines (with inputs, each followed by `#illuminance R G B`), so the
+ *         file stays one plain OBJ for every reader.
+ * With options->inputs, the illuminance: per patch the irradiance (B_i - E_i) / rho_i per
+ * channel where rho_i > 0 (the incident light, direct and interreflected; a negative
+ * rounding residue is 0), and H_i, the light sources' direct light alone, where rho_i = 0:
+ * a black patch reflects nothing, so B tells nothing of the light other surfaces send it.
+ * Vertices get it exactly as the radiance (area-weighted means, T-vertices and added
+ * vertices interpolated), times pi instead of over pi: lux with lights in candela and lux,
+ * else pi x the unit of Ke. Without inputs the files hold no illuminance at all.
+ * options NULL = automatic exposure, no illuminance. Atomic like rad_image_write.
+ * RAD_ERR_INVALID for an unknown extension, a non-finite exposure, a non-finite B or
+ * irradiance (naming the patch), or inputs->n other than mesh->patch_count (naming
+ * both). */
 rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char *path,
                               const rad_lit_mesh_options *options, rad_error *error);
 

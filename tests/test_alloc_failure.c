@@ -322,14 +322,17 @@ static rad_status trace_and_images(rad_error *error)
 static rad_scene *solved_scene;
 static rad_mesh *solved_mesh;
 static rad_rgb *solved_B;
+static rad_patch_inputs *solved_inputs;
 
-/* (g) the lit mesh as .ply, .glb and .obj, and the solution written, read and matched. */
+/* (g) the lit mesh as .ply, .glb and .obj (with the vertices' illuminance: the patch
+ * inputs given), and the solution written, read and matched. */
 static rad_status lit_mesh_and_solution(rad_error *error)
 {
     static const char *const names[3] = {"lit.ply", "lit.glb", "lit.obj"};
     rad_status status = RAD_OK;
+    rad_lit_mesh_options options = {.inputs = solved_inputs};
     for (int k = 0; k < 3 && status == RAD_OK; k++)
-        status = rad_lit_mesh_write(solved_mesh, solved_B, test_path(names[k]), NULL, error);
+        status = rad_lit_mesh_write(solved_mesh, solved_B, test_path(names[k]), &options, error);
     rad_solution *solution = NULL;
     if (status == RAD_OK)
         status = rad_solution_write(solved_scene, solved_mesh, solved_B, test_path("saved.rad"),
@@ -512,10 +515,13 @@ int main(void)
         rad_scene_solve_options options = {.solver = RAD_SOLVER_JACOBI, .threads = 1};
         CHECK(rad_solve_scene(solved_scene, solved_mesh, &options, solved_B, NULL, &error) ==
               RAD_OK);
+        CHECK(rad_patch_inputs_build(solved_scene, solved_mesh, &solved_inputs, &error) ==
+              RAD_OK);
         CHECK(sweep("lit mesh (PLY, GLB, OBJ) and solution file", lit_mesh_and_solution,
                     NULL) > 0);
     }
     free(solved_B);
+    rad_patch_inputs_destroy(solved_inputs);
     rad_mesh_destroy(solved_mesh);
     rad_scene_destroy(solved_scene);
     return test_finish("test_alloc_failure");

@@ -13,7 +13,14 @@
  *     POSITION min/max equal to the data, unit normals, colours in [0,1];
  *   - physics: in the furnace (every face Kd 0.5, Ke 1) every vertex radiance is
  *     Le / (1 - rho) = 2 within 0.5 %;
- *   - creases: vertices at one position on two walls keep different radiances.
+ *   - creases: vertices at one position on two walls keep different radiances;
+ *   - illuminance (the CLI passes the patch inputs): in the furnace every vertex has
+ *     pi x 2 (the radiance 2 arriving from the whole hemisphere) within 0.5 %; in the
+ *     Cornell box the per-patch irradiance (B - E) / rho computed here from the patch
+ *     inputs, through rad_reconstruct_vertices, times pi; a floor under a point light
+ *     (library calls) against E = I h / (h^2 + r^2)^(3/2), and radiance = rho / pi x
+ *     illuminance on its grey floor; files written without inputs hold no illuminance
+ *     and keep today's exact layout; a wrong patch count and non-finite inputs refused.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -23,6 +30,7 @@
 
 #include "testlib.h"
 
+#define PI 3.14159265358979323846
 #define CORNELL_PATCH_SIZE 100.0
 #define FLOAT_RELATIVE 1e-6 /* a double stored as float, or printed with 9 digits */
 
@@ -31,6 +39,9 @@ typedef struct reference {
     rad_scene *scene;
     rad_mesh *mesh;
     rad_rgb *radiance; /* per mesh vertex */
+    rad_rgb *illuminance; /* per mesh vertex: the irradiance from the patch inputs */
+    rad_patch_inputs *inputs;
+    rad_rgb *B;
     uint32_t (*triangles)[3];
     uint32_t triangle_count;
     double scale; /* the automatic exposure, recomputed here */
@@ -69,9 +80,33 @@ static void compute_reference(const char *scene_path, double patch_size, referen
         fprintf(stderr, "reference: %s\n", error.message);
         exit(1);
     }
+    if (rad_patch_inputs_build(ref->scene, ref->mesh, &ref->inputs, &error) != RAD_OK) {
+        fprintf(stderr, "reference inputs: %s\n", error.message);
+        exit(1);
+    }
     uint32_t n = ref->mesh->vertex_count;
     ref->radiance = calloc(n, sizeof(*ref->radiance));
     rad_reconstruct_vertices(ref->mesh, B, ref->radiance);
+    /* the light arriving at each patch: B = E + rho x (incident), per channel */
+    rad_rgb *irradiance = calloc(ref->mesh->patch_count, sizeof(*irradiance));
+    for (uint32_t p = 0; p < ref->mesh->patch_count; p++) {
+        const double b[3] = {B[p].r, B[p].g, B[p].b};
+        const rad_rgb *in_E = &ref->inputs->exitance[p], *in_rho = &ref->inputs->albedo[p],
+                      *in_H = &ref->inputs->direct[p];
+        const double e[3] = {in_E->r, in_E->g, in_E->b}, rho[3] = {in_rho->r, in_rho->g, in_rho->b},
+                     h[3] = {in_H->r, in_H->g, in_H->b};
+        double out[3];
+        for (int k = 0; k < 3; k++)
+            out[k] = rho[k] > 0 ? fmax((b[k] - e[k]) / rho[k], 0) : h[k];
+        irradiance[p] = (rad_rgb){out[0], out[1], out[2]};
+    }
+    ref->illuminance = calloc(n, sizeof(*ref->illuminance));
+    rad_reconstruct_vertices(ref->mesh, irradiance, ref->illuminance);
+    for (uint32_t v = 0; v < n; v++) /* rad_reconstruct_vertices gives value / pi */
+        ref->illuminance[v] = (rad_rgb){PI * ref->illuminance[v].r,
+                                        PI * ref->illuminance[v].g,
+                                        PI * ref->illuminance[v].b};
+    free(irradiance);
     ref->triangles = calloc(2 * (size_t)ref->mesh->patch_count, sizeof(*ref->triangles));
     for (uint32_t p = 0; p < ref->mesh->patch_count; p++) {
         const rad_patch *patch = &ref->mesh->patches[p];
@@ -95,12 +130,15 @@ static void compute_reference(const char *scene_path, double patch_size, referen
         quantile += (position - (double)below) * (lit[below + 1] - lit[below]);
     ref->scale = 0.9 / quantile;
     free(lit);
-    free(B);
+    ref->B = B;
 }
 
 static void free_reference(reference *ref)
 {
     free(ref->radiance);
+    free(ref->illuminance);
+    free(ref->B);
+    rad_patch_inputs_destroy(ref->inputs);
     free(ref->triangles);
     rad_mesh_destroy(ref->mesh);
     rad_scene_destroy(ref->scene);
@@ -164,8 +202,9 @@ static const uint8_t *accessor_data(const cJSON *json, int index, const uint8_t 
     return bin + offset;
 }
 
-/* Reads x.glb back by hand and checks it against the reference and the glTF rules. */
-static void check_glb(const char *name, const reference *ref)
+/* Reads x.glb back by hand and checks it against the reference and the glTF rules;
+ * `illuminance`: whether it must have _ILLUMINANCE (the reference's), or must not. */
+static void check_glb(const char *name, const reference *ref, bool illuminance)
 {
     size_t size = 0;
     uint8_t *bytes = test_read_bytes(test_path(name), &size);
@@ -217,10 +256,22 @@ static void check_glb(const char *name, const reference *ref)
     const uint8_t *radiance = accessor_data(json, json_int(attributes, "_RADIANCE"), bin,
                                             bin_length, &count, 5126, "VEC3");
     CHECK(count == n);
+    const uint8_t *illuminance_data = NULL;
+    CHECK((cJSON_GetObjectItem(attributes, "_ILLUMINANCE") != NULL) == illuminance);
+    if (illuminance) {
+        illuminance_data = accessor_data(json, json_int(attributes, "_ILLUMINANCE"), bin,
+                                         bin_length, &count, 5126, "VEC3");
+        CHECK(count == n && illuminance_data != NULL);
+        /* five vertex views and the indices: the buffer holds all of them, nothing else */
+        CHECK(bin_length == 5 * 12 * n + 12 * ref->triangle_count);
+    } else {
+        CHECK(bin_length == 4 * 12 * n + 12 * ref->triangle_count);
+    }
     const uint8_t *indices = accessor_data(json, json_int(primitive, "indices"), bin,
                                            bin_length, &count, 5125, "SCALAR");
     CHECK(count == 3 * ref->triangle_count);
-    if (!position || !normal || !colour || !radiance || !indices || count != 3 * ref->triangle_count) {
+    if (!position || !normal || !colour || !radiance || !indices ||
+        count != 3 * ref->triangle_count || (illuminance && !illuminance_data)) {
         cJSON_Delete(json);
         free(bytes);
         return;
@@ -229,13 +280,15 @@ static void check_glb(const char *name, const reference *ref)
     /* POSITION: the mesh's vertices, and min/max exactly those of the data */
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     uint32_t bad_position = 0, bad_normal = 0, bad_colour = 0, bad_radiance = 0;
+    uint32_t bad_illuminance = 0;
     for (uint32_t v = 0; v < n; v++) {
-        float p[3], nn[3], c[3], L[3];
+        float p[3], nn[3], c[3], L[3], E[3];
         for (int k = 0; k < 3; k++) {
             p[k] = get_f32(position + 12 * v + 4 * k);
             nn[k] = get_f32(normal + 12 * v + 4 * k);
             c[k] = get_f32(colour + 12 * v + 4 * k);
             L[k] = get_f32(radiance + 12 * v + 4 * k);
+            E[k] = illuminance ? get_f32(illuminance_data + 12 * v + 4 * k) : 0;
             lo[k] = fminf(lo[k], p[k]);
             hi[k] = fmaxf(hi[k], p[k]);
         }
@@ -245,14 +298,17 @@ static void check_glb(const char *name, const reference *ref)
                                 (double)nn[2] * nn[2]) - 1) > 1e-6;
         rad_rgb Lr = ref->radiance[v];
         bad_radiance += !same_rgb(L, Lr);
+        bad_illuminance += illuminance && !same_rgb(E, ref->illuminance[v]);
         rad_rgb d = {display(Lr.r, ref->scale), display(Lr.g, ref->scale),
                      display(Lr.b, ref->scale)};
         bad_colour += !same_rgb(c, d) || c[0] < 0 || c[0] > 1 || c[1] < 0 || c[1] > 1 ||
                       c[2] < 0 || c[2] > 1;
     }
     printf("%s: %u vertices, %u triangles; mismatches: position %u, normal %u, colour %u, "
-           "radiance %u\n",
-           name, n, ref->triangle_count, bad_position, bad_normal, bad_colour, bad_radiance);
+           "radiance %u, illuminance %u%s\n",
+           name, n, ref->triangle_count, bad_position, bad_normal, bad_colour, bad_radiance,
+           bad_illuminance, illuminance ? "" : " (none written)");
+    CHECK(bad_illuminance == 0);
     CHECK(bad_position == 0);
     CHECK(bad_normal == 0);
     CHECK(bad_colour == 0);
@@ -318,8 +374,9 @@ static void check_geometry_through_assimp(const char *name, const reference *ref
     rad_scene_destroy(scene);
 }
 
-/* A PLY as this writer makes it: the header line by line, then the binary records. */
-static void check_ply(const char *name, const reference *ref, bool furnace)
+/* A PLY as this writer makes it: the header line by line, then the binary records;
+ * `illuminance`: whether the records end with the reference's illuminance, or have none. */
+static void check_ply(const char *name, const reference *ref, bool furnace, bool illuminance)
 {
     size_t size = 0;
     uint8_t *bytes = test_read_bytes(test_path(name), &size);
@@ -340,19 +397,27 @@ static void check_ply(const char *name, const reference *ref, bool furnace)
              "property float nx\nproperty float ny\nproperty float nz\n"
              "property uchar red\nproperty uchar green\nproperty uchar blue\n"
              "property float radiance_r\nproperty float radiance_g\nproperty float radiance_b\n"
+             "%s"
              "element face %u\nproperty list uchar int vertex_indices\n",
-             ref->mesh->vertex_count, ref->triangle_count);
+             ref->mesh->vertex_count,
+             illuminance ? "property float illuminance_r\nproperty float illuminance_g\n"
+                           "property float illuminance_b\n"
+                         : "",
+             ref->triangle_count);
     CHECK(strncmp((const char *)bytes, "ply\nformat binary_little_endian 1.0\n", 36) == 0);
     CHECK(strstr((const char *)bytes, expected_elements) != NULL);
     uint32_t n = ref->mesh->vertex_count;
-    size_t vertex_bytes = 39, face_bytes = 13;
+    size_t vertex_bytes = illuminance ? 51 : 39, face_bytes = 13;
+    CHECK((strstr((const char *)bytes, "illuminance") != NULL) == illuminance);
     CHECK(size == header + n * vertex_bytes + ref->triangle_count * face_bytes);
     if (size != header + n * vertex_bytes + ref->triangle_count * face_bytes) {
         free(bytes);
         return;
     }
     uint32_t bad_position = 0, bad_colour = 0, bad_radiance = 0, bad_face = 0, off_furnace = 0;
+    uint32_t bad_illuminance = 0, off_furnace_illuminance = 0;
     double worst = 0; /* largest |L - 2| / 2 in the furnace */
+    double worst_illuminance = 0; /* largest |E - 2 pi| / (2 pi) in the furnace */
     for (uint32_t v = 0; v < n; v++) {
         const uint8_t *r = bytes + header + v * vertex_bytes;
         rad_vec3 q = ref->mesh->vertices[v];
@@ -361,6 +426,16 @@ static void check_ply(const char *name, const reference *ref, bool furnace)
         rad_rgb L = ref->radiance[v];
         float stored[3] = {get_f32(r + 27), get_f32(r + 31), get_f32(r + 35)};
         bad_radiance += !same_rgb(stored, L);
+        if (illuminance) {
+            float E[3] = {get_f32(r + 39), get_f32(r + 43), get_f32(r + 47)};
+            bad_illuminance += !same_rgb(E, ref->illuminance[v]);
+            /* (B - E) / rho turns B's error dB into dB / (B - E) relative: here B - E = B / 2,
+             * so twice B's relative error, and twice its 0.5 % bound */
+            for (int k = 0; k < 3; k++) {
+                off_furnace_illuminance += furnace && fabs(E[k] - 2 * PI) > 0.01 * 2 * PI;
+                worst_illuminance = fmax(worst_illuminance, fabs(E[k] - 2 * PI) / (2 * PI));
+            }
+        }
         double channel[3] = {L.r, L.g, L.b};
         for (int k = 0; k < 3; k++) {
             int expected = (int)lround(255 * srgb(display(channel[k], ref->scale)));
@@ -375,24 +450,29 @@ static void check_ply(const char *name, const reference *ref, bool furnace)
         for (int k = 0; k < 3; k++)
             bad_face += get_u32(f + 1 + 4 * k) != ref->triangles[t][k];
     }
-    printf("%s: %u vertices; mismatches: position %u, colour %u, radiance %u, face %u%s\n",
-           name, n, bad_position, bad_colour, bad_radiance, bad_face,
-           furnace ? "" : " (not the furnace)");
+    printf("%s: %u vertices; mismatches: position %u, colour %u, radiance %u, illuminance "
+           "%u%s, face %u%s\n",
+           name, n, bad_position, bad_colour, bad_radiance, bad_illuminance,
+           illuminance ? "" : " (none written)", bad_face, furnace ? "" : " (not the furnace)");
+    CHECK(bad_illuminance == 0);
     CHECK(bad_position == 0);
     CHECK(bad_colour == 0);
     CHECK(bad_radiance == 0);
     CHECK(bad_face == 0);
     if (furnace) {
-        printf("%s: %u channels off Le / (1 - rho) = 2 by over 0.5 %%; largest deviation "
-               "%.2e relative\n",
-               name, off_furnace, worst);
+        printf("%s: %u channels off Le / (1 - rho) = 2 by over 0.5 %%, %u illuminance "
+               "channels off pi x 2 by over 1 %%; largest deviation %.2e relative "
+               "(illuminance %.2e)\n",
+               name, off_furnace, off_furnace_illuminance, worst, worst_illuminance);
+        CHECK(off_furnace_illuminance == 0);
         CHECK(off_furnace == 0);
     }
     free(bytes);
 }
 
-/* The OBJ: `v x y z r g b`, then `#radiance R G B` per vertex in the same order. */
-static void check_obj(const char *name, const reference *ref, double scale)
+/* The OBJ: `v x y z r g b`, then `#radiance R G B` per vertex in the same order, each
+ * followed by `#illuminance R G B` when `illuminance` (the reference's), else none. */
+static void check_obj(const char *name, const reference *ref, double scale, bool illuminance)
 {
     FILE *f = fopen(test_path(name), "r");
     CHECK(f != NULL);
@@ -400,7 +480,8 @@ static void check_obj(const char *name, const reference *ref, double scale)
         return;
     char line[512];
     uint32_t v = 0, radiance_lines = 0, faces = 0, bad_colour = 0, bad_radiance = 0;
-    bool described = false;
+    uint32_t illuminance_lines = 0, bad_illuminance = 0;
+    bool described = false, after_radiance = false;
     while (fgets(line, sizeof(line), f)) {
         double x, y, z, r, g, b;
         if (strncmp(line, "# v x y z r g b:", 16) == 0)
@@ -419,19 +500,378 @@ static void check_obj(const char *name, const reference *ref, double scale)
                 bad_radiance += !same_rgb(stored, ref->radiance[radiance_lines]);
             }
             radiance_lines++;
+            after_radiance = true;
+            continue;
+        } else if (sscanf(line, "#illuminance %lf %lf %lf", &r, &g, &b) == 3) {
+            /* right after its vertex's #radiance line */
+            bad_illuminance += !after_radiance || illuminance_lines + 1 != radiance_lines;
+            if (illuminance_lines < ref->mesh->vertex_count) {
+                float stored[3] = {(float)r, (float)g, (float)b};
+                bad_illuminance += !same_rgb(stored, ref->illuminance[illuminance_lines]);
+            }
+            illuminance_lines++;
         } else if (line[0] == 'f' && line[1] == ' ') {
             faces++;
         }
+        after_radiance = false;
     }
     fclose(f);
-    printf("%s: %u v lines, %u #radiance lines, %u faces; mismatches: colour %u, radiance %u\n",
-           name, v, radiance_lines, faces, bad_colour, bad_radiance);
+    printf("%s: %u v lines, %u #radiance lines, %u #illuminance lines, %u faces; mismatches: "
+           "colour %u, radiance %u, illuminance %u\n",
+           name, v, radiance_lines, illuminance_lines, faces, bad_colour, bad_radiance,
+           bad_illuminance);
+    CHECK(illuminance_lines == (illuminance ? ref->mesh->vertex_count : 0));
+    CHECK(bad_illuminance == 0);
     CHECK(described);
     CHECK(v == ref->mesh->vertex_count);
     CHECK(radiance_lines == ref->mesh->vertex_count);
     CHECK(faces == ref->triangle_count);
     CHECK(bad_colour == 0);
     CHECK(bad_radiance == 0);
+}
+
+/* ---- illuminance through the library: files read back by name, not by this writer's layout */
+
+/* The vertex element's three float properties `names` of a binary PLY (any property
+ * order, float/uchar/int types), malloc'd as count x 3 floats; NULL when one is missing. */
+static float *ply_vertex_floats(const char *name, const char *const names[3], uint32_t *count)
+{
+    *count = 0;
+    size_t size = 0;
+    uint8_t *bytes = test_read_bytes(test_path(name), &size);
+    const char *end = bytes ? strstr((const char *)bytes, "end_header\n") : NULL;
+    if (!end) {
+        free(bytes);
+        return NULL;
+    }
+    size_t header = (size_t)(end - (const char *)bytes) + strlen("end_header\n");
+    size_t record = 0, offset[3] = {SIZE_MAX, SIZE_MAX, SIZE_MAX};
+    uint32_t vertices = 0;
+    bool in_vertex = false;
+    for (const char *line = (const char *)bytes; line < end;) {
+        const char *next = strchr(line, '\n');
+        char text[128] = {0}, type[32], property[64];
+        memcpy(text, line, (size_t)(next - line) < sizeof(text) - 1 ? (size_t)(next - line)
+                                                                    : sizeof(text) - 1);
+        unsigned u;
+        if (sscanf(text, "element vertex %u", &u) == 1) {
+            in_vertex = true;
+            vertices = u;
+        } else if (strncmp(text, "element ", 8) == 0) {
+            in_vertex = false;
+        } else if (in_vertex && sscanf(text, "property %31s %63s", type, property) == 2) {
+            for (int k = 0; k < 3; k++)
+                if (strcmp(property, names[k]) == 0 && strcmp(type, "float") == 0)
+                    offset[k] = record;
+            record += strcmp(type, "uchar") == 0 ? 1 : 4;
+        }
+        line = next + 1;
+    }
+    float *values = NULL;
+    if (offset[0] != SIZE_MAX && offset[1] != SIZE_MAX && offset[2] != SIZE_MAX &&
+        header + (size_t)vertices * record <= size) {
+        values = calloc(3 * (size_t)vertices + 1, sizeof(*values));
+        for (uint32_t v = 0; v < vertices; v++)
+            for (int k = 0; k < 3; k++)
+                values[3 * v + k] = get_f32(bytes + header + v * record + offset[k]);
+        *count = vertices;
+    }
+    free(bytes);
+    return values;
+}
+
+/* A float VEC3 attribute of a .glb's first primitive, malloc'd; NULL when it has none. */
+static float *glb_attribute(const char *name, const char *attribute, uint32_t *count)
+{
+    *count = 0;
+    size_t size = 0;
+    uint8_t *bytes = test_read_bytes(test_path(name), &size);
+    if (!bytes || size < 28) {
+        free(bytes);
+        return NULL;
+    }
+    uint32_t json_length = get_u32(bytes + 12);
+    const uint8_t *bin_header = bytes + 20 + json_length;
+    cJSON *json = 20 + (size_t)json_length + 8 <= size
+                      ? cJSON_ParseWithLength((const char *)bytes + 20, json_length)
+                      : NULL;
+    float *values = NULL;
+    const cJSON *attributes = cJSON_GetObjectItem(
+        cJSON_GetArrayItem(
+            cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(json, "meshes"), 0),
+                                "primitives"),
+            0),
+        "attributes");
+    if (cJSON_GetObjectItem(attributes, attribute)) {
+        uint32_t n = 0;
+        const uint8_t *data = accessor_data(json, json_int(attributes, attribute), bin_header + 8,
+                                            get_u32(bin_header), &n, 5126, "VEC3");
+        if (data) {
+            values = calloc(3 * (size_t)n + 1, sizeof(*values));
+            for (size_t k = 0; k < 3 * (size_t)n; k++)
+                values[k] = get_f32(data + 4 * k);
+            *count = n;
+        }
+    }
+    cJSON_Delete(json);
+    free(bytes);
+    return values;
+}
+
+/* The numbers of every OBJ comment line `TAG R G B` (tag with its '#'), malloc'd. */
+static float *obj_comments(const char *name, const char *tag, uint32_t *count)
+{
+    *count = 0;
+    FILE *f = fopen(test_path(name), "r");
+    if (!f)
+        return NULL;
+    size_t capacity = 1024;
+    float *values = calloc(3 * capacity, sizeof(*values));
+    char line[512];
+    float r, g, b;
+    size_t tag_length = strlen(tag);
+    while (fgets(line, sizeof(line), f))
+        if (strncmp(line, tag, tag_length) == 0 && line[tag_length] == ' ' &&
+            sscanf(line + tag_length, "%f %f %f", &r, &g, &b) == 3) {
+            if (*count == capacity) {
+                capacity *= 2;
+                values = realloc(values, 3 * capacity * sizeof(*values));
+            }
+            values[3 * *count] = r, values[3 * *count + 1] = g, values[3 * *count + 2] = b;
+            (*count)++;
+        }
+    fclose(f);
+    return values;
+}
+
+#define FLOOR_HALF 3.0        /* the floor: [-3, 3] x [-3, 3] at y = 0, facing +y */
+#define FLOOR_PATCH 0.1       /* 60 x 60 square patches */
+#define FLOOR_INNER 2.0       /* vertices checked: |x|, |z| <= 2, a metre from every edge */
+#define LAMP_HEIGHT 2.0       /* a 100 cd point light at (0, 2, 0) */
+#define LAMP_CANDELA 100.0
+#define FLOOR_ALBEDO 0.5      /* the default material: grey */
+/* A vertex holds the area-weighted mean of its four patches' mean irradiance, i.e. the mean
+ * of E over the square of side 2a (a = FLOOR_PATCH) around it: E + a^2/6 lap E + O(a^4).
+ * For E = I h / (h^2 + r^2)^(3/2), lap E / E = (9 r^2 - 6 h^2) / (h^2 + r^2)^2, largest in
+ * size at r = 0: -6 / h^2, so the vertex is low by a^2 / h^2 = 0.25 % at most; each
+ * patch's H itself is an 8 x 8 point mean (under 0.1 % here). 2 % leaves room for both and
+ * still fails for any wrong factor (pi, rho, a missing bounce weight). */
+#define FLOOR_BOUND 0.02
+
+/* E = I h / (h^2 + r^2)^(3/2) below the lamp. */
+static double floor_illuminance(rad_vec3 p)
+{
+    double r2 = p.x * p.x + p.z * p.z;
+    return LAMP_CANDELA * LAMP_HEIGHT / pow(LAMP_HEIGHT * LAMP_HEIGHT + r2, 1.5);
+}
+
+/* Checks a floor file's vertex values: illuminance against the closed form inside, and
+ * radiance = rho / pi x illuminance at every vertex; returns the worst relative error. */
+static double check_floor_values(const char *label, const rad_mesh *mesh, const float *radiance,
+                                 uint32_t radiance_count, const float *illuminance,
+                                 uint32_t illuminance_count)
+{
+    CHECK(radiance != NULL && illuminance != NULL);
+    CHECK(radiance_count == mesh->vertex_count && illuminance_count == mesh->vertex_count);
+    if (!radiance || !illuminance || radiance_count != mesh->vertex_count ||
+        illuminance_count != mesh->vertex_count)
+        return HUGE_VAL;
+    double worst = 0, worst_ratio = 0;
+    uint32_t checked = 0;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+        rad_vec3 p = mesh->vertices[v];
+        for (int k = 0; k < 3; k++) {
+            double E = illuminance[3 * v + k], L = radiance[3 * v + k];
+            double expected_L = FLOOR_ALBEDO / PI * E;
+            worst_ratio = fmax(worst_ratio, fabs(L - expected_L) / fmax(expected_L, 1e-30));
+            if (fabs(p.x) <= FLOOR_INNER && fabs(p.z) <= FLOOR_INNER)
+                worst = fmax(worst, fabs(E - floor_illuminance(p)) / floor_illuminance(p));
+        }
+        checked += fabs(p.x) <= FLOOR_INNER && fabs(p.z) <= FLOOR_INNER;
+    }
+    printf("%s: %u inner vertices, illuminance worst %.2e relative to I h / (h^2 + r^2)^1.5; "
+           "radiance vs rho / pi x illuminance worst %.2e relative\n",
+           label, checked, worst, worst_ratio);
+    CHECK(checked >= 41 * 41);
+    CHECK(worst < FLOOR_BOUND);
+    CHECK(worst_ratio < FLOAT_RELATIVE);
+    return worst;
+}
+
+static void write_ok(const rad_mesh *mesh, const rad_rgb *B, const char *name,
+                     const rad_lit_mesh_options *options)
+{
+    rad_error error = {0};
+    rad_status status = rad_lit_mesh_write(mesh, B, test_path(name), options, &error);
+    CHECK(status == RAD_OK);
+    if (status != RAD_OK)
+        fprintf(stderr, "%s: %s\n", name, error.message);
+}
+
+/* A lone floor under a point light, written with the patch inputs in all three formats. */
+static void test_floor_under_point_light(void)
+{
+    char text[256];
+    snprintf(text, sizeof(text), "o floor\nv %g 0 %g\nv %g 0 %g\nv %g 0 %g\nv %g 0 %g\nf 1 2 3 4\n",
+             -FLOOR_HALF, FLOOR_HALF, FLOOR_HALF, FLOOR_HALF, FLOOR_HALF, -FLOOR_HALF,
+             -FLOOR_HALF, -FLOOR_HALF);
+    rad_scene *scene = NULL;
+    rad_mesh *mesh = NULL;
+    rad_patch_inputs *inputs = NULL;
+    rad_error error = {0};
+    rad_light lamp = {.type = RAD_LIGHT_POINT, .position = {0, LAMP_HEIGHT, 0},
+                      .intensity = {LAMP_CANDELA, LAMP_CANDELA, LAMP_CANDELA}};
+    rad_status status = rad_scene_load(test_write_file("floor.obj", text), NULL, &scene, &error);
+    if (status == RAD_OK)
+        status = rad_scene_add_light(scene, &lamp, &error);
+    if (status == RAD_OK)
+        status = rad_mesh_build(scene, FLOOR_PATCH, &mesh, &error);
+    if (status == RAD_OK)
+        status = rad_patch_inputs_build(scene, mesh, &inputs, &error);
+    rad_rgb *B = calloc(mesh ? mesh->patch_count : 1, sizeof(*B));
+    rad_scene_solve_options solve = {.solver = RAD_SOLVER_JACOBI, .threads = 2, .inputs = inputs};
+    if (status == RAD_OK)
+        status = rad_solve_scene(scene, mesh, &solve, B, NULL, &error);
+    CHECK(status == RAD_OK);
+    if (status != RAD_OK) {
+        fprintf(stderr, "floor: %s\n", error.message);
+        exit(1);
+    }
+    uint32_t grey = 0;
+    for (uint32_t p = 0; p < mesh->patch_count; p++)
+        grey += inputs->albedo[p].r == FLOOR_ALBEDO && inputs->albedo[p].g == FLOOR_ALBEDO &&
+                inputs->albedo[p].b == FLOOR_ALBEDO;
+    CHECK(grey == mesh->patch_count);
+    printf("floor: %u patches, %u vertices\n", mesh->patch_count, mesh->vertex_count);
+
+    rad_lit_mesh_options options = {.inputs = inputs};
+    write_ok(mesh, B, "floor.ply", &options);
+    write_ok(mesh, B, "floor.glb", &options);
+    write_ok(mesh, B, "floor.obj.obj", &options);
+    static const char *const radiance_names[3] = {"radiance_r", "radiance_g", "radiance_b"};
+    static const char *const illuminance_names[3] = {"illuminance_r", "illuminance_g",
+                                                     "illuminance_b"};
+    uint32_t nL, nE;
+    float *L = ply_vertex_floats("floor.ply", radiance_names, &nL);
+    float *E = ply_vertex_floats("floor.ply", illuminance_names, &nE);
+    check_floor_values("floor.ply", mesh, L, nL, E, nE);
+    free(L);
+    free(E);
+    L = glb_attribute("floor.glb", "_RADIANCE", &nL);
+    E = glb_attribute("floor.glb", "_ILLUMINANCE", &nE);
+    check_floor_values("floor.glb", mesh, L, nL, E, nE);
+    free(L);
+    free(E);
+    L = obj_comments("floor.obj.obj", "#radiance", &nL);
+    E = obj_comments("floor.obj.obj", "#illuminance", &nE);
+    check_floor_values("floor.obj", mesh, L, nL, E, nE);
+    free(L);
+    free(E);
+
+    /* a black floor reflects nothing (B = 0): its vertices show the lamp's direct light
+     * alone, which on a lone floor is all the light there is */
+    rad_rgb *black = calloc(mesh->patch_count, sizeof(*black));
+    rad_patch_inputs dark = *inputs;
+    dark.albedo = black;
+    rad_lit_mesh_options dark_options = {.inputs = &dark};
+    write_ok(mesh, black, "black.ply", &dark_options);
+    E = ply_vertex_floats("black.ply", illuminance_names, &nE);
+    CHECK(E != NULL && nE == mesh->vertex_count);
+    double worst_black = 0;
+    for (uint32_t v = 0; E && v < nE && v < mesh->vertex_count; v++)
+        if (fabs(mesh->vertices[v].x) <= FLOOR_INNER && fabs(mesh->vertices[v].z) <= FLOOR_INNER)
+            worst_black = fmax(worst_black, fabs(E[3 * v + 1] - floor_illuminance(mesh->vertices[v])) /
+                                                floor_illuminance(mesh->vertices[v]));
+    printf("black.ply: illuminance (H alone) worst %.2e relative to the closed form\n",
+           worst_black);
+    CHECK(worst_black < FLOOR_BOUND);
+    free(E);
+
+    /* without inputs: no illuminance in any format */
+    write_ok(mesh, B, "plain.ply", NULL);
+    write_ok(mesh, B, "plain.glb", &(rad_lit_mesh_options){0});
+    write_ok(mesh, B, "plain.obj", NULL);
+    E = ply_vertex_floats("plain.ply", illuminance_names, &nE);
+    CHECK(E == NULL);
+    free(E);
+    E = glb_attribute("plain.glb", "_ILLUMINANCE", &nE);
+    CHECK(E == NULL);
+    free(E);
+    E = obj_comments("plain.obj", "#illuminance", &nE);
+    CHECK(nE == 0);
+    free(E);
+    CHECK(!strstr(test_read_text(test_path("plain.obj")), "illuminance"));
+
+    free(black);
+    free(B);
+    rad_patch_inputs_destroy(inputs);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+}
+
+/* The Cornell box through the library without inputs: today's exact files; with inputs
+ * of the wrong size, or non-finite ones, refused and nothing written. */
+static void test_library_cornell(const reference *ref)
+{
+    write_ok(ref->mesh, ref->B, "plain_cornell.ply", NULL);
+    write_ok(ref->mesh, ref->B, "plain_cornell.glb", NULL);
+    write_ok(ref->mesh, ref->B, "plain_cornell.obj", NULL);
+    check_ply("plain_cornell.ply", ref, false, false);
+    check_glb("plain_cornell.glb", ref, false);
+    check_obj("plain_cornell.obj", ref, ref->scale, false);
+    rad_lit_mesh_options with = {.inputs = ref->inputs};
+    write_ok(ref->mesh, ref->B, "with_cornell.ply", &with);
+    check_ply("with_cornell.ply", ref, false, true);
+
+    const char *names[3] = {"refused.ply", "refused.glb", "refused.obj"};
+    uint32_t n = ref->mesh->patch_count, k = n / 3;
+    rad_rgb *albedo = calloc(n, sizeof(*albedo)), *exitance = calloc(n, sizeof(*exitance)),
+            *direct = calloc(n, sizeof(*direct));
+    for (int f = 0; f < 3; f++) {
+        const char *path = test_path(names[f]);
+        rad_error error = {0};
+        char expected[64];
+        /* a patch count other than the mesh's */
+        rad_patch_inputs wrong = *ref->inputs;
+        wrong.n = n - 1;
+        rad_lit_mesh_options options = {.inputs = &wrong};
+        CHECK(rad_lit_mesh_write(ref->mesh, ref->B, path, &options, &error) == RAD_ERR_INVALID);
+        snprintf(expected, sizeof(expected), "have %u patches, the mesh %u", n - 1, n);
+        printf("%s\n", error.message);
+        CHECK(strstr(error.message, path) != NULL && strstr(error.message, expected) != NULL);
+        CHECK(!test_file_exists(path));
+
+        /* a NaN exitance on a patch that reflects: its irradiance is not finite */
+        memcpy(albedo, ref->inputs->albedo, n * sizeof(*albedo));
+        memcpy(exitance, ref->inputs->exitance, n * sizeof(*exitance));
+        memcpy(direct, ref->inputs->direct, n * sizeof(*direct));
+        CHECK(albedo[k].g > 0);
+        exitance[k].g = NAN;
+        rad_patch_inputs bad = *ref->inputs;
+        bad.albedo = albedo, bad.exitance = exitance, bad.direct = direct;
+        options.inputs = &bad;
+        memset(&error, 0, sizeof(error));
+        CHECK(rad_lit_mesh_write(ref->mesh, ref->B, path, &options, &error) == RAD_ERR_INVALID);
+        snprintf(expected, sizeof(expected), "patch %u has an irradiance", k);
+        printf("%s\n", error.message);
+        CHECK(strstr(error.message, path) != NULL && strstr(error.message, expected) != NULL);
+        CHECK(!test_file_exists(path));
+        /* a black patch whose direct light is infinite */
+        exitance[k].g = ref->inputs->exitance[k].g;
+        albedo[k].b = 0;
+        direct[k].b = INFINITY;
+        memset(&error, 0, sizeof(error));
+        CHECK(rad_lit_mesh_write(ref->mesh, ref->B, path, &options, &error) == RAD_ERR_INVALID);
+        CHECK(strstr(error.message, expected) != NULL);
+        CHECK(!test_file_exists(path));
+        /* and a finite one is written */
+        direct[k].b = 1;
+        CHECK(rad_lit_mesh_write(ref->mesh, ref->B, path, &options, &error) == RAD_OK);
+        CHECK(test_file_exists(path));
+    }
+    free(albedo);
+    free(exitance);
+    free(direct);
 }
 
 static void run_ok(const char *arguments)
@@ -451,13 +891,14 @@ int main(void)
     run_ok("solve -o cornell.glb --patch-size 100");
     run_ok("solve -o cornell.ply --patch-size 100");
     run_ok("solve -o cornell.obj --patch-size 100");
-    check_glb("cornell.glb", &cornell);
+    check_glb("cornell.glb", &cornell, true);
     check_geometry_through_assimp("cornell.glb", &cornell, 0);
-    check_ply("cornell.ply", &cornell, false);
+    check_ply("cornell.ply", &cornell, false, true);
     check_geometry_through_assimp("cornell.ply", &cornell, 0);
-    check_obj("cornell.obj", &cornell, cornell.scale);
+    check_obj("cornell.obj", &cornell, cornell.scale, true);
     /* 9 significant digits of coordinates up to 560 mm */
     check_geometry_through_assimp("cornell.obj", &cornell, 1e-6 * 560);
+    test_library_cornell(&cornell);
     free_reference(&cornell);
 
     /* the furnace: radiance 2 everywhere; a uniform mesh exposes to 0.9 exactly */
@@ -465,10 +906,12 @@ int main(void)
     reference furnace;
     compute_reference(test_path("furnace.obj"), 0.125, &furnace);
     run_ok("solve furnace.obj -o furnace.ply --patch-size 0.125");
-    check_ply("furnace.ply", &furnace, true);
+    check_ply("furnace.ply", &furnace, true, true);
     run_ok("solve furnace.obj -o furnace.obj.obj --patch-size 0.125 --exposure -3");
-    check_obj("furnace.obj.obj", &furnace, 0.125); /* 2^-3 */
+    check_obj("furnace.obj.obj", &furnace, 0.125, true); /* 2^-3 */
     free_reference(&furnace);
+
+    test_floor_under_point_light();
 
     /* refusals: a usage error, no file left */
     CHECK(test_run_tool("solve -o out.stl") == 2);

@@ -15,14 +15,17 @@ static const char usage[] =
     "built-in Cornell box) and writes the lit mesh to OUT, view-independent: every vertex\n"
     "has its linear radiance (what `render` interpolates) and a display colour (radiance\n"
     "times the exposure, clamped to [0,1], sRGB). The automatic exposure is PNG's: the 95th\n"
-    "percentile of the lit vertices' luminance goes to 0.9. Creases stay sharp: vertices\n"
-    "are shared only inside a smooth region. OUT's extension picks the format:\n"
-    "  .ply  binary PLY: uchar red green blue (sRGB), float radiance_r radiance_g\n"
-    "        radiance_b (linear), float nx ny nz\n"
+    "percentile of the lit vertices' luminance goes to 0.9. Every vertex also has its\n"
+    "illuminance, direct and interreflected (lux with lights in candela and lux; on a\n"
+    "black surface its direct light alone). Creases stay sharp: vertices are shared only\n"
+    "inside a smooth region. OUT's extension picks the format:\n"
+    "  .ply  binary PLY: float nx ny nz, uchar red green blue (sRGB), float radiance_r\n"
+    "        radiance_g radiance_b (linear), float illuminance_r illuminance_g\n"
+    "        illuminance_b\n"
     "  .glb  binary glTF 2.0: COLOR_0 (the display colour, stored linear as glTF wants),\n"
-    "        _RADIANCE (linear radiance), NORMAL, an unlit material\n"
-    "  .obj  'v x y z r g b' (sRGB in [0,1]), and a '#radiance R G B' comment line per\n"
-    "        vertex with the linear radiance\n"
+    "        _RADIANCE (linear radiance), _ILLUMINANCE, NORMAL, an unlit material\n"
+    "  .obj  'v x y z r g b' (sRGB in [0,1]), and per vertex a '#radiance R G B'\n"
+    "        comment line with the linear radiance, then '#illuminance R G B'\n"
     "\n"
     "  -o, --output FILE    the lit mesh (.ply, .glb or .obj)\n"
     "  --exposure EV        display colour: radiance times 2^EV (default: automatic)\n"
@@ -86,8 +89,10 @@ int command_solve(int argc, char **argv)
     double t0 = rad_clock_seconds();
     rad_status status = cli_solve_scene(scene_path, &shared, &solve, &solved, &error);
     double t_solved = rad_clock_seconds();
-    if (status == RAD_OK && shared.output)
+    if (status == RAD_OK && shared.output) {
+        write.inputs = solved.inputs; /* the vertices' illuminance */
         status = rad_lit_mesh_write(solved.mesh, solved.B, shared.output, &write, &error);
+    }
     double t_write = rad_clock_seconds();
     if (status != RAD_OK) {
         exit_code = cli_failed(&error);

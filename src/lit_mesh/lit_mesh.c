@@ -3,6 +3,13 @@
  * display colour, in .ply, .glb or .obj (the encoders are lit_mesh_ply.c, lit_mesh_glb.c
  * and lit_mesh_obj.c; see lit_mesh.h for why they are ours).
  *
+ * Given the patch inputs, every vertex also carries the illuminance a lighting designer
+ * reads. B_i = E_i + rho_i (H_i + sum_j F_ij B_j) makes the light arriving at patch i,
+ * direct and interreflected, (B_i - E_i) / rho_i per channel; where rho_i = 0 the patch
+ * reflects nothing and only its direct light H_i is known. That per-patch irradiance goes
+ * through the radiance's own reconstruction (display_mesh_radiance gives value / pi per
+ * vertex, so the result is multiplied by pi): one code path for both quantities.
+ *
  * A two-sided surface needs nothing here: the mesh gives each side its own patches and
  * vertices (rad_patch.twin), wound to face their side, so the file holds both sides as
  * ordinary faces, each with its own colours and normals (a viewer that culls back faces
@@ -66,6 +73,39 @@ static void vertex_normals(const rad_mesh *mesh, rad_vec3 *normal)
         normal[v] = v3_length(normal[v]) > 0 ? v3_normalize(normal[v]) : v3(0, 0, 1);
 }
 
+/* One channel's irradiance of a patch: (B - E) / rho where rho > 0 (a negative value is
+ * a rounding residue of B = E, written as 0), else the direct light H. NaN when an input
+ * is not finite, so the caller refuses it. */
+static double channel_irradiance(double B, double E, double rho, double H)
+{
+    if (!isfinite(rho))
+        return NAN;
+    double value = rho > 0 ? (B - E) / rho : H;
+    return isfinite(value) ? fmax(value, 0) : NAN;
+}
+
+/* The per-patch irradiance (see the top of this file); RAD_ERR_INVALID naming the first
+ * patch whose value is not finite. */
+static rad_status patch_irradiance(const rad_mesh *mesh, const rad_rgb *B,
+                                   const rad_patch_inputs *inputs, const char *path,
+                                   rad_rgb *irradiance, rad_error *error)
+{
+    for (uint32_t i = 0; i < mesh->patch_count; i++) {
+        rad_rgb E = inputs->exitance[i], rho = inputs->albedo[i], H = inputs->direct[i];
+        rad_rgb value = {channel_irradiance(B[i].r, E.r, rho.r, H.r),
+                         channel_irradiance(B[i].g, E.g, rho.g, H.g),
+                         channel_irradiance(B[i].b, E.b, rho.b, H.b)};
+        if (!(isfinite(value.r) && isfinite(value.g) && isfinite(value.b)))
+            return rad_fail(error, RAD_ERR_INVALID,
+                            "%s: patch %u has an irradiance that is not finite (its albedo, "
+                            "exitance or direct light in the patch inputs); nothing was "
+                            "written",
+                            path, i);
+        irradiance[i] = value;
+    }
+    return RAD_OK;
+}
+
 rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char *path,
                               const rad_lit_mesh_options *options, rad_error *error)
 {
@@ -85,10 +125,16 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
                             "%s: patch %u has a radiosity that is not finite; nothing was "
                             "written",
                             path, i);
+    const rad_patch_inputs *inputs = options ? options->inputs : NULL;
+    if (inputs && inputs->n != mesh->patch_count)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "%s: the patch inputs have %u patches, the mesh %u; nothing was "
+                        "written",
+                        path, inputs->n, mesh->patch_count);
 
     rad_status status = RAD_OK;
     rad_vec3 *position = NULL, *normal = NULL;
-    rad_rgb *radiance = NULL, *display = NULL;
+    rad_rgb *radiance = NULL, *display = NULL, *irradiance = NULL, *illuminance = NULL;
     double *luminance = NULL;
     display_mesh shown = {0};
     status = display_mesh_build(mesh, true, &shown, error);
@@ -109,6 +155,25 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
         status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for %u vertices", path, n);
         goto done;
     }
+    if (inputs) {
+        irradiance = rad_alloc_array(mesh->patch_count, sizeof(*irradiance));
+        illuminance = rad_alloc_array(n, sizeof(*illuminance));
+        if (!irradiance || !illuminance) {
+            status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for the illuminance of "
+                              "%u vertices", path, n);
+            goto done;
+        }
+        status = patch_irradiance(mesh, B, inputs, path, irradiance, error);
+        if (status != RAD_OK)
+            goto done;
+        if (!display_mesh_radiance(mesh, &shown, irradiance, illuminance)) {
+            status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for %u vertices", path,
+                              n);
+            goto done;
+        }
+        for (uint32_t v = 0; v < n; v++) /* display_mesh_radiance divides by pi */
+            illuminance[v] = rgb_scale(illuminance[v], RAD_PI);
+    }
     vertex_normals(mesh, normal);
     for (uint32_t k = 0; k < shown.extra_count; k++) { /* along their edge, as the values */
         const display_extra *x = &shown.extras[k];
@@ -121,6 +186,7 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
         .position = position,
         .normal = normal,
         .radiance = radiance,
+        .illuminance = illuminance,
         .display = display,
         .triangles = (const uint32_t(*)[3])shown.triangles,
         .triangle_count = shown.triangle_count,
@@ -159,6 +225,8 @@ done:
     free(radiance);
     free(display);
     free(luminance);
+    free(irradiance);
+    free(illuminance);
     display_mesh_free(&shown);
     return status;
 }

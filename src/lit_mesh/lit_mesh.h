@@ -1,10 +1,10 @@
 /*
  * lit_mesh.h - the lit mesh handed to its per-format writers (internal).
  *
- * lit_mesh.c (rad_lit_mesh_write) reconstructs the vertex radiance, works out normals,
- * the display colour and the triangles, opens the atomic file and picks the writer by
- * the extension; each writer only encodes into the open stream and reports failures as
- * one line naming `path`.
+ * lit_mesh.c (rad_lit_mesh_write) reconstructs the vertex radiance (and, given the patch
+ * inputs, the vertex illuminance), works out normals, the display colour and the
+ * triangles, opens the atomic file and picks the writer by the extension; each writer
+ * only encodes into the open stream and reports failures as one line naming `path`.
  *
  * The writers are our own, not Assimp's exporters: Assimp 5.2's PLY exporter has no
  * float properties besides positions, normals and texture coordinates (and truncates
@@ -24,6 +24,8 @@ typedef struct lit_mesh {
     const rad_vec3 *position;      /* the mesh's vertices, then the display's added ones */
     const rad_vec3 *normal;        /* unit: the area-weighted mean of the patches' normals */
     const rad_rgb *radiance;       /* linear radiance, rad_reconstruct_vertices */
+    const rad_rgb *illuminance;    /* NULL (no patch inputs given: the file holds none),
+                                      or the irradiance, reconstructed as the radiance */
     const rad_rgb *display;        /* radiance * scale clamped to [0,1], still linear */
     uint32_t triangle_count;
     const uint32_t (*triangles)[3];/* counter-clockwise: front */

@@ -7,7 +7,8 @@
  * they display, so COLOR_0 holds the display colour *before* the sRGB curve (radiance x
  * exposure, clamped): a viewer then shows exactly the 8-bit colours of the .ply. _RADIANCE
  * (an application attribute: glTF lets names starting with an underscore through) holds
- * the linear radiance. The material is unlit (KHR_materials_unlit), so viewers show the
+ * the linear radiance; when the mesh has it, _ILLUMINANCE (float VEC3, likewise) the
+ * illuminance. The material is unlit (KHR_materials_unlit), so viewers show the
  * colours instead of shading them a second time. The JSON is built with cJSON.
  *
  * Layout: 12-byte header, JSON chunk padded with spaces to 4 bytes, BIN chunk; every
@@ -31,7 +32,15 @@
 #define GL_ARRAY_BUFFER 34962
 #define GL_ELEMENT_ARRAY_BUFFER 34963
 
-enum { VIEW_POSITION, VIEW_NORMAL, VIEW_COLOUR, VIEW_RADIANCE, VIEW_INDICES, VIEW_COUNT };
+/* Buffer views (and accessors, one each, same index): the vertex attributes, then the
+ * indices. */
+enum { VIEW_POSITION, VIEW_NORMAL, VIEW_COLOUR, VIEW_RADIANCE, VIEW_ILLUMINANCE };
+
+/* How many vertex attributes the mesh has: the indices' view comes after them. */
+static int vertex_views(const lit_mesh *mesh)
+{
+    return mesh->illuminance ? VIEW_ILLUMINANCE + 1 : VIEW_RADIANCE + 1;
+}
 
 /* Adds a buffer view of `length` bytes at `offset` in buffer 0. */
 static void add_view(cJSON *views, size_t offset, size_t length, int target)
@@ -85,6 +94,9 @@ static char *glb_json(const lit_mesh *mesh, size_t vertex_view, size_t index_vie
     cJSON *extras = cJSON_AddObjectToObject(asset, "extras");
     cJSON_AddStringToObject(extras, "COLOR_0", colour);
     cJSON_AddStringToObject(extras, "_RADIANCE", "linear radiance, unit of the emitters' Ke");
+    if (mesh->illuminance)
+        cJSON_AddStringToObject(extras, "_ILLUMINANCE",
+                                "illuminance (irradiance), lux with lights in candela and lux");
     cJSON_AddNumberToObject(extras, "exposure_scale", mesh->scale);
     cJSON_AddItemToObject(root, "extensionsUsed", cJSON_CreateStringArray(
                                                       (const char *[]){"KHR_materials_unlit"}, 1));
@@ -112,7 +124,10 @@ static char *glb_json(const lit_mesh *mesh, size_t vertex_view, size_t index_vie
     cJSON_AddNumberToObject(attributes, "NORMAL", VIEW_NORMAL);
     cJSON_AddNumberToObject(attributes, "COLOR_0", VIEW_COLOUR);
     cJSON_AddNumberToObject(attributes, "_RADIANCE", VIEW_RADIANCE);
-    cJSON_AddNumberToObject(primitive, "indices", VIEW_INDICES);
+    if (mesh->illuminance)
+        cJSON_AddNumberToObject(attributes, "_ILLUMINANCE", VIEW_ILLUMINANCE);
+    int indices = vertex_views(mesh);
+    cJSON_AddNumberToObject(primitive, "indices", indices);
     cJSON_AddNumberToObject(primitive, "material", 0);
     cJSON_AddNumberToObject(primitive, "mode", 4); /* triangles */
     cJSON *gltf_mesh = cJSON_CreateObject();
@@ -128,14 +143,17 @@ static char *glb_json(const lit_mesh *mesh, size_t vertex_view, size_t index_vie
     add_accessor(accessors, VIEW_NORMAL, GL_FLOAT, mesh->vertex_count, "VEC3");
     add_accessor(accessors, VIEW_COLOUR, GL_FLOAT, mesh->vertex_count, "VEC3");
     add_accessor(accessors, VIEW_RADIANCE, GL_FLOAT, mesh->vertex_count, "VEC3");
-    add_accessor(accessors, VIEW_INDICES, GL_UNSIGNED_INT, 3 * mesh->triangle_count, "SCALAR");
+    if (mesh->illuminance)
+        add_accessor(accessors, VIEW_ILLUMINANCE, GL_FLOAT, mesh->vertex_count, "VEC3");
+    add_accessor(accessors, indices, GL_UNSIGNED_INT, 3 * mesh->triangle_count, "SCALAR");
 
     cJSON *views = cJSON_AddArrayToObject(root, "bufferViews");
-    for (int k = VIEW_POSITION; k <= VIEW_RADIANCE; k++)
+    for (int k = VIEW_POSITION; k < indices; k++)
         add_view(views, (size_t)k * vertex_view, vertex_view, GL_ARRAY_BUFFER);
-    add_view(views, 4 * vertex_view, index_view, GL_ELEMENT_ARRAY_BUFFER);
+    add_view(views, (size_t)indices * vertex_view, index_view, GL_ELEMENT_ARRAY_BUFFER);
     cJSON *buffer = cJSON_CreateObject();
-    cJSON_AddNumberToObject(buffer, "byteLength", (double)(4 * vertex_view + index_view));
+    cJSON_AddNumberToObject(buffer, "byteLength",
+                            (double)((size_t)indices * vertex_view + index_view));
     cJSON_AddItemToArray(cJSON_AddArrayToObject(root, "buffers"), buffer);
 
     char *text = cJSON_PrintUnformatted(root); /* NULL if any step above ran out of memory */
@@ -182,7 +200,7 @@ rad_status lit_mesh_write_glb(const lit_mesh *mesh, FILE *stream, const char *pa
         return rad_fail(error, RAD_ERR_INVALID, "%s: the mesh is empty", path);
     size_t vertex_view = (size_t)mesh->vertex_count * 12;
     size_t index_view = (size_t)mesh->triangle_count * 12;
-    size_t bin_length = 4 * vertex_view + index_view;
+    size_t bin_length = (size_t)vertex_views(mesh) * vertex_view + index_view;
     char *json = glb_json(mesh, vertex_view, index_view);
     if (!json)
         return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for the glTF JSON", path);
@@ -203,7 +221,8 @@ rad_status lit_mesh_write_glb(const lit_mesh *mesh, FILE *stream, const char *pa
     ok = ok && put_vec3s(stream, mesh->position, mesh->vertex_count) &&
          put_vec3s(stream, mesh->normal, mesh->vertex_count) &&
          put_rgbs(stream, mesh->display, mesh->vertex_count) &&
-         put_rgbs(stream, mesh->radiance, mesh->vertex_count);
+         put_rgbs(stream, mesh->radiance, mesh->vertex_count) &&
+         (!mesh->illuminance || put_rgbs(stream, mesh->illuminance, mesh->vertex_count));
     for (uint32_t t = 0; ok && t < mesh->triangle_count; t++)
         ok = put_u32(stream, mesh->triangles[t][0]) && put_u32(stream, mesh->triangles[t][1]) &&
              put_u32(stream, mesh->triangles[t][2]);

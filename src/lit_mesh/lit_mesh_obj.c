@@ -5,7 +5,9 @@
  * display colour sRGB-encoded in [0,1] (what those tools show as is). OBJ has no place for
  * a second colour, so the linear radiance follows the vertices as comment lines
  * `#radiance R G B`, one per vertex in the same order: every OBJ reader skips them, and
- * the file stays one file. Triangles reference the normals: `f a//a b//b c//c`.
+ * the file stays one file. When the mesh has the illuminance, each `#radiance` line is
+ * followed by that vertex's `#illuminance R G B`. Triangles reference the normals:
+ * `f a//a b//b c//c`.
  */
 #include <errno.h>
 #include <string.h>
@@ -25,6 +27,9 @@ rad_status lit_mesh_write_obj(const lit_mesh *mesh, FILE *stream, const char *pa
             "# #radiance R G B: each vertex's linear radiance (unit of the emitters' Ke), in "
             "the order of the v lines\n",
             colour);
+    if (mesh->illuminance)
+        fprintf(stream, "# #illuminance R G B: after each #radiance line, that vertex's "
+                        "illuminance (irradiance; lux with lights in candela and lux)\n");
     for (uint32_t v = 0; v < mesh->vertex_count; v++) {
         const rad_vec3 *p = &mesh->position[v];
         const rad_rgb *d = &mesh->display[v];
@@ -39,6 +44,10 @@ rad_status lit_mesh_write_obj(const lit_mesh *mesh, FILE *stream, const char *pa
     for (uint32_t v = 0; v < mesh->vertex_count; v++) {
         const rad_rgb *L = &mesh->radiance[v];
         fprintf(stream, "#radiance %.9g %.9g %.9g\n", L->r, L->g, L->b);
+        if (mesh->illuminance) {
+            const rad_rgb *E = &mesh->illuminance[v];
+            fprintf(stream, "#illuminance %.9g %.9g %.9g\n", E->r, E->g, E->b);
+        }
     }
     for (uint32_t t = 0; t < mesh->triangle_count; t++) {
         const uint32_t *f = mesh->triangles[t];
