@@ -1192,14 +1192,15 @@ typedef struct rad_render_options {
      * sharp light sources added per pixel as for radiance; a black patch shows its direct
      * light alone; misses and mirrors show nothing. Needs `scene`. */
     bool irradiance;
-    /* The direct light of emissive surfaces is computed at every pixel sample by
-     * `direct_samples` shadow rays to points of the emitters (stratified over the pixel's
-     * samples; exact soft shadows), and the rest (their light reflected once or more, the
-     * sky) taken from the solution with their patch means (16 x 8 samples per patch) taken
-     * out first. Needs `scene`; 0 = RAD_DEFAULT_DIRECT_SAMPLES. */
+    /* With `emitter_direct` (and `scene`), the direct light of emissive surfaces is
+     * computed at every pixel sample by `direct_samples` shadow rays to points of the
+     * emitters (stratified over the pixel's samples; exact soft shadows), and the rest
+     * (their light reflected more than once, the sky) taken from the solution with their
+     * patch means (16 x 8 samples per patch) taken out first. Off: the emitters' direct
+     * light is interpolated from the solution like the rest (the classic radiosity
+     * image). direct_samples 0 = RAD_DEFAULT_DIRECT_SAMPLES. */
+    bool emitter_direct;
     uint32_t direct_samples;
-    bool direct_from_solution; /* instead: the emitters' direct light interpolated from the
-                                  solution like the rest (the classic radiosity image) */
 } rad_render_options;
 
 /* Radiance at every mesh vertex: the area-weighted average of B/pi over the patches that

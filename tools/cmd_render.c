@@ -30,12 +30,13 @@ static const char usage[] =
     "  --max-depth N        mirror reflections followed with --specular (default 5)\n"
     "  --quantity illuminance  pixels: illuminance (lux) at the surface seen, not radiance\n"
     "  --false-colour       PNG in false colour with a legend; --scale LOW,HIGH, --log\n"
+    "  --direct pixel       emitters' direct light at each pixel (shadow rays), not patches\n"
     CLI_TWO_SIDED_HELP
     CLI_SOLVE_HELP;
 
 enum {
     OPT_SPECULAR = OPT_OWN, OPT_MAX_DEPTH, OPT_TWO_SIDED, OPT_QUANTITY, OPT_FALSE_COLOUR,
-    OPT_SCALE, OPT_LOG, OPT_COUNT
+    OPT_SCALE, OPT_LOG, OPT_DIRECT, OPT_COUNT
 };
 
 static const cli_option options[OPT_COUNT] = {
@@ -51,6 +52,7 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_FALSE_COLOUR] = {"false-colour", 0, false},
     [OPT_SCALE] = {"scale", 0, true},
     [OPT_LOG] = {"log", 0, false},
+    [OPT_DIRECT] = {"direct", 0, true},
 };
 
 #define RENDER_MAX_SPP 256u
@@ -93,6 +95,12 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
     }
     s->render.irradiance =
         quantity && (strcmp(quantity, "illuminance") == 0 || strcmp(quantity, "irradiance") == 0);
+    const char *direct = args.value[OPT_DIRECT];
+    if (direct && strcmp(direct, "pixel") != 0 && strcmp(direct, "solution") != 0) {
+        cli_error("--direct: '%s' is not pixel or solution", direct);
+        return false;
+    }
+    s->render.emitter_direct = direct && strcmp(direct, "pixel") == 0;
     s->false_colour = args.value[OPT_FALSE_COLOUR] != NULL;
     s->colours.logarithmic = args.value[OPT_LOG] != NULL;
     s->colours.unit = s->render.irradiance ? "lx" : "cd/m^2";

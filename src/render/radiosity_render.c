@@ -441,7 +441,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
 
     /* the emitters' direct light at every pixel sample, and its patch means to take out of
      * the solution first */
-    if (options->scene && !options->direct_from_solution && rad_scene_has_emitter(options->scene)) {
+    if (options->scene && options->emitter_direct && rad_scene_has_emitter(options->scene)) {
         status = emitters_build(options->scene, &emitters, error);
         if (status == RAD_OK)
             status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, options->scene,
