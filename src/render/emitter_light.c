@@ -5,6 +5,7 @@
 #include "render/emitter_light.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <omp.h>
 #include <stdlib.h>
 
@@ -14,6 +15,7 @@
 #include "core/rgb.h"
 #include "core/vec3.h"
 #include "mesh/patch_point.h"
+#include "scene/material_at.h"
 #include "trace/ray.h"
 
 #define PATCH_EMITTER_POINTS 4u  /* per side: 16 points per patch */
@@ -22,10 +24,10 @@
 
 static double wrap(double u) { return u < 1 ? u : u - 1; }
 
-uint32_t emitter_light_rays(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
-                            rad_vec3 n, double leave, uint32_t count, double turn,
-                            uint32_t first, double shift1, double shift2, rad_rng *rng,
-                            rad_ray *rays, rad_rgb *irradiance)
+static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
+                           rad_vec3 n, double leave, uint32_t count, double turn, uint32_t first,
+                           double shift1, double shift2, rad_rng *rng, bool mis, rad_ray *rays,
+                           rad_rgb *irradiance)
 {
     if (set->count == 0)
         return 0;
@@ -45,7 +47,9 @@ uint32_t emitter_light_rays(const emitter_set *set, const rad_scene *scene, rad_
         double cos_x = v3_dot(n, wi), cos_e = emitter_cosine(&light, wi, &facing);
         if (!(cos_x > 0) || !(cos_e > 0))
             continue;
-        rad_rgb value = rgb_scale(light.radiance, cos_x * cos_e / (r2 * light.pdf_area * count));
+        double p_light = light.pdf_area * r2 / cos_e; /* per solid angle */
+        double p_cosine = mis ? cos_x / RAD_PI : 0;
+        rad_rgb value = rgb_scale(light.radiance, cos_x / ((p_light + p_cosine) * count));
         if (rgb_is_zero(value))
             continue;
         irradiance[made] = value;
@@ -53,6 +57,70 @@ uint32_t emitter_light_rays(const emitter_set *set, const rad_scene *scene, rad_
         made++;
     }
     return made;
+}
+
+uint32_t emitter_light_rays(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
+                            rad_vec3 n, double leave, uint32_t count, double turn,
+                            uint32_t first, double shift1, double shift2, rad_rng *rng,
+                            rad_ray *rays, rad_rgb *irradiance)
+{
+    return light_rays(set, scene, x, n, leave, count, turn, first, shift1, shift2, rng, false,
+                      rays, irradiance);
+}
+
+uint32_t emitter_light_rays_mis(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
+                                rad_vec3 n, double leave, uint32_t count, double turn,
+                                uint32_t first, double shift1, double shift2, rad_rng *rng,
+                                rad_ray *rays, rad_rgb *irradiance)
+{
+    return light_rays(set, scene, x, n, leave, count, turn, first, shift1, shift2, rng, true,
+                      rays, irradiance);
+}
+
+void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, rad_rng *rng,
+                         rad_ray *rays, double *cos_x)
+{
+    rad_vec3 helper = fabs(n.x) < 0.6 ? v3(1, 0, 0) : fabs(n.y) < 0.6 ? v3(0, 1, 0) : v3(0, 0, 1);
+    rad_vec3 a = v3_normalize(v3_cross(helper, n)), b = v3_cross(n, a);
+    rad_vec3 origin = v3_add(x, v3_scale(n, leave));
+    uint32_t side = (uint32_t)floor(sqrt((double)count));
+    double turn = 2 * RAD_PI * rad_rng_uniform(rng);
+    for (uint32_t k = 0; k < count; k++) {
+        double u1 = rad_rng_uniform(rng), u2 = rad_rng_uniform(rng);
+        if (k < side * side) {
+            u1 = ((k % side) + u1) / side;
+            u2 = ((k / side) + u2) / side;
+        }
+        double r = sqrt(u1), phi = 2 * RAD_PI * u2 + turn, c = sqrt(fmax(0, 1 - u1));
+        rad_vec3 w = v3_add(v3_scale(n, c), v3_add(v3_scale(a, r * cos(phi)), v3_scale(b, r * sin(phi))));
+        ray_set(&rays[k], origin, w, 0, INFINITY);
+        cos_x[k] = c;
+    }
+}
+
+rad_rgb emitter_cosine_value(const emitter_set *set, const rad_scene *scene, const rad_ray *ray,
+                             const rad_hit *hit, double cos_x, uint32_t count)
+{
+    rad_rgb none = {0, 0, 0};
+    if (hit->triangle == RAD_NO_HIT || !(cos_x > 0))
+        return none;
+    double pdf_area = set->pdf_area_of[hit->triangle];
+    if (!(pdf_area > 0) || (!hit->front && !triangle_two_sided(scene, hit->triangle)))
+        return none;
+    rad_rgb emitted = material_emission_at(scene, hit->triangle, hit->u, hit->v);
+    if (rgb_is_zero(emitted))
+        return none;
+    const uint32_t *v = scene->triangles[hit->triangle].vertex;
+    rad_vec3 p0 = scene->positions[v[0]];
+    rad_vec3 normal = v3_normalize(v3_cross(v3_sub(scene->positions[v[1]], p0),
+                                            v3_sub(scene->positions[v[2]], p0)));
+    rad_vec3 d = v3(ray->direction[0], ray->direction[1], ray->direction[2]);
+    double length = v3_length(d);
+    double cos_e = fabs(v3_dot(normal, d)) / length, distance = (double)hit->t * length;
+    if (!(cos_e > 0))
+        return none;
+    double p_light = pdf_area * distance * distance / cos_e, p_cosine = cos_x / RAD_PI;
+    return rgb_scale(emitted, RAD_PI * p_cosine / ((p_cosine + p_light) * count));
 }
 
 rad_status emitter_patch_direct(const emitter_set *set, const rad_scene *scene,
@@ -66,43 +134,59 @@ rad_status emitter_patch_direct(const emitter_set *set, const rad_scene *scene,
     if (set->count == 0 || n == 0)
         return RAD_OK;
     const uint32_t points = PATCH_EMITTER_POINTS * PATCH_EMITTER_POINTS;
-    const uint32_t total = points * PATCH_EMITTER_SAMPLES; /* samples per patch */
-    rad_ray *rays = rad_alloc_array((size_t)threads * total, sizeof(*rays));
-    rad_rgb *values = rad_alloc_array((size_t)threads * total, sizeof(*values));
-    uint8_t *blocked = rad_alloc_array((size_t)threads * total, sizeof(*blocked));
-    if (!rays || !values || !blocked) {
-        free(rays);
-        free(values);
-        free(blocked);
-        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the emitters' direct light");
-    }
+    const uint32_t total = points * PATCH_EMITTER_SAMPLES; /* of each kind, per patch */
+    size_t size = (size_t)threads * total;
+    rad_ray *rays = rad_alloc_array(size, sizeof(*rays));
+    rad_rgb *values = rad_alloc_array(size, sizeof(*values));
+    uint8_t *blocked = rad_alloc_array(size, sizeof(*blocked));
+    rad_ray *cosine_rays = rad_alloc_array(size, sizeof(*cosine_rays));
+    rad_hit *hits = rad_alloc_array(size, sizeof(*hits));
+    double *cosines = rad_alloc_array(size, sizeof(*cosines));
+    bool ok = rays && values && blocked && cosine_rays && hits && cosines;
+    if (ok) {
 #pragma omp parallel for schedule(dynamic, 32) num_threads(threads)
-    for (int64_t p = 0; p < (int64_t)n; p++) {
-        size_t base = (size_t)omp_get_thread_num() * total;
-        const rad_patch *patch = &mesh->patches[p];
-        rad_rng rng = rad_rng_seed(seed ^ PATCH_EMITTER_STREAM, (uint64_t)p, 0);
-        double shift1 = rad_rng_uniform(&rng), shift2 = rad_rng_uniform(&rng);
-        uint32_t count = 0;
-        for (uint32_t q = 0; q < points; q++) {
-            double s = ((q % PATCH_EMITTER_POINTS) + rad_rng_uniform(&rng)) / PATCH_EMITTER_POINTS;
-            double t = ((q / PATCH_EMITTER_POINTS) + rad_rng_uniform(&rng)) / PATCH_EMITTER_POINTS;
-            rad_vec3 x = patch_point(mesh, patch, s, t);
-            /* every point samples the whole light; consecutive Halton points and turns
-             * spread over the points make the patch's samples cover it evenly */
-            count += emitter_light_rays(set, scene, x, patch->normal, 2 * patch->bulge + leave,
-                                        PATCH_EMITTER_SAMPLES, (q + 0.5) / points,
-                                        q * PATCH_EMITTER_SAMPLES, shift1, shift2, &rng,
-                                        &rays[base + count], &values[base + count]);
+        for (int64_t p = 0; p < (int64_t)n; p++) {
+            size_t base = (size_t)omp_get_thread_num() * total;
+            const rad_patch *patch = &mesh->patches[p];
+            rad_rng rng = rad_rng_seed(seed ^ PATCH_EMITTER_STREAM, (uint64_t)p, 0);
+            double shift1 = rad_rng_uniform(&rng), shift2 = rad_rng_uniform(&rng);
+            double off = 2 * patch->bulge + leave;
+            uint32_t count = 0;
+            for (uint32_t q = 0; q < points; q++) {
+                double s = ((q % PATCH_EMITTER_POINTS) + rad_rng_uniform(&rng)) / PATCH_EMITTER_POINTS;
+                double t = ((q / PATCH_EMITTER_POINTS) + rad_rng_uniform(&rng)) / PATCH_EMITTER_POINTS;
+                rad_vec3 x = patch_point(mesh, patch, s, t);
+                /* every point samples the whole light and its hemisphere; consecutive Halton
+                 * points and turns spread over the points make the patch's samples cover the
+                 * light evenly */
+                count += emitter_light_rays_mis(set, scene, x, patch->normal, off,
+                                                PATCH_EMITTER_SAMPLES, (q + 0.5) / points,
+                                                q * PATCH_EMITTER_SAMPLES, shift1, shift2, &rng,
+                                                &rays[base + count], &values[base + count]);
+                emitter_cosine_rays(x, patch->normal, off, PATCH_EMITTER_SAMPLES, &rng,
+                                    &cosine_rays[base + q * PATCH_EMITTER_SAMPLES],
+                                    &cosines[base + q * PATCH_EMITTER_SAMPLES]);
+            }
+            rad_tracer_occluded(occluders, &rays[base], count, &blocked[base]);
+            rad_tracer_intersect(occluders, &cosine_rays[base], total, &hits[base]);
+            rad_rgb sum = {0, 0, 0};
+            for (uint32_t k = 0; k < count; k++)
+                if (!blocked[base + k])
+                    rgb_add_to(&sum, values[base + k]);
+            for (uint32_t k = 0; k < total; k++)
+                rgb_add_to(&sum, emitter_cosine_value(set, scene, &cosine_rays[base + k],
+                                                      &hits[base + k], cosines[base + k],
+                                                      PATCH_EMITTER_SAMPLES));
+            direct[p] = rgb_scale(sum, 1.0 / points); /* the mean of the points' estimates */
         }
-        rad_tracer_occluded(occluders, &rays[base], count, &blocked[base]);
-        rad_rgb sum = {0, 0, 0};
-        for (uint32_t k = 0; k < count; k++)
-            if (!blocked[base + k])
-                rgb_add_to(&sum, values[base + k]);
-        direct[p] = rgb_scale(sum, 1.0 / points); /* the mean of the points' estimates */
     }
     free(rays);
     free(values);
     free(blocked);
+    free(cosine_rays);
+    free(hits);
+    free(cosines);
+    if (!ok)
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the emitters' direct light");
     return RAD_OK;
 }

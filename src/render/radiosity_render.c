@@ -45,6 +45,7 @@
 #define EDGE_STREAM 0x5EED0EDCEull /* keeps edge samples' random numbers apart */
 #define LIGHT_STREAM 0x5EED11647ull /* the same for shadow rays toward light sources */
 #define LIGHT_BATCH 65536u         /* shadow rays traced together, at most */
+#define MAX_DIRECT_SAMPLES 1024u   /* emitter samples per pixel sample, at most */
 #define EMITTER_STREAM 0x5EEDE3177ull /* the per-pixel shifts of the emitters' samples */
 
 /* One thread's rays of one image row, compacted bounce by bounce. */
@@ -64,6 +65,13 @@ typedef struct row_work {
     uint32_t *light_sample;
     uint8_t *light_blocked;
     uint32_t light_count, light_capacity;
+    /* cosine-weighted rays toward the emitters (their MIS half), closest-hit queries */
+    rad_ray *cosine_rays;
+    rad_hit *cosine_hits;
+    double *cosine_of;
+    rad_rgb *cosine_factor;
+    uint32_t *cosine_sample;
+    uint32_t cosine_count, cosine_capacity;
 } row_work;
 
 typedef struct shading {
@@ -91,6 +99,7 @@ typedef struct shading {
     uint32_t emitter_samples;       /* per pixel sample */
     size_t per_row;                 /* first samples of a row: W k^2 */
     uint32_t edge_strata;           /* edge samples of an edge pixel */
+    const rad_tracer *scene_tracer; /* the scene's own triangles: the emitters hit */
 } shading;
 
 static double mean_luminance(const rad_rgb *samples, unsigned count)
@@ -165,9 +174,20 @@ static uint32_t twin_triangle(const shading *sh, uint32_t twin, rad_vec3 point, 
     return best;
 }
 
-/* Traces the pending shadow rays and adds the light of those that got through. */
+/* Traces the pending shadow rays and adds the light of those that got through; and the
+ * cosine-weighted rays, adding what the emitters they hit send. */
 static void flush_lights(const shading *sh, row_work *w)
 {
+    if (w->cosine_count) {
+        rad_tracer_intersect(sh->scene_tracer, w->cosine_rays, w->cosine_count, w->cosine_hits);
+        for (uint32_t k = 0; k < w->cosine_count; k++) {
+            rad_rgb value = emitter_cosine_value(sh->emitters, sh->scene, &w->cosine_rays[k],
+                                                 &w->cosine_hits[k], w->cosine_of[k],
+                                                 sh->emitter_samples);
+            rgb_add_to(&w->sum[w->cosine_sample[k]], rgb_mul(value, w->cosine_factor[k]));
+        }
+        w->cosine_count = 0;
+    }
     if (w->light_count == 0)
         return;
     rad_tracer_occluded(sh->tracer, w->light_rays, w->light_count, w->light_blocked);
@@ -186,7 +206,8 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
                          const rad_patch *patch, rad_rgb factor)
 {
     uint32_t room = (sh->lights ? sh->lights->sharp_count : 0) + sh->emitter_samples;
-    if (w->light_count + room > w->light_capacity)
+    if (w->light_count + room > w->light_capacity ||
+        w->cosine_count + sh->emitter_samples > w->cosine_capacity)
         flush_lights(sh, w);
     rad_rng rng = rad_rng_seed(sh->seed ^ LIGHT_STREAM, w->row, slot);
     double leave = 2 * patch->bulge + sh->leave;
@@ -209,11 +230,19 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
                shift2 = rad_rng_uniform(&per_pixel);
         uint32_t total = sh->strata + sh->edge_strata;
         turn += (double)index / (sh->emitter_samples * (double)total);
-        count += emitter_light_rays(sh->emitters, sh->scene, point, patch->normal, leave,
-                                    sh->emitter_samples, turn - floor(turn),
-                                    index * sh->emitter_samples, shift1, shift2, &rng,
-                                    &w->light_rays[w->light_count + count],
-                                    &w->light_value[w->light_count + count]);
+        count += emitter_light_rays_mis(sh->emitters, sh->scene, point, patch->normal, leave,
+                                        sh->emitter_samples, turn - floor(turn),
+                                        index * sh->emitter_samples, shift1, shift2, &rng,
+                                        &w->light_rays[w->light_count + count],
+                                        &w->light_value[w->light_count + count]);
+        uint32_t c = w->cosine_count;
+        emitter_cosine_rays(point, patch->normal, leave, sh->emitter_samples, &rng,
+                            &w->cosine_rays[c], &w->cosine_of[c]);
+        for (uint32_t k = c; k < c + sh->emitter_samples; k++) {
+            w->cosine_factor[k] = factor;
+            w->cosine_sample[k] = slot;
+        }
+        w->cosine_count += sh->emitter_samples;
     }
     for (uint32_t k = 0; k < count; k++) {
         uint32_t q = w->light_count + k;
@@ -438,6 +467,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     double leave = RAD_SURFACE_LEAVE_DIAGONAL * diagonal + RAD_SURFACE_LEAVE_COORDINATE * largest;
     uint32_t emitter_samples =
         options->direct_samples ? options->direct_samples : RAD_DEFAULT_DIRECT_SAMPLES;
+    if (emitter_samples > MAX_DIRECT_SAMPLES)
+        emitter_samples = MAX_DIRECT_SAMPLES;
 
     /* the emitters' direct light at every pixel sample, and its patch means to take out of
      * the solution first */
@@ -525,6 +556,17 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
             if (!w->light_rays || !w->light_value || !w->light_sample || !w->light_blocked)
                 goto nomem;
         }
+        if (emitters_ptr) {
+            w->cosine_capacity = LIGHT_BATCH;
+            w->cosine_rays = rad_alloc_array(LIGHT_BATCH, sizeof(*w->cosine_rays));
+            w->cosine_hits = rad_alloc_array(LIGHT_BATCH, sizeof(*w->cosine_hits));
+            w->cosine_of = rad_alloc_array(LIGHT_BATCH, sizeof(*w->cosine_of));
+            w->cosine_factor = rad_alloc_array(LIGHT_BATCH, sizeof(*w->cosine_factor));
+            w->cosine_sample = rad_alloc_array(LIGHT_BATCH, sizeof(*w->cosine_sample));
+            if (!w->cosine_rays || !w->cosine_hits || !w->cosine_of || !w->cosine_factor ||
+                !w->cosine_sample)
+                goto nomem;
+        }
     }
     shading shade = {mesh,      (const uint32_t(*)[3])display.triangles,
                      display.patch_of, first_triangle,
@@ -537,7 +579,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                      options->irradiance,
                      emitters_ptr, options->scene,
                      emitter_samples, per_row,
-                     edge_k * edge_k};
+                     edge_k * edge_k, scene_tracer};
 
     render_progress progress =
         render_progress_start(options->progress, options->progress_user, "render", H);
@@ -623,6 +665,11 @@ done:
             free(work[th].edge);
             free(work[th].level);
             free(work[th].edge_pixel);
+            free(work[th].cosine_rays);
+            free(work[th].cosine_hits);
+            free(work[th].cosine_of);
+            free(work[th].cosine_factor);
+            free(work[th].cosine_sample);
             free(work[th].light_rays);
             free(work[th].light_value);
             free(work[th].light_sample);
