@@ -56,9 +56,10 @@ static void test_cornell(void)
            "  direct light per pixel:  block rel RMSE %.4f, pixel rel RMSE %.4f\n",
            classic.block_relative_rmse, classic.pixel_relative_rmse,
            per_pixel.block_relative_rmse, per_pixel.pixel_relative_rmse);
-    /* measured 2026-12-02: 0.0343 / 0.0448 and 0.0199 / 0.0268 */
-    CHECK(classic.block_relative_rmse < 0.04 && classic.pixel_relative_rmse < 0.05);
-    CHECK(per_pixel.block_relative_rmse < 0.025 && per_pixel.pixel_relative_rmse < 0.032);
+    /* measured 2026-12-02 (seed 0, 2 threads): 0.0371 / 0.0397 and 0.0226 / 0.0242; from
+     * seed to seed the per-pixel render's blocks move by about 0.7 % (its noise) */
+    CHECK(classic.block_relative_rmse < 0.045 && classic.pixel_relative_rmse < 0.05);
+    CHECK(per_pixel.block_relative_rmse < 0.03 && per_pixel.pixel_relative_rmse < 0.03);
     CHECK(per_pixel.block_relative_rmse < 0.7 * classic.block_relative_rmse);
     CHECK(per_pixel.pixel_relative_rmse < 0.7 * classic.pixel_relative_rmse);
     /* the mean radiance agrees within the reference's noise and the mesh's bias */

@@ -746,6 +746,13 @@ void display_mesh_positions(const rad_mesh *mesh, const display_mesh *display,
 bool display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, const rad_rgb *B,
                            rad_rgb *vertex_radiance)
 {
+    return display_mesh_radiance_weighted(mesh, display, B, NULL, vertex_radiance);
+}
+
+bool display_mesh_radiance_weighted(const rad_mesh *mesh, const display_mesh *display,
+                                    const rad_rgb *B, const uint8_t *hidden,
+                                    rad_rgb *vertex_radiance)
+{
     double *weight = rad_alloc_array(mesh->vertex_count, sizeof(*weight));
     memset(vertex_radiance, 0,
            (display ? display->vertex_count : mesh->vertex_count) * sizeof(*vertex_radiance));
@@ -753,6 +760,8 @@ bool display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, co
         return false;
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
         const rad_patch *patch = &mesh->patches[p];
+        if (hidden && hidden[p])
+            continue; /* seen by no one: it must not darken its visible neighbours */
         for (uint32_t k = 0; k < patch->vertex_count; k++) {
             rad_rgb *L = &vertex_radiance[patch->vertex[k]];
             L->r += patch->area * B[p].r;

@@ -60,6 +60,19 @@ rad_status display_mesh_build(const rad_mesh *mesh, bool triangles, display_mesh
 bool display_mesh_radiance(const rad_mesh *mesh, const display_mesh *display, const rad_rgb *B,
                            rad_rgb *vertex_radiance);
 
+/* The same, leaving out the patches marked in `hidden` (NULL: none), which nothing can
+ * see (inside a closed object, or under one resting on them): a vertex they share with
+ * visible patches takes the visible ones' mean, and a vertex of hidden patches alone 0. */
+bool display_mesh_radiance_weighted(const rad_mesh *mesh, const display_mesh *display,
+                                    const rad_rgb *B, const uint8_t *hidden,
+                                    rad_rgb *vertex_radiance);
+
+/* Marks in hidden[p] (mesh->patch_count values) the patches no one can see: every ray of
+ * a few over the patch's hemisphere meets the back of a surface of `tracer` (the scene, or
+ * the patches); rays leave the centre `leave` off the patch (hidden_patches.c). */
+void display_hidden_patches(const rad_mesh *mesh, const rad_tracer *tracer, double leave,
+                            uint8_t *hidden);
+
 /* The positions of all display->vertex_count vertices. */
 void display_mesh_positions(const rad_mesh *mesh, const display_mesh *display,
                             rad_vec3 *positions);

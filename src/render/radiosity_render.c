@@ -450,6 +450,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     const emitter_set *emitters_ptr = NULL;
     rad_tracer *scene_tracer = NULL;
     rad_rgb *emitter_direct = NULL;
+    uint8_t *hidden = NULL;
     status = display_mesh_build(mesh, true, &display, error);
     if (status != RAD_OK)
         goto done;
@@ -497,8 +498,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         light_set_init(&lights, options->scene);
         lights_ptr = &lights;
     }
-    if (!display_mesh_radiance(mesh, &display, shaded ? shaded : B, radiance))
-        goto nomem;
+
     /* the tracer sees the front patches: the twins come after them (rad_mesh), and so do
      * their display triangles, which are in patch order */
     uint32_t traced = display.triangle_count;
@@ -519,6 +519,13 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                                (const uint32_t(*)[3])display.triangles, traced, &tracer, error);
     if (status != RAD_OK)
         goto done;
+    /* the radiance at the vertices, patches no one sees left out */
+    hidden = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1, sizeof(*hidden));
+    if (!hidden)
+        goto nomem;
+    display_hidden_patches(mesh, tracer, leave, hidden);
+    if (!display_mesh_radiance_weighted(mesh, &display, shaded ? shaded : B, hidden, radiance))
+        goto nomem;
 
     float t_near = (float)(RAD_CAMERA_NEAR * diagonal);
 
@@ -680,6 +687,7 @@ done:
     rad_tracer_destroy(scene_tracer);
     emitters_free(&emitters);
     free(emitter_direct);
+    free(hidden);
     display_mesh_free(&display);
     free(radiance);
     free(positions);
