@@ -112,6 +112,7 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 #define RAD_DEFAULT_EMISSIVITY 0.9      /* rad_surface.emissivity when the file gives none */
 #define RAD_DEFAULT_RENDER_SPP 16       /* rad_render_options.samples_per_pixel */
 #define RAD_DEFAULT_DIRECT_SAMPLES 4    /* rad_render_options.direct_samples */
+#define RAD_DEFAULT_RENDER_GATHER_RAYS 16 /* rad_render_options.gather_rays */
 #define RAD_DEFAULT_EDGE_SAMPLES 64     /* rad_render_options.edge_samples */
 #define RAD_DEFAULT_MAX_DEPTH 5         /* max_depth of rad_render_options (mirror
                                            reflections) and rad_raytrace_options */
@@ -1164,7 +1165,7 @@ typedef struct rad_render_options {
     uint32_t edge_samples;      /* more samples (rounded to a square) for a pixel whose first
                                    ones disagree by over 10 % in luminance, or that differs
                                    so from a row neighbour: silhouettes and the light's rim;
-                                   0 = 64 */
+                                   0 = 64 (256 with emitter_direct) */
     /* The two-pass method: with `materials` (the scene's) given, a surface whose specular
      * reflectance Ks > 0 adds Ks times the radiance seen along the mirror direction, traced
      * through the radiosity-lit scene, up to max_depth reflections (0 = 5). NULL = the
@@ -1201,6 +1202,12 @@ typedef struct rad_render_options {
      * image). direct_samples 0 = RAD_DEFAULT_DIRECT_SAMPLES. */
     bool emitter_direct;
     uint32_t direct_samples;
+    /* With emitter_direct: at a patch with another surface within 1.5 patch widths (a
+     * crease, a contact, a corner), the light reflected more than once is gathered at each
+     * pixel sample by `gather_rays` cosine-weighted rays meeting the solution (B - E
+     * interpolated; the sky where they leave) instead of being interpolated; 0 =
+     * RAD_DEFAULT_RENDER_GATHER_RAYS. */
+    uint32_t gather_rays;
 } rad_render_options;
 
 /* Radiance at every mesh vertex: the area-weighted average of B/pi over the patches that

@@ -4,7 +4,8 @@
  * independent estimator of the same scene), with the image issue's measures: block
  * relative RMSE of 8 x 8 luminance blocks and pixel relative RMSE without the light. The
  * classic render (the emitters' direct light interpolated from the solution) and the one
- * with the emitters' direct light at every pixel (--direct pixel: shadow rays, MIS) are
+ * with the emitters' direct light at every pixel (--direct pixel: shadow rays, MIS; the
+ * light reflected more than once gathered at pixels next to creases and contacts) are
  * held to what they measure today, and the second must beat the first; a furnace checks
  * that the per-pixel direct light stays unbiased where every wall is an emitter.
  */
@@ -56,10 +57,10 @@ static void test_cornell(void)
            "  direct light per pixel:  block rel RMSE %.4f, pixel rel RMSE %.4f\n",
            classic.block_relative_rmse, classic.pixel_relative_rmse,
            per_pixel.block_relative_rmse, per_pixel.pixel_relative_rmse);
-    /* measured 2026-12-02 (seed 0, 2 threads): 0.0371 / 0.0397 and 0.0226 / 0.0242; from
-     * seed to seed the per-pixel render's blocks move by about 0.7 % (its noise) */
+    /* measured 2026-12-02 (seed 0, 2 threads): 0.0371 / 0.0397 and 0.0196 / 0.0209; from
+     * seed to seed the per-pixel render's blocks move by about 0.5 % (its noise) */
     CHECK(classic.block_relative_rmse < 0.045 && classic.pixel_relative_rmse < 0.05);
-    CHECK(per_pixel.block_relative_rmse < 0.03 && per_pixel.pixel_relative_rmse < 0.03);
+    CHECK(per_pixel.block_relative_rmse < 0.026 && per_pixel.pixel_relative_rmse < 0.027);
     CHECK(per_pixel.block_relative_rmse < 0.7 * classic.block_relative_rmse);
     CHECK(per_pixel.pixel_relative_rmse < 0.7 * classic.pixel_relative_rmse);
     /* the mean radiance agrees within the reference's noise and the mesh's bias */

@@ -69,9 +69,11 @@ bool display_mesh_radiance_weighted(const rad_mesh *mesh, const display_mesh *di
 
 /* Marks in hidden[p] (mesh->patch_count values) the patches no one can see: every ray of
  * a few over the patch's hemisphere meets the back of a surface of `tracer` (the scene, or
- * the patches); rays leave the centre `leave` off the patch (hidden_patches.c). */
+ * the patches); rays leave the centre `leave` off the patch (hidden_patches.c). With
+ * `near` (NULL: not wanted), marks there the patches with a surface within near_widths x
+ * sqrt(area) along one of those rays. */
 void display_hidden_patches(const rad_mesh *mesh, const rad_tracer *tracer, double leave,
-                            uint8_t *hidden);
+                            uint8_t *hidden, uint8_t *near, double near_widths);
 
 /* The positions of all display->vertex_count vertices. */
 void display_mesh_positions(const rad_mesh *mesh, const display_mesh *display,

@@ -7,7 +7,9 @@
  *
  * A patch is hidden when every one of HIDDEN_RAYS rays from its centre over its
  * hemisphere (cosine-weighted, stratified) meets the back of a surface: it is enclosed.
- * A patch that sees any front, or the open sky, is not.
+ * A patch that sees any front, or the open sky, is not. The same rays tell which patches
+ * are near another surface (a crease, a contact, a corner): one of them hits within a few
+ * patch widths.
  */
 #include <math.h>
 
@@ -20,7 +22,7 @@
 #define HIDDEN_STREAM 0x41DDE4ull
 
 void display_hidden_patches(const rad_mesh *mesh, const rad_tracer *tracer, double leave,
-                            uint8_t *hidden)
+                            uint8_t *hidden, uint8_t *near, double near_widths)
 {
 #pragma omp parallel for schedule(dynamic, 64)
     for (int64_t p = 0; p < (int64_t)mesh->patch_count; p++) {
@@ -41,8 +43,14 @@ void display_hidden_patches(const rad_mesh *mesh, const rad_tracer *tracer, doub
         }
         rad_tracer_intersect(tracer, rays, HIDDEN_RAYS, hits);
         uint8_t enclosed = 1;
-        for (uint32_t k = 0; k < HIDDEN_RAYS && enclosed; k++)
-            enclosed = hits[k].triangle != RAD_NO_HIT && !hits[k].front;
+        double closest = INFINITY;
+        for (uint32_t k = 0; k < HIDDEN_RAYS; k++) {
+            enclosed &= hits[k].triangle != RAD_NO_HIT && !hits[k].front;
+            if (hits[k].triangle != RAD_NO_HIT)
+                closest = fmin(closest, hits[k].t);
+        }
         hidden[p] = enclosed;
+        if (near)
+            near[p] = closest < near_widths * sqrt(patch->area);
     }
 }

@@ -46,6 +46,10 @@
 #define LIGHT_STREAM 0x5EED11647ull /* the same for shadow rays toward light sources */
 #define LIGHT_BATCH 65536u         /* shadow rays traced together, at most */
 #define MAX_DIRECT_SAMPLES 1024u   /* emitter samples per pixel sample, at most */
+#define GATHER_STREAM 0x5EED6A7Eull /* the final gather's directions */
+#define MAX_GATHER_RAYS 1024u      /* final-gather rays per pixel sample, at most */
+#define NEAR_RAYS 16u              /* rays that find a patch's neighbours */
+#define NEAR_DISTANCE 1.5          /* a surface this many patch widths away is near */
 #define EMITTER_STREAM 0x5EEDE3177ull /* the per-pixel shifts of the emitters' samples */
 
 /* One thread's rays of one image row, compacted bounce by bounce. */
@@ -72,6 +76,12 @@ typedef struct row_work {
     rad_rgb *cosine_factor;
     uint32_t *cosine_sample;
     uint32_t cosine_count, cosine_capacity;
+    /* final-gather rays from hits next to a crease or contact, closest-hit queries */
+    rad_ray *gather_rays;
+    rad_hit *gather_hits;
+    rad_rgb *gather_factor;
+    uint32_t *gather_sample;
+    uint32_t gather_count, gather_capacity;
 } row_work;
 
 typedef struct shading {
@@ -100,6 +110,14 @@ typedef struct shading {
     size_t per_row;                 /* first samples of a row: W k^2 */
     uint32_t edge_strata;           /* edge samples of an edge pixel */
     const rad_tracer *scene_tracer; /* the scene's own triangles: the emitters hit */
+    const uint8_t *near;            /* per patch: next to a crease or contact, where the
+                                       light reflected more than once is gathered at the
+                                       pixel (NULL: interpolated everywhere) */
+    const rad_rgb *reflected;       /* per display vertex: (B - E) / pi, what a gather ray
+                                       sees (emission left out: the direct light is the
+                                       pixel's own) */
+    const rad_rgb *B;
+    uint32_t gather_rays;           /* per pixel sample */
 } shading;
 
 static double mean_luminance(const rad_rgb *samples, unsigned count)
@@ -178,6 +196,34 @@ static uint32_t twin_triangle(const shading *sh, uint32_t twin, rad_vec3 point, 
  * cosine-weighted rays, adding what the emitters they hit send. */
 static void flush_lights(const shading *sh, row_work *w)
 {
+    if (w->gather_count) {
+        rad_tracer_intersect(sh->tracer, w->gather_rays, w->gather_count, w->gather_hits);
+        for (uint32_t k = 0; k < w->gather_count; k++) {
+            const rad_hit *hit = &w->gather_hits[k];
+            rad_rgb L = {0, 0, 0};
+            if (hit->triangle == RAD_NO_HIT) {
+                if (sh->lights && sh->lights->has_sky) {
+                    const rad_ray *ray = &w->gather_rays[k];
+                    L = light_set_sky_radiance(sh->lights, v3(ray->direction[0], ray->direction[1],
+                                                              ray->direction[2]));
+                }
+            } else if (hit->front) {
+                const uint32_t *v = sh->triangles[hit->triangle];
+                double u = hit->u, vv = hit->v;
+                L = rgb_add(rgb_scale(sh->reflected[v[0]], 1 - u - vv),
+                            rgb_add(rgb_scale(sh->reflected[v[1]], u),
+                                    rgb_scale(sh->reflected[v[2]], vv)));
+            } else {
+                uint32_t twin = sh->mesh->patches[sh->patch_of[hit->triangle]].twin;
+                if (twin)
+                    L = rgb_scale(rgb_max0(rgb_add(sh->B[twin - 1],
+                                                   rgb_scale(sh->inputs->exitance[twin - 1], -1))),
+                                  1 / RAD_PI);
+            }
+            rgb_add_to(&w->sum[w->gather_sample[k]], rgb_mul(L, w->gather_factor[k]));
+        }
+        w->gather_count = 0;
+    }
     if (w->cosine_count) {
         rad_tracer_intersect(sh->scene_tracer, w->cosine_rays, w->cosine_count, w->cosine_hits);
         for (uint32_t k = 0; k < w->cosine_count; k++) {
@@ -252,6 +298,26 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
     w->light_count += count;
 }
 
+/* Queues the final gather of a hit next to a crease or contact: gather_rays
+ * cosine-weighted directions (stratified, turned at random), each adding
+ * factor x pi / gather_rays x the radiance it meets. */
+static void queue_gather(const shading *sh, row_work *w, uint32_t slot, rad_vec3 point,
+                         const rad_patch *patch, rad_rgb factor)
+{
+    if (w->gather_count + sh->gather_rays > w->gather_capacity)
+        flush_lights(sh, w);
+    rad_rng rng = rad_rng_seed(sh->seed ^ GATHER_STREAM, w->row, slot);
+    double cosines[MAX_GATHER_RAYS];
+    emitter_cosine_rays(point, patch->normal, 2 * patch->bulge + sh->leave, sh->gather_rays, &rng,
+                        &w->gather_rays[w->gather_count], cosines);
+    rad_rgb each = rgb_scale(factor, RAD_PI / sh->gather_rays);
+    for (uint32_t k = w->gather_count; k < w->gather_count + sh->gather_rays; k++) {
+        w->gather_factor[k] = each;
+        w->gather_sample[k] = slot;
+    }
+    w->gather_count += sh->gather_rays;
+}
+
 /* Adds each hit's interpolated radiance (times the ray's weight) to its sample and, when
  * mirrors are allowed, writes the mirror rays of specular hits to the front of the arrays.
  * Returns how many rays are left for the next bounce. */
@@ -293,7 +359,15 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
         rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit_u - hit_v),
                                        rgb_add(rgb_scale(L[v[1]], hit_u), rgb_scale(L[v[2]], hit_v)));
         rad_rgb albedo = sh->inputs ? sh->inputs->albedo[patch_index] : (rad_rgb){0, 0, 0};
-        if (sh->irradiance) {
+        bool gathered = sh->near && sh->near[patch_index] && !sh->irradiance;
+        if (gathered) {
+            /* next to a crease or contact: the emitted radiance at the point, and the light
+             * reflected more than once gathered here rather than interpolated */
+            interpolated = rgb_scale(sh->inputs->exitance[patch_index], 1 / RAD_PI);
+            if (patch_material_textured(sh->textures, sh->mesh->patches[patch_index].material))
+                interpolated = textured_radiance(sh, &w->rays[r], hit, patch_index,
+                                                 (rad_rgb){0, 0, 0}, &albedo);
+        } else if (sh->irradiance) {
             /* the vertices hold irradiance / pi; the sharp sources come below, whole */
             interpolated = rgb_scale(interpolated, RAD_PI);
             albedo = (rad_rgb){RAD_PI, RAD_PI, RAD_PI};
@@ -309,6 +383,9 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
                                 ray->origin[2] + (double)hit->t * ray->direction[2]);
             queue_lights(sh, w, w->sample[r], point, &sh->mesh->patches[patch_index],
                          rgb_scale(rgb_mul(weight, albedo), 1.0 / RAD_PI));
+            if (gathered)
+                queue_gather(sh, w, w->sample[r], point, &sh->mesh->patches[patch_index],
+                             rgb_scale(rgb_mul(weight, albedo), 1.0 / RAD_PI));
         }
         if (!mirrors || !sh->materials || sh->irradiance)
             continue;
@@ -450,7 +527,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     const emitter_set *emitters_ptr = NULL;
     rad_tracer *scene_tracer = NULL;
     rad_rgb *emitter_direct = NULL;
-    uint8_t *hidden = NULL;
+    uint8_t *hidden = NULL, *near = NULL;
+    rad_rgb *reflected = NULL;
     status = display_mesh_build(mesh, true, &display, error);
     if (status != RAD_OK)
         goto done;
@@ -470,6 +548,9 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         options->direct_samples ? options->direct_samples : RAD_DEFAULT_DIRECT_SAMPLES;
     if (emitter_samples > MAX_DIRECT_SAMPLES)
         emitter_samples = MAX_DIRECT_SAMPLES;
+    uint32_t gather_rays = options->gather_rays ? options->gather_rays : RAD_DEFAULT_RENDER_GATHER_RAYS;
+    if (gather_rays > MAX_GATHER_RAYS)
+        gather_rays = MAX_GATHER_RAYS;
 
     /* the emitters' direct light at every pixel sample, and its patch means to take out of
      * the solution first */
@@ -523,15 +604,33 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     hidden = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1, sizeof(*hidden));
     if (!hidden)
         goto nomem;
-    display_hidden_patches(mesh, tracer, leave, hidden);
+    if (emitters_ptr) {
+        near = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1, sizeof(*near));
+        reflected = rad_alloc_array(display.vertex_count, sizeof(*reflected));
+        rad_rgb *outgoing = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1,
+                                            sizeof(*outgoing));
+        bool made = near && reflected && outgoing;
+        for (uint32_t p = 0; made && p < mesh->patch_count; p++)
+            outgoing[p] = rgb_max0(rgb_add(B[p], rgb_scale(inputs->exitance[p], -1)));
+        display_hidden_patches(mesh, tracer, leave, hidden, near, NEAR_DISTANCE);
+        made = made && display_mesh_radiance_weighted(mesh, &display, outgoing, hidden, reflected);
+        free(outgoing);
+        if (!made)
+            goto nomem;
+    } else
+        display_hidden_patches(mesh, tracer, leave, hidden, NULL, 0);
     if (!display_mesh_radiance_weighted(mesh, &display, shaded ? shaded : B, hidden, radiance))
         goto nomem;
 
     float t_near = (float)(RAD_CAMERA_NEAR * diagonal);
 
     size_t per_row = (size_t)W * k * k;
-    unsigned edge_k = (unsigned)lround(sqrt((double)(options->edge_samples ? options->edge_samples
-                                                                          : RAD_DEFAULT_EDGE_SAMPLES)));
+    /* with the direct light per pixel the image is accurate enough for the light's rim to
+     * show: its pixels get four times the samples */
+    uint32_t edge_samples = options->edge_samples     ? options->edge_samples
+                            : options->emitter_direct ? 4 * RAD_DEFAULT_EDGE_SAMPLES
+                                                      : RAD_DEFAULT_EDGE_SAMPLES;
+    unsigned edge_k = (unsigned)lround(sqrt((double)edge_samples));
     edge_k = edge_k < 1 ? 1 : edge_k > MAX_STRATA ? MAX_STRATA : edge_k;
     size_t per_row_edges = (size_t)W * edge_k * edge_k;
     size_t ray_capacity = per_row > per_row_edges ? per_row : per_row_edges;
@@ -564,6 +663,13 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                 goto nomem;
         }
         if (emitters_ptr) {
+            w->gather_capacity = LIGHT_BATCH;
+            w->gather_rays = rad_alloc_array(LIGHT_BATCH, sizeof(*w->gather_rays));
+            w->gather_hits = rad_alloc_array(LIGHT_BATCH, sizeof(*w->gather_hits));
+            w->gather_factor = rad_alloc_array(LIGHT_BATCH, sizeof(*w->gather_factor));
+            w->gather_sample = rad_alloc_array(LIGHT_BATCH, sizeof(*w->gather_sample));
+            if (!w->gather_rays || !w->gather_hits || !w->gather_factor || !w->gather_sample)
+                goto nomem;
             w->cosine_capacity = LIGHT_BATCH;
             w->cosine_rays = rad_alloc_array(LIGHT_BATCH, sizeof(*w->cosine_rays));
             w->cosine_hits = rad_alloc_array(LIGHT_BATCH, sizeof(*w->cosine_hits));
@@ -586,7 +692,9 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                      options->irradiance,
                      emitters_ptr, options->scene,
                      emitter_samples, per_row,
-                     edge_k * edge_k, scene_tracer};
+                     edge_k * edge_k, scene_tracer,
+                     near,      reflected,
+                     B,         gather_rays};
 
     render_progress progress =
         render_progress_start(options->progress, options->progress_user, "render", H);
@@ -672,6 +780,10 @@ done:
             free(work[th].edge);
             free(work[th].level);
             free(work[th].edge_pixel);
+            free(work[th].gather_rays);
+            free(work[th].gather_hits);
+            free(work[th].gather_factor);
+            free(work[th].gather_sample);
             free(work[th].cosine_rays);
             free(work[th].cosine_hits);
             free(work[th].cosine_of);
@@ -688,6 +800,8 @@ done:
     emitters_free(&emitters);
     free(emitter_direct);
     free(hidden);
+    free(near);
+    free(reflected);
     display_mesh_free(&display);
     free(radiance);
     free(positions);
