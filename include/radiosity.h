@@ -1231,11 +1231,11 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
 /* ------------------------------------------------------------------------------------ */
 /* Illuminance at points: work planes and measuring points                               */
 
-#define RAD_DEFAULT_GATHER_RAYS 1024 /* rad_illuminance_options.gather_rays */
+#define RAD_DEFAULT_GATHER_RAYS 4096 /* rad_illuminance_options.gather_rays */
 
 typedef struct rad_illuminance_options {
     uint32_t gather_rays;      /* directions over the hemisphere for the light from surfaces
-                                  and the sky, stratified, cosine-weighted; 0 = 1024 */
+                                  and the sky, stratified, cosine-weighted; 0 = 4096 */
     uint64_t seed;
     int threads;
 } rad_illuminance_options;

@@ -444,6 +444,61 @@ static void test_bad_lights(void)
     CHECK(strstr(test_read_text(test_path("stdout.txt")), "below the horizon") != NULL);
 }
 
+/* A room 4 x 3 x 5 m (albedo 0.5, inward) with a 2 x 1 m window in its south wall under the
+ * CIE overcast sky: the illuminance at floor points (rad_illuminance, as the daylight
+ * factor is computed) against the path tracer's (pi / rho x the mean radiance of a small
+ * patch of floor seen from straight above) within 2 % and 3 standard errors. */
+static void test_daylight_factor(void)
+{
+    const char *room = test_write_file(
+        "window_room.obj",
+        "v 0 0 0\nv 4 0 0\nv 4 0 5\nv 0 0 5\nv 0 3 0\nv 4 3 0\nv 4 3 5\nv 0 3 5\n"
+        "v 1 1 0\nv 3 1 0\nv 3 2 0\nv 1 2 0\nv 0 1 0\nv 4 1 0\nv 4 2 0\nv 0 2 0\n"
+        "o floor\nf 1 4 3 2\no ceiling\nf 5 6 7 8\no west\nf 1 5 8 4\no east\nf 2 3 7 6\n"
+        "o north\nf 4 8 7 3\n"
+        "o south\nf 1 2 14 13\nf 16 15 6 5\nf 13 9 12 16\nf 10 14 15 11\n");
+    rad_scene *scene = NULL;
+    rad_error error;
+    CHECK(rad_scene_load(room, NULL, &scene, &error) == RAD_OK);
+    rad_light sky = {.type = RAD_LIGHT_SKY, .sky = RAD_SKY_CIE_OVERCAST, .intensity = {1000, 1000, 1000}};
+    add_light(scene, &sky);
+    rad_mesh *mesh = NULL;
+    CHECK(rad_mesh_build(scene, 0.2, &mesh, &error) == RAD_OK);
+    rad_rgb *B = calloc(mesh->patch_count, sizeof(*B));
+    rad_scene_solve_options options = {.threads = 2};
+    CHECK(rad_solve_scene(scene, mesh, &options, B, NULL, &error) == RAD_OK);
+    const rad_vec3 at[] = {{2, 0, 1.2}, {2, 0, 2.5}, {1, 0, 4}, {3.2, 0, 1.8}};
+    const int n = (int)(sizeof(at) / sizeof(at[0]));
+    rad_vec3 up[4] = {{0, 1, 0}, {0, 1, 0}, {0, 1, 0}, {0, 1, 0}};
+    rad_rgb E[4];
+    rad_illuminance_options measure = {.threads = 2}; /* the default gather */
+    CHECK(rad_illuminance(scene, mesh, B, at, up, (uint32_t)n, &measure, E, &error) == RAD_OK);
+    double outside = rad_sky_horizontal_illuminance(scene);
+    CHECK_NEAR(outside, 7 * PI * 1000 / 9, 1e-9);
+    for (int k = 0; k < n; k++) {
+        rad_image *image = test_new_image(8, 8), *se = test_new_image(8, 8);
+        rad_camera camera = {{at[k].x, 2.9, at[k].z}, at[k], {0, 0, 1}, 2};
+        rad_pathtrace_options trace = {.samples_per_pixel = 4096, .threads = 2, .seed = 3 + (uint64_t)k};
+        CHECK(rad_pathtrace(scene, &camera, &trace, image, se, NULL, &error) == RAD_OK);
+        double mean = 0, var = 0;
+        for (uint32_t y = 0; y < 8; y++)
+            for (uint32_t x = 0; x < 8; x++) {
+                mean += test_pixel(image, x, y)[1] / 64;
+                var += pow(test_pixel(se, x, y)[1], 2) / (64.0 * 64.0);
+            }
+        double traced = PI / 0.5 * mean, error_of_mean = PI / 0.5 * sqrt(var);
+        printf("daylight factor at (%.1f, %.1f): radiosity %.3f %%, path tracer %.3f %% +- %.3f\n",
+               at[k].x, at[k].z, 100 * E[k].g / outside, 100 * traced / outside,
+               100 * error_of_mean / outside);
+        CHECK(fabs(E[k].g - traced) <= 0.02 * traced + 3 * error_of_mean);
+        rad_image_destroy(image);
+        rad_image_destroy(se);
+    }
+    free(B);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+}
+
 /* The false-colour scale: its ends, its legend band, a refused scale. */
 static void test_false_colour(void)
 {
@@ -476,6 +531,7 @@ int main(void)
     test_spot_cone();
     test_sun();
     test_skies();
+    test_daylight_factor();
     test_energy();
     test_bad_lights();
     return test_finish("test_lights");
