@@ -434,12 +434,13 @@ typedef struct rad_photometry {
     double lumens;               /* the flux of the web, integrated over the sphere (lm) */
 } rad_photometry;
 
-/* Reads an IES LM-63 file (1986, 1991, 1995, 2002 and 2019 headers; TILT=NONE or INCLUDE
- * or a TILT file beside it is ignored with a warning through `log`), every symmetric
- * variant of the horizontal angles (a single 0: symmetric about the axis; 0..90 quadrant;
- * 0..180 bilateral; 90..270; 0..360). RAD_ERR_PARSE naming the file and line for a short
- * table, angles that are not ascending or out of range, a bad header or count, a negative
- * candela value. */
+/* Reads an IES LM-63 file (1986, 1991, 1995, 2002 and 2019 headers; TILT=NONE, or the
+ * tilt data of TILT=INCLUDE or of a TILT file beside it ignored with a warning through
+ * `log`), every symmetric variant of the horizontal angles (a single 0: symmetric about the
+ * axis; 0..90 quadrant; 0..180 bilateral; 90..270; 0..360). RAD_ERR_IO when it cannot be
+ * read; RAD_ERR_PARSE naming the file and line for a short table, angles that are not
+ * ascending or out of range, a bad header, count or number, a negative candela value or
+ * multiplier, NUL bytes, a file over 16 MiB. */
 rad_status rad_photometry_read(const char *path, rad_log_fn log, void *log_user,
                                rad_photometry **out, rad_error *error);
 void rad_photometry_destroy(rad_photometry *photometry);
@@ -447,7 +448,8 @@ void rad_photometry_destroy(rad_photometry *photometry);
 /* Candela toward (vertical angle, horizontal angle), degrees, photometric type C
  * conventions (vertical 0 = nadir, 180 = zenith; horizontal counter-clockwise seen from
  * above); bilinear in the table, the symmetric variants unfolded; 0 outside the table's
- * vertical range. */
+ * vertical range. Types A and B take the file's own angles, vertical and horizontal in
+ * [-90, 90] (horizontal mirrored when the file lists 0..90), 0 beyond. */
 double rad_photometry_candela(const rad_photometry *photometry, double vertical_degrees,
                               double horizontal_degrees);
 
