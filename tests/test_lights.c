@@ -499,6 +499,84 @@ static void test_daylight_factor(void)
     rad_scene_destroy(scene);
 }
 
+/* An IES luminaire (a table written here: I = 1000 cos v candela at 5-degree steps of the
+ * vertical angle, rotationally symmetric) 2 m above a floor, aimed down: the illuminance
+ * at floor points is I(v) cos^3 v / h^2, through the library and the command line. */
+static void test_luminaire(void)
+{
+    char table[4096];
+    int used = snprintf(table, sizeof(table),
+                        "IESNA:LM-63-2002\n[TEST] written by test_lights\n[MANUFAC] none\n"
+                        "TILT=NONE\n1 -1 1 19 1 1 2 0 0 0\n1 1 100\n");
+    for (int k = 0; k < 19; k++)
+        used += snprintf(table + used, sizeof(table) - (size_t)used, "%d ", 5 * k);
+    used += snprintf(table + used, sizeof(table) - (size_t)used, "\n0\n");
+    for (int k = 0; k < 19; k++)
+        used += snprintf(table + used, sizeof(table) - (size_t)used, "%.9f ",
+                         1000 * cos(5 * k * PI / 180));
+    snprintf(table + used, sizeof(table) - (size_t)used, "\n");
+    const char *ies = test_write_file("downlight.ies", table);
+    rad_photometry *web = NULL;
+    rad_error error;
+    CHECK(rad_photometry_read(ies, NULL, NULL, &web, &error) == RAD_OK);
+    if (!web)
+        return;
+    CHECK_NEAR(web->lumens, PI * 1000, 0.005); /* a cosine web: pi I0 */
+    rad_scene *scene = floor_scene(10, NULL);
+    rad_light luminaire = {.type = RAD_LIGHT_LUMINAIRE, .position = {0, 2, 0},
+                           .direction = {0, -1, 0}, .intensity = {1, 1, 1}, .photometry = web};
+    add_light(scene, &luminaire);
+    rad_mesh *mesh = NULL;
+    CHECK(rad_mesh_build(scene, 0.5, &mesh, &error) == RAD_OK);
+    rad_rgb *B = calloc(mesh->patch_count, sizeof(*B));
+    CHECK(rad_solve_scene(scene, mesh, NULL, B, NULL, &error) == RAD_OK);
+    double angles[] = {0, 10, 22.5, 37.5, 50, 60};
+    rad_vec3 at[6], up[6];
+    rad_rgb E[6];
+    for (int k = 0; k < 6; k++) {
+        at[k] = (rad_vec3){2 * tan(angles[k] * PI / 180) * cos(k), 0, 2 * tan(angles[k] * PI / 180) * sin(k)};
+        up[k] = (rad_vec3){0, 1, 0};
+    }
+    rad_illuminance_options measure = {.threads = 2, .gather_rays = 16};
+    CHECK(rad_illuminance(scene, mesh, B, at, up, 6, &measure, E, &error) == RAD_OK);
+    char points[1024] = "";
+    for (int k = 0; k < 6; k++) {
+        double c = cos(angles[k] * PI / 180), expected = 1000 * c * c * c * c / 4;
+        /* between listed angles the table is linear in the angle, cos is not: 0.1 % */
+        CHECK_NEAR(E[k].g, expected, 0.005);
+        size_t len = strlen(points);
+        snprintf(points + len, sizeof(points) - len, "%.9f,0,%.9f\n", at[k].x, at[k].z);
+    }
+    free(B);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene); /* frees the web */
+
+    /* the command line: --luminaire, --points, the CSV's E column */
+    test_write_file("floor_points.csv", points);
+    char command[1024];
+    snprintf(command, sizeof(command),
+             "illuminance floor.obj --luminaire downlight.ies:0,2,0 --points floor_points.csv "
+             "--gather-rays 16 -o lux.csv --quiet");
+    CHECK(test_run_tool(command) == 0);
+    const char *csv = test_read_text(test_path("lux.csv"));
+    const char *line = strchr(csv, '\n');
+    for (int k = 0; k < 6 && line; k++, line = strchr(line + 1, '\n')) {
+        double v[10];
+        if (sscanf(line + 1, "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3],
+                   &v[4], &v[5], &v[6], &v[7], &v[8], &v[9]) != 10) {
+            CHECK(!"a row of x,y,z,nx,ny,nz,E_r,E_g,E_b,E");
+            break;
+        }
+        double c = cos(angles[k] * PI / 180);
+        CHECK_NEAR(v[9], 1000 * c * c * c * c / 4, 0.005);
+    }
+    /* a malformed file: one line naming it and its line, nothing written */
+    test_write_file("short.ies", "IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 3 1 1 2 0 0 0\n1 1 100\n0 45 90\n0\n100 50\n");
+    CHECK(test_run_tool("render floor.obj --luminaire short.ies:0,2,0 -o short.png") != 0);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "short.ies") != NULL);
+    CHECK(!test_file_exists(test_path("short.png")));
+}
+
 /* The false-colour scale: its ends, its legend band, a refused scale. */
 static void test_false_colour(void)
 {
@@ -532,6 +610,7 @@ int main(void)
     test_sun();
     test_skies();
     test_daylight_factor();
+    test_luminaire();
     test_energy();
     test_bad_lights();
     return test_finish("test_lights");
