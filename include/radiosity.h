@@ -111,7 +111,7 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 #define RAD_DEFAULT_MAX_RAYS 1024       /* rad_viewfactor_options.max_rays */
 #define RAD_DEFAULT_EMISSIVITY 0.9      /* rad_surface.emissivity when the file gives none */
 #define RAD_DEFAULT_RENDER_SPP 16       /* rad_render_options.samples_per_pixel */
-#define RAD_DEFAULT_DIRECT_SAMPLES 4    /* rad_render_options.direct_samples */
+#define RAD_DEFAULT_DIRECT_SAMPLES 8    /* rad_render_options.direct_samples */
 #define RAD_DEFAULT_RENDER_GATHER_RAYS 16 /* rad_render_options.gather_rays */
 #define RAD_DEFAULT_EDGE_SAMPLES 64     /* rad_render_options.edge_samples */
 #define RAD_DEFAULT_MAX_DEPTH 5         /* max_depth of rad_render_options (mirror

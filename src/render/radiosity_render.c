@@ -63,6 +63,10 @@ typedef struct row_work {
     double *level;    /* per pixel of the row: mean luminance of its first samples */
     uint32_t row;     /* the image row being rendered (random numbers) */
     uint32_t *edge_pixel; /* the pixels of the row that get edge samples, in order */
+    uint32_t *first_surface; /* per first sample: the surface its camera ray met
+                                (UINT32_MAX: none); with the direct light per pixel,
+                                edges are where these differ, not where noise does */
+    uint32_t *corner_surface; /* the same at the row's pixel corners: 2 (W + 1) */
     /* shadow rays toward the sharp light sources from the hits of a bounce */
     rad_ray *light_rays;
     rad_rgb *light_value;   /* radiance the ray adds to its sample when unblocked */
@@ -411,10 +415,16 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
 }
 
 static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work *w,
-                          uint32_t count, unsigned max_depth)
+                          uint32_t count, unsigned max_depth, bool first)
 {
     for (unsigned depth = 0; count > 0; depth++) {
         rad_tracer_intersect(tracer, w->rays, count, w->hits);
+        if (first && depth == 0 && w->first_surface)
+            for (uint32_t r = 0; r < count; r++)
+                w->first_surface[w->sample[r]] =
+                    w->hits[r].triangle == RAD_NO_HIT
+                        ? UINT32_MAX
+                        : sh->mesh->patches[sh->patch_of[w->hits[r].triangle]].surface;
         count = shade_hits(sh, w, count, depth < max_depth);
         flush_lights(sh, w);
     }
@@ -634,6 +644,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     edge_k = edge_k < 1 ? 1 : edge_k > MAX_STRATA ? MAX_STRATA : edge_k;
     size_t per_row_edges = (size_t)W * edge_k * edge_k;
     size_t ray_capacity = per_row > per_row_edges ? per_row : per_row_edges;
+    if (ray_capacity < 2 * ((size_t)W + 1))
+        ray_capacity = 2 * ((size_t)W + 1); /* the corner rays */
     unsigned max_depth = options->max_depth ? options->max_depth : RAD_DEFAULT_MAX_DEPTH;
     work = rad_alloc_array((size_t)threads, sizeof(*work));
     if (!work)
@@ -652,6 +664,12 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         w->edge_pixel = rad_alloc_array(W, sizeof(*w->edge_pixel));
         if (!w->edge_pixel)
             goto nomem;
+        if (emitters_ptr) {
+            w->first_surface = rad_alloc_array(per_row, sizeof(*w->first_surface));
+            w->corner_surface = rad_alloc_array(2 * ((size_t)W + 1), sizeof(*w->corner_surface));
+            if (!w->first_surface || !w->corner_surface)
+                goto nomem;
+        }
         uint32_t room = (lights_ptr ? lights.sharp_count : 0) + (emitters_ptr ? emitter_samples : 0);
         if (room > 0) {
             w->light_capacity = LIGHT_BATCH > room ? LIGHT_BATCH : room;
@@ -703,6 +721,19 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         int thread = omp_get_thread_num();
         row_work *w = &work[thread];
         w->row = y;
+        if (w->first_surface) {
+            /* the surfaces at the pixels' corners: an edge that crosses a pixel but none of
+             * its first samples (the light's rim covering a tenth of it) still shows */
+            for (uint32_t c = 0; c < 2 * (W + 1); c++) {
+                rad_vec3 d = v3_normalize(camera_direction(&frame, c % (W + 1), y + c / (W + 1), W, H));
+                ray_set(&w->rays[c], frame.eye, d, t_near, INFINITY);
+            }
+            rad_tracer_intersect(tracer, w->rays, 2 * (W + 1), w->hits);
+            for (uint32_t c = 0; c < 2 * (W + 1); c++)
+                w->corner_surface[c] = w->hits[c].triangle == RAD_NO_HIT
+                                           ? UINT32_MAX
+                                           : mesh->patches[display.patch_of[w->hits[c].triangle]].surface;
+        }
         for (uint32_t x = 0; x < W; x++) {
             rad_rng rng = rad_rng_seed(options->seed, y, x);
             for (unsigned s = 0; s < k * k; s++) {
@@ -716,7 +747,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                 w->sum[index] = (rad_rgb){0, 0, 0};
             }
         }
-        trace_samples(&shade, tracer, w, (uint32_t)per_row, max_depth);
+        trace_samples(&shade, tracer, w, (uint32_t)per_row, max_depth, true);
 
         /* edges: pixels whose first samples disagree (a silhouette, the light's rim) get
          * edge_k x edge_k more, so that high-contrast edges are antialiased */
@@ -726,9 +757,20 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         for (uint32_t x = 0; x < W; x++) {
             /* an edge shows inside the pixel's samples, or as a step to a row neighbour
              * (samples that all fell on one side of an edge crossing the pixel) */
-            w->edge[x] = is_edge(&w->sum[(size_t)x * k * k], k * k, w->level[x]) ||
-                         (x > 0 && is_step(w->level[x], w->level[x - 1])) ||
-                         (x + 1 < W && is_step(w->level[x], w->level[x + 1]));
+            if (w->first_surface) {
+                /* the direct light per pixel is noisy: an edge is where the camera rays
+                 * meet different surfaces (a silhouette, a crease, the light's rim) */
+                const uint32_t *seen = &w->first_surface[(size_t)x * k * k];
+                const uint32_t *corner = w->corner_surface;
+                bool differ = corner[x] != seen[0] || corner[x + 1] != seen[0] ||
+                              corner[W + 1 + x] != seen[0] || corner[W + 2 + x] != seen[0];
+                for (unsigned q = 1; q < k * k && !differ; q++)
+                    differ = seen[q] != seen[0];
+                w->edge[x] = differ;
+            } else
+                w->edge[x] = is_edge(&w->sum[(size_t)x * k * k], k * k, w->level[x]) ||
+                             (x > 0 && is_step(w->level[x], w->level[x - 1])) ||
+                             (x + 1 < W && is_step(w->level[x], w->level[x + 1]));
             if (!w->edge[x])
                 continue;
             w->edge_pixel[extra / (edge_k * edge_k)] = x;
@@ -745,7 +787,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
             }
         }
         if (extra)
-            trace_samples(&shade, tracer, w, extra, max_depth);
+            trace_samples(&shade, tracer, w, extra, max_depth, false);
 
         uint32_t next_extra = 0;
         for (uint32_t x = 0; x < W; x++) {
@@ -780,6 +822,8 @@ done:
             free(work[th].edge);
             free(work[th].level);
             free(work[th].edge_pixel);
+            free(work[th].first_surface);
+            free(work[th].corner_surface);
             free(work[th].gather_rays);
             free(work[th].gather_hits);
             free(work[th].gather_factor);
