@@ -479,7 +479,9 @@ typedef struct rad_light {
  * them. RAD_ERR_INVALID with a message naming the light for: a type out of range, a
  * non-finite value, a negative intensity, a zero direction where one is needed, spot
  * angles outside 0 <= inner <= outer <= 90, an angular diameter outside [0, 20), a
- * luminaire without photometry, an environment map that is missing or not 2:1. */
+ * luminaire without photometry, an environment map that is missing or not 2:1;
+ * RAD_ERR_UNSUPPORTED for a luminaire whose web is of photometric type B or A (type C, the
+ * usual, only). */
 rad_status rad_scene_add_light(rad_scene *scene, const rad_light *light, rad_error *error);
 
 /* "point", "spot", "sun", "sky", "environment", "luminaire". Never NULL. */
@@ -1238,15 +1240,17 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
 typedef struct rad_illuminance_options {
     uint32_t gather_rays;      /* directions over the hemisphere for the light from surfaces
                                   and the sky, stratified, cosine-weighted; 0 = 4096 */
+    const rad_patch_inputs *inputs; /* the patch inputs the solve used (E_i); NULL: built */
     uint64_t seed;
     int threads;
 } rad_illuminance_options;
 
 /* The irradiance (illuminance in lux with photometric lights) at each point, on the
  * side its unit normal faces: the sharp light sources (point, spot, luminaire, sun) by
- * exact shadow rays, then a final gather over the hemisphere: a ray that hits a patch
- * brings its radiance (B / pi interpolated from the vertices, emitters included), a ray
- * that leaves the scene the sky's. `E` receives `count` values. */
+ * exact shadow rays; the emitters' direct light by 64 light samples and 64 cosine rays
+ * combined by multiple importance sampling; then a final gather over the hemisphere: a
+ * ray that hits a patch brings its reflected radiance ((B - E) / pi interpolated from the
+ * vertices), a ray that leaves the scene the sky's. `E` receives `count` values. */
 rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
                            const rad_vec3 *points, const rad_vec3 *normals, uint32_t count,
                            const rad_illuminance_options *options, rad_rgb *E,

@@ -439,6 +439,39 @@ static void test_bad_lights(void)
     CHECK(strstr(test_read_text(test_path("stderr.txt")), "needs the sun") != NULL);
     CHECK(test_run_tool("render --size 8x8 --unit furlong -o bad.png") == 2);
     CHECK(!test_file_exists(out));
+    CHECK(test_run_tool("render --size 8x8 --sky uniform:-5 -o bad.png") == 2);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "must not be negative") != NULL);
+    CHECK(test_run_tool("render --size 8x8 --sun 0,0,0 -o bad.png") == 2);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "zero") != NULL);
+    CHECK(test_run_tool("render --size 8x8 --time 2024-06-21T12:00 -o bad.png") == 2);
+    CHECK(test_run_tool("render --size 8x8 --sun 45,0 --time 2024-06-21T12:60 -o bad.png") == 1);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "--time") != NULL);
+    CHECK(!test_file_exists(out));
+    /* Whitted with a sky and more sky directions than a shadow batch holds (4096) */
+    CHECK(test_run_tool("raytrace floor.obj --sky uniform --light-samples 5000 --size 8x8 "
+                        "--eye 0,3,3 --target 0,0,0 -o sky.pfm") == 0);
+    /* the daylight factor is the sky's alone: with a sun it is left out, with a warning */
+    CHECK(test_run_tool("illuminance floor.obj --sky cie-overcast --plane 0.5 --gather-rays 16 "
+                        "-o df.csv") == 0);
+    CHECK(strstr(test_read_text(test_path("df.csv")), "daylight_factor_percent") != NULL);
+    CHECK(test_run_tool("illuminance floor.obj --sky cie-clear --sun 1,1,0 --plane 0.5 "
+                        "--gather-rays 16 -o df.csv") == 0);
+    CHECK(strstr(test_read_text(test_path("df.csv")), "daylight_factor_percent") == NULL);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "no daylight factor") != NULL);
+    /* --points: a header line of names is skipped; trailing text on a row is refused */
+    test_write_file("named.csv", "x,y,z\n0,0,0\n");
+    CHECK(test_run_tool("illuminance floor.obj --point 0,2,0:100 --points named.csv "
+                        "--gather-rays 16 -o named_out.csv") == 0);
+    test_write_file("junk.csv", "0,0,0\n1,0,1junk\n");
+    CHECK(test_run_tool("illuminance floor.obj --point 0,2,0:100 --points junk.csv "
+                        "--gather-rays 16 -o junk_out.csv") != 0);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "junk.csv:2") != NULL);
+    CHECK(!test_file_exists(test_path("junk_out.csv")));
+    /* a type B web is read, but not taken as a light (its angles are not type C's) */
+    test_write_file("typeb.ies", "IESNA:LM-63-2002\nTILT=NONE\n1 -1 1 3 1 2 2 0 0 0\n1 1 10\n"
+                                 "-90 0 90\n0\n100 100 100\n");
+    CHECK(test_run_tool("render floor.obj --luminaire typeb.ies:0,2,0 --size 8x8 -o b.png") == 1);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "type B") != NULL);
     /* a sun below the horizon: a warning, no sunlight, the run goes on */
     CHECK(test_run_tool("info --sun 0,-1,0") == 0);
     CHECK(strstr(test_read_text(test_path("stdout.txt")), "below the horizon") != NULL);

@@ -183,6 +183,10 @@ static bool build_light(const light_spec *spec, rad_light *light, bool *place, d
             (n > 2 && !parse_number(option, f[2], "angular diameter, degrees",
                                     &light->angular_diameter_degrees)))
             return false;
+        if (k == 3 && where[0] == 0 && where[1] == 0 && where[2] == 0) {
+            cli_error("--sun: '%s': the direction toward the sun is zero", spec->text);
+            return false;
+        }
         if (k == 3)
             light->direction = (rad_vec3){-where[0], -where[1], -where[2]};
         else {
@@ -210,8 +214,14 @@ static bool build_light(const light_spec *spec, rad_light *light, bool *place, d
             return false;
         }
         intensity = -1; /* the default: set once the sun is known */
-        if (n > 1 && !parse_number(option, f[1], "zenith luminance, cd/m^2", &intensity))
-            return false;
+        if (n > 1) {
+            if (!parse_number(option, f[1], "zenith luminance, cd/m^2", &intensity))
+                return false;
+            if (!(intensity >= 0)) {
+                cli_error("--sky: '%s': the zenith luminance must not be negative", spec->text);
+                return false;
+            }
+        }
         break;
     }
     case OPT_LUMINAIRE:
@@ -280,6 +290,10 @@ bool cli_parse_lights(const cli_args *args)
         cli_error("--sun LATITUDE,LONGITUDE needs --time YYYY-MM-DDTHH:MM[+HH:MM]");
         return false;
     }
+    if (time_text && !sun_by_place) {
+        cli_error("--time places the sun: it goes with --sun LATITUDE,LONGITUDE");
+        return false;
+    }
     if (unit_text && strcmp(unit_text, "m") != 0 && strcmp(unit_text, "cm") != 0 &&
         strcmp(unit_text, "mm") != 0 && strcmp(unit_text, "in") != 0 &&
         strcmp(unit_text, "ft") != 0) {
@@ -298,13 +312,14 @@ static bool parse_time(const char *text, rad_place_time *when, rad_error *error)
     int year, month, day, hour, minute, consumed = 0;
     double second = 0;
     if (sscanf(text, "%4d-%2d-%2dT%2d:%2d%n", &year, &month, &day, &hour, &minute,
-               &consumed) != 5)
+               &consumed) != 5 ||
+        minute < 0 || minute > 59 || hour < 0)
         goto bad;
     const char *rest = text + consumed;
     if (*rest == ':') {
         char *end;
         second = strtod(rest + 1, &end);
-        if (end == rest + 1)
+        if (end == rest + 1 || !(second >= 0 && second < 61))
             goto bad;
         rest = end;
     }

@@ -27,8 +27,8 @@ static const char usage[] =
     "\n"
     "  --plane HEIGHT       a horizontal grid HEIGHT scene units above the floor (lighting\n"
     "                       standards use 0.75 or 0.8 m), over the floor only\n"
-    "  --spacing S          grid spacing (default: 0.25 m in metres, else 1/40 of the\n"
-    "                       scene's width)\n"
+    "  --spacing S          grid spacing (default: 0.25 m when the scene's unit is known,\n"
+    "                       from the file or --unit; else 1/40 of the scene's width)\n"
     "  --points FILE.csv    measuring points instead: rows x,y,z[,nx,ny,nz] (normal\n"
     "                       default: the scene's up); lines starting with # are skipped\n"
     "  --gather-rays N      hemisphere directions per point (default "
@@ -52,7 +52,7 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_TWO_SIDED] = {"two-sided", 0, true},
 };
 
-#define MAX_POINTS_FILE (64u << 20)
+#define MAX_POINTS 10000000u /* in a --points file */
 
 /* Reads measuring points: x,y,z[,nx,ny,nz] per line. */
 static rad_status read_points(const char *path, rad_vec3 up, rad_vec3 **points,
@@ -77,8 +77,15 @@ static rad_status read_points(const char *path, rad_vec3 up, rad_vec3 **points,
             text++;
         if (*text == '#' || *text == '\n' || *text == '\r' || *text == '\0')
             continue;
+        if (!strchr(line, '\n') && !feof(file)) {
+            snprintf(error->message, sizeof(error->message), "%s:%u: line longer than %zu bytes",
+                     path, line_number, sizeof(line) - 2);
+            status = error->status = RAD_ERR_PARSE;
+            break;
+        }
         double v[6];
         int n = 0;
+        bool clean = false; /* the numbers end the line */
         char *cursor = text;
         while (n < 6) {
             char *end;
@@ -89,17 +96,27 @@ static rad_status read_points(const char *path, rad_vec3 up, rad_vec3 **points,
             n++;
             while (*end == ' ' || *end == '\t')
                 end++;
+            if (*end == '\n' || *end == '\r' || *end == '\0') {
+                clean = true;
+                break;
+            }
             if (*end != ',')
                 break;
             cursor = end + 1;
         }
-        if ((n != 3 && n != 6) || (n == 6 && !(v[3] != 0 || v[4] != 0 || v[5] != 0))) {
-            /* a header line of names is allowed as the first line */
-            if (line_number == 1 && n == 0)
+        if (!clean || (n != 3 && n != 6) || (n == 6 && !(v[3] != 0 || v[4] != 0 || v[5] != 0))) {
+            /* a header line of names (no digit in it) is allowed as the first line */
+            if (line_number == 1 && !strpbrk(text, "0123456789"))
                 continue;
             snprintf(error->message, sizeof(error->message),
                      "%s:%u: not x,y,z or x,y,z,nx,ny,nz (numbers; a non-zero normal)", path,
                      line_number);
+            status = error->status = RAD_ERR_PARSE;
+            break;
+        }
+        if (*count == MAX_POINTS) {
+            snprintf(error->message, sizeof(error->message), "%s:%u: more than %u points", path,
+                     line_number, MAX_POINTS);
             status = error->status = RAD_ERR_PARSE;
             break;
         }
@@ -188,8 +205,8 @@ int command_illuminance(int argc, char **argv)
             rad_scene_bounds(solved.scene, &lo, &hi);
             double metres = solved.scene->unit_metres > 0 ? solved.scene->unit_metres : 1;
             double width = fmax(fmax(hi.x - lo.x, hi.y - lo.y), hi.z - lo.z);
-            spacing = solved.scene->unit_metres == 1 || width * metres > 10 ? 0.25 / metres
-                                                                          : width / 40;
+            spacing = solved.scene->unit_metres > 0 ? 0.25 / metres : width / 40;
+            (void)metres;
         }
         status = rad_work_plane(solved.scene, height, spacing, &points, &count, &error);
         if (status == RAD_OK && count == 0) {
@@ -211,13 +228,25 @@ int command_illuminance(int argc, char **argv)
     }
     if (status == RAD_OK) {
         E = rad_alloc_array(1, (size_t)(count ? count : 1) * sizeof(*E));
-        rad_illuminance_options o = {.gather_rays = gather_rays, .seed = shared.seed,
+        rad_illuminance_options o = {.gather_rays = gather_rays, .inputs = solved.inputs,
+                                     .seed = shared.seed,
                                      .threads = shared.threads};
         status = E ? rad_illuminance(solved.scene, solved.mesh, solved.B, points, normals, count,
                                      &o, E, &error)
                    : RAD_ERR_NOMEM;
     }
+    /* the daylight factor is the sky's alone: with a sun, other sources or emitters the
+     * illuminance is not daylight from the sky, and the column is left out */
     double sky = rad_sky_horizontal_illuminance(solved.scene);
+    bool only_sky = !rad_scene_has_emitter(solved.scene);
+    for (uint32_t l = 0; l < solved.scene->light_count; l++)
+        only_sky &= solved.scene->lights[l].type == RAD_LIGHT_SKY;
+    if (sky > 0 && !only_sky) {
+        cli_warn("%s: no daylight factor: light sources or emitters besides the sky light "
+                 "the scene (the factor is the sky's alone)",
+                 solved.scene->source);
+        sky = 0;
+    }
     double e_min = INFINITY, e_max = 0, e_sum = 0;
     size_t size = 0;
     if (status == RAD_OK) {

@@ -117,6 +117,14 @@ static bool check_light(const rad_scene *scene, rad_light *l, rad_error *error,
             rad_fail(error, RAD_ERR_INVALID, "luminaire '%s' has no photometric data", name);
             return false;
         }
+        if (l->photometry->photometric_type != 1) {
+            rad_fail(error, RAD_ERR_UNSUPPORTED,
+                     "luminaire '%s': %s is photometric type %s; only type C (the usual, 1) "
+                     "is supported as a light",
+                     name, l->photometry->source, l->photometry->photometric_type == 2 ? "B" : "A");
+            *status = RAD_ERR_UNSUPPORTED;
+            return false;
+        }
         rad_vec3 d = l->direction, r = l->reference;
         r = v3_sub(r, v3_scale(d, v3_dot(r, d)));
         if (!(v3_length(r) > 1e-6 * (v3_length(l->reference) + 1))) {

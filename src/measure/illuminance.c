@@ -19,15 +19,19 @@
 #include "core/vec3.h"
 #include "lights/direct_light.h"
 #include "reconstruct/display_mesh.h"
+#include "render/emitter_light.h"
+#include "render/emitters.h"
 #include "trace/ray.h"
 
 #define GATHER_STREAM 0x6A7E2ull
+#define EMITTER_SAMPLES 64u /* light samples, and as many cosine rays, per point */
 
 typedef struct point_buffers {
     rad_ray *rays;
     rad_rgb *value;
     uint8_t *blocked;
     rad_hit *hits;
+    double *cosines;
 } point_buffers;
 
 rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
@@ -59,6 +63,12 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
     point_buffers *buffers = NULL;
     uint32_t sharp = light_set_capacity(&lights, LIGHTS_SHARP, 0);
     uint32_t capacity = sharp > gather ? sharp : gather;
+    if (capacity < EMITTER_SAMPLES)
+        capacity = EMITTER_SAMPLES;
+    emitter_set emitters = {0};
+    rad_patch_inputs *built = NULL;
+    const rad_patch_inputs *inputs = options->inputs;
+    rad_rgb *reflected = NULL;
     rad_status status = display_mesh_build(mesh, true, &display, error);
     if (status != RAD_OK)
         goto done;
@@ -72,13 +82,36 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
         b->rays = rad_alloc_array(capacity, sizeof(*b->rays));
         b->value = rad_alloc_array(capacity, sizeof(*b->value));
         b->blocked = rad_alloc_array(capacity, sizeof(*b->blocked));
-        b->hits = rad_alloc_array(gather, sizeof(*b->hits));
-        if (!b->rays || !b->value || !b->blocked || !b->hits)
+        b->hits = rad_alloc_array(capacity, sizeof(*b->hits));
+        b->cosines = rad_alloc_array(capacity, sizeof(*b->cosines));
+        if (!b->rays || !b->value || !b->blocked || !b->hits || !b->cosines)
             goto nomem;
     }
     display_mesh_positions(mesh, &display, positions);
-    if (!display_mesh_radiance(mesh, &display, B, radiance))
+    if (inputs && inputs->n != mesh->patch_count) {
+        status = rad_fail(error, RAD_ERR_INVALID,
+                          "illuminance: the patch inputs are for %u patches, the mesh has %u",
+                          inputs->n, mesh->patch_count);
+        goto done;
+    }
+    if (!inputs) {
+        status = rad_patch_inputs_build(scene, mesh, &built, error);
+        if (status != RAD_OK)
+            goto done;
+        inputs = built;
+    }
+    /* what a gather ray sees: the light a surface reflects, its emission left out (the
+     * emitters' direct light is sampled on its own) */
+    reflected = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1, sizeof(*reflected));
+    if (!reflected)
         goto nomem;
+    for (uint32_t p = 0; p < mesh->patch_count; p++)
+        reflected[p] = rgb_max0(rgb_add(B[p], rgb_scale(inputs->exitance[p], -1)));
+    if (!display_mesh_radiance(mesh, &display, reflected, radiance))
+        goto nomem;
+    status = emitters_build(scene, &emitters, error);
+    if (status != RAD_OK)
+        goto done;
     /* the front patches' triangles (twins come after them, and so do their display
      * triangles); a hit on the back of a two-sided patch takes its twin's B */
     uint32_t traced = display.triangle_count;
@@ -106,6 +139,22 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
         for (uint32_t q = 0; q < k; q++)
             if (!b->blocked[q])
                 rgb_add_to(&sum, b->value[q]);
+        if (emitters.count) {
+            /* the emitters' direct light: light samples and cosine rays, MIS-weighted */
+            double shift1 = rad_rng_uniform(&rng), shift2 = rad_rng_uniform(&rng);
+            k = emitter_light_rays_mis(&emitters, scene, x, n, lights.leave, EMITTER_SAMPLES,
+                                       rad_rng_uniform(&rng), 0, shift1, shift2, &rng, b->rays,
+                                       b->value);
+            rad_tracer_occluded(occluders, b->rays, k, b->blocked);
+            for (uint32_t q = 0; q < k; q++)
+                if (!b->blocked[q])
+                    rgb_add_to(&sum, b->value[q]);
+            emitter_cosine_rays(x, n, lights.leave, EMITTER_SAMPLES, &rng, b->rays, b->cosines);
+            rad_tracer_intersect(occluders, b->rays, EMITTER_SAMPLES, b->hits);
+            for (uint32_t q = 0; q < EMITTER_SAMPLES; q++)
+                rgb_add_to(&sum, emitter_cosine_value(&emitters, scene, &b->rays[q], &b->hits[q],
+                                                      b->cosines[q], EMITTER_SAMPLES));
+        }
         /* the gather: cosine-weighted directions, stratified over a grid */
         rad_vec3 helper = fabs(n.x) < 0.6 ? v3(1, 0, 0) : fabs(n.y) < 0.6 ? v3(0, 1, 0) : v3(0, 0, 1);
         rad_vec3 a = v3_normalize(v3_cross(helper, n)), c = v3_cross(n, a);
@@ -139,7 +188,7 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
             if (!hit->front) {
                 uint32_t twin = mesh->patches[display.patch_of[hit->triangle]].twin;
                 if (twin)
-                    rgb_add_to(&gathered, rgb_scale(B[twin - 1], 1 / RAD_PI));
+                    rgb_add_to(&gathered, rgb_scale(reflected[twin - 1], 1 / RAD_PI));
                 continue;
             }
             const uint32_t *v = display.triangles[hit->triangle];
@@ -160,11 +209,15 @@ done:
             free(buffers[t].value);
             free(buffers[t].blocked);
             free(buffers[t].hits);
+            free(buffers[t].cosines);
         }
     free(buffers);
     rad_tracer_destroy(surfaces);
     rad_tracer_destroy(occluders);
     display_mesh_free(&display);
+    emitters_free(&emitters);
+    rad_patch_inputs_destroy(built);
+    free(reflected);
     free(radiance);
     free(positions);
     return status;

@@ -49,7 +49,9 @@ static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_v
             continue;
         double p_light = light.pdf_area * r2 / cos_e; /* per solid angle */
         double p_cosine = mis ? cos_x / RAD_PI : 0;
-        rad_rgb value = rgb_scale(light.radiance, cos_x / ((p_light + p_cosine) * count));
+        /* L cos_x / p_light times the power heuristic's p_light^2 / (p_light^2 + p_cosine^2) */
+        rad_rgb value = rgb_scale(light.radiance, cos_x * p_light /
+                                                      ((p_light * p_light + p_cosine * p_cosine) * count));
         if (rgb_is_zero(value))
             continue;
         irradiance[made] = value;
@@ -120,7 +122,9 @@ rad_rgb emitter_cosine_value(const emitter_set *set, const rad_scene *scene, con
     if (!(cos_e > 0))
         return none;
     double p_light = pdf_area * distance * distance / cos_e, p_cosine = cos_x / RAD_PI;
-    return rgb_scale(emitted, RAD_PI * p_cosine / ((p_cosine + p_light) * count));
+    /* pi L times the power heuristic's p_cosine^2 / (p_cosine^2 + p_light^2) */
+    return rgb_scale(emitted, RAD_PI * p_cosine * p_cosine /
+                                  ((p_cosine * p_cosine + p_light * p_light) * count));
 }
 
 rad_status emitter_patch_direct(const emitter_set *set, const rad_scene *scene,

@@ -29,11 +29,12 @@ uint32_t emitter_light_rays(const emitter_set *set, const rad_scene *scene, rad_
                             uint32_t first, double shift1, double shift2, rad_rng *rng,
                             rad_ray *rays, rad_rgb *irradiance);
 
-/* Multiple importance sampling with the cosine-weighted directions below (balance
+/* Multiple importance sampling with the cosine-weighted directions below (power
  * heuristic, as many of each): with it, a light sample's irradiance is
- * L cos_x / ((p_L + p_B) count) instead of L cos_x / (p_L count), p_L its density per
- * solid angle under light sampling and p_B = cos_x / pi, so points next to an emitter (a
- * wall touching a light, the inside of a furnace) get no 1 / r^2 spikes. */
+ * L cos_x p_L / ((p_L^2 + p_B^2) count) instead of L cos_x / (p_L count), p_L its density
+ * per solid angle under light sampling and p_B = cos_x / pi, so points next to an emitter
+ * (a wall touching a light, the inside of a furnace) get no 1 / r^2 spikes, and a small
+ * far light is left to light sampling (a cosine ray that finds it weighs next to nothing). */
 uint32_t emitter_light_rays_mis(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
                                 rad_vec3 n, double leave, uint32_t count, double turn,
                                 uint32_t first, double shift1, double shift2, rad_rng *rng,
@@ -45,7 +46,7 @@ void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, r
                          rad_ray *rays, double *cos_x);
 
 /* The irradiance a cosine-weighted ray brings from the emitter it hit (0 for anything
- * else), MIS-weighted against light sampling: pi L_e p_B / ((p_B + p_L) count). */
+ * else), MIS-weighted against light sampling: pi L_e p_B^2 / ((p_B^2 + p_L^2) count). */
 rad_rgb emitter_cosine_value(const emitter_set *set, const rad_scene *scene, const rad_ray *ray,
                              const rad_hit *hit, double cos_x, uint32_t count);
 

@@ -483,9 +483,10 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
         double *out = &(*shaded)[p].r;
         if (options->irradiance) {
             /* (B - E) / rho is the irradiance; a black patch shows its direct light only */
-            const double *all = &(*inputs)->direct[p].r;
+            const double *all = &(*inputs)->direct[p].r, *sources = &(*inputs)->direct_sharp[p].r;
+            /* (the light sources' H holds no emitter light: only their sharp part goes) */
             for (int c = 0; c < 3; c++)
-                out[c] = fmax((rho[c] > 0 ? (b[c] - e[c]) / rho[c] : all[c]) - h[c], 0);
+                out[c] = fmax(rho[c] > 0 ? (b[c] - e[c]) / rho[c] - h[c] : all[c] - sources[c], 0);
             continue;
         }
         if (!patch_material_textured(*lookup, mesh->patches[p].material)) {

@@ -150,7 +150,7 @@ static void flush_shadows(const rt_context *ctx, rt_workspace *ws)
 static void queue_shadow(const rt_context *ctx, rt_workspace *ws, rad_vec3 from, rad_vec3 to,
                          double end_gap, uint32_t sample, rad_rgb add)
 {
-    if (ws->shadow_count == SHADOW_BATCH)
+    if (ws->shadow_count >= SHADOW_BATCH) /* the light sources' rays may have gone past it */
         flush_shadows(ctx, ws);
     uint32_t k = ws->shadow_count++;
     rad_vec3 d = v3_sub(to, from);
