@@ -15,6 +15,7 @@
  */
 #include <math.h>
 
+#include "core/hemisphere.h"
 #include "core/rgb.h"
 #include "core/tolerance.h"
 #include "core/vec3.h"
@@ -59,14 +60,6 @@ uint32_t light_set_capacity(const light_set *set, unsigned which, uint32_t sky_r
     if ((which & LIGHTS_SOFT) && set->has_sky)
         count += sky_rays;
     return count;
-}
-
-/* Two unit vectors completing n to an orthonormal frame. */
-static void frame_of(rad_vec3 n, rad_vec3 *a, rad_vec3 *b)
-{
-    rad_vec3 helper = fabs(n.x) < 0.6 ? v3(1, 0, 0) : fabs(n.y) < 0.6 ? v3(0, 1, 0) : v3(0, 0, 1);
-    *a = v3_normalize(v3_cross(helper, n));
-    *b = v3_cross(n, *a);
 }
 
 /* Stratum `s` of a k x k grid over [0,1)^2, jittered. */
@@ -168,7 +161,7 @@ uint32_t light_set_rays(const light_set *set, unsigned which, rad_vec3 x, rad_ve
                     double cos_t = 1 - u1 * (1 - cos(half));
                     double sin_t = sqrt(fmax(0, 1 - cos_t * cos_t)), phi = 2 * RAD_PI * u2;
                     rad_vec3 a, b;
-                    frame_of(w, &a, &b);
+                    hemisphere_frame(w, &a, &b);
                     w = v3_add(v3_scale(w, cos_t), v3_add(v3_scale(a, sin_t * cos(phi)),
                                                           v3_scale(b, sin_t * sin(phi))));
                 }
@@ -201,7 +194,7 @@ uint32_t light_set_rays(const light_set *set, unsigned which, rad_vec3 x, rad_ve
         }
     if ((which & LIGHTS_SOFT) && set->has_sky && sky_rays > 0) {
         rad_vec3 a, b;
-        frame_of(n, &a, &b);
+        hemisphere_frame(n, &a, &b);
         /* one direction: stratum `sample` of the caller's samples; several: stratified
          * among themselves (the first k^2), with a random turn per call */
         uint32_t k = sky_rays == 1 ? grid_side(sample_count) : grid_side(sky_rays);
@@ -216,9 +209,7 @@ uint32_t light_set_rays(const light_set *set, unsigned which, rad_vec3 x, rad_ve
                 u1 = rad_rng_uniform(rng);
                 u2 = rad_rng_uniform(rng);
             }
-            double radius = sqrt(u1), phi = 2 * RAD_PI * u2 + turn;
-            rad_vec3 w = v3_add(v3_scale(n, sqrt(fmax(0, 1 - u1))),
-                                v3_add(v3_scale(a, radius * cos(phi)), v3_scale(b, radius * sin(phi))));
+            rad_vec3 w = cosine_direction(n, a, b, u1, u2, turn, NULL);
             rad_rgb L = light_set_sky_radiance(set, w);
             if (rgb_is_zero(L))
                 continue;

@@ -14,6 +14,7 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/hemisphere.h"
 #include "core/random.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
@@ -156,8 +157,8 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
                                                       b->cosines[q], EMITTER_SAMPLES));
         }
         /* the gather: cosine-weighted directions, stratified over a grid */
-        rad_vec3 helper = fabs(n.x) < 0.6 ? v3(1, 0, 0) : fabs(n.y) < 0.6 ? v3(0, 1, 0) : v3(0, 0, 1);
-        rad_vec3 a = v3_normalize(v3_cross(helper, n)), c = v3_cross(n, a);
+        rad_vec3 a, c;
+        hemisphere_frame(n, &a, &c);
         uint32_t side = (uint32_t)floor(sqrt((double)gather));
         rad_vec3 origin = v3_add(x, v3_scale(n, lights.leave));
         for (uint32_t j = 0; j < gather; j++) {
@@ -166,9 +167,7 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
                 u1 = ((j % side) + u1) / side;
                 u2 = ((j / side) + u2) / side;
             }
-            double r = sqrt(u1), phi = 2 * RAD_PI * u2;
-            rad_vec3 w = v3_add(v3_scale(n, sqrt(fmax(0, 1 - u1))),
-                                v3_add(v3_scale(a, r * cos(phi)), v3_scale(c, r * sin(phi))));
+            rad_vec3 w = cosine_direction(n, a, c, u1, u2, 0, NULL);
             ray_set(&b->rays[j], origin, w, 0, INFINITY);
         }
         rad_tracer_intersect(surfaces, b->rays, gather, b->hits);

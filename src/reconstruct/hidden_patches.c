@@ -13,6 +13,7 @@
  */
 #include <math.h>
 
+#include "core/hemisphere.h"
 #include "core/random.h"
 #include "core/vec3.h"
 #include "reconstruct/display_mesh.h"
@@ -28,17 +29,15 @@ void display_hidden_patches(const rad_mesh *mesh, const rad_tracer *tracer, doub
     for (int64_t p = 0; p < (int64_t)mesh->patch_count; p++) {
         const rad_patch *patch = &mesh->patches[p];
         rad_vec3 n = patch->normal;
-        rad_vec3 helper = fabs(n.x) < 0.6 ? v3(1, 0, 0) : fabs(n.y) < 0.6 ? v3(0, 1, 0) : v3(0, 0, 1);
-        rad_vec3 a = v3_normalize(v3_cross(helper, n)), b = v3_cross(n, a);
+        rad_vec3 a, b;
+        hemisphere_frame(n, &a, &b);
         rad_vec3 origin = v3_add(patch->centroid, v3_scale(n, 2 * patch->bulge + leave));
         rad_rng rng = rad_rng_seed(HIDDEN_STREAM, (uint64_t)p, 0);
         rad_ray rays[HIDDEN_RAYS];
         rad_hit hits[HIDDEN_RAYS];
         for (uint32_t k = 0; k < HIDDEN_RAYS; k++) {
             double u1 = ((k % 4) + rad_rng_uniform(&rng)) / 4, u2 = ((k / 4) + rad_rng_uniform(&rng)) / 4;
-            double r = sqrt(u1), phi = 2 * RAD_PI * u2;
-            rad_vec3 w = v3_add(v3_scale(n, sqrt(fmax(0, 1 - u1))),
-                                v3_add(v3_scale(a, r * cos(phi)), v3_scale(b, r * sin(phi))));
+            rad_vec3 w = cosine_direction(n, a, b, u1, u2, 0, NULL);
             ray_set(&rays[k], origin, w, 0, INFINITY);
         }
         rad_tracer_intersect(tracer, rays, HIDDEN_RAYS, hits);

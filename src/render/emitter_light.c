@@ -11,6 +11,7 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/hemisphere.h"
 #include "core/random.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
@@ -82,8 +83,8 @@ uint32_t emitter_light_rays_mis(const emitter_set *set, const rad_scene *scene, 
 void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, rad_rng *rng,
                          rad_ray *rays, double *cos_x)
 {
-    rad_vec3 helper = fabs(n.x) < 0.6 ? v3(1, 0, 0) : fabs(n.y) < 0.6 ? v3(0, 1, 0) : v3(0, 0, 1);
-    rad_vec3 a = v3_normalize(v3_cross(helper, n)), b = v3_cross(n, a);
+    rad_vec3 a, b;
+    hemisphere_frame(n, &a, &b);
     rad_vec3 origin = v3_add(x, v3_scale(n, leave));
     uint32_t side = (uint32_t)floor(sqrt((double)count));
     double turn = 2 * RAD_PI * rad_rng_uniform(rng);
@@ -93,10 +94,8 @@ void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, r
             u1 = ((k % side) + u1) / side;
             u2 = ((k / side) + u2) / side;
         }
-        double r = sqrt(u1), phi = 2 * RAD_PI * u2 + turn, c = sqrt(fmax(0, 1 - u1));
-        rad_vec3 w = v3_add(v3_scale(n, c), v3_add(v3_scale(a, r * cos(phi)), v3_scale(b, r * sin(phi))));
+        rad_vec3 w = cosine_direction(n, a, b, u1, u2, turn, &cos_x[k]);
         ray_set(&rays[k], origin, w, 0, INFINITY);
-        cos_x[k] = c;
     }
 }
 
