@@ -1235,11 +1235,11 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
 /* ------------------------------------------------------------------------------------ */
 /* Illuminance at points: work planes and measuring points                               */
 
-#define RAD_DEFAULT_GATHER_RAYS 4096 /* rad_illuminance_options.gather_rays */
+#define RAD_DEFAULT_GATHER_RAYS 16384 /* rad_illuminance_options.gather_rays */
 
 typedef struct rad_illuminance_options {
     uint32_t gather_rays;      /* directions over the hemisphere for the light from surfaces
-                                  and the sky, stratified, cosine-weighted; 0 = 4096 */
+                                  and the sky, stratified, cosine-weighted; 0 = 16384 */
     const rad_patch_inputs *inputs; /* the patch inputs the solve used (E_i); NULL: built */
     uint64_t seed;
     int threads;
