@@ -105,7 +105,7 @@ static const rad_camera room_camera = {{0.5, 0.5, 0.03}, {0.5, 0.5, 1}, {0, 1, 0
 static const rad_solver solvers[] = {RAD_SOLVER_DIRECT,       RAD_SOLVER_JACOBI,
                                      RAD_SOLVER_GAUSS_SEIDEL, RAD_SOLVER_SHOOT,
                                      RAD_SOLVER_HIERARCHICAL, RAD_SOLVER_AUTO};
-enum { SOLVER_COUNT = sizeof(solvers) / sizeof(solvers[0]), MAX_SURFACES = 16 };
+enum { SOLVER_COUNT = sizeof(solvers) / sizeof(solvers[0]), MAX_SURFACES = TEST_MAX_SURFACES };
 
 static double channel(rad_rgb v, int c) { return c == 0 ? v.r : c == 1 ? v.g : v.b; }
 
@@ -330,11 +330,7 @@ static const char *const override_mtl =
 /* ---------------------------------------------------------------------------------- */
 /* Per-surface means                                                                   */
 
-typedef struct surface_means {
-    rad_rgb mean[MAX_SURFACES];
-    rad_rgb se[MAX_SURFACES]; /* standard error of the mean (path tracer only) */
-    uint32_t count[MAX_SURFACES];
-} surface_means;
+typedef test_surface_means surface_means; /* se: the path tracer's only */
 
 static int surface_index(const rad_scene *scene, const char *name)
 {
@@ -453,33 +449,6 @@ static void classify_pixels(const rad_scene *scene, const rad_camera *camera, in
     rad_tracer_destroy(tracer);
 }
 
-/* Mean of each surface's classified pixels; with `se`, the standard error of that mean
- * from the per-pixel standard errors (pixels are independent samples). */
-static void image_means(const rad_image *image, const rad_image *se, const int *surface,
-                        surface_means *out)
-{
-    double var[MAX_SURFACES][3] = {{0}};
-    memset(out, 0, sizeof(*out));
-    for (int p = 0; p < W * H; p++) {
-        int s = surface[p];
-        if (s < 0 || s >= MAX_SURFACES)
-            continue;
-        const float *v = &image->rgb[(size_t)p * 3];
-        out->mean[s].r += v[0];
-        out->mean[s].g += v[1];
-        out->mean[s].b += v[2];
-        out->count[s]++;
-        if (se)
-            for (int c = 0; c < 3; c++)
-                var[s][c] += (double)se->rgb[(size_t)p * 3 + c] * se->rgb[(size_t)p * 3 + c];
-    }
-    for (int s = 0; s < MAX_SURFACES; s++)
-        if (out->count[s]) {
-            double n = out->count[s];
-            out->mean[s] = (rad_rgb){out->mean[s].r / n, out->mean[s].g / n, out->mean[s].b / n};
-            out->se[s] = (rad_rgb){sqrt(var[s][0]) / n, sqrt(var[s][1]) / n, sqrt(var[s][2]) / n};
-        }
-}
 
 /* ---------------------------------------------------------------------------------- */
 /* Solving and rendering                                                               */
@@ -956,13 +925,13 @@ static void run_feature(feature_kind kind)
     rad_image *se = NULL;
     rad_image *traced = pathtrace(scene, &room_camera, 128, &se);
     surface_means reference;
-    image_means(traced, se, surface, &reference);
+    test_image_surface_means(traced, se, surface, &reference);
     for (size_t k = 0; k < SOLVER_COUNT; k++) {
         if (!B[k])
             continue;
         rad_image *image = render(scene, mesh, inputs, B[k], &room_camera);
         surface_means m;
-        image_means(image, NULL, surface, &m);
+        test_image_surface_means(image, NULL, surface, &m);
         compare_render(feature, rad_solver_name(solvers[k]), scene, &m, &reference);
         rad_image_destroy(image);
     }

@@ -41,7 +41,7 @@
 
 #define PI 3.14159265358979323846
 
-enum { W = 64, H = 48, MAX_SURFACES = 16 };
+enum { W = 64, H = 48, MAX_SURFACES = TEST_MAX_SURFACES };
 /* Inside the room near the front wall, looking at the window: the back wall, the window's
  * sky, the floor with the box, both side walls and some of the ceiling. */
 static const rad_camera camera = {{2, 1.6, 0.3}, {2, 1.1, 5}, {0, 1, 0}, 75};
@@ -557,11 +557,7 @@ static bool away_from_corners(int px, int py)
 /* ---------------------------------------------------------------------------------- */
 /* Means                                                                               */
 
-typedef struct means {
-    rad_rgb mean[MAX_SURFACES];
-    rad_rgb se[MAX_SURFACES];
-    uint32_t count[MAX_SURFACES];
-} means;
+typedef test_surface_means means; /* MAX_SURFACES == TEST_MAX_SURFACES */
 
 static void solution_means(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
                            means *out)
@@ -584,31 +580,6 @@ static void solution_means(const rad_scene *scene, const rad_mesh *mesh, const r
                                      out->mean[s].b / area[s]};
 }
 
-static void image_means(const rad_image *image, const rad_image *se, const int *surface,
-                        means *out)
-{
-    double var[MAX_SURFACES][3] = {{0}};
-    memset(out, 0, sizeof(*out));
-    for (int p = 0; p < W * H; p++) {
-        int s = surface[p];
-        if (s < 0 || s >= MAX_SURFACES)
-            continue;
-        const float *v = &image->rgb[(size_t)p * 3];
-        out->mean[s].r += v[0];
-        out->mean[s].g += v[1];
-        out->mean[s].b += v[2];
-        out->count[s]++;
-        if (se)
-            for (int c = 0; c < 3; c++)
-                var[s][c] += (double)se->rgb[(size_t)p * 3 + c] * se->rgb[(size_t)p * 3 + c];
-    }
-    for (int s = 0; s < MAX_SURFACES; s++)
-        if (out->count[s]) {
-            double n = out->count[s];
-            out->mean[s] = (rad_rgb){out->mean[s].r / n, out->mean[s].g / n, out->mean[s].b / n};
-            out->se[s] = (rad_rgb){sqrt(var[s][0]) / n, sqrt(var[s][1]) / n, sqrt(var[s][2]) / n};
-        }
-}
 
 static const char *surface_name(const rad_scene *scene, int s)
 {
@@ -827,8 +798,8 @@ static void run_case(light_case c)
     CHECK(same_image);
     rad_image_destroy(image_two);
     means rendered, traced;
-    image_means(image, NULL, surface, &rendered);
-    image_means(path, path_se, surface, &traced);
+    test_image_surface_means(image, NULL, surface, &rendered);
+    test_image_surface_means(path, path_se, surface, &traced);
     compare_surfaces(name, "render/path", scene, &rendered, &traced,
                      is_sharp(c) ? RENDER_ALLOWANCE : SOFT_RENDER_ALLOWANCE, 3, 30);
     if (!is_closed(c))

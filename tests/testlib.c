@@ -200,3 +200,30 @@ double test_srgb_to_linear(unsigned byte)
     double c = byte / 255.0;
     return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
 }
+
+void test_image_surface_means(const rad_image *image, const rad_image *se, const int *surface,
+                              test_surface_means *out)
+{
+    double var[TEST_MAX_SURFACES][3] = {{0}};
+    memset(out, 0, sizeof(*out));
+    size_t pixels = (size_t)image->width * image->height;
+    for (size_t p = 0; p < pixels; p++) {
+        int s = surface[p];
+        if (s < 0 || s >= TEST_MAX_SURFACES)
+            continue;
+        const float *v = &image->rgb[p * 3];
+        out->mean[s].r += v[0];
+        out->mean[s].g += v[1];
+        out->mean[s].b += v[2];
+        out->count[s]++;
+        if (se)
+            for (int c = 0; c < 3; c++)
+                var[s][c] += (double)se->rgb[p * 3 + c] * se->rgb[p * 3 + c];
+    }
+    for (int s = 0; s < TEST_MAX_SURFACES; s++)
+        if (out->count[s]) {
+            double n = out->count[s];
+            out->mean[s] = (rad_rgb){out->mean[s].r / n, out->mean[s].g / n, out->mean[s].b / n};
+            out->se[s] = (rad_rgb){sqrt(var[s][0]) / n, sqrt(var[s][1]) / n, sqrt(var[s][2]) / n};
+        }
+}

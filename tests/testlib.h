@@ -99,4 +99,19 @@ void test_write_png(const char *name, uint32_t width, uint32_t height, const uns
 /* The linear value of an 8-bit sRGB byte (IEC 61966-2-1), the reference for textures. */
 double test_srgb_to_linear(unsigned byte);
 
+/* Per-surface means of an image's pixels: `surface[p]` classifies pixel p (row-major) as a
+ * surface index in [0, TEST_MAX_SURFACES), or < 0 to leave it out. With `se` (an image of
+ * per-pixel standard errors, the path tracer's) the standard error of each mean, the
+ * pixels being independent samples. */
+#define TEST_MAX_SURFACES 16
+
+typedef struct test_surface_means {
+    rad_rgb mean[TEST_MAX_SURFACES];
+    rad_rgb se[TEST_MAX_SURFACES];
+    uint32_t count[TEST_MAX_SURFACES];
+} test_surface_means;
+
+void test_image_surface_means(const rad_image *image, const rad_image *se, const int *surface,
+                              test_surface_means *out);
+
 #endif
