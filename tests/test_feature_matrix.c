@@ -341,29 +341,6 @@ static int surface_index(const rad_scene *scene, const char *name)
     return -1;
 }
 
-/* Area-weighted mean of B / pi over each surface's patches. */
-static void solution_means(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
-                           surface_means *out)
-{
-    double area[MAX_SURFACES] = {0};
-    memset(out, 0, sizeof(*out));
-    for (uint32_t i = 0; i < mesh->patch_count; i++) {
-        const rad_patch *p = &mesh->patches[i];
-        if (p->surface >= MAX_SURFACES || p->surface >= scene->surface_count)
-            continue;
-        area[p->surface] += p->area;
-        out->mean[p->surface].r += p->area * B[i].r / PI;
-        out->mean[p->surface].g += p->area * B[i].g / PI;
-        out->mean[p->surface].b += p->area * B[i].b / PI;
-        out->count[p->surface]++;
-    }
-    for (uint32_t s = 0; s < scene->surface_count && s < MAX_SURFACES; s++)
-        if (area[s] > 0) {
-            out->mean[s].r /= area[s];
-            out->mean[s].g /= area[s];
-            out->mean[s].b /= area[s];
-        }
-}
 
 /* The camera model of rad_render and the tracers, written from its documented convention
  * (radiosity.h; render/camera.h): vertical fov, right = forward x up, pixel (0,0) the
@@ -877,7 +854,7 @@ static void run_feature(feature_kind kind)
         }
         if (solvers[k] == RAD_SOLVER_AUTO)
             CHECK(report.solver == RAD_SOLVER_JACOBI); /* 600 patches: dense gather */
-        solution_means(scene, mesh, B[k], &means[k]);
+        test_solution_surface_means(scene, mesh, B[k], &means[k]);
         check_balance(feature, rad_solver_name(solvers[k]), inputs, B[k]);
         if (k > 0 && B[0])
             compare_means(feature, rad_solver_name(solvers[k]), "solution", scene, &means[k],
@@ -899,7 +876,7 @@ static void run_feature(feature_kind kind)
                 surface_means file_means;
                 CHECK(Bf != NULL && file_mesh->patch_count == mesh->patch_count);
                 if (Bf && solve(file_scene, file_mesh, RAD_SOLVER_DIRECT, Bf, &report) == RAD_OK) {
-                    solution_means(file_scene, file_mesh, Bf, &file_means);
+                    test_solution_surface_means(file_scene, file_mesh, Bf, &file_means);
                     /* same geometry, same materials: the same matrix to float rounding */
                     compare_means(feature, "direct", "file/overr", scene, &file_means, &means[0],
                                   1e-6);
@@ -994,8 +971,8 @@ static void run_big(void)
     printf("big room: auto ran %s (%s)\n", rad_solver_name(report.solver), report.reason);
     bool ok_dense = solve(scene, mesh, RAD_SOLVER_JACOBI, Bdense, &report) == RAD_OK;
     if (ok_auto && ok_dense) {
-        solution_means(scene, mesh, Bauto, &a);
-        solution_means(scene, mesh, Bdense, &d);
+        test_solution_surface_means(scene, mesh, Bauto, &a);
+        test_solution_surface_means(scene, mesh, Bdense, &d);
         compare_means("big", "auto=hier", "vs gather", scene, &a, &d, SOLVER_TOLERANCE);
     }
     free(Bauto);

@@ -559,26 +559,6 @@ static bool away_from_corners(int px, int py)
 
 typedef test_surface_means means; /* MAX_SURFACES == TEST_MAX_SURFACES */
 
-static void solution_means(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
-                           means *out)
-{
-    double area[MAX_SURFACES] = {0};
-    memset(out, 0, sizeof(*out));
-    for (uint32_t i = 0; i < mesh->patch_count; i++) {
-        const rad_patch *p = &mesh->patches[i];
-        if (p->surface >= MAX_SURFACES || p->surface >= scene->surface_count)
-            continue;
-        area[p->surface] += p->area;
-        out->mean[p->surface].r += p->area * B[i].r / PI;
-        out->mean[p->surface].g += p->area * B[i].g / PI;
-        out->mean[p->surface].b += p->area * B[i].b / PI;
-        out->count[p->surface]++;
-    }
-    for (uint32_t s = 0; s < scene->surface_count && s < MAX_SURFACES; s++)
-        if (area[s] > 0)
-            out->mean[s] = (rad_rgb){out->mean[s].r / area[s], out->mean[s].g / area[s],
-                                     out->mean[s].b / area[s]};
-}
 
 
 static const char *surface_name(const rad_scene *scene, int s)
@@ -747,7 +727,7 @@ static void run_case(light_case c)
             B[k] = NULL;
             continue;
         }
-        solution_means(scene, mesh, B[k], &solved[k]);
+        test_solution_surface_means(scene, mesh, B[k], &solved[k]);
         if (k > 0 && B[0]) {
             double tolerance =
                 solvers[k] == RAD_SOLVER_HIERARCHICAL ? HIER_TOLERANCE : SOLVER_TOLERANCE;

@@ -227,3 +227,24 @@ void test_image_surface_means(const rad_image *image, const rad_image *se, const
             out->se[s] = (rad_rgb){sqrt(var[s][0]) / n, sqrt(var[s][1]) / n, sqrt(var[s][2]) / n};
         }
 }
+
+void test_solution_surface_means(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
+                                 test_surface_means *out)
+{
+    double area[TEST_MAX_SURFACES] = {0};
+    memset(out, 0, sizeof(*out));
+    for (uint32_t i = 0; i < mesh->patch_count; i++) {
+        const rad_patch *p = &mesh->patches[i];
+        if (p->surface >= TEST_MAX_SURFACES || p->surface >= scene->surface_count)
+            continue;
+        area[p->surface] += p->area;
+        out->mean[p->surface].r += p->area * B[i].r / 3.14159265358979323846;
+        out->mean[p->surface].g += p->area * B[i].g / 3.14159265358979323846;
+        out->mean[p->surface].b += p->area * B[i].b / 3.14159265358979323846;
+        out->count[p->surface]++;
+    }
+    for (uint32_t s = 0; s < scene->surface_count && s < TEST_MAX_SURFACES; s++)
+        if (area[s] > 0)
+            out->mean[s] = (rad_rgb){out->mean[s].r / area[s], out->mean[s].g / area[s],
+                                     out->mean[s].b / area[s]};
+}

@@ -114,4 +114,8 @@ typedef struct test_surface_means {
 void test_image_surface_means(const rad_image *image, const rad_image *se, const int *surface,
                               test_surface_means *out);
 
+/* Per-surface area-weighted means of B / pi over the surfaces' patches (count: patches). */
+void test_solution_surface_means(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
+                                 test_surface_means *out);
+
 #endif
