@@ -1266,9 +1266,9 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
 rad_status rad_work_plane(const rad_scene *scene, double height, double spacing,
                           rad_vec3 **points, uint32_t *count, rad_error *error);
 
-/* The illuminance on an unobstructed horizontal plane under the scene's sky and
- * environment lights alone (their sum, lux): the reference of the daylight factor. 0
- * when there is none. */
+/* The illuminance on an unobstructed horizontal plane under the scene's sky lights alone
+ * (their sum, lux; environment maps are not counted): the reference of the daylight
+ * factor. 0 when there is none. */
 double rad_sky_horizontal_illuminance(const rad_scene *scene);
 
 /* ------------------------------------------------------------------------------------ */
