@@ -115,10 +115,7 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
         goto done;
     /* the front patches' triangles (twins come after them, and so do their display
      * triangles); a hit on the back of a two-sided patch takes its twin's B */
-    uint32_t traced = display.triangle_count;
-    while (traced > 0 && mesh->patches[display.patch_of[traced - 1]].twin != 0 &&
-           mesh->patches[display.patch_of[traced - 1]].twin - 1 < display.patch_of[traced - 1])
-        traced--;
+    uint32_t traced = display_mesh_front_triangles(mesh, &display);
     status = rad_tracer_create(RAD_TRACER_EMBREE, positions, display.vertex_count,
                                (const uint32_t(*)[3])display.triangles, traced, &surfaces,
                                error);

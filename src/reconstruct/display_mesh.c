@@ -792,6 +792,15 @@ bool display_mesh_radiance_weighted(const rad_mesh *mesh, const display_mesh *di
     return true;
 }
 
+uint32_t display_mesh_front_triangles(const rad_mesh *mesh, const display_mesh *display)
+{
+    uint32_t traced = display->triangle_count;
+    while (traced > 0 && mesh->patches[display->patch_of[traced - 1]].twin != 0 &&
+           mesh->patches[display->patch_of[traced - 1]].twin - 1 < display->patch_of[traced - 1])
+        traced--;
+    return traced;
+}
+
 void display_mesh_free(display_mesh *display)
 {
     free(display->triangles);

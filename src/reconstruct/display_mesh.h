@@ -75,6 +75,12 @@ bool display_mesh_radiance_weighted(const rad_mesh *mesh, const display_mesh *di
 void display_hidden_patches(const rad_mesh *mesh, const rad_tracer *tracer, double leave,
                             uint8_t *hidden, uint8_t *near, double near_widths);
 
+/* How many display triangles, from the first, belong to front patches: the twins of
+ * two-sided surfaces come after every front patch (rad_mesh), and so do their display
+ * triangles, which are in patch order. A tracer of these alone sees each cell once; a hit
+ * on a front's back is its twin. */
+uint32_t display_mesh_front_triangles(const rad_mesh *mesh, const display_mesh *display);
+
 /* The positions of all display->vertex_count vertices. */
 void display_mesh_positions(const rad_mesh *mesh, const display_mesh *display,
                             rad_vec3 *positions);

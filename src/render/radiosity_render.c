@@ -48,7 +48,6 @@
 #define MAX_DIRECT_SAMPLES 1024u   /* emitter samples per pixel sample, at most */
 #define GATHER_STREAM 0x5EED6A7Eull /* the final gather's directions */
 #define MAX_GATHER_RAYS 1024u      /* final-gather rays per pixel sample, at most */
-#define NEAR_RAYS 16u              /* rays that find a patch's neighbours */
 #define NEAR_DISTANCE 1.5          /* a surface this many patch widths away is near */
 #define EMITTER_STREAM 0x5EEDE3177ull /* the per-pixel shifts of the emitters' samples */
 
@@ -593,10 +592,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
 
     /* the tracer sees the front patches: the twins come after them (rad_mesh), and so do
      * their display triangles, which are in patch order */
-    uint32_t traced = display.triangle_count;
-    while (traced > 0 && mesh->patches[display.patch_of[traced - 1]].twin != 0 &&
-           mesh->patches[display.patch_of[traced - 1]].twin - 1 < display.patch_of[traced - 1])
-        traced--;
+    uint32_t traced = display_mesh_front_triangles(mesh, &display);
     if (traced < display.triangle_count) {
         first_triangle = rad_alloc_array((size_t)mesh->patch_count + 1, sizeof(*first_triangle));
         if (!first_triangle)
@@ -638,9 +634,9 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     size_t per_row = (size_t)W * k * k;
     /* with the direct light per pixel the image is accurate enough for the light's rim to
      * show: its pixels get four times the samples */
-    uint32_t edge_samples = options->edge_samples     ? options->edge_samples
-                            : options->emitter_direct ? 4 * RAD_DEFAULT_EDGE_SAMPLES
-                                                      : RAD_DEFAULT_EDGE_SAMPLES;
+    uint32_t edge_samples = options->edge_samples ? options->edge_samples
+                            : emitters_ptr        ? 4 * RAD_DEFAULT_EDGE_SAMPLES
+                                                  : RAD_DEFAULT_EDGE_SAMPLES;
     unsigned edge_k = (unsigned)lround(sqrt((double)edge_samples));
     edge_k = edge_k < 1 ? 1 : edge_k > MAX_STRATA ? MAX_STRATA : edge_k;
     size_t per_row_edges = (size_t)W * edge_k * edge_k;
