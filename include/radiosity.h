@@ -391,7 +391,10 @@ rad_status rad_scene_set_material(rad_scene *scene, const char *name, const rad_
  * given in W/sr, W/m^2 and W/(m^2 sr) it gives W/(m^2 sr) and W/m^2. Emitted radiance of a
  * surface (Ke) is in the same unit as a luminance. Distances to point-like lights are
  * converted to metres with rad_scene.unit_metres (1 when 0), so a 100 cd lamp 2 m above
- * a floor gives 25 lux there whether the scene is in metres or millimetres. */
+ * a floor gives 25 lux there whether the scene is in metres or millimetres. A light whose
+ * file gives no unit (rad_light.unit_unknown: Collada and FBX lights), an environment map
+ * (the map's own unit) or emitting surfaces alone make the answer relative: `radiosity
+ * render --false-colour` then labels its legend "relative" instead of lx or cd/m^2. */
 
 typedef enum rad_light_type {
     RAD_LIGHT_POINT = 1,   /* isotropic: intensity I (cd) in every direction */
@@ -472,6 +475,9 @@ typedef struct rad_light {
     double rotate_degrees;     /* environment: turned about rad_scene.up */
     rad_photometry *photometry; /* luminaire: owned by the scene once added */
     struct rad_image *environment; /* environment: owned by the scene once added */
+    bool unit_unknown;         /* the file gives `intensity` in no known unit (Assimp's
+                                  Collada and FBX lights: their colour, taken as cd or lux
+                                  as given); results lit by it are relative, not photometric */
 } rad_light;
 
 /* Adds a copy of `light` to the scene (rad_scene.lights); on success the scene owns its
@@ -1149,7 +1155,9 @@ typedef struct rad_false_colour_options {
     double low, high; /* the scale's ends (the quantity's unit); both 0 = automatic: 0 (or,
                          logarithmic, the 1st percentile) to the 99th percentile */
     bool logarithmic; /* a logarithmic scale (low > 0) */
-    const char *unit; /* written above the legend, e.g. "lx"; NULL = none */
+    const char *unit; /* written above the legend, e.g. "lx"; NULL = none. The legend's
+                         font has digits and the letters of lx, cd/m^2, W/m^2, W/sr and
+                         relative; other characters are left blank */
 } rad_false_colour_options;
 
 /* The luminance of each pixel of `values` in false colour, blue (low) through cyan, green

@@ -110,7 +110,8 @@ static double shown(double v)
 }
 
 /* One line per light: type, name, where it is and where it points (as the type has
- * them), its intensity in its unit, a spot's cone half-angles. */
+ * them), its intensity in its unit (or in none, for Collada's and FBX's), a spot's cone
+ * half-angles. */
 static void describe_lights(report *r, const rad_scene *scene)
 {
     say(r, "lights: %u\n", scene->light_count);
@@ -132,8 +133,9 @@ static void describe_lights(report *r, const rad_scene *scene)
         if (directed)
             say(r, "  direction (%.6g, %.6g, %.6g)", shown(light->direction.x),
                 shown(light->direction.y), shown(light->direction.z));
-        say(r, "  intensity (%.6g, %.6g, %.6g)%s", light->intensity.r, light->intensity.g,
-            light->intensity.b, unit);
+        say(r, "  intensity (%.6g, %.6g, %.6g)%s%s%s", light->intensity.r, light->intensity.g,
+            light->intensity.b, light->unit_unknown ? " in no known unit (taken as" : "", unit,
+            light->unit_unknown ? ")" : "");
         if (type == RAD_LIGHT_SPOT)
             say(r, "  cone %.5g to %.5g degrees from the axis", light->inner_degrees,
                 light->outer_degrees);
@@ -309,12 +311,15 @@ int command_info(int argc, char **argv)
     stats_integer(&stats, "vertices", scene->position_count);
     stats_integer(&stats, "surfaces", scene->surface_count);
     stats_integer(&stats, "materials", scene->material_count);
+    stats_integer(&stats, "lights", scene->light_count);
     stats_integer(&stats, "warnings", w.count);
     stats_number(&stats, "seconds_load", t_load);
     exit_code = cli_finish(&stats, shared.stats_path,
-                           "%u triangles, %u surfaces, %u materials, %u warnings, %.2f s: wrote %s",
+                           "%u triangles, %u surfaces, %u materials, %u lights, %u warnings, "
+                           "%.2f s: wrote %s",
                            scene->triangle_count, scene->surface_count, scene->material_count,
-                           w.count, t_load, shared.output ? shared.output : "standard output");
+                           scene->light_count, w.count, t_load,
+                           shared.output ? shared.output : "standard output");
 done:
     free(r.text);
     free(w.lines.text);

@@ -68,6 +68,19 @@ typedef struct render_settings {
     rad_false_colour_options colours;
 } render_settings;
 
+/* The false-colour legend's unit: lux (illuminance) or cd/m^2 (luminance) when every light
+ * of the scene is photometric (radiosity.h, "Units."); "relative" when there is none (the
+ * emitters' Ke in the file's own unit) or when one is not: a light the file gives in no
+ * known unit (Collada, FBX), an environment map (its radiance in the map's unit). */
+static const char *legend_unit(const rad_scene *scene, bool irradiance)
+{
+    bool photometric = scene->light_count > 0;
+    for (uint32_t l = 0; l < scene->light_count; l++)
+        photometric = photometric && !scene->lights[l].unit_unknown &&
+                      scene->lights[l].type != RAD_LIGHT_ENVIRONMENT;
+    return !photometric ? "relative" : irradiance ? "lx" : "cd/m^2";
+}
+
 static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_code)
 {
     cli_args args;
@@ -103,7 +116,6 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
     s->render.emitter_direct = direct && strcmp(direct, "pixel") == 0;
     s->false_colour = args.value[OPT_FALSE_COLOUR] != NULL;
     s->colours.logarithmic = args.value[OPT_LOG] != NULL;
-    s->colours.unit = s->render.irradiance ? "lx" : "cd/m^2";
     if (args.value[OPT_SCALE]) {
         double lo, hi;
         char tail;
@@ -201,6 +213,7 @@ int command_render(int argc, char **argv)
     }
     if (s.false_colour) {
         rad_image *coloured = NULL;
+        s.colours.unit = legend_unit(solved.scene, s.render.irradiance);
         status = rad_image_false_colour(image, &s.colours, &coloured, &error);
         if (status == RAD_OK) {
             rad_image_write_options exact = {.fixed_exposure = true, .exposure = 0};

@@ -44,7 +44,8 @@ static void scale_colour(double t, float *rgb)
         rgb[c] = (float)srgb_to_linear((1 - f) * scale_colours[i][c] + f * scale_colours[i + 1][c]);
 }
 
-/* 3 x 5 glyphs, one row per 3 bits (bit 2 = left), for the characters a legend needs. */
+/* 3 x 5 glyphs, one row per 3 bits (bit 2 = left), for the characters a legend needs:
+ * the values and the units lx, cd/m^2, W/m^2, W/sr and relative. */
 typedef struct glyph {
     char c;
     unsigned char rows[5];
@@ -60,6 +61,8 @@ static const glyph font[] = {
     {'d', {1, 1, 7, 5, 7}}, {'m', {0, 7, 7, 5, 5}}, {'/', {1, 1, 2, 4, 4}},
     {'W', {5, 5, 5, 7, 5}}, {'^', {2, 5, 0, 0, 0}},
     {' ', {0, 0, 0, 0, 0}}, {'s', {0, 7, 4, 1, 7}}, {'r', {0, 6, 5, 4, 4}},
+    {'a', {0, 3, 5, 5, 3}}, {'t', {2, 7, 2, 2, 3}}, {'i', {2, 0, 2, 2, 2}},
+    {'v', {0, 5, 5, 5, 2}},
 };
 
 static void put_pixel(rad_image *image, int x, int y, float value)

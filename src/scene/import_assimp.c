@@ -25,6 +25,7 @@
  * extension or content) to import_ply.c: Assimp never reads PLY.
  */
 #include <assimp/cimport.h>
+#include <assimp/commonMetaData.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -575,19 +576,114 @@ static rad_status add_gltf_lights(const import_state *state, rad_scene *scene, r
     return RAD_OK;
 }
 
-/* Other formats: Assimp's lights (Collada, FBX, ...). An aiLight is named after the node
- * that holds it, its mPosition and mDirection in that node's space; Assimp's cone angles
- * are full angles (Collada's falloff_angle; its outer cone is falloff_angle plus
- * penumbra_angle, or Assimp's guess from falloff_exponent), halved here. These formats'
- * light values are not photometric: the colour is taken as candela or lux, as given. */
+/* Assimp's scene came from an FBX file (its importer names itself in the metadata). */
+static bool from_fbx(const struct aiScene *ai)
+{
+    const struct aiMetadata *meta = ai->mMetaData;
+    for (unsigned k = 0; meta && k < meta->mNumProperties; k++)
+        if (strcmp(meta->mKeys[k].data, AI_METADATA_SOURCE_FORMAT) == 0 &&
+            meta->mValues[k].mType == AI_AISTRING && meta->mValues[k].mData)
+            return strstr(((const struct aiString *)meta->mValues[k].mData)->data, "FBX") != NULL;
+    return false;
+}
+
+/* Every node of the tree in depth-first pre-order, with its transform to the world. */
+typedef struct placed_node {
+    const struct aiNode *node;
+    struct aiMatrix4x4 to_world;
+} placed_node;
+
+static size_t count_nodes(const struct aiNode *node, unsigned depth)
+{
+    size_t count = 1;
+    for (unsigned i = 0; depth < 256 && i < node->mNumChildren; i++)
+        count += count_nodes(node->mChildren[i], depth + 1);
+    return count;
+}
+
+static void place_nodes(const struct aiNode *node, const struct aiMatrix4x4 *parent,
+                        unsigned depth, placed_node *nodes, size_t *count)
+{
+    placed_node *here = &nodes[(*count)++];
+    here->node = node;
+    here->to_world = multiply(parent, &node->mTransformation);
+    for (unsigned i = 0; depth < 256 && i < node->mNumChildren; i++)
+        place_nodes(node->mChildren[i], &here->to_world, depth + 1, nodes, count);
+}
+
+/* The node holding light k. An aiLight names its node, and names need not be unique (an
+ * FBX light instanced under two nodes, 3ds Max's duplicate names): Assimp 5.2's Collada
+ * and FBX importers make lights in a depth-first pre-order walk of the nodes, so the j-th
+ * light named N belongs to the j-th node named N that holds no mesh. When the counts
+ * disagree (a mesh or an empty node of the same name besides), the only node of that
+ * name, else the first, is taken, and *ambiguous says so. NULL: no node of that name. */
+static const placed_node *light_node(const struct aiScene *ai, unsigned k,
+                                     const placed_node *nodes, size_t node_count,
+                                     bool *ambiguous)
+{
+    const char *name = ai->mLights[k]->mName.data;
+    unsigned before = 0, lights = 0;
+    for (unsigned l = 0; l < ai->mNumLights; l++)
+        if (strcmp(ai->mLights[l]->mName.data, name) == 0) {
+            before += l < k;
+            lights++;
+        }
+    const placed_node *first = NULL, *chosen = NULL;
+    unsigned named = 0, holders = 0;
+    for (size_t n = 0; n < node_count; n++) {
+        if (strcmp(nodes[n].node->mName.data, name) != 0)
+            continue;
+        if (!first)
+            first = &nodes[n];
+        named++;
+        if (nodes[n].node->mNumMeshes == 0 && holders++ == before)
+            chosen = &nodes[n];
+    }
+    *ambiguous = false;
+    if (holders == lights && chosen)
+        return chosen;
+    *ambiguous = named > 1;
+    return first;
+}
+
+/* Other formats: Assimp's lights (Collada, FBX, ...), each at its node (light_node), its
+ * mPosition and mDirection in that node's space. Assimp's cone angles are full angles,
+ * halved here. What Assimp 5.2 makes of each format, verified by tests/test_file_lights.c:
+ * - Collada: the colour as given; the inner cone is falloff_angle, the outer one
+ *   falloff_angle plus penumbra_angle (or Assimp's guess from falloff_exponent).
+ * - FBX: colour = Color x Intensity / 100 (FBX's Intensity is a percentage); a light
+ *   shines along its node's -Y (mDirection (0,-1,0)); InnerAngle and OuterAngle are the
+ *   full cone angles in degrees, which Assimp turns into radians (the convention of the
+ *   FBX SDK, Maya and Blender's exporter); LightType 3 and 4 (area, volume) come as
+ *   undefined lights; DecayType becomes attenuation factors (none: constant = DecayStart;
+ *   linear: linear = 2 / DecayStart; quadratic, Assimp's default: quadratic = 2 /
+ *   DecayStart^2; cubic: linear 1, quadratic 1), which are ignored: every light falls off
+ *   by the inverse-square law, and a warning names an FBX light whose decay is another.
+ *   Lengths stay in the file's unit (UnitScaleFactor, in take_frame).
+ * Neither format's light values are photometric: the colour is taken as candela or lux as
+ * given and the light is marked unit_unknown. */
 static rad_status add_assimp_lights(const import_state *state, rad_scene *scene,
                                     rad_error *error)
 {
     rad_log_fn log = state->options ? state->options->log : NULL;
     void *user = state->options ? state->options->log_user : NULL;
     const struct aiScene *ai = state->ai;
+    if (ai->mNumLights == 0)
+        return RAD_OK;
+    bool fbx = from_fbx(ai);
+    size_t node_count = 0;
+    placed_node *nodes = NULL;
+    if (ai->mRootNode) {
+        nodes = rad_alloc_array(count_nodes(ai->mRootNode, 0), sizeof(*nodes));
+        if (!nodes)
+            return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for its lights",
+                            state->path);
+        struct aiMatrix4x4 identity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        place_nodes(ai->mRootNode, &identity, 0, nodes, &node_count);
+    }
     unsigned taken = 0;
-    for (unsigned k = 0; k < ai->mNumLights; k++) {
+    rad_status status = RAD_OK;
+    for (unsigned k = 0; k < ai->mNumLights && status == RAD_OK; k++) {
         const struct aiLight *a = ai->mLights[k];
         rad_light light = {0};
         snprintf(light.name, sizeof(light.name), "%.*s", (int)sizeof(light.name) - 1,
@@ -597,18 +693,26 @@ static rad_status add_assimp_lights(const import_state *state, rad_scene *scene,
         case aiLightSource_SPOT: light.type = RAD_LIGHT_SPOT; break;
         case aiLightSource_DIRECTIONAL: light.type = RAD_LIGHT_DIRECTIONAL; break;
         default:
-            rad_warn(log, user, "%s: light '%s' is an %s light, which is not read", state->path,
+            rad_warn(log, user, "%s: light '%s' is %s, which is not read", state->path,
                      light.name,
-                     a->mType == aiLightSource_AREA      ? "area"
-                     : a->mType == aiLightSource_AMBIENT ? "ambient"
-                                                         : "unknown");
+                     a->mType == aiLightSource_AREA      ? "an area light"
+                     : a->mType == aiLightSource_AMBIENT ? "an ambient light"
+                     : fbx ? "an area or volume light (Assimp reads neither's shape)"
+                           : "of a type Assimp does not know");
             continue;
         }
+        bool ambiguous;
+        const placed_node *node = light_node(ai, k, nodes, node_count, &ambiguous);
         struct aiMatrix4x4 to_world = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-        struct aiMatrix4x4 identity = to_world;
-        if (!ai->mRootNode || !find_node(ai->mRootNode, a->mName.data, &identity, 0, &to_world))
+        if (node)
+            to_world = node->to_world;
+        else
             rad_warn(log, user, "%s: light '%s': no node of that name; its position and "
                      "direction are taken as given",
+                     state->path, light.name);
+        if (ambiguous)
+            rad_warn(log, user, "%s: light '%s': several nodes have that name; it is placed at "
+                     "the first",
                      state->path, light.name);
         struct aiVector3D ahead = {a->mPosition.x + a->mDirection.x,
                                    a->mPosition.y + a->mDirection.y,
@@ -616,6 +720,7 @@ static rad_status add_assimp_lights(const import_state *state, rad_scene *scene,
         light.position = transform(&to_world, a->mPosition);
         light.direction = v3_sub(transform(&to_world, ahead), light.position);
         light.intensity = (rad_rgb){a->mColorDiffuse.r, a->mColorDiffuse.g, a->mColorDiffuse.b};
+        light.unit_unknown = true;
         if (light.type == RAD_LIGHT_SPOT) {
             light.inner_degrees = a->mAngleInnerCone / 2 * 180 / RAD_PI;
             light.outer_degrees = a->mAngleOuterCone / 2 * 180 / RAD_PI;
@@ -628,17 +733,39 @@ static rad_status add_assimp_lights(const import_state *state, rad_scene *scene,
             if (light.inner_degrees > light.outer_degrees)
                 light.inner_degrees = light.outer_degrees;
         }
-        rad_status status = add_file_light(state, scene, &light, error);
-        if (status != RAD_OK)
-            return status;
-        taken++;
+        bool inverse_square = a->mAttenuationConstant == 0 && a->mAttenuationLinear == 0 &&
+                              a->mAttenuationQuadratic > 0;
+        if (fbx && light.type != RAD_LIGHT_DIRECTIONAL && !inverse_square)
+            rad_warn(log, user, "%s: light '%s': its FBX decay is %s; it falls off by the "
+                     "inverse-square law instead",
+                     state->path, light.name,
+                     a->mAttenuationQuadratic > 0 ? "cubic"
+                     : a->mAttenuationLinear > 0  ? "linear"
+                                                  : "none (constant light at any distance)");
+        status = add_file_light(state, scene, &light, error);
+        taken += status == RAD_OK;
     }
-    if (taken)
-        rad_warn(log, user, "%s: %u light%s: this format's light values are not photometric; "
-                 "each colour is taken as candela (point, spot) or lux (sun) as given "
-                 "(--point, --spot and --sun give exact photometric values)",
-                 state->path, taken, taken > 1 ? "s" : "");
-    return RAD_OK;
+    free(nodes);
+    if (status == RAD_OK && taken)
+        rad_warn(log, user, "%s: %u light%s in no known unit: %s is taken as candela "
+                 "(point, spot) or lux (sun), so results are relative, not photometric "
+                 "(--point, --spot and --sun give photometric lights)",
+                 state->path, taken, taken > 1 ? "s" : "",
+                 fbx ? "FBX's Color x Intensity / 100" : "each colour");
+    return status;
+}
+
+/* The shortest decimal that reads back as the float f: the value the file wrote, where
+ * Assimp kept it in single precision (FBX's UnitScaleFactor 2.54 is 2.5399999618f). */
+static double decimal_of_float(float f)
+{
+    char text[32];
+    for (int digits = 1; digits <= 9; digits++) {
+        snprintf(text, sizeof(text), "%.*g", digits, (double)f);
+        if (strtof(text, NULL) == f)
+            return strtod(text, NULL);
+    }
+    return f;
 }
 
 /* A numeric metadata value. */
@@ -652,7 +779,7 @@ static bool metadata_number(const struct aiScene *ai, const char *key, double *o
         switch (meta->mValues[k].mType) {
         case AI_INT32: *out = *(const int32_t *)data; return true;
         case AI_UINT64: *out = (double)*(const uint64_t *)data; return true;
-        case AI_FLOAT: *out = *(const float *)data; return true;
+        case AI_FLOAT: *out = decimal_of_float(*(const float *)data); return true;
         case AI_DOUBLE: *out = *(const double *)data; return true;
         default: return false;
         }
