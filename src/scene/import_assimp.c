@@ -20,7 +20,8 @@
  * and emission textures are decoded once each and triangles of textured materials keep
  * their texture coordinates; (4) takes the first glTF camera, and the up axis and unit
  * from the file's metadata; (5) adds the file's lights: glTF's KHR_lights_punctual as
- * gltf_json.c read them, other formats' from Assimp's aiLight.
+ * gltf_json.c read them, other formats' (Collada, FBX) from Assimp's aiLight, each at the
+ * node of its name, its values marked as in no known unit (rad_light.unit_unknown).
  * View3D input files are recognised here and handed to import_vs3.c, PLY files (by
  * extension or content) to import_ply.c: Assimp never reads PLY.
  */
