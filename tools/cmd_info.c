@@ -16,15 +16,15 @@ static const char usage[] =
     "Tells what was read from SCENE (any file the other commands read; none = the built-in\n"
     "Cornell box): each surface (name, triangles, area, material; two-sided ones say so),\n"
     "each material (albedo, emitted radiance, specular colour), each light (type, name,\n"
-    "position, direction, intensity in cd or lux, a spot's cone), the emitters and their\n"
-    "power, the bounding box, the camera the image commands would use, the unit and up\n"
-    "axis when the file says, and the warnings.\n"
+    "position, direction, intensity in cd or lux, or in no known unit for Collada's and\n"
+    "FBX's, a spot's cone), the emitters and their power, the bounding box, the camera the\n"
+    "image commands would use, the unit and up axis when the file says, and the warnings.\n"
     "The --emit, --albedo and --two-sided options show their effect. Exit status 1 when\n"
     "the scene cannot be read.\n"
     "\n"
     CLI_TWO_SIDED_HELP
     "  -o FILE              write the report to FILE instead of stdout\n"
-    "  --stats FILE.json    load time, counts and peak memory\n"
+    "  --stats FILE.json    load time, counts (triangles to lights) and peak memory\n"
     CLI_QUIET_HELP;
 
 enum { OPT_TWO_SIDED = OPT_OWN, OPT_COUNT };
