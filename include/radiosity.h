@@ -567,6 +567,9 @@ typedef struct rad_mesh {
     rad_patch *patches;
     uint32_t patch_count;
     double patch_size; /* the longest-edge limit the mesh was built with */
+    uint32_t shadow_splits;     /* cells split where a sharp light's shadow edge crosses
+                                   them (rad_mesh_options.shadow_levels) */
+    bool shadow_budget_reached; /* the splits stopped at max_added_patches */
 } rad_mesh;
 
 /* A patch size that gives roughly `target_patches` patches for the scene's area; 0 when
@@ -578,6 +581,31 @@ double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patch
  * RAD_SURFACE_TWO_SIDED surfaces get their twins (above). */
 rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **out,
                           rad_error *error);
+
+/* Shadow refinement. A patch carries one radiosity, so a sharp shadow edge across it is
+ * smeared over it. Where the scene's point, spot, luminaire or sun lights cast a shadow
+ * (or a cone's edge) across a cell, the mesh splits the cell in four (quads into four
+ * quads, triangles into four similar triangles), and the children again, `shadow_levels`
+ * times at most: the shadow edges of the sharp lights are met at the patch size /
+ * 2^levels, in every solver (the hierarchical solver's leaves are these patches) and in
+ * the lit mesh. A cell is split when, at 4 x 4 points of it (both sides for a two-sided
+ * surface), the share of the sharp lights' irradiance that the shadow rays let through
+ * differs by more than 1/4 between two points and that difference is more than 1/4 of
+ * the light there; smooth fall-off never splits. Emitters' and the sky's shadows are soft
+ * and do not split patches. The splits stop when they have added max_added_patches. */
+#define RAD_SHADOW_LEVELS_DEFAULT 2
+#define RAD_SHADOW_LEVELS_MAX 6
+
+typedef struct rad_mesh_options {
+    double patch_size;          /* the longest edge of a patch (required, > 0) */
+    int shadow_levels;          /* 0: RAD_SHADOW_LEVELS_DEFAULT; -1: none; at most
+                                   RAD_SHADOW_LEVELS_MAX */
+    uint32_t max_added_patches; /* 0: as many as the unrefined mesh has, at least 4096 */
+} rad_mesh_options;
+
+/* rad_mesh_build with options (rad_mesh_build is this with patch_size alone). */
+rad_status rad_mesh_build_with(const rad_scene *scene, const rad_mesh_options *options,
+                               rad_mesh **out, rad_error *error);
 
 void rad_mesh_destroy(rad_mesh *mesh);
 

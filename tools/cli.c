@@ -297,6 +297,13 @@ bool cli_parse_shared(const cli_args *args, cli_shared *shared)
         if (!cli_parse_positive("patch-size", args->value[OPT_PATCH_SIZE], &shared->patch_size))
             return false;
     }
+    if (args->value[OPT_SHADOW_LEVELS]) {
+        uint32_t levels = 0;
+        if (!cli_parse_count("shadow-levels", args->value[OPT_SHADOW_LEVELS], 0,
+                             RAD_SHADOW_LEVELS_MAX, &levels))
+            return false;
+        shared->shadow_levels = levels == 0 ? -1 : (int)levels;
+    }
     if (!cli_parse_count("visibility-rays", args->value[OPT_VISIBILITY_RAYS], 0, 256,
                          &shared->formfactor.visibility_rays) ||
         !cli_parse_count("quadrature", args->value[OPT_QUADRATURE], 0, 8,
@@ -439,6 +446,8 @@ bool cli_begin(const char *command, const char *usage, int argc, char **argv,
         return false;
     if (args->value[OPT_HELP]) {
         fputs(usage, stdout);
+        if (options[OPT_SHADOW_LEVELS].name)
+            fputs("\nMeshing:\n" CLI_MESH_HELP, stdout);
         if (options[OPT_POINT].name) {
             fputs("\nScene:\n" CLI_SCENE_HELP, stdout);
             fputs(CLI_LIGHT_HELP, stdout);

@@ -63,7 +63,7 @@ int cli_value_count(const cli_args *args, int option);
  * of a group a command does not include stay empty (NULL name) and are never matched. */
 enum {
     OPT_OUTPUT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_QUIET, OPT_HELP, /* BASE */
-    OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS, OPT_QUADRATURE,                /* FORMFACTOR */
+    OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS, OPT_QUADRATURE, OPT_SHADOW_LEVELS, /* FORMFACTOR */
     OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE, /* VIEW */
     OPT_EXR_FLOAT,
     OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_SOLUTION,        /* SOLVE */
@@ -104,7 +104,8 @@ enum {
 #define CLI_FORMFACTOR_OPTIONS                                                             \
     [OPT_PATCH_SIZE] = {"patch-size", 0, true},                                            \
     [OPT_VISIBILITY_RAYS] = {"visibility-rays", 0, true},                                  \
-    [OPT_QUADRATURE] = {"quadrature", 0, true}
+    [OPT_QUADRATURE] = {"quadrature", 0, true},                                            \
+    [OPT_SHADOW_LEVELS] = {"shadow-levels", 0, true}
 
 #define CLI_VIEW_OPTIONS                                                                   \
     [OPT_EYE] = {"eye", 0, true}, [OPT_TARGET] = {"target", 0, true},                      \
@@ -121,6 +122,13 @@ enum {
 
 /* The help of the options `render` and `solve` share (SOLVE, FORMFACTOR, SCENE, BASE but
  * -o), the same for both: a solution file of one is a solution file of the other. */
+/* Printed after the command's usage by every command that meshes a scene. */
+#define CLI_MESH_HELP                                                                      \
+    "  --shadow-levels N    split a patch that a point, spot, luminaire or sun shadow\n"   \
+    "                       edge crosses into four, and its children again, N times\n"    \
+    "                       (default " CLI_STR(RAD_SHADOW_LEVELS_DEFAULT) ", at most "        \
+    CLI_STR(RAD_SHADOW_LEVELS_MAX) ", 0 = none)\n"
+
 #define CLI_SOLVE_HELP                                                                     \
     "Solution:\n"                                                                          \
     "  --solution FILE      take the solution saved in FILE (by --save-solution) instead\n" \
@@ -234,6 +242,7 @@ rad_status cli_apply_two_sided(const cli_two_sided *two_sided, rad_scene *scene,
 typedef struct cli_shared {
     const char *output, *stats_path;
     double patch_size;
+    int shadow_levels; /* rad_mesh_options.shadow_levels: 0 default, -1 none */
     rad_formfactor_options formfactor; /* quadrature, visibility rays, threads, seed, progress */
     int threads;
     unsigned long seed;

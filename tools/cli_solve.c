@@ -166,7 +166,9 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         snprintf(error->message, sizeof(error->message), "out of memory");
         goto done;
     }
-    status = rad_mesh_build(out->scene, patch_size, &out->mesh, error);
+    rad_mesh_options mesh_options = {.patch_size = patch_size,
+                                     .shadow_levels = shared->shadow_levels};
+    status = rad_mesh_build_with(out->scene, &mesh_options, &out->mesh, error);
     if (status != RAD_OK)
         goto done;
     out->seconds_mesh = rad_clock_seconds() - t_load;
@@ -239,6 +241,8 @@ void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *st
     stats_integer(stats, "triangles", s->scene->triangle_count);
     stats_integer(stats, "patches", s->mesh->patch_count);
     stats_number(stats, "patch_size", s->mesh->patch_size);
+    stats_integer(stats, "shadow_splits", s->mesh->shadow_splits);
+    stats_bool(stats, "shadow_budget_reached", s->mesh->shadow_budget_reached);
     stats_number(stats, "seconds_load", s->seconds_load);
     stats_number(stats, "seconds_mesh", s->seconds_mesh);
     if (s->from_file) {

@@ -29,9 +29,13 @@
 #include "core/union_find.h"
 #include "core/vec3.h"
 #include "core/weld.h"
+#include "mesh/shadow_refine.h"
 
 /* Refuse meshes beyond this many patches: the dense form-factor matrix would not fit. */
 #define MESH_MAX_PATCHES 50000000u
+/* The shadow refinement may add as many patches as the unrefined mesh has, and at least
+ * this many (a small scene's shadows still get their finer cells). */
+#define SHADOW_BUDGET_FLOOR 4096.0
 
 typedef struct edge_slot {
     uint64_t key;       /* (low vertex << 32) | high vertex; 0 with triangle UINT32_MAX = empty */
@@ -109,6 +113,8 @@ typedef struct mesh_output {
     rad_weld weld;
     rad_patch *patches;
     size_t patch_count, patch_capacity;
+    shadow_refiner *refiner; /* splits cells crossed by sharp shadows (shadow_refine.h) */
+    bool two_sided;          /* the polygon being subdivided */
 } mesh_output;
 
 /* Point k/n of the way along the input edge (a, b), computed from its lower-numbered end. */
@@ -164,6 +170,41 @@ static int add_patch(mesh_output *out, const polygon *poly, const rad_vec3 *p, u
     return 1;
 }
 
+/* A cell of a polygon's grid: a patch, or, where a sharp light's shadow edge crosses it
+ * (shadow_refine.h), its four children, tested again down to the refiner's levels. An
+ * edge's midpoint is the sum of its ends halved, the same bits from either cell that
+ * shares the edge, so split neighbours weld their midpoints; an unsplit neighbour leaves a
+ * T-vertex, which the display mesh makes continuous (display_mesh.h). */
+static int emit_cell(mesh_output *out, const polygon *poly, const rad_vec3 *p, uint32_t count,
+                     uint32_t level)
+{
+    shadow_refiner *refiner = out->refiner;
+    if (!refiner || level >= refiner->levels ||
+        !shadow_refiner_splits(refiner, p, count, out->in->normal[poly->triangle], poly->bulge,
+                               out->two_sided))
+        return add_patch(out, poly, p, count);
+    rad_vec3 m[4];
+    for (uint32_t k = 0; k < count; k++)
+        m[k] = v3_scale(v3_add(p[k], p[(k + 1) % count]), 0.5);
+    if (count == 3) {
+        rad_vec3 children[4][3] = {
+            {p[0], m[0], m[2]}, {m[0], p[1], m[1]}, {m[2], m[1], p[2]}, {m[0], m[1], m[2]}};
+        for (int k = 0; k < 4; k++)
+            if (!emit_cell(out, poly, children[k], 3, level + 1))
+                return 0;
+        return 1;
+    }
+    rad_vec3 centre = v3_scale(v3_add(v3_add(p[0], p[1]), v3_add(p[2], p[3])), 0.25);
+    rad_vec3 children[4][4] = {{p[0], m[0], centre, m[3]},
+                               {m[0], p[1], m[1], centre},
+                               {centre, m[1], p[2], m[2]},
+                               {m[3], centre, m[2], p[3]}};
+    for (int k = 0; k < 4; k++)
+        if (!emit_cell(out, poly, children[k], 4, level + 1))
+            return 0;
+    return 1;
+}
+
 static uint32_t divisions(double length, double patch_size)
 {
     double n = ceil(length / patch_size - 1e-9);
@@ -205,11 +246,11 @@ static int subdivide_triangle(mesh_output *out, const polygon *poly, double patc
     for (uint32_t j = 0; j < n; j++)
         for (uint32_t i = 0; i + j < n; i++) {
             rad_vec3 up[3] = {GRID(i, j), GRID(i + 1, j), GRID(i, j + 1)};
-            if (!add_patch(out, poly, up, 3))
+            if (!emit_cell(out, poly, up, 3, 0))
                 return 0;
             if (i + j + 1 < n) {
                 rad_vec3 down[3] = {GRID(i + 1, j), GRID(i + 1, j + 1), GRID(i, j + 1)};
-                if (!add_patch(out, poly, down, 3))
+                if (!emit_cell(out, poly, down, 3, 0))
                     return 0;
             }
         }
@@ -237,7 +278,7 @@ static int subdivide_quad(mesh_output *out, const polygon *poly, double patch_si
     for (uint32_t j = 0; j < nv; j++)
         for (uint32_t i = 0; i < nu; i++) {
             rad_vec3 cell[4] = {GRID(i, j), GRID(i + 1, j), GRID(i + 1, j + 1), GRID(i, j + 1)};
-            if (!add_patch(out, poly, cell, 4))
+            if (!emit_cell(out, poly, cell, 4, 0))
                 return 0;
         }
 #undef GRID
@@ -483,14 +524,27 @@ void rad_mesh_destroy(rad_mesh *mesh)
 rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **out,
                           rad_error *error)
 {
+    rad_mesh_options options = {.patch_size = patch_size};
+    return rad_mesh_build_with(scene, &options, out, error);
+}
+
+rad_status rad_mesh_build_with(const rad_scene *scene, const rad_mesh_options *options,
+                               rad_mesh **out, rad_error *error)
+{
     *out = NULL;
+    double patch_size = options->patch_size;
     if (!(patch_size > 0) || !isfinite(patch_size))
         return rad_fail(error, RAD_ERR_INVALID, "patch size must be a positive number");
+    if (options->shadow_levels < -1 || options->shadow_levels > RAD_SHADOW_LEVELS_MAX)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "shadow levels must be from 1 to %d, 0 for the default or -1 for none",
+                        RAD_SHADOW_LEVELS_MAX);
     mesh_plan plan;
     rad_status status = plan_build(scene, &plan, error);
     if (status != RAD_OK)
         return status;
-    mesh_output result = {&plan.in, {0}, NULL, 0, 0};
+    shadow_refiner refiner = {0};
+    mesh_output result = {&plan.in, {0}, NULL, 0, 0, NULL, false};
     rad_mesh *mesh = rad_alloc_array(1, sizeof(*mesh));
     if (!mesh || !rad_weld_init(&result.weld, 16))
         goto nomem;
@@ -504,11 +558,21 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
                           patch_size, count, MESH_MAX_PATCHES);
         goto done;
     }
+    uint32_t levels = options->shadow_levels == 0  ? RAD_SHADOW_LEVELS_DEFAULT
+                      : options->shadow_levels < 0 ? 0
+                                                   : (uint32_t)options->shadow_levels;
+    size_t budget = options->max_added_patches ? options->max_added_patches
+                                               : (size_t)fmax(count, SHADOW_BUDGET_FLOOR);
+    status = shadow_refiner_init(&refiner, scene, levels, budget, error);
+    if (status != RAD_OK)
+        goto done;
+    result.refiner = refiner.tracer ? &refiner : NULL;
     size_t *first_patch = rad_alloc_array(plan.polygon_count + 1, sizeof(*first_patch));
     if (!first_patch)
         goto nomem;
     for (size_t p = 0; p < plan.polygon_count; p++) {
         first_patch[p] = result.patch_count;
+        result.two_sided = polygon_two_sided(scene, &plan.polygons[p]);
         int ok = plan.polygons[p].count == 3
                      ? subdivide_triangle(&result, &plan.polygons[p], patch_size)
                      : subdivide_quad(&result, &plan.polygons[p], patch_size);
@@ -518,6 +582,14 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
         }
     }
     first_patch[plan.polygon_count] = result.patch_count;
+    if (result.patch_count > MESH_MAX_PATCHES) {
+        free(first_patch);
+        status = rad_fail(error, RAD_ERR_INVALID,
+                          "the shadow refinement made %zu patches (limit %u): use a larger "
+                          "--patch-size or fewer --shadow-levels",
+                          result.patch_count, MESH_MAX_PATCHES);
+        goto done;
+    }
     /* the back sides, after every front */
     for (size_t p = 0; p < plan.polygon_count; p++)
         if (polygon_two_sided(scene, &plan.polygons[p]) &&
@@ -533,12 +605,15 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
     mesh->vertex_count = result.weld.count;
     mesh->vertices = rad_weld_take_positions(&result.weld);
     mesh->patch_size = patch_size;
+    mesh->shadow_splits = refiner.split;
+    mesh->shadow_budget_reached = refiner.budget_reached;
     *out = mesh;
     mesh = NULL;
     goto done;
 nomem:
     status = rad_fail(error, RAD_ERR_NOMEM, "out of memory while building patches");
 done:
+    shadow_refiner_free(&refiner);
     rad_weld_free(&result.weld);
     free(result.patches);
     plan_free(&plan);
