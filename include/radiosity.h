@@ -593,7 +593,7 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
  * differs by more than 1/4 between two points and that difference is more than 1/4 of
  * the light there; smooth fall-off never splits. Emitters' and the sky's shadows are soft
  * and do not split patches. The splits stop when they have added max_added_patches. */
-#define RAD_SHADOW_LEVELS_DEFAULT 2
+#define RAD_SHADOW_LEVELS_DEFAULT 1
 #define RAD_SHADOW_LEVELS_MAX 6
 
 typedef struct rad_mesh_options {
