@@ -128,7 +128,8 @@ int command_pathtrace(int argc, char **argv)
     char image_name[80];
     snprintf(image_name, sizeof(image_name), "the %u x %u image%s", s.view.width,
              s.view.height, images == 2 ? " with its standard error" : "");
-    if (!cli_memory_take(&s.max_memory, cli_image_bytes(&s.view, output, images), image_name))
+    cli_memory_budget(s.max_memory);
+    if (!cli_memory_take(cli_image_bytes(&s.view, output, images), image_name))
         return EXIT_ERROR;
 
     rad_error error = {0};

@@ -176,9 +176,9 @@ int command_raytrace(int argc, char **argv)
     }
     char image_name[64];
     snprintf(image_name, sizeof(image_name), "the %u x %u image", s.view.width, s.view.height);
+    cli_memory_budget(s.max_memory);
     if (!cli_outputs_writable((const char *[]){s.shared.output, s.shared.stats_path}, 2) ||
-        !cli_memory_take(&s.max_memory, cli_image_bytes(&s.view, s.shared.output, 1),
-                         image_name)) {
+        !cli_memory_take(cli_image_bytes(&s.view, s.shared.output, 1), image_name)) {
         free(s.lights);
         return EXIT_ERROR;
     }
