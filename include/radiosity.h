@@ -1058,7 +1058,11 @@ typedef struct rad_scene_solve_options {
                                   RAD_ERR_NOMEM before any work (AUTO then chooses
                                   hierarchical). Hierarchical: the trees (a bound, about
                                   700 n bytes) must fit, else RAD_ERR_NOMEM; the links
-                                  get the rest (rad_hierarchy_options.max_memory) */
+                                  get the rest (rad_hierarchy_options.max_memory). With a
+                                  run's budget set (rad_memory_budget_set) the limit is
+                                  also what is left of it: for the dense matrix after the
+                                  patch inputs, the BVH and the threads; for the trees
+                                  with 2 MB a thread; the links a quarter less */
     uint64_t seed;
     int threads;               /* 0 = all cores */
     const volatile int *stop;  /* hierarchical: stops at the next sweep (report.interrupted) */

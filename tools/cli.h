@@ -136,9 +136,9 @@ enum {
     "  --refine-threshold X hierarchical: split a link while B x F x A exceeds X times\n"   \
     "                       the emitted power per patch (default "                     \
     CLI_STR(RAD_DEFAULT_REFINE_THRESHOLD) "; smaller = finer)\n"  \
-    "  --max-memory SIZE    bytes for the image, the dense matrix (4 n^2) or the trees\n"  \
-    "                       and links (K, M, G): refused up front if it cannot fit, or\n" \
-    "                       links stop there, saying so (default: half of RAM)\n"          \
+    "  --max-memory SIZE    bytes the whole run may hold (K, M, G): known sizes (image,\n" \
+    "                       matrix 4 n^2, trees) refused up front, links stop there,\n"    \
+    "                       the rest an error (default: none; links: half of RAM)\n"       \
     "  --tolerance X        relative residual, or unshot fraction for shoot, or change of\n" \
     "                       a sweep for hierarchical (default "                            \
     CLI_STR(RAD_DEFAULT_TOLERANCE) ")\n"                                                   \
