@@ -5,6 +5,9 @@
  * error naming the budget, exit 1 and no output; a budget at the run's need succeeds and
  * the process's peak resident size stays under the budget plus a fixed overhead.
  *
+ * In process: rad_image_create past the budget fails with RAD_ERR_NOMEM and the refusal
+ * names its 12 W H bytes; reservations take exactly their bytes from what is left.
+ *
  * Up front (the Cornell box at patch size 30 has n patches, counted with rad_mesh_build):
  *   - gather with a budget of 4 n^2 + 1 MB: the 4 n^2-byte matrix does not fit what the
  *     scene, mesh and image leave, refused with the line; the automatic choice then goes
@@ -12,8 +15,8 @@
  *   - images: a 1000 x 1000 PNG with automatic exposure is 20,000,000 bytes, a PFM
  *     12,000,000; a path-traced PFM with its standard error 24,000,000;
  *   - viewfactors on a K x K grid of floor cells under a K x K grid of ceiling cells (each
- *     cell one surface, a View3D file): K^4 floor-ceiling pairs face each other (coplanar ones face away),
- *     so the matrix's bound is 24 K^4 + 20 (2 K^4) + 16 (2 K^2 + 1) bytes;
+ *     cell one surface, a View3D file): K^4 floor-ceiling pairs face each other
+ *     (coplanar ones face away), so the matrix's bound is 24 K^4 + 20 (2 K^4) + 16 (2 K^2 + 1) bytes;
  *   - hierarchical: its trees first.
  * Each command (render, solve, viewfactors, pathtrace, raytrace, illuminance) with one
  * thread: run with a large budget, its --stats give the budget's high-water mark P (the
@@ -150,7 +153,8 @@ static void write_grid(const char *name)
                                            "V %d %d %d %d\nV %d %d %d %d\nV %d %d %d %d\n"
                                            "V %d %d %d %d\n",
                                            vertex + 1, i, j, z, vertex + 2, i + 1, j, z,
-                                           vertex + 3, i + 1, j + 1, z, vertex + 4, i, j + 1, z);
+                                           vertex + 3, i + 1, j + 1, z, vertex + 4, i, j + 1,
+                                           z);
                 surface++;
                 if (level)
                     length += (size_t)snprintf(text + length, size - length,
@@ -168,9 +172,55 @@ static void write_grid(const char *name)
     free(text);
 }
 
+/* The library's budget in process: an allocation past it fails as out of memory and says
+ * how much it asked for; up-front checks and reservations draw on the same budget; no
+ * budget, no limit. A W x H image asks for 12 W H bytes at once (rad_image_create). */
+static void check_library_budget(void)
+{
+    rad_error error = {0};
+    rad_image *image = NULL;
+    char text[256];
+    rad_memory_budget_set(0);
+    CHECK(rad_memory_budget() == 0 && rad_memory_budget_left() == UINT64_MAX);
+    CHECK(!rad_memory_budget_refusal(text, sizeof(text)));
+    uint64_t in_use = rad_memory_in_use();
+    CHECK(in_use > 0);
+
+    /* 8 MB more than in use: a 1000 x 1000 image (12,000,000 bytes) does not fit */
+    rad_memory_budget_set(in_use + (8u << 20));
+    CHECK(rad_image_create(1000, 1000, &image, &error) == RAD_ERR_NOMEM);
+    CHECK(image == NULL);
+    CHECK(rad_memory_budget_refusal(text, sizeof(text)));
+    CHECK(strncmp(text, "--max-memory: 11.4 MB more, with ", 33) == 0);
+    CHECK(strstr(text, " in use, would exceed the budget of ") != NULL);
+    /* a 512 x 512 one (3,145,728 bytes) does, and the high-water mark holds it */
+    CHECK(rad_image_create(512, 512, &image, &error) == RAD_OK);
+    CHECK(rad_memory_budget_peak() >= in_use + 512 * 512 * 12);
+    CHECK(rad_memory_budget_peak() <= rad_memory_budget());
+    rad_image_destroy(image);
+    image = NULL;
+
+    /* reserved bytes are taken from what is left, exactly, until given back */
+    uint64_t left = rad_memory_budget_left();
+    rad_memory_budget_reserve(1u << 20);
+    CHECK(left - rad_memory_budget_left() == 1u << 20);
+    CHECK(rad_memory_budget_need(left, "the test's buffer", &error) == RAD_ERR_NOMEM);
+    CHECK(strncmp(error.message, "--max-memory: the test's buffer needs ", 38) == 0);
+    CHECK(strstr(error.message, " MB left of the budget of ") != NULL);
+    rad_memory_budget_unreserve(1u << 20);
+    CHECK(rad_memory_budget_left() == left);
+    CHECK(rad_memory_budget_need(left / 2, "half", &error) == RAD_OK);
+
+    /* no budget: the large image again */
+    rad_memory_budget_set(0);
+    CHECK(rad_image_create(1000, 1000, &image, &error) == RAD_OK);
+    rad_image_destroy(image);
+}
+
 int main(void)
 {
     test_tmpdir();
+    check_library_budget();
     rad_scene *scene = NULL;
     rad_mesh *mesh = NULL;
     rad_error error = {0};
@@ -236,16 +286,20 @@ int main(void)
     /* the images: 20 bytes a pixel as PNG with automatic exposure, 12 as PFM or with a
      * fixed exposure; refused before the scene is loaded */
     expect_refused("render -o out.png --size 1000x1000 --max-memory 10M",
-                   "radiosity: --max-memory: the 1000 x 1000 image needs 19.1 MB, more than the ",
+                   "radiosity: --max-memory: the 1000 x 1000 image needs 19.1 MB, more than "
+                   "the ",
                    " MB left of the budget of 10.0 MB\n");
     expect_refused("render -o out.pfm --size 1000x1000 --max-memory 10M",
-                   "radiosity: --max-memory: the 1000 x 1000 image needs 11.4 MB, more than the ",
+                   "radiosity: --max-memory: the 1000 x 1000 image needs 11.4 MB, more than "
+                   "the ",
                    " MB left of the budget of 10.0 MB\n");
     expect_refused("render -o out.png --exposure 0 --size 1000x1000 --max-memory 10M",
-                   "radiosity: --max-memory: the 1000 x 1000 image needs 11.4 MB, more than the ",
+                   "radiosity: --max-memory: the 1000 x 1000 image needs 11.4 MB, more than "
+                   "the ",
                    " MB left of the budget of 10.0 MB\n");
     expect_refused("raytrace -o out.png --size 1000x1000 --max-memory 15M",
-                   "radiosity: --max-memory: the 1000 x 1000 image needs 19.1 MB, more than the ",
+                   "radiosity: --max-memory: the 1000 x 1000 image needs 19.1 MB, more than "
+                   "the ",
                    " MB left of the budget of 15.0 MB\n");
     expect_refused("pathtrace -o out.pfm --standard-error out-error.pfm --size 1000x1000 "
                    "--max-memory 20M",

@@ -14,7 +14,9 @@
 
 #include <inttypes.h>
 #include <stdatomic.h>
+#include <stddef.h>
 #include <stdio.h>
+#include <string.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -27,7 +29,9 @@
 #endif
 
 #if defined(RAD_ASAN)
-#include <sanitizer/allocator_interface.h>
+/* the sanitizer runtime's count of bytes allocated and not freed (its
+ * sanitizer/allocator_interface.h, which gcc does not install) */
+size_t __sanitizer_get_current_allocated_bytes(void);
 #elif defined(__GLIBC__)
 #include <malloc.h>
 #endif
@@ -44,7 +48,9 @@ static atomic_int_fast64_t embree_bytes;     /* Embree's live blocks (its monito
 static atomic_uint_fast64_t budget_peak;     /* most in use + reserved + asked at a check */
 static atomic_bool refusal_recorded;         /* the first refusal since the budget was set */
 static atomic_uint_fast64_t refusal_need, refusal_in_use, refusal_limit;
-static _Thread_local uint64_t unchecked_bytes; /* this thread's requests since its check */
+/* this thread's requests since its last check: the allocator's, and Embree's apart (so
+ * that how Embree shares a build among threads does not move the allocator's checks) */
+static _Thread_local uint64_t unchecked_bytes, embree_unchecked_bytes;
 
 uint64_t rad_physical_memory_bytes(void)
 {
@@ -130,25 +136,30 @@ static bool budget_fits(uint64_t limit, uint64_t need, uint64_t *in_use)
     return true;
 }
 
+/* A request of `bytes` is checked: it is large, or this thread's smaller requests since
+ * its last check reach MEMORY_CHECK_BYTES with it (they are in use already, so only the
+ * request itself is added to what is counted). */
+static bool check_due(uint64_t *unchecked, uint64_t bytes)
+{
+    if (bytes < MEMORY_CHECK_BYTES && *unchecked + bytes < MEMORY_CHECK_BYTES) {
+        *unchecked += bytes;
+        return false;
+    }
+    *unchecked = 0;
+    return true;
+}
+
 bool rad_memory_budget_allows(uint64_t bytes)
 {
-    uint64_t limit = atomic_load_explicit(&budget_limit, memory_order_relaxed);
-    if (limit == 0)
-        return true;
-    if (bytes < MEMORY_CHECK_BYTES && unchecked_bytes + bytes < MEMORY_CHECK_BYTES) {
-        unchecked_bytes += bytes;
-        return true;
-    }
-    /* the small requests since the last check are in the heap's count already */
-    unchecked_bytes = 0;
-    uint64_t in_use;
-    return budget_fits(limit, bytes, &in_use);
+    uint64_t limit = atomic_load_explicit(&budget_limit, memory_order_relaxed), in_use;
+    return limit == 0 || !check_due(&unchecked_bytes, bytes) || budget_fits(limit, bytes, &in_use);
 }
 
 bool rad_memory_budget_embree(int64_t bytes, bool post)
 {
     uint64_t limit = atomic_load(&budget_limit), in_use;
-    if (limit != 0 && bytes > 0 && !post && !budget_fits(limit, (uint64_t)bytes, &in_use))
+    if (limit != 0 && bytes > 0 && !post && check_due(&embree_unchecked_bytes, (uint64_t)bytes) &&
+        !budget_fits(limit, (uint64_t)bytes, &in_use))
         return false; /* cancelled: never allocated, so not counted */
     atomic_fetch_add(&embree_bytes, bytes);
     return true;
@@ -185,6 +196,10 @@ rad_status rad_memory_budget_need(uint64_t bytes, const char *what, rad_error *e
     format_bytes(bytes, need, sizeof(need));
     format_bytes(in_use < limit ? limit - in_use : 0, left, sizeof(left));
     format_bytes(limit, given, sizeof(given));
+    if (strcmp(need, left) == 0) { /* alike when rounded: the bytes tell them apart */
+        snprintf(need, sizeof(need), "%" PRIu64 " bytes", bytes);
+        snprintf(left, sizeof(left), "%" PRIu64 " bytes", in_use < limit ? limit - in_use : 0);
+    }
     return rad_fail(error, RAD_ERR_NOMEM,
                     "--max-memory: %s needs %s, more than the %s left of the budget of %s",
                     what, need, left, given);

@@ -37,7 +37,7 @@ bool rad_memory_budget_allows(uint64_t bytes);
 
 /* Embree's memory monitor, as rtcSetDeviceMemoryMonitorFunction calls it: counts Embree's
  * blocks (bytes < 0: freed) and returns false to cancel an allocation (post false, bytes
- * > 0) that would exceed the budget. */
+ * > 0) that would exceed the budget, checked as the allocator's requests are. */
 bool rad_memory_budget_embree(int64_t bytes, bool post);
 
 #endif

@@ -161,8 +161,8 @@ rad_status rad_tracer_embree_build(rad_tracer *tracer, rad_error *error)
     }
     char what[64];
     snprintf(what, sizeof(what), "the Embree BVH of %u triangles", tracer->triangle_count);
-    status = rad_memory_budget_need((uint64_t)tracer->triangle_count * RAD_EMBREE_BYTES_PER_TRIANGLE,
-                                    what, error);
+    uint64_t estimate = (uint64_t)tracer->triangle_count * RAD_EMBREE_BYTES_PER_TRIANGLE;
+    status = rad_memory_budget_need(estimate, what, error);
     if (status != RAD_OK)
         return status;
     unsigned int modes = fp_modes_enter();
