@@ -6,7 +6,9 @@
  * the process's peak resident size stays under the budget plus a fixed overhead.
  *
  * In process: rad_image_create past the budget fails with RAD_ERR_NOMEM and the refusal
- * names its 12 W H bytes; reservations take exactly their bytes from what is left.
+ * names its 12 W H bytes; reservations take exactly their bytes from what is left; a BVH
+ * build is cancelled by Embree's memory monitor (RAD_ERR_NOMEM, no leak) when it would
+ * pass the budget, and runs with enough.
  *
  * Up front (the Cornell box at patch size 30 has n patches, counted with rad_mesh_build):
  *   - gather with a budget of 4 n^2 + 1 MB: the 4 n^2-byte matrix does not fit what the
@@ -217,10 +219,65 @@ static void check_library_budget(void)
     rad_image_destroy(image);
 }
 
+/* Embree's monitor: T random triangles, budgets from what the copies and the BVH's
+ * estimate need (128 T) upward in steps of 16 T. Embree's blocks taken from malloc count
+ * twice (the heap and the monitor), so the smaller budgets pass the estimate and are
+ * refused by the monitor during the build; every refusal is RAD_ERR_NOMEM with the
+ * refusal recorded, nothing leaks (ASan), and a large enough budget builds. */
+static void check_embree_monitor(void)
+{
+    enum { T = 100000 };
+    rad_vec3 *positions = malloc(3 * T * sizeof(*positions));
+    uint32_t(*triangles)[3] = malloc(T * sizeof(*triangles));
+    CHECK(positions && triangles);
+    if (!positions || !triangles) {
+        free(positions);
+        free(triangles);
+        return;
+    }
+    uint64_t state = 12345;
+    for (uint32_t k = 0; k < 3 * T; k++) {
+        double c[3];
+        for (int axis = 0; axis < 3; axis++) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            c[axis] = (double)(state >> 11) / 9007199254740992.0;
+        }
+        positions[k] = (rad_vec3){c[0], c[1], c[2]};
+        triangles[k / 3][k % 3] = k;
+    }
+    rad_error error = {0};
+    rad_tracer *tracer = NULL;
+    int by_monitor = 0, refused = 0;
+    uint64_t base = rad_memory_in_use();
+    for (uint64_t extra = 128 * (uint64_t)T; extra < 1024 * (uint64_t)T; extra += 16 * T) {
+        rad_memory_budget_set(base + extra);
+        rad_status status = rad_tracer_create(RAD_TRACER_EMBREE_FAST, positions, 3 * T,
+                                              (const uint32_t(*)[3])triangles, T, &tracer,
+                                              &error);
+        if (status == RAD_OK)
+            break;
+        char text[256];
+        refused++;
+        CHECK(status == RAD_ERR_NOMEM && tracer == NULL);
+        CHECK(rad_memory_budget_refusal(text, sizeof(text)));
+        by_monitor += strstr(error.message, "Embree error 4 (out of memory) while building "
+                                            "the BVH") != NULL;
+    }
+    printf("Embree monitor: %d budgets refused, %d of them during the build\n", refused,
+           by_monitor);
+    CHECK(tracer != NULL);
+    CHECK(by_monitor > 0);
+    rad_tracer_destroy(tracer);
+    rad_memory_budget_set(0);
+    free(positions);
+    free(triangles);
+}
+
 int main(void)
 {
     test_tmpdir();
     check_library_budget();
+    check_embree_monitor();
     rad_scene *scene = NULL;
     rad_mesh *mesh = NULL;
     rad_error error = {0};
