@@ -1551,10 +1551,10 @@ uint64_t rad_peak_memory_bytes(void);
  *     were out of memory (RAD_ERR_NOMEM from the function that made it; nothing is
  *     written), and Embree's monitor cancels a BVH build that would (RAD_ERR_NOMEM);
  *     rad_memory_budget_refusal then says how much was asked for;
- *   - the hierarchical solver's links get what is left after its trees, less a quarter
- *     kept for its other buffers (rad_scene_solve_options.max_memory).
- * Small allocations are checked once every megabyte of them per thread, so the heap may
- * pass the budget by at most 1 MB per thread. Thread safe. */
+ *   - the hierarchical solver's links get what is left after its trees and 2 MB a thread,
+ *     less a quarter kept for its per-pass buffers (rad_scene_solve_options.max_memory).
+ * Small allocations (and Embree's small blocks) are checked once every megabyte of them
+ * per thread, so the heap may pass the budget by at most 1 MB per thread. Thread safe. */
 
 /* Sets the budget to `bytes` (0 = none, the default) and clears the reservations, the
  * high-water mark and the recorded refusal. Set it before the run's first step. */
