@@ -1092,7 +1092,11 @@ typedef struct rad_scene_solve_options {
                                   RAD_ERR_NOMEM before any work (AUTO then chooses
                                   hierarchical). Hierarchical: the trees (a bound, about
                                   700 n bytes) must fit, else RAD_ERR_NOMEM; the links
-                                  get the rest (rad_hierarchy_options.max_memory) */
+                                  get the rest (rad_hierarchy_options.max_memory). With a
+                                  run's budget set (rad_memory_budget_set) the limit is
+                                  also what is left of it: for the dense matrix after the
+                                  patch inputs, the BVH and the threads; for the trees
+                                  with 2 MB a thread; the links a quarter less */
     uint64_t seed;
     int threads;               /* 0 = all cores */
     const volatile int *stop;  /* hierarchical: stops at the next sweep (report.interrupted) */
@@ -1561,6 +1565,67 @@ rad_status rad_write_file_atomic(const char *path, const void *data, size_t size
 
 /* Peak resident memory of this process so far, in bytes. */
 uint64_t rad_peak_memory_bytes(void);
+
+/* The memory budget (the CLI's --max-memory): one process-wide limit on the bytes the run
+ * holds, drawn down as it proceeds. "In use" is every byte of the C heap not yet freed
+ * (the library's buffers, the scene, mesh, patch inputs, trees, links, matrices, images,
+ * per-thread buffers, and Assimp's, libpng's, ... allocations: the allocator's own count)
+ * plus Embree's BVH blocks (its memory monitor; those Embree takes from malloc are
+ * counted twice, erring on the side of refusing) plus what rad_memory_budget_reserve
+ * promised to buffers made later. Not counted: the program's code and static data, the
+ * shared libraries, thread stacks, and heap memory freed but kept by the allocator (the
+ * gap between the budget and the peak resident size).
+ *
+ * With a budget set:
+ *   - steps whose size is known before their work refuse up front, with RAD_ERR_NOMEM and
+ *     a message "--max-memory: WHAT needs X, more than the Y left of the budget of Z":
+ *     the dense matrix (rad_solve_scene), the hierarchical trees, the Embree BVH (an
+ *     estimate of 128 bytes a triangle), the view-factor matrix (20 bytes an entry, up to
+ *     both directions of every pair of surfaces that do not face away), and the images
+ *     the CLI reserves;
+ *   - any other allocation of the library that would exceed it fails as if the machine
+ *     were out of memory (RAD_ERR_NOMEM from the function that made it; nothing is
+ *     written), and Embree's monitor cancels a BVH build that would (RAD_ERR_NOMEM);
+ *     rad_memory_budget_refusal then says how much was asked for;
+ *   - the hierarchical solver's links get what is left after its trees and 2 MB a thread,
+ *     less a quarter kept for its per-pass buffers (rad_scene_solve_options.max_memory).
+ * Small allocations (and Embree's small blocks) are checked once every megabyte of them
+ * per thread, so the heap may pass the budget by at most 1 MB per thread. Thread safe. */
+
+/* Sets the budget to `bytes` (0 = none, the default) and clears the reservations, the
+ * high-water mark and the recorded refusal. Set it before the run's first step. */
+void rad_memory_budget_set(uint64_t bytes);
+
+/* The budget set, 0 = none. */
+uint64_t rad_memory_budget(void);
+
+/* Bytes in use now as the budget counts them (heap + Embree), without reservations. */
+uint64_t rad_memory_in_use(void);
+
+/* Bytes left: the budget less what is in use and reserved (0 when over); UINT64_MAX
+ * without a budget. */
+uint64_t rad_memory_budget_left(void);
+
+/* The high-water mark since rad_memory_budget_set: the most that was in use and reserved
+ * plus the bytes asked for, at a check that passed. A run given exactly this budget makes
+ * the same checks and passes them (with one thread; Embree's parallel build and several
+ * threads' allocations make it vary by a little). 0 without a budget. */
+uint64_t rad_memory_budget_peak(void);
+
+/* Up-front check: RAD_OK when `bytes` more fit the budget (or there is none), else
+ * RAD_ERR_NOMEM with "--max-memory: WHAT needs X, more than the Y left of the budget of
+ * Z". Takes nothing: the step allocates afterwards, and those allocations count. */
+rad_status rad_memory_budget_need(uint64_t bytes, const char *what, rad_error *error);
+
+/* Promises `bytes` to a buffer made later (an image after the solve): counted as in use
+ * until rad_memory_budget_unreserve gives them back, just before that buffer is made. */
+void rad_memory_budget_reserve(uint64_t bytes);
+void rad_memory_budget_unreserve(uint64_t bytes);
+
+/* After a RAD_ERR_NOMEM: true when the budget refused something since it was set, with
+ * "--max-memory: X more, with Y in use, would exceed the budget of Z" (the first refusal)
+ * in `text`. */
+bool rad_memory_budget_refusal(char *text, size_t size);
 
 /* Seconds on a monotonic clock (CLOCK_MONOTONIC; its zero is arbitrary): the clock of every
  * `seconds` field of the reports above. A duration is the difference of two readings. */

@@ -42,7 +42,13 @@ void cli_warn(const char *format, ...)
 
 int cli_failed(const rad_error *error)
 {
-    cli_error("%s", error->message);
+    /* out of memory under --max-memory: say it was the budget, and how much was asked */
+    char refusal[192];
+    if (error->status == RAD_ERR_NOMEM && strncmp(error->message, "--max-memory", 12) != 0 &&
+        rad_memory_budget_refusal(refusal, sizeof(refusal)))
+        cli_error("%s: %s", error->message, refusal);
+    else
+        cli_error("%s", error->message);
     return EXIT_ERROR;
 }
 
@@ -401,30 +407,29 @@ uint64_t cli_image_bytes(const cli_view *view, const char *path, int images)
     return pixels * (uint64_t)images * 3 * sizeof(float) + (png_auto ? pixels * sizeof(double) : 0);
 }
 
-/* A byte count for a message, in the units --max-memory takes (powers of 1024). */
-static void format_bytes(uint64_t bytes, char *text, size_t size)
-{
-    if (bytes < 1024)
-        snprintf(text, size, "%llu bytes", (unsigned long long)bytes);
-    else if (bytes < 1024u * 1024 * 1024)
-        snprintf(text, size, "%.1f MB", bytes / 1048576.0);
-    else
-        snprintf(text, size, "%.2f GB", bytes / 1073741824.0);
-}
+/* What cli_memory_take reserved and cli_memory_release gives back. */
+static uint64_t memory_reserved;
 
-bool cli_memory_take(uint64_t *budget, uint64_t need, const char *what)
+void cli_memory_budget(uint64_t bytes) { rad_memory_budget_set(bytes); }
+
+bool cli_memory_take(uint64_t need, const char *what)
 {
-    if (*budget == 0)
+    if (rad_memory_budget() == 0)
         return true;
-    if (need >= *budget) {
-        char needed[32], given[32];
-        format_bytes(need, needed, sizeof(needed));
-        format_bytes(*budget, given, sizeof(given));
-        cli_error("--max-memory: %s needs %s, more than the budget of %s", what, needed, given);
+    rad_error error = {0};
+    if (rad_memory_budget_need(need, what, &error) != RAD_OK) {
+        cli_error("%s", error.message);
         return false;
     }
-    *budget -= need;
+    rad_memory_budget_reserve(need);
+    memory_reserved += need;
     return true;
+}
+
+void cli_memory_release(void)
+{
+    rad_memory_budget_unreserve(memory_reserved);
+    memory_reserved = 0;
 }
 
 bool cli_image_output_ok(const char *path)
@@ -503,6 +508,7 @@ rad_status cli_image_run_begin(cli_image_run *run, const char *scene_path,
         return status;
     run->camera = cli_view_camera(view, run->scene);
     cli_progress_mark(); /* the trace's phase starts here, after the load */
+    cli_memory_release(); /* the images reserved up front are made now */
     return rad_image_create(view->width, view->height, &run->image, error);
 }
 
@@ -807,6 +813,10 @@ int cli_finish(cli_stats *stats, const char *stats_path, const char *summary_for
 {
     if (stats_path) {
         stats_integer(stats, "peak_memory_bytes", rad_peak_memory_bytes());
+        if (rad_memory_budget()) {
+            stats_integer(stats, "memory_budget_bytes", rad_memory_budget());
+            stats_integer(stats, "memory_budget_peak_bytes", rad_memory_budget_peak());
+        }
         if (!stats_write(stats, stats_path))
             return EXIT_ERROR;
     }

@@ -144,9 +144,9 @@ enum {
     "  --refine-threshold X hierarchical: split a link while B x F x A exceeds X times\n"   \
     "                       the emitted power per patch (default "                     \
     CLI_STR(RAD_DEFAULT_REFINE_THRESHOLD) "; smaller = finer)\n"  \
-    "  --max-memory SIZE    bytes for the image, the dense matrix (4 n^2) or the trees\n"  \
-    "                       and links (K, M, G): refused up front if it cannot fit, or\n" \
-    "                       links stop there, saying so (default: half of RAM)\n"          \
+    "  --max-memory SIZE    bytes the whole run may hold (K, M, G): known sizes (image,\n" \
+    "                       matrix 4 n^2, trees) refused up front, links stop there,\n"    \
+    "                       the rest an error (default: none; links: half of RAM)\n"       \
     "  --tolerance X        relative residual, or unshot fraction for shoot, or change of\n" \
     "                       a sweep for hierarchical (default "                            \
     CLI_STR(RAD_DEFAULT_TOLERANCE) ")\n"                                                   \
@@ -303,10 +303,18 @@ bool cli_parse_bytes(const char *name, const char *text, uint64_t *out);
  * --max-memory must hold for them from the start. */
 uint64_t cli_image_bytes(const cli_view *view, const char *path, int images);
 
-/* --max-memory: with a budget (*budget > 0), `need` bytes for `what` ("the 512 x 512
- * image") come out of it; false, with the line "--max-memory: WHAT needs X, more than the
- * budget of Y", when they do not fit. True at once without a budget. */
-bool cli_memory_take(uint64_t *budget, uint64_t need, const char *what);
+/* --max-memory SIZE (0 = not given): the whole run's memory budget (rad_memory_budget_set),
+ * set before anything is loaded. */
+void cli_memory_budget(uint64_t bytes);
+
+/* Up front: `need` bytes for `what`, made later ("the 512 x 512 image"), are reserved out
+ * of the budget (rad_memory_budget_reserve); false, after printing the line "--max-memory:
+ * WHAT needs X, more than the Y left of the budget of Z", when they do not fit. True at
+ * once without a budget. */
+bool cli_memory_take(uint64_t need, const char *what);
+
+/* Gives back what cli_memory_take reserved, just before those buffers are made. */
+void cli_memory_release(void);
 
 /* True for .png, .hdr and .pfm; prints the usage error otherwise. */
 bool cli_image_output_ok(const char *path);

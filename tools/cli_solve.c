@@ -63,6 +63,7 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
     if (args->value[OPT_MAX_MEMORY] &&
         !cli_parse_bytes("max-memory", args->value[OPT_MAX_MEMORY], &o->max_memory))
         return false;
+    cli_memory_budget(o->max_memory);
     o->quadrature = shared->formfactor.quadrature;
     o->visibility_rays = shared->formfactor.visibility_rays;
     o->seed = shared->seed;
@@ -79,12 +80,10 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
     if (solve->solution_path) {
         /* nothing is solved: options of the form factors and the solver have no effect */
         static const int unused[] = {OPT_SOLVER,          OPT_TOLERANCE,  OPT_MAX_ITERATIONS,
-                                     OPT_VISIBILITY_RAYS, OPT_QUADRATURE, OPT_REFINE_THRESHOLD,
-                                     OPT_MAX_MEMORY};
+                                     OPT_VISIBILITY_RAYS, OPT_QUADRATURE, OPT_REFINE_THRESHOLD};
         static const char *const names[] = {"--solver",          "--tolerance",
                                             "--max-iterations",  "--visibility-rays",
-                                            "--quadrature",      "--refine-threshold",
-                                            "--max-memory"};
+                                            "--quadrature",      "--refine-threshold"};
         char given[192] = "";
         for (size_t k = 0; k < sizeof(unused) / sizeof(unused[0]); k++)
             if (args->value[unused[k]]) {

@@ -33,7 +33,9 @@ static const char usage[] =
     "  --standard-error FILE  also write each pixel's standard error of the mean, per\n"
     "                       channel (.hdr, .pfm or .exr)\n"
     CLI_TWO_SIDED_HELP
-    "  --max-memory SIZE    refuse at once images needing more bytes (K, M, G)\n"
+    "  --max-memory SIZE    bytes the whole run may hold (K, M, G): images (refused at\n"
+    "                       once when they cannot fit), scene, BVH, buffers; anything\n"
+    "                       else past it ends the run with an error\n"
     CLI_BASE_HELP("rays, times, mean radiance and peak memory");
 
 enum { OPT_MAX_DEPTH = OPT_OWN, OPT_STANDARD_ERROR, OPT_TWO_SIDED, OPT_COUNT };
@@ -128,7 +130,8 @@ int command_pathtrace(int argc, char **argv)
     char image_name[80];
     snprintf(image_name, sizeof(image_name), "the %u x %u image%s", s.view.width,
              s.view.height, images == 2 ? " with its standard error" : "");
-    if (!cli_memory_take(&s.max_memory, cli_image_bytes(&s.view, output, images), image_name))
+    cli_memory_budget(s.max_memory);
+    if (!cli_memory_take(cli_image_bytes(&s.view, output, images), image_name))
         return EXIT_ERROR;
 
     rad_error error = {0};

@@ -33,7 +33,9 @@ static const char usage[] =
     "                       (default " CLI_STR(RAD_DEFAULT_LIGHT_SAMPLES) ")\n"
     "  --max-depth N        most mirror reflections followed (default "
     CLI_STR(RAD_DEFAULT_MAX_DEPTH) ")\n"
-    "  --max-memory SIZE    refuse at once an image needing more bytes (K, M, G)\n"
+    "  --max-memory SIZE    bytes the whole run may hold (K, M, G): the image (refused\n"
+    "                       at once when it cannot fit), scene, BVH, buffers; anything\n"
+    "                       else past it ends the run with an error\n"
     CLI_CAMERA_HELP
     "  --spp N              samples per pixel, rounded to a square, stratified, box filter\n"
     "                       (default " CLI_STR(RAD_DEFAULT_RAYTRACE_SPP) "; 1 = through the pixel centre)\n"
@@ -176,9 +178,9 @@ int command_raytrace(int argc, char **argv)
     }
     char image_name[64];
     snprintf(image_name, sizeof(image_name), "the %u x %u image", s.view.width, s.view.height);
+    cli_memory_budget(s.max_memory);
     if (!cli_outputs_writable((const char *[]){s.shared.output, s.shared.stats_path}, 2) ||
-        !cli_memory_take(&s.max_memory, cli_image_bytes(&s.view, s.shared.output, 1),
-                         image_name)) {
+        !cli_memory_take(cli_image_bytes(&s.view, s.shared.output, 1), image_name)) {
         free(s.lights);
         return EXIT_ERROR;
     }

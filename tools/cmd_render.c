@@ -172,9 +172,7 @@ int command_render(int argc, char **argv)
         return EXIT_ERROR;
     char image_name[64];
     snprintf(image_name, sizeof(image_name), "the %u x %u image", s.view.width, s.view.height);
-    if (!s.solve.solution_path &&
-        !cli_memory_take(&s.solve.options.max_memory, cli_image_bytes(&s.view, s.output, 1),
-                         image_name))
+    if (!cli_memory_take(cli_image_bytes(&s.view, s.output, 1), image_name))
         return EXIT_ERROR;
 
     rad_error error = {0};
@@ -192,6 +190,7 @@ int command_render(int argc, char **argv)
         s.render.materials = solved.scene->materials;
     s.render.scene = solved.scene;
     s.render.inputs = solved.inputs;
+    cli_memory_release(); /* the image reserved up front is made now */
     status = rad_image_create(s.view.width, s.view.height, &image, &error);
     cli_progress_mark();
     if (status == RAD_OK)

@@ -43,6 +43,11 @@ static const char usage[] =
     CLI_STR(RAD_DEFAULT_ACCURACY) ")\n"
     "  --max-rays N         visibility rays per sampled polygon pair at most\n"
     "                       (default " CLI_STR(RAD_DEFAULT_MAX_RAYS) ")\n"
+    "  --max-memory SIZE    bytes the whole run may hold (K, M, G): scene, occluders,\n"
+    "                       per-thread buffers, matrix. Refused up front when the matrix's\n"
+    "                       bound cannot fit (24 bytes per pair of surfaces that do not\n"
+    "                       face away, plus 20 per factor); anything else that would\n"
+    "                       exceed it ends the run with an error (default: no budget)\n"
     CLI_BASE_HELP("counts, times, invariants and error bounds");
 
 enum {
@@ -54,7 +59,8 @@ static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS, CLI_SCENE_OPTIONS, [OPT_ACCURACY] = {"accuracy", 0, true},
     [OPT_MAX_RAYS] = {"max-rays", 0, true},   [OPT_FORMAT] = {"format", 0, true},
     [OPT_ENCLOSURE] = {"enclosure", 0, false}, [OPT_SCRIPT_F] = {"script-f", 0, false},
-    [OPT_OBSTRUCTION] = {"obstruction", 0, true}, [OPT_TWO_SIDED] = {"two-sided", 0, true}};
+    [OPT_OBSTRUCTION] = {"obstruction", 0, true}, [OPT_TWO_SIDED] = {"two-sided", 0, true},
+    [OPT_MAX_MEMORY] = {"max-memory", 0, true}};
 
 /* --obstruction files at most; as many SCENE files (cli_args.positional). */
 #define MAX_FILES 256
@@ -118,6 +124,11 @@ int command_viewfactors(int argc, char **argv)
     }
     if (!cli_parse_count("max-rays", args.value[OPT_MAX_RAYS], 64, 1u << 24, &vf.max_rays))
         return EXIT_USAGE;
+    uint64_t max_memory = 0;
+    if (args.value[OPT_MAX_MEMORY] &&
+        !cli_parse_bytes("max-memory", args.value[OPT_MAX_MEMORY], &max_memory))
+        return EXIT_USAGE;
+    cli_memory_budget(max_memory);
     const char *output = shared.output, *stats_path = shared.stats_path;
     rad_viewfactor_write_options write = {RAD_VIEWFACTOR_CSV, false, false};
     if (output)

@@ -5,6 +5,8 @@
 
 #include <stdatomic.h>
 
+#include "core/memory.h"
+
 static atomic_bool hook_armed;
 static atomic_uint_fast64_t hook_count;
 static atomic_uint_fast64_t hook_fail_at;
@@ -39,7 +41,7 @@ void *rad_alloc_array(size_t count, size_t size)
 {
     if (size != 0 && count > SIZE_MAX / size)
         return NULL;
-    if (hook_fails())
+    if (hook_fails() || !rad_memory_budget_allows((uint64_t)count * size))
         return NULL;
     return calloc(count ? count : 1, size ? size : 1);
 }
@@ -48,9 +50,9 @@ void *rad_resize_array(void *array, size_t count, size_t size)
 {
     if (size != 0 && count > SIZE_MAX / size)
         return NULL;
-    if (hook_fails())
-        return NULL;
     size_t bytes = count * size;
+    if (hook_fails() || !rad_memory_budget_allows(bytes))
+        return NULL;
     return realloc(array, bytes ? bytes : 1);
 }
 

@@ -11,6 +11,10 @@
  * require a clean RAD_ERR_NOMEM each time. Only tests call it; unarmed, the cost is one
  * relaxed atomic load per allocation. Allocations made inside Embree, Assimp, libpng,
  * libjpeg, cJSON and OpenEXR do not pass through here.
+ *
+ * With a memory budget set (rad_memory_budget_set, --max-memory), an allocation that
+ * would take the run over it fails the same way (NULL, then the caller's RAD_ERR_NOMEM),
+ * and rad_memory_budget_refusal says how much was asked for (core/memory.h).
  */
 #ifndef RAD_CORE_ALLOC_H
 #define RAD_CORE_ALLOC_H

@@ -23,6 +23,15 @@
  * form-factor computation itself refuses above 3/4). */
 #define AUTO_DENSE_MEMORY_SHARE 0.5
 
+/* What each thread of the hierarchical solver holds besides the links, at most: its
+ * refinement ray buffers (4096 links x 4 segments and 64 more, about 1 MB) and its final
+ * gather's, rounded up. */
+#define HIERARCHY_THREAD_BYTES ((uint64_t)2 << 20)
+
+/* What each thread of the dense form-factor computation holds besides the matrix, at
+ * most (its pair buffers: 192 KB measured, rounded up). */
+#define FORMFACTOR_THREAD_BYTES ((uint64_t)256 << 10)
+
 static double seconds_now(void) { return omp_get_wtime(); }
 
 /* The dense solvers' matrices: F in floats, and the direct solver's LU copy in doubles. */
@@ -37,6 +46,44 @@ double rad_default_patch_size(const rad_scene *scene, rad_solver solver)
     return rad_mesh_default_patch_size(scene, solver == RAD_SOLVER_HIERARCHICAL
                                                   ? RAD_HIERARCHICAL_DEFAULT_PATCHES
                                                   : RAD_DEFAULT_PATCHES);
+}
+
+/* What the solver's large buffers may take: options.max_memory, and, with a memory budget
+ * set (rad_memory_budget_set, --max-memory), no more than is left of it; 0 = no limit. */
+static uint64_t solver_budget(const rad_scene_solve_options *o)
+{
+    uint64_t left = rad_memory_budget_left();
+    if (left == UINT64_MAX)
+        return o->max_memory;
+    if (left == 0)
+        left = 1; /* nothing left is still a limit */
+    return o->max_memory && o->max_memory < left ? o->max_memory : left;
+}
+
+/* " the budget of X MB", or with a memory budget set " the X MB left of the budget of Y
+ * MB", for the messages of a buffer that does not fit `budget` (solver_budget). */
+static void budget_words(uint64_t budget, char *text, size_t size)
+{
+    uint64_t whole = rad_memory_budget();
+    if (whole && budget < whole)
+        snprintf(text, size, "the %.1f MB left of the budget of %.1f MB", budget / 1048576.0,
+                 whole / 1048576.0);
+    else
+        snprintf(text, size, "the budget of %.1f MB", budget / 1048576.0);
+}
+
+/* With a memory budget: what rad_solve_scene makes before a dense solver's matrix, so
+ * that the matrix is judged on what those leave: the patch inputs (unless the caller
+ * gives them), the occluders' BVH (its estimate) and the form factors' per-thread
+ * buffers. */
+static uint64_t before_matrix_bytes(const rad_scene *scene, const rad_mesh *mesh,
+                                    const rad_scene_solve_options *o)
+{
+    uint64_t n = mesh->patch_count;
+    uint64_t inputs = o->inputs ? 0 : n * (sizeof(double) + 5 * sizeof(rad_rgb));
+    uint64_t threads = o->threads > 0 ? (uint64_t)o->threads : (uint64_t)omp_get_max_threads();
+    return inputs + (uint64_t)scene->triangle_count * RAD_EMBREE_BYTES_PER_TRIANGLE +
+           threads * FORMFACTOR_THREAD_BYTES;
 }
 
 rad_solver rad_solve_scene_choice(const rad_mesh *mesh, const rad_scene_solve_options *options,
@@ -55,15 +102,16 @@ rad_solver rad_solve_scene_choice(const rad_mesh *mesh, const rad_scene_solve_op
         return o->solver;
     }
     double matrix_bytes = (double)patches * patches * sizeof(float);
+    uint64_t budget = solver_budget(o);
     uint64_t physical = rad_physical_memory_bytes();
     if (patches > RAD_DENSE_MAX_PATCHES) {
         snprintf(reason, size, "%u patches > %d: no dense matrix", patches,
                  RAD_DENSE_MAX_PATCHES);
         return RAD_SOLVER_HIERARCHICAL;
     }
-    if (o->max_memory && matrix_bytes > (double)o->max_memory) {
+    if (budget && matrix_bytes > (double)budget) {
         snprintf(reason, size, "the %.1f MB matrix would not fit --max-memory (%.1f MB)",
-                 matrix_bytes / 1048576.0, (double)o->max_memory / 1048576.0);
+                 matrix_bytes / 1048576.0, (double)budget / 1048576.0);
         return RAD_SOLVER_HIERARCHICAL;
     }
     if (physical && matrix_bytes > AUTO_DENSE_MEMORY_SHARE * (double)physical) {
@@ -150,19 +198,33 @@ static rad_status solve_hierarchy(const rad_scene *scene, const rad_mesh *mesh, 
                                   const rad_scene_solve_options *o, rad_rgb *B,
                                   rad_scene_solve_report *r, rad_error *error)
 {
-    uint64_t link_budget = o->max_memory;
-    if (o->max_memory) {
+    uint64_t budget = solver_budget(o), link_budget = budget;
+    if (budget) {
         /* the budget holds the trees first: at most 2 n - 1 elements over the planes and
-         * n - 1 clusters above them, with their values, and the per-patch arrays */
+         * n - 1 clusters above them, with their values, and the per-patch arrays; within a
+         * run's budget (rad_memory_budget_set) also each thread's buffers besides the
+         * links (refinement's ray buffers, the final gather's) */
         uint64_t n = mesh->patch_count;
         uint64_t trees = 3 * n * (sizeof(hnode) + 3 * sizeof(rad_rgb) + sizeof(size_t)) +
                          n * (sizeof(rad_rgb) + sizeof(float) + sizeof(uint32_t) + sizeof(double));
-        if (trees >= o->max_memory)
+        uint64_t threads = o->threads > 0 ? (uint64_t)o->threads
+                                          : (uint64_t)omp_get_max_threads();
+        bool whole_run = rad_memory_budget() != 0;
+        uint64_t need = trees + (whole_run ? threads * HIERARCHY_THREAD_BYTES : 0);
+        if (need >= budget) {
+            char words[96];
+            budget_words(budget, words, sizeof(words));
             return rad_fail(error, RAD_ERR_NOMEM,
-                            "--max-memory: the element and cluster trees of %u patches need up "
-                            "to %.1f MB, more than the budget of %.1f MB",
-                            mesh->patch_count, trees / 1048576.0, o->max_memory / 1048576.0);
-        link_budget = o->max_memory - trees;
+                            "--max-memory: the element and cluster trees of %u patches%s need "
+                            "up to %.1f MB, more than %s",
+                            mesh->patch_count,
+                            whole_run ? " and the solver's per-thread buffers" : "",
+                            need / 1048576.0, words);
+        }
+        link_budget = budget - need;
+        /* and a pass's per-link decisions and ranking, at most a quarter of the links' */
+        if (whole_run)
+            link_budget -= link_budget / 4;
     }
     rad_hierarchy_options h = {o->refine_threshold, o->visibility_rays, o->tolerance,
                                o->max_iterations,   link_budget,        o->seed,
@@ -216,17 +278,29 @@ rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
     double t0 = seconds_now();
     r.patches = mesh->patch_count;
     r.solver_chosen = o.solver == RAD_SOLVER_AUTO;
+    /* the choice and the matrix's check see the budget as the steps before the matrix
+     * will leave it: those bytes are promised while they look */
+    uint64_t before_matrix = rad_memory_budget() ? before_matrix_bytes(scene, mesh, &o) : 0;
+    rad_memory_budget_reserve(before_matrix);
     r.solver = rad_solve_scene_choice(mesh, &o, r.reason, sizeof(r.reason));
     double dense_bytes = dense_matrix_bytes(mesh->patch_count, r.solver);
-    if (o.max_memory && r.solver != RAD_SOLVER_HIERARCHICAL &&
-        dense_bytes > (double)o.max_memory)
+    uint64_t budget = solver_budget(&o);
+    rad_memory_budget_unreserve(before_matrix);
+    if (budget && r.solver != RAD_SOLVER_HIERARCHICAL && dense_bytes > (double)budget) {
+        char words[96], before[96] = "";
+        budget_words(budget, words, sizeof(words));
+        if (before_matrix)
+            snprintf(before, sizeof(before),
+                     " after %.1f MB for the patch inputs, the occluders and the threads",
+                     before_matrix / 1048576.0);
         return rad_fail(error, RAD_ERR_NOMEM,
                         "--max-memory: the %s solver's matrix for %u patches needs %.1f MB (%s), "
-                        "more than the budget of %.1f MB: use a larger --patch-size, the "
-                        "hierarchical solver or a larger budget",
+                        "more than %s%s: use a larger --patch-size, the hierarchical solver or "
+                        "a larger budget",
                         rad_solver_name(r.solver), mesh->patch_count, dense_bytes / 1048576.0,
-                        r.solver == RAD_SOLVER_DIRECT ? "12 n^2 bytes" : "4 n^2 bytes",
-                        (double)o.max_memory / 1048576.0);
+                        r.solver == RAD_SOLVER_DIRECT ? "12 n^2 bytes" : "4 n^2 bytes", words,
+                        before);
+    }
     if (!rad_scene_has_emitter(scene) && scene->light_count == 0)
         rad_warn(o.log, o.log_user,
                  "%s: no surface emits light (no material with non-zero Ke) and no light "

@@ -12,10 +12,13 @@
  *
  * Memory: each row keeps only its non-zero G_IJ (J >= I) while it is computed; the rows
  * are then assembled into compressed sparse rows. Random numbers come from (seed, p, q),
- * so the result is bitwise the same for any thread count.
+ * so the result is bitwise the same for any thread count. With a memory budget set
+ * (rad_memory_budget_set), the matrix is refused up front when its bound cannot fit
+ * (matrix_bound_bytes).
  */
 #include <math.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -105,6 +108,33 @@ static bool behind_plane(const vf_geometry *g, const vf_surface *plane, const vf
 static bool surfaces_face_away(const vf_geometry *g, const vf_surface *a, const vf_surface *b)
 {
     return behind_plane(g, a, b) || behind_plane(g, b, a);
+}
+
+/* The most the matrix can take: every pair (I, J >= I) that the rows will visit (both
+ * with polygons, not facing away, a planar surface not with itself) one pending entry
+ * while computing, and its one or two entries (F_IJ and F_JI) of the assembled matrix
+ * (column, value and bound) while the pending rows are still held. *pairs receives the
+ * pair count. */
+static uint64_t matrix_bound_bytes(const vf_geometry *g, uint64_t *pairs)
+{
+    uint64_t visited = 0, entries = 0;
+    for (uint32_t I = 0; I < g->surface_count; I++) {
+        const vf_surface *a = &g->surfaces[I];
+        if (a->polygon_count == 0)
+            continue;
+        for (uint32_t J = I; J < g->surface_count; J++) {
+            const vf_surface *b = &g->surfaces[J];
+            if (b->polygon_count == 0 || (J == I && a->planar) ||
+                (J != I && surfaces_face_away(g, a, b)))
+                continue;
+            visited++;
+            entries += J == I ? 1 : 2;
+        }
+    }
+    *pairs = visited;
+    return visited * sizeof(row_entry) +
+           entries * (sizeof(uint32_t) + 2 * sizeof(double)) +
+           2 * ((uint64_t)g->surface_count + 1) * sizeof(uint64_t);
 }
 
 /* G_pq and its error bound; 0 when they do not face each other. */
@@ -299,6 +329,18 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     rad_status status = vf_geometry_build(scene, &geometry, error);
     if (status != RAD_OK)
         return status;
+    if (rad_memory_budget()) {
+        uint64_t pairs, bound = matrix_bound_bytes(&geometry, &pairs);
+        char what[128];
+        snprintf(what, sizeof(what),
+                 "the view-factor matrix of %u surfaces (%llu pairs that face each other)",
+                 scene->surface_count, (unsigned long long)pairs);
+        status = rad_memory_budget_need(bound, what, error);
+        if (status != RAD_OK) {
+            vf_geometry_free(&geometry);
+            return status;
+        }
+    }
     status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);

@@ -8,6 +8,10 @@
  * tracer_internal.h), thread safe because nothing but the stack is written. Embree 4 drops
  * the stream calls: only the two query functions here would change.
  *
+ * Memory: Embree's monitor counts every block it allocates against the run's budget
+ * (core/memory.h), which cancels a build that would exceed it; before the build, an
+ * estimate (RAD_EMBREE_BYTES_PER_TRIANGLE) refuses up front one that cannot fit.
+ *
  * Not here: the front/back decision (rad_tracer_hit_front, shared with the oracle) and any
  * use of Embree's geometric normal, whose orientation convention is not ours.
  */
@@ -15,10 +19,12 @@
 
 #include <embree3/rtcore.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/memory.h"
 
 #if defined(__x86_64__) || defined(__i386__) || defined(_M_X64) || defined(_M_IX86)
 #include <pmmintrin.h>
@@ -30,6 +36,13 @@
 
 /* Rays converted per stream call: 256 RTCRayHit are 20 KiB of stack. */
 enum { CHUNK = 256 };
+
+/* Embree's memory monitor: its blocks count against the budget (memory.h). */
+static bool monitor_memory(void *user, ssize_t bytes, bool post)
+{
+    (void)user;
+    return rad_memory_budget_embree((int64_t)bytes, post);
+}
 
 struct rad_tracer_embree {
     RTCDevice device;
@@ -127,6 +140,7 @@ rad_status rad_tracer_embree_build(rad_tracer *tracer, rad_error *error)
                         "tracer: Embree error %d (%s) while creating the device", (int)code,
                         error_name(code));
     }
+    rtcSetDeviceMemoryMonitorFunction(e->device, monitor_memory, NULL);
     e->scene = rtcNewScene(e->device);
     rad_status status = check_device(e->device, "creating the scene", error);
     if (status != RAD_OK)
@@ -145,6 +159,12 @@ rad_status rad_tracer_embree_build(rad_tracer *tracer, rad_error *error)
         if (status != RAD_OK)
             return status;
     }
+    char what[64];
+    snprintf(what, sizeof(what), "the Embree BVH of %u triangles", tracer->triangle_count);
+    uint64_t estimate = (uint64_t)tracer->triangle_count * RAD_EMBREE_BYTES_PER_TRIANGLE;
+    status = rad_memory_budget_need(estimate, what, error);
+    if (status != RAD_OK)
+        return status;
     unsigned int modes = fp_modes_enter();
     rtcCommitScene(e->scene);
     fp_modes_leave(modes);
