@@ -489,6 +489,12 @@ int command_view(int argc, char **argv)
     char default_path[4096];
     default_output(input, default_path, sizeof(default_path));
     const char *output = shared.output ? shared.output : default_path;
+    const char *slash = strrchr(output, '/');
+    const char *dot = strrchr(slash ? slash + 1 : output, '.');
+    if (!dot || (strcasecmp(dot, ".html") != 0 && strcasecmp(dot, ".htm") != 0)) {
+        cli_error("%s: the page is HTML: give -o PAGE.html", output);
+        return EXIT_USAGE;
+    }
     const char *outputs[] = {output, shared.stats_path, solve.save_solution_path};
     if (!cli_outputs_writable(outputs, 3))
         return EXIT_ERROR;

@@ -241,6 +241,9 @@ test('bad input: one line naming the file, non-zero exit, no page written', () =
     assert.ok(lines[0].includes(input), `${name}: names the file: ${lines[0]}`);
     assert.equal(existsSync(output), false, `${name}: no page`);
   }
+  const clobber = spawnSync(tool, ['view', cornellGlb, '-o', cornellGlb], { encoding: 'utf8' });
+  assert.equal(clobber.status, 2, 'an output that is not .html is a usage error');
+  assert.ok(readFileSync(cornellGlb).equals(glb), 'the input is left as it was');
   const missing = spawnSync(tool, ['view', join(tmp, 'missing.glb'), '-o', join(tmp, 'm.html')], { encoding: 'utf8' });
   assert.notEqual(missing.status, 0);
   assert.ok(missing.stderr.includes('missing.glb'));
