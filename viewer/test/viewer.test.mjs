@@ -209,6 +209,62 @@ test('the false-colour legend spans the data: radiance in cd/m², illuminance in
   await page.close();
 });
 
+test('the exposure slider scales the shown radiance by 2^EV', async () => {
+  const { page, problems } = await open(cornellPage);
+  const linear = (v) => { const c = v / 255; return c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4); };
+  const shot = async (ev, name) => {
+    await page.evaluate((value) => {
+      const slider = document.getElementById('exposure');
+      slider.value = String(value);
+      slider.dispatchEvent(new Event('input'));
+    }, ev);
+    await page.evaluate(() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done))));
+    return (await canvasShot(page, join(tmp, name))).image;
+  };
+  const backWall = [420, 420, 559.2]; // the back wall, left of both blocks as the camera sees it
+  const at = (image) => meanColour(image, project(backWall, image.width, image.height));
+  const base = at(await shot(0, 'exposure_0.png'));
+  const darker = at(await shot(-1, 'exposure_minus_1.png'));
+  const darkest = at(await shot(-3, 'exposure_minus_3.png'));
+  assert.ok(base[1] > 60 && base[1] < 240, `a mid-tone pixel: ${base}`);
+  near(linear(darker[1]) / linear(base[1]), 0.5, 0.04, 'green at -1 EV over 0 EV');
+  near(linear(darkest[1]) / linear(base[1]), 0.125, 0.08, 'green at -3 EV over 0 EV');
+  assert.equal(await page.$eval('#exposure-value', (e) => e.textContent), '-3.0 EV');
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test('walking: W moves the eye forward by 2 % of the bounding radius a press', async () => {
+  const html = readFileSync(cornellPage, 'utf8');
+  const { page, problems } = await open(cornellPage);
+  // the bounding sphere as the viewer takes it: the box's centre, the farthest vertex
+  const p = embeddedAttribute(html, 'POSITION');
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let k = 0; k < p.length; k++) { lo[k % 3] = Math.min(lo[k % 3], p[k]); hi[k % 3] = Math.max(hi[k % 3], p[k]); }
+  const centre = lo.map((x, k) => (x + hi[k]) / 2);
+  let radius = 0;
+  for (let k = 0; k < p.length; k += 3) radius = Math.max(radius, Math.hypot(p[k] - centre[0], p[k + 1] - centre[1], p[k + 2] - centre[2]));
+  const presses = 10;
+  await page.click('#view canvas', { offset: { x: 5, y: 5 } });
+  for (let k = 0; k < presses; k++) await page.keyboard.press('w');
+  await page.evaluate(() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done))));
+  const { image } = await canvasShot(page, join(tmp, 'walked.png'));
+  const step = presses * 0.02 * radius; // along +z, the view's horizontal forward
+  const moved = { ...CAMERA, eye: [CAMERA.eye[0], CAMERA.eye[1], CAMERA.eye[2] + step],
+    target: [CAMERA.target[0], CAMERA.target[1], CAMERA.target[2] + step] };
+  const saved = { ...CAMERA };
+  Object.assign(CAMERA, moved);
+  const lightNow = meanColour(image, project(LIGHT_CENTRE, image.width, image.height));
+  const leftNow = meanColour(image, project(LEFT_WALL_POINT, image.width, image.height));
+  Object.assign(CAMERA, saved);
+  const lightBefore = meanColour(image, project(LIGHT_CENTRE, image.width, image.height));
+  assert.ok(lightNow.every((c) => c >= 250), `the light where it projects after the walk: ${lightNow}`);
+  assert.ok(!lightBefore.every((c) => c >= 250), `not where it was before: ${lightBefore}`);
+  assert.ok(leftNow[0] > 2 * leftNow[1], `the red wall where it projects after the walk: ${leftNow}`);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test('a lit mesh from `solve -o X.glb` opens as it is, picking shows the value there', async () => {
   const { page, problems, requests } = await open(glbPage);
   assert.deepEqual(requests, [`file://${glbPage}`]);
