@@ -64,8 +64,12 @@ try {
   if (pick) {
     const box = await (await page.$('#view canvas')).boundingBox();
     const [x, y] = pick.split(',').map(Number);
+    const t1 = Date.now();
     await page.mouse.click(box.x + x, box.y + y);
-    await page.waitForFunction(() => document.getElementById('picked').dataset.surface !== undefined);
+    await page.waitForFunction(() => document.getElementById('picked').dataset.surface !== undefined,
+      { polling: 10 });
+    console.log(`picked '${await page.$eval('#picked', (e) => e.dataset.surface)}' after ` +
+      `${((Date.now() - t1) / 1000).toFixed(2)} s`);
   }
   await page.evaluate(() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done))));
   await page.screenshot({ path: out });

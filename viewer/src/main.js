@@ -102,15 +102,15 @@ function start() {
   renderer.setPixelRatio(window.devicePixelRatio || 1);
   view.appendChild(renderer.domElement);
 
-  const start = defaultCamera(info, geometry);
+  const initial = defaultCamera(info, geometry);
   // near and far bound the depth buffer's resolution: at 1 % of the scene's radius the
   // Cornell box's light, 0.1 mm below its ceiling, does not fight it at 1 m
-  const camera = new PerspectiveCamera(start.fov, 1, geometry.boundingSphere.radius * 0.01,
+  const camera = new PerspectiveCamera(initial.fov, 1, geometry.boundingSphere.radius * 0.01,
     geometry.boundingSphere.radius * 20);
-  camera.position.copy(start.eye);
-  camera.up.copy(start.up);
+  camera.position.copy(initial.eye);
+  camera.up.copy(initial.up);
   const controls = new OrbitControls(camera, renderer.domElement);
-  controls.target.copy(start.target);
+  controls.target.copy(initial.target);
   controls.update();
 
   panel.appendChild(element('h1', {}, 'radiosity'));
