@@ -284,6 +284,14 @@ test('bad input: one line naming the file, non-zero exit, no page written', () =
     ['truncated.glb', glb.subarray(0, glb.length - 100)],
     ['bad_index.glb', (() => { const b = Buffer.from(glb); b.writeUInt32LE(0xfffffff0, b.length - 4); return b; })()],
     ['empty.glb', Buffer.alloc(0)],
+    ['nan_radiance.glb', (() => {
+      const b = Buffer.from(glb);
+      const jsonLength = b.readUInt32LE(12);
+      const gltf = JSON.parse(b.toString('utf8', 20, 20 + jsonLength));
+      const accessor = gltf.accessors[gltf.meshes[0].primitives[0].attributes._RADIANCE];
+      b.writeFloatLE(NaN, 20 + jsonLength + 8 + gltf.bufferViews[accessor.bufferView].byteOffset + 12 * 5);
+      return b;
+    })()],
   ];
   for (const [name, bytes] of cases) {
     const input = join(tmp, name);
