@@ -76,7 +76,7 @@ static void page_append(page *p, const void *bytes, size_t count)
         size_t capacity = p->capacity ? p->capacity : 1 << 16;
         while (capacity < p->length + count + 1)
             capacity *= 2;
-        char *grown = realloc(p->data, capacity);
+        char *grown = rad_resize_array(p->data, capacity, 1);
         if (!grown) {
             p->failed = true;
             return;
@@ -173,13 +173,13 @@ static bool read_whole_file(const char *path, unsigned char **bytes, size_t *siz
         return false;
     }
     size_t capacity = 1 << 16, length = 0;
-    unsigned char *data = malloc(capacity);
+    unsigned char *data = rad_alloc_array(capacity, 1);
     while (data) {
         size_t got = fread(data + length, 1, capacity - length, f);
         length += got;
         if (length < capacity)
             break;
-        unsigned char *grown = capacity <= SIZE_MAX / 2 ? realloc(data, capacity * 2) : NULL;
+        unsigned char *grown = capacity <= SIZE_MAX / 2 ? rad_resize_array(data, capacity * 2, 1) : NULL;
         if (!grown) {
             free(data);
             data = NULL;

@@ -53,6 +53,8 @@ try {
   await page.waitForFunction(() => document.body.dataset.ready && Number(document.body.dataset.frames || 0) > 0,
     { timeout: 600000, polling: 100 });
   const seconds = (Date.now() - t0) / 1000;
+  const pageMs = await page.evaluate(() => Number(document.body.dataset.firstFrameMs));
+  console.log(`${pagePath}: the page's own clock: first frame ${(pageMs / 1000).toFixed(2)} s after navigation began`);
   const metrics = await page.metrics();
   const rss = treeResidentBytes(browser.process().pid);
   console.log(`${pagePath}: first frame after ${seconds.toFixed(2)} s (navigation to first frame), ` +

@@ -204,6 +204,8 @@ function start() {
     requestAnimationFrame(() => {
       pending = false;
       renderer.render(scene, camera);
+      if (!document.body.dataset.firstFrameMs) // since navigation began: the load time
+        document.body.dataset.firstFrameMs = performance.now().toFixed(0);
       document.body.dataset.frames = String(Number(document.body.dataset.frames || 0) + 1);
     });
   }
