@@ -278,6 +278,13 @@ test('a lit mesh from `solve -o X.glb` opens as it is, picking shows the value t
   await page.close();
 });
 
+test('the page is the same bytes for 1 and 2 threads', () => {
+  const one = join(tmp, 'threads1.html'), two = join(tmp, 'threads2.html');
+  execFileSync(tool, ['view', '--threads', '1', '-o', one, '--quiet']);
+  execFileSync(tool, ['view', '--threads', '2', '-o', two, '--quiet']);
+  assert.ok(readFileSync(one).equals(readFileSync(two)));
+});
+
 test('bad input: one line naming the file, non-zero exit, no page written', () => {
   const glb = readFileSync(cornellGlb);
   const cases = [
