@@ -20,7 +20,7 @@ await build({
   minify: true,
   format: 'iife',
   target: 'es2020',
-  legalComments: 'none',
+  legalComments: 'eof', // three.js's MIT notice stays with the code
   outfile: out,
   logLevel: 'warning',
 });
