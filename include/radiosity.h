@@ -1480,6 +1480,14 @@ typedef struct rad_lit_mesh_options {
 rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char *path,
                               const rad_lit_mesh_options *options, rad_error *error);
 
+/* The patch (index into mesh->patches) of each triangle of the lit mesh rad_lit_mesh_write
+ * writes for this mesh, in the file's triangle order: *patch_of gets *triangle_count
+ * values (malloc'ed: free() it), so patches[p].surface and .material name what a picked
+ * triangle belongs to (`radiosity view` does). On failure *patch_of is NULL and
+ * *triangle_count 0. */
+rad_status rad_lit_mesh_triangle_patches(const rad_mesh *mesh, uint32_t **patch_of,
+                                         uint32_t *triangle_count, rad_error *error);
+
 /* A solution file: the per-patch radiosity B of one scene and meshing, so a scene is
  * solved once and rendered from many views (radiosity is view-independent). Binary,
  * little-endian: magic "\x89RADSOL\n", format version (uint32, RAD_SOLUTION_VERSION),

@@ -22,6 +22,8 @@ static const char usage[] =
     "                            at --points FILE: E_min, E_avg, E_max, uniformity\n"
     "  compare A B [-o DIFF]     differences between two HDR images (.pfm, .hdr, .exr)\n"
     "  info [SCENE]              what was read: surfaces, materials, emitters, camera\n"
+    "  view [SCENE|LIT.glb]      an HTML page showing the lit mesh in a browser (a build\n"
+    "                            with -DRAD_VIEWER=ON)\n"
     "  help [COMMAND]            this text, or a command's\n"
     "\n"
     "'radiosity COMMAND --help' tells a command's options.\n";
@@ -36,7 +38,7 @@ static const command commands[] = {
     {"viewfactors", command_viewfactors},
     {"raytrace", command_raytrace}, {"pathtrace", command_pathtrace},
     {"compare", command_compare},   {"info", command_info},
-    {"illuminance", command_illuminance},
+    {"illuminance", command_illuminance}, {"view", command_view},
 };
 
 static const command *find_command(const char *name)
