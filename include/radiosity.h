@@ -1331,8 +1331,11 @@ typedef struct rad_pathtrace_options {
 } rad_pathtrace_options;
 
 typedef struct rad_pathtrace_report {
-    uint64_t rays;  /* closest-hit and shadow rays */
+    uint64_t rays;  /* closest-hit and shadow rays (of every rank) */
     double seconds;
+    uint64_t rank_tiles;  /* 16 x 16 tiles this process traced: all of them unless the work
+                             was shared over MPI ranks (rad_ranks_begin) */
+    double rank_seconds;  /* this process's time tracing them (no waiting) */
 } rad_pathtrace_report;
 
 /* An unbiased path tracer for the same Lambertian scenes radiosity solves (albedo Kd,
@@ -1342,7 +1345,12 @@ typedef struct rad_pathtrace_report {
  * Russian roulette. Deterministic per seed for any thread count; parallel over tiles. The
  * reference for checking radiosity images. `standard_error` (NULL, or an image of the
  * same size) receives each pixel's standard error of the mean, per channel, estimated
- * from that pixel's own samples (+INFINITY with one sample per pixel). */
+ * from that pixel's own samples (+INFINITY with one sample per pixel).
+ * After rad_ranks_begin joined a job of several MPI ranks this is collective: every rank
+ * calls it with the same arguments, traces the tiles given to it by estimated cost, and
+ * rank 0's image (and standard error) is then whole, bitwise the same as a serial run's;
+ * the other ranks' images hold only their own tiles. A failure on any rank fails it on
+ * every rank (rank 0 alone may fail gathering). */
 rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
                          const rad_pathtrace_options *options, rad_image *image,
                          rad_image *standard_error, rad_pathtrace_report *report,

@@ -199,3 +199,10 @@ rad_status rad_ranks_gather_reports(const rad_rank_report *mine, rad_rank_report
 }
 
 int rad_ranks_failures(bool failed) { return ranks_failures(failed); }
+
+rad_status ranks_agree(rad_status status, const char *what, rad_error *error)
+{
+    if (ranks_failures(status != RAD_OK) && status == RAD_OK)
+        return rad_fail(error, RAD_ERR_INVALID, "%s: another rank failed", what);
+    return status;
+}

@@ -23,6 +23,11 @@ int ranks_count(void);
 /* Collective: how many ranks passed failed = true (0 when all went well). */
 int ranks_failures(bool failed);
 
+/* Collective: status when it failed here; when it is RAD_OK here but failed on another
+ * rank, RAD_ERR_INVALID with "WHAT: another rank failed" in error; else RAD_OK. For a
+ * step that may fail on one rank before the ranks work together. */
+rad_status ranks_agree(rad_status status, const char *what, rad_error *error);
+
 /* Collective: values[k] becomes the sum over ranks of values[k], on every rank. */
 void ranks_sum(uint64_t *values, int count);
 

@@ -459,9 +459,8 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     rad_tracer *occluders = NULL;
     pending_row *rows = NULL;
     rad_status status = vf_geometry_build(scene, &geometry, error);
-    if (status != RAD_OK)
-        return status;
-    status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
+    if (status == RAD_OK)
+        status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
     uint32_t n = scene->surface_count;
@@ -470,7 +469,9 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         if (!rows)
             status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u rows", n);
     }
+    status = ranks_agree(status, "view factors", error);
     if (status != RAD_OK) {
+        free(rows);
         rad_tracer_destroy(occluders);
         occluder_tree_destroy(tree);
         vf_geometry_free(&geometry);
