@@ -106,6 +106,17 @@ void ranks_sum(uint64_t *values, int count)
     }
 }
 
+void ranks_broadcast(void *data, uint64_t size)
+{
+    if (rank_total == 1)
+        return;
+    for (uint64_t at = 0; at < size; at += CHUNK_BYTES) {
+        uint64_t part = size - at < CHUNK_BYTES ? size - at : CHUNK_BYTES;
+        MPI_Bcast((unsigned char *)data + at, (int)part, MPI_BYTE, 0, MPI_COMM_WORLD);
+    }
+    bytes_communicated += size;
+}
+
 /* Sends or receives `size` bytes in chunks of at most CHUNK_BYTES. */
 static void send_bytes(const unsigned char *data, uint64_t size)
 {
@@ -169,6 +180,11 @@ int rad_ranks_begin(void) { return 1; }
 void rad_ranks_end(void) {}
 void rad_ranks_abort(int exit_code) { exit(exit_code); }
 int ranks_failures(bool failed) { return failed ? 1 : 0; }
+void ranks_broadcast(void *data, uint64_t size)
+{
+    (void)data;
+    (void)size;
+}
 void ranks_sum(uint64_t *values, int count)
 {
     (void)values;

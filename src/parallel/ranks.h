@@ -31,6 +31,9 @@ rad_status ranks_agree(rad_status status, const char *what, rad_error *error);
 /* Collective: values[k] becomes the sum over ranks of values[k], on every rank. */
 void ranks_sum(uint64_t *values, int count);
 
+/* Collective: rank 0's `size` bytes at `data` replace every other rank's. */
+void ranks_broadcast(void *data, uint64_t size);
+
 /* Collective: rank 0 receives every rank's `size` bytes at `data`, in rank order, in
  * *gathered (one allocation, free() it) with each rank's size in sizes[rank] (room for
  * ranks_count()); other ranks get *gathered = NULL. Fails (on every rank) when rank 0 is out

@@ -541,13 +541,14 @@ rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
 
     uint64_t tiles_x = (c.width - 1) / TILE + 1, tiles_y = (c.height - 1) / TILE + 1;
     uint64_t tiles = tiles_x * tiles_y;
-    /* over several ranks: who traces which tile (owner NULL: this process, all) */
+    /* over several ranks: who traces which tile (owner NULL: this process, all), decided
+     * by rank 0 alone so that no rank can disagree */
     int rank = ranks_rank();
     if (ranks_count() > 1) {
-        double *cost = rad_alloc_array(tiles, sizeof(double));
+        double *cost = rank == 0 ? rad_alloc_array(tiles, sizeof(double)) : NULL;
         owner = rad_alloc_array(tiles, sizeof(uint32_t));
-        bool failed = !cost || !owner || tiles > UINT32_MAX;
-        if (!failed) {
+        bool failed = (rank == 0 && !cost) || !owner || tiles > UINT32_MAX;
+        if (!failed && rank == 0) {
             estimate_tile_costs(&c, tiles, &workspaces[0], cost);
             failed = partition_by_cost(cost, (uint32_t)tiles, ranks_count(), owner, error) !=
                      RAD_OK;
@@ -555,6 +556,7 @@ rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
         free(cost);
         if (ranks_failures(failed))
             goto nomem;
+        ranks_broadcast(owner, tiles * sizeof(uint32_t));
     }
     uint64_t rank_tiles = 0;
     for (uint64_t tile = 0; tile < tiles; tile++)

@@ -248,21 +248,21 @@ static double pair_cost_estimate(const engine *e, const vf_surface *a, const vf_
 }
 
 /* cost[I]: row I's polygon pairs times the mean estimated cost of COST_SAMPLES of its
- * surface pairs, spread over J >= I. The same on every rank (no random numbers, and the
- * threads only split the rows). */
-static void estimate_row_costs(const engine *e, int threads, double *cost)
+ * surface pairs, spread over J >= I. False when out of memory. */
+static bool estimate_row_costs(const engine *e, int threads, double *cost)
 {
     const vf_geometry *g = e->geometry;
     uint32_t n = g->surface_count;
     double *polygons_after = rad_alloc_array((size_t)n + 1, sizeof(double));
-    if (polygons_after)
-        for (uint32_t I = n; I-- > 0;)
-            polygons_after[I] = polygons_after[I + 1] + g->surfaces[I].polygon_count;
+    if (!polygons_after)
+        return false;
+    for (uint32_t I = n; I-- > 0;)
+        polygons_after[I] = polygons_after[I + 1] + g->surfaces[I].polygon_count;
 #pragma omp parallel for schedule(dynamic, 16) num_threads(threads)
     for (uint32_t I = 0; I < n; I++) {
         const vf_surface *a = &g->surfaces[I];
         double p = a->polygon_count;
-        double pairs = polygons_after ? p * (polygons_after[I] - p) : p;
+        double pairs = p * (polygons_after[I] - p);
         if (!a->planar)
             pairs += 0.5 * p * (p - 1);
         if (a->polygon_count == 0 || !(pairs > 0)) {
@@ -282,6 +282,7 @@ static void estimate_row_costs(const engine *e, int threads, double *cost)
         cost[I] = pairs * (samples ? sum / samples : 1.0);
     }
     free(polygons_after);
+    return true;
 }
 
 /* Row I's record in the bytes sent to rank 0: I, count, then count (column, transfer,
@@ -481,17 +482,17 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     e.tree = tree;
     e.occluders = occluders;
 
-    /* over several ranks: who computes which row (owner NULL: this process, all) */
+    /* over several ranks: who computes which row (owner NULL: this process, all), decided
+     * by rank 0 alone so that no rank can disagree */
     uint32_t *owner = NULL;
     int rank = ranks_rank();
     if (ranks_count() > 1) {
-        double *cost = rad_alloc_array(n ? n : 1, sizeof(double));
+        double *cost = rank == 0 ? rad_alloc_array(n ? n : 1, sizeof(double)) : NULL;
         owner = rad_alloc_array(n ? n : 1, sizeof(uint32_t));
-        bool failed = !cost || !owner;
-        if (!failed) {
-            estimate_row_costs(&e, threads, cost);
-            failed = partition_by_cost(cost, n, ranks_count(), owner, error) != RAD_OK;
-        }
+        bool failed = (rank == 0 && !cost) || !owner;
+        if (!failed && rank == 0)
+            failed = !estimate_row_costs(&e, threads, cost) ||
+                     partition_by_cost(cost, n, ranks_count(), owner, error) != RAD_OK;
         free(cost);
         if (ranks_failures(failed)) {
             free(owner);
@@ -502,6 +503,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
             return rad_fail(error, RAD_ERR_NOMEM, "out of memory sharing %u rows over %d ranks",
                             n, ranks_count());
         }
+        ranks_broadcast(owner, (uint64_t)n * sizeof(uint32_t));
     }
 
     /* polygon pairs (I, J >= I) the rows of this rank will visit */
