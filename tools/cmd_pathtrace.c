@@ -142,7 +142,8 @@ int command_pathtrace(int argc, char **argv)
     rad_status status = cli_image_run_begin(&run, s.scene_path, &s.view, &error);
     if (status == RAD_OK)
         status = cli_apply_two_sided(&s.two_sided, run.scene, &error);
-    if (status == RAD_OK && !rad_scene_has_emitter(run.scene) && run.scene->light_count == 0)
+    if (status == RAD_OK && !rad_scene_has_emitter(run.scene) && run.scene->light_count == 0 &&
+        rad_rank() == 0) /* once per job */
         cli_warn("%s: no surface emits light (no material with non-zero Ke) and no light "
                  "source is given: the image will be black (--emit NAME=R,G,B makes a surface "
                  "a light; --point, --spot, --sun, --sky add sources)",

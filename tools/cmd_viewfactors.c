@@ -155,7 +155,7 @@ int command_viewfactors(int argc, char **argv)
     int cursor = 0;
     for (const char *name; status == RAD_OK && (name = cli_next_value(&args, OPT_TWO_SIDED, &cursor));)
         status = rad_scene_set_surface_flags(scene, name, RAD_SURFACE_TWO_SIDED, &error);
-    if (status == RAD_OK && is_vs3 && (control.row || control.col))
+    if (status == RAD_OK && is_vs3 && (control.row || control.col) && rad_rank() == 0)
         cli_warn("%s: the control line's row/col are ignored: every factor is computed",
                  scene->source);
     write.enclosure = args.value[OPT_ENCLOSURE] || (is_vs3 && control.enclosure);
