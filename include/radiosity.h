@@ -788,13 +788,21 @@ typedef struct rad_viewfactor_report {
     double largest_error_bound;  /* largest error_bound (absolute, in units of F) */
     double seconds;
     int threads;
+    uint32_t rank_rows;          /* rows this process computed: all of them unless the work
+                                    was shared over MPI ranks (rad_ranks_begin) */
+    double rank_seconds;         /* this process's time computing its rows (no waiting) */
 } rad_viewfactor_report;
 
 /* Computes the view factors between the scene's surfaces, each surface taken as a whole
  * (its triangles need not be coplanar: a curved surface given as a mesh is one surface and
  * may see itself). Every triangle of the scene, obstruction surfaces included, blocks.
  * Reciprocity A_I F_IJ = A_J F_JI holds by construction, 0 <= F_IJ <= 1, and an obstructed
- * factor never exceeds its unobstructed value. Memory grows with the non-zero count. */
+ * factor never exceeds its unobstructed value. Memory grows with the non-zero count.
+ * After rad_ranks_begin joined a job of several MPI ranks this is collective: every rank
+ * calls it with the same scene and options, computes the rows given to it by estimated
+ * cost (their obstruction), and rank 0 gets the whole matrix, bitwise the same as a serial
+ * run, and the report's counts summed over the ranks; the other ranks get *out = NULL (and
+ * RAD_OK). A failure on any rank fails it on every rank. */
 rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
                                          const rad_viewfactor_options *options,
                                          rad_viewfactor_matrix **out,
@@ -1363,8 +1371,11 @@ typedef struct rad_pathtrace_options {
 } rad_pathtrace_options;
 
 typedef struct rad_pathtrace_report {
-    uint64_t rays;  /* closest-hit and shadow rays */
+    uint64_t rays;  /* closest-hit and shadow rays (of every rank) */
     double seconds;
+    uint64_t rank_tiles;  /* 16 x 16 tiles this process traced: all of them unless the work
+                             was shared over MPI ranks (rad_ranks_begin) */
+    double rank_seconds;  /* this process's time tracing them (no waiting) */
 } rad_pathtrace_report;
 
 /* An unbiased path tracer for the same Lambertian scenes radiosity solves (albedo Kd,
@@ -1374,7 +1385,12 @@ typedef struct rad_pathtrace_report {
  * Russian roulette. Deterministic per seed for any thread count; parallel over tiles. The
  * reference for checking radiosity images. `standard_error` (NULL, or an image of the
  * same size) receives each pixel's standard error of the mean, per channel, estimated
- * from that pixel's own samples (+INFINITY with one sample per pixel). */
+ * from that pixel's own samples (+INFINITY with one sample per pixel).
+ * After rad_ranks_begin joined a job of several MPI ranks this is collective: every rank
+ * calls it with the same arguments, traces the tiles given to it by estimated cost, and
+ * rank 0's image (and standard error) is then whole, bitwise the same as a serial run's;
+ * the other ranks' images hold only their own tiles. A failure on any rank fails it on
+ * every rank (rank 0 alone may fail gathering). */
 rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
                          const rad_pathtrace_options *options, rad_image *image,
                          rad_image *standard_error, rad_pathtrace_report *report,
@@ -1634,6 +1650,50 @@ void rad_memory_budget_unreserve(uint64_t bytes);
  * "--max-memory: X more, with Y in use, would exceed the budget of Z" (the first refusal)
  * in `text`. */
 bool rad_memory_budget_refusal(char *text, size_t size);
+
+/* ---- Several processes: MPI ranks (a build with -DRAD_MPI=ON) ----
+ * A program (the tool) launched by `mpirun -np N` or `srun` calls rad_ranks_begin first;
+ * from then on the functions documented as collective share their work over the N ranks
+ * and return the result on rank 0. Without that call, in a build without RAD_MPI, or in a
+ * process not started by mpirun or srun, there is one rank and nothing changes. */
+
+/* Joins the MPI job when this process was launched by mpirun or srun (MPI_Init, OpenMP
+ * threads below each rank); returns the rank count (1 when not launched so, and always
+ * without RAD_MPI). */
+int rad_ranks_begin(void);
+
+/* Leaves the job (MPI_Finalize) when rad_ranks_begin joined it; one rank again. */
+void rad_ranks_end(void);
+
+/* This process's rank (0 .. count - 1) and the rank count: 0 and 1 outside a job. */
+int rad_rank(void);
+int rad_rank_count(void);
+
+/* Ends the whole job at once with exit_code (MPI_Abort over several ranks, else exit()):
+ * for a rank that failed alone, after it printed its message. The one library function
+ * that exits; it does not return. */
+void rad_ranks_abort(int exit_code);
+
+/* Bytes this rank has sent and received through the collective steps so far. */
+uint64_t rad_ranks_bytes_communicated(void);
+
+/* Collective: how many ranks pass failed = true (0 when every rank went well), on every
+ * rank: lets the ranks agree to stop together (same error everywhere) or to abort (a rank
+ * failed alone). Outside a job: failed ? 1 : 0. */
+int rad_ranks_failures(bool failed);
+
+/* One rank's share of a run, for the run summary. */
+typedef struct rad_rank_report {
+    uint64_t work;               /* items done: view-factor rows, image rows */
+    double seconds;              /* time spent on them (without waiting for other ranks) */
+    uint64_t peak_memory;        /* rad_peak_memory_bytes() */
+    uint64_t bytes_communicated; /* rad_ranks_bytes_communicated() */
+} rad_rank_report;
+
+/* Collective: every rank's report to rank 0's all[0 .. rad_rank_count() - 1] (other ranks'
+ * `all` is not touched). */
+rad_status rad_ranks_gather_reports(const rad_rank_report *mine, rad_rank_report *all,
+                                    rad_error *error);
 
 /* Seconds on a monotonic clock (CLOCK_MONOTONIC; its zero is arbitrary): the clock of every
  * `seconds` field of the reports above. A duration is the difference of two readings. */

@@ -1,7 +1,8 @@
 /*
  * cmd_pathtrace.c - `radiosity pathtrace [SCENE] -o OUT [options]`: the Monte-Carlo
  * reference image of a scene (or the built-in Cornell box) by unbiased path tracing.
- * A thin client of rad_pathtrace; nothing here computes light.
+ * A thin client of rad_pathtrace; nothing here computes light. Under mpirun the ranks
+ * share the tiles (the library does) and rank 0 alone writes.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -9,6 +10,7 @@
 #include <strings.h>
 
 #include "cli.h"
+#include "cli_ranks.h"
 
 static const char usage[] =
     "usage: radiosity pathtrace [SCENE] -o OUT [options]\n"
@@ -138,21 +140,32 @@ int command_pathtrace(int argc, char **argv)
     cli_image_run run;
     rad_image *standard_error = NULL;
     rad_pathtrace_report report = {0};
+    if (cli_ranks_begin() > 1 && rad_rank() != 0)
+        s.trace.progress = NULL; /* rank 0 shows its own tiles' progress */
     rad_status status = cli_image_run_begin(&run, s.scene_path, &s.view, &error);
     if (status == RAD_OK)
         status = cli_apply_two_sided(&s.two_sided, run.scene, &error);
-    if (status == RAD_OK && !rad_scene_has_emitter(run.scene) && run.scene->light_count == 0)
+    if (status == RAD_OK && !rad_scene_has_emitter(run.scene) && run.scene->light_count == 0 &&
+        rad_rank() == 0) /* once per job */
         cli_warn("%s: no surface emits light (no material with non-zero Ke) and no light "
                  "source is given: the image will be black (--emit NAME=R,G,B makes a surface "
                  "a light; --point, --spot, --sun, --sky add sources)",
                  run.scene->source);
     if (status == RAD_OK && (s.error_path || s.shared.stats_path))
         status = rad_image_create(s.view.width, s.view.height, &standard_error, &error);
-    if (status == RAD_OK)
-        status = rad_pathtrace(run.scene, &run.camera, &s.trace, run.image, standard_error,
-                               &report, &error);
-    if (status == RAD_OK)
-        status = cli_image_run_write(&run, output, &s.view, &error);
+    if (!cli_ranks_ok(status, &error))
+        goto fail;
+    status = rad_pathtrace(run.scene, &run.camera, &s.trace, run.image, standard_error, &report,
+                           &error);
+    if (!cli_ranks_ok(status, &error))
+        goto fail;
+    rad_rank_report rank_report = {report.rank_tiles, report.rank_seconds, 0, 0};
+    double imbalance = 1;
+    if (!cli_ranks_summary(&rank_report, "tiles", &imbalance, &error))
+        goto fail;
+    if (rad_rank() != 0) /* rank 0 has the whole image and writes it */
+        goto done;
+    status = cli_image_run_write(&run, output, &s.view, &error);
     if (status == RAD_OK && s.error_path)
         status = rad_image_write(standard_error, s.error_path,
                                  &(rad_image_write_options){.exr_float = s.view.write.exr_float},
@@ -176,16 +189,20 @@ int command_pathtrace(int argc, char **argv)
     if (standard_error)
         stats_number(&stats, "rms_standard_error", rms_standard_error(standard_error));
     cli_image_run_times(&run, &stats);
+    if (rad_rank_count() > 1) {
+        stats_integer(&stats, "ranks", (unsigned long long)rad_rank_count());
+        stats_number(&stats, "load_imbalance", imbalance);
+    }
     exit_code = cli_finish(&stats, s.shared.stats_path,
                            "%u samples per pixel, %.1f M rays (%.1f M/s), %.2f s: wrote %s%s%s",
                            spp, report.rays / 1e6, rays_per_second / 1e6, run.t_write - run.t0,
                            output, s.error_path ? " and " : "", s.error_path ? s.error_path : "");
     goto done;
 fail:
-    exit_code = cli_failed(&error);
+    exit_code = cli_ranks_failed(&error);
 done:
     cli_progress_end();
     rad_image_destroy(standard_error);
     cli_image_run_free(&run);
-    return exit_code;
+    return cli_ranks_end(exit_code);
 }

@@ -2,13 +2,15 @@
  * cmd_viewfactors.c - `radiosity viewfactors SCENE... [-o OUT]`: the surface-to-surface
  * view-factor matrix, a surface being an OBJ object or group, a View3D surface, or a whole
  * mesh file when several are given; then the optional enclosure correction and script-F
- * factors, written as CSV, Matrix Market or View3D's text layout.
+ * factors, written as CSV, Matrix Market or View3D's text layout. Under mpirun the ranks
+ * share the rows (the library does) and rank 0 alone does the rest and writes.
  */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
+#include "cli_ranks.h"
 
 static const char usage[] =
     "usage: radiosity viewfactors SCENE [MESH...] [-o OUT.csv|OUT.mtx] [options]\n"
@@ -158,11 +160,13 @@ int command_viewfactors(int argc, char **argv)
     rad_vs3_control control = {0};
     bool is_vs3 = false;
     double t0 = rad_clock_seconds();
+    if (cli_ranks_begin() > 1 && rad_rank() != 0)
+        vf.progress = NULL; /* rank 0 shows its own rows' progress */
     rad_status status = load_surfaces(&args, &scene, &control, &is_vs3, &error);
     int cursor = 0;
     for (const char *name; status == RAD_OK && (name = cli_next_value(&args, OPT_TWO_SIDED, &cursor));)
         status = rad_scene_set_surface_flags(scene, name, RAD_SURFACE_TWO_SIDED, &error);
-    if (status == RAD_OK && is_vs3 && (control.row || control.col))
+    if (status == RAD_OK && is_vs3 && (control.row || control.col) && rad_rank() == 0)
         cli_warn("%s: the control line's row/col are ignored: every factor is computed",
                  scene->source);
     write.enclosure = args.value[OPT_ENCLOSURE] || (is_vs3 && control.enclosure);
@@ -174,12 +178,19 @@ int command_viewfactors(int argc, char **argv)
                  scene->source, RAD_SCRIPT_F_MAX_SURFACES, scene->surface_count);
         status = RAD_ERR_UNSUPPORTED;
     }
+    if (!cli_ranks_ok(status, &error))
+        goto fail;
     cli_progress_mark();
-    if (status == RAD_OK)
-        status = rad_viewfactor_matrix_compute(scene, &vf, &matrix, &report, &error);
-    if (status != RAD_OK)
+    status = rad_viewfactor_matrix_compute(scene, &vf, &matrix, &report, &error);
+    if (!cli_ranks_ok(status, &error))
         goto fail;
     cli_progress_end();
+    rad_rank_report rank_report = {report.rank_rows, report.rank_seconds, 0, 0};
+    double imbalance = 1;
+    if (!cli_ranks_summary(&rank_report, "rows", &imbalance, &error))
+        goto fail;
+    if (rad_rank() != 0) /* rank 0 has the matrix and does the rest */
+        goto done;
 
     rad_viewfactor_check check;
     rad_viewfactor_matrix_check(matrix, scene, &check);
@@ -274,6 +285,10 @@ int command_viewfactors(int argc, char **argv)
                      enclosure.row_deviation_after);
     }
     stats_bool(&stats, "script_f", write.script_f);
+    if (rad_rank_count() > 1) {
+        stats_integer(&stats, "ranks", (unsigned long long)rad_rank_count());
+        stats_number(&stats, "load_imbalance", imbalance);
+    }
     exit_code = cli_finish(&stats, stats_path,
                            "%zu surfaces, %llu polygon pairs (%llu hidden, %llu obstructed, "
                            "%llu of them sampled), %llu rays, %llu non-zero factors, %.2f s: "
@@ -286,10 +301,10 @@ int command_viewfactors(int argc, char **argv)
                            seconds, output ? output : "standard output");
     goto done;
 fail:
-    exit_code = cli_failed(&error);
+    exit_code = cli_ranks_failed(&error);
 done:
     free(emissivity);
     rad_viewfactor_matrix_destroy(matrix);
     rad_scene_destroy(scene);
-    return exit_code;
+    return cli_ranks_end(exit_code);
 }

@@ -16,7 +16,9 @@
  * one batched closest-hit query followed by one batched shadow query (next-event
  * estimation). Each path draws its random numbers from its own generator seeded by
  * (seed, pixel, sample), and a tile's results are summed in sample order, so the image is
- * bitwise the same for any thread count and any tile schedule.
+ * bitwise the same for any thread count and any tile schedule. Over several MPI ranks the
+ * tiles are shared by estimated cost (a few camera rays per tile: a tile of sky is cheap)
+ * and rank 0 gathers them (parallel/image_tiles.h): the same image, bitwise.
  *
  * Per path vertex: a miss or the back of a one-sided surface ends the path (the back of a
  * two-sided one is its front turned towards the ray, emitting too); emission is
@@ -39,6 +41,9 @@
 #include "core/rgb.h"
 #include "core/vec3.h"
 #include "lights/direct_light.h"
+#include "parallel/image_tiles.h"
+#include "parallel/partition.h"
+#include "parallel/ranks.h"
 #include "render/camera.h"
 #include "render/emitters.h"
 #include "render/progress.h"
@@ -375,6 +380,45 @@ static void trace_tile(const pt_context *c, pt_workspace *w, uint64_t tile, rad_
     }
 }
 
+/* Camera rays per tile side for its cost estimate. */
+#define COST_RAYS 4u
+
+/* cost[k]: tile k's pixels times (0.1 + the fraction of COST_RAYS^2 camera rays through it
+ * that hit the scene): rays that leave at once cost almost nothing. The same on every rank
+ * (camera rays through fixed film points). Uses w's ray and hit arrays. */
+static void estimate_tile_costs(const pt_context *c, uint64_t tiles, pt_workspace *w,
+                                double *cost)
+{
+    uint32_t tiles_x = (c->width - 1) / TILE + 1, per_tile = COST_RAYS * COST_RAYS;
+    uint64_t batch = WAVE_PATHS / per_tile; /* tiles per tracer call */
+    for (uint64_t first = 0; first < tiles; first += batch) {
+        uint64_t count = tiles - first < batch ? tiles - first : batch;
+        for (uint64_t k = 0; k < count; k++) {
+            uint64_t tile = first + k;
+            uint32_t x0 = (uint32_t)(tile % tiles_x) * TILE, y0 = (uint32_t)(tile / tiles_x) * TILE;
+            uint32_t tw = c->width - x0 < TILE ? c->width - x0 : TILE;
+            uint32_t th = c->height - y0 < TILE ? c->height - y0 : TILE;
+            for (uint32_t j = 0; j < per_tile; j++) {
+                double px = x0 + tw * ((j % COST_RAYS) + 0.5) / COST_RAYS;
+                double py = y0 + th * ((j / COST_RAYS) + 0.5) / COST_RAYS;
+                rad_vec3 d = v3_normalize(camera_direction(&c->frame, px, py, c->width, c->height));
+                ray_set(&w->rays[k * per_tile + j], c->frame.eye, d, c->camera_near, INFINITY);
+            }
+        }
+        rad_tracer_intersect(c->tracer, w->rays, (uint32_t)(count * per_tile), w->hits);
+        for (uint64_t k = 0; k < count; k++) {
+            uint64_t tile = first + k;
+            uint32_t x0 = (uint32_t)(tile % tiles_x) * TILE, y0 = (uint32_t)(tile / tiles_x) * TILE;
+            double pixels = (double)(c->width - x0 < TILE ? c->width - x0 : TILE) *
+                            (c->height - y0 < TILE ? c->height - y0 : TILE);
+            uint32_t hits = 0;
+            for (uint32_t j = 0; j < per_tile; j++)
+                hits += w->hits[k * per_tile + j].triangle != RAD_NO_HIT;
+            cost[tile] = pixels * (0.1 + (double)hits / per_tile);
+        }
+    }
+}
+
 static void workspace_free(pt_workspace *w)
 {
     free(w->paths);
@@ -461,25 +505,30 @@ rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
     rad_tracer *tracer = NULL;
     rad_vec3 *normals = NULL;
     pt_workspace *workspaces = NULL;
+    uint32_t *owner = NULL;
 
     status = emitters_build(scene, &emitters, error);
-    if (status != RAD_OK)
-        goto done;
-    status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &tracer, error);
-    if (status != RAD_OK)
-        goto done;
-    normals = rad_alloc_array(scene->triangle_count, sizeof(*normals));
-    workspaces = rad_alloc_array((size_t)threads, sizeof(*workspaces));
-    if (!normals || !workspaces)
-        goto nomem;
+    if (status == RAD_OK)
+        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &tracer, error);
+    if (status == RAD_OK) {
+        normals = rad_alloc_array(scene->triangle_count, sizeof(*normals));
+        workspaces = rad_alloc_array((size_t)threads, sizeof(*workspaces));
+        if (!normals || !workspaces)
+            status = rad_fail(error, RAD_ERR_NOMEM, "pathtrace: out of memory");
+    }
     light_set lights;
-    light_set_init(&lights, scene);
-    c.lights = &lights;
-    /* per path and bounce: one emitter sample and one ray per sharp light */
-    c.shadow_capacity = WAVE_PATHS * (1 + lights.sharp_count);
-    for (int t = 0; t < threads; t++)
-        if (!workspace_alloc(&workspaces[t], c.shadow_capacity))
-            goto nomem;
+    if (status == RAD_OK) {
+        light_set_init(&lights, scene);
+        c.lights = &lights;
+        /* per path and bounce: one emitter sample and one ray per sharp light */
+        c.shadow_capacity = WAVE_PATHS * (1 + lights.sharp_count);
+        for (int t = 0; t < threads && status == RAD_OK; t++)
+            if (!workspace_alloc(&workspaces[t], c.shadow_capacity))
+                status = rad_fail(error, RAD_ERR_NOMEM, "pathtrace: out of memory");
+    }
+    status = ranks_agree(status, "pathtrace", error); /* every rank, before working together */
+    if (status != RAD_OK)
+        goto done;
     for (uint32_t t = 0; t < scene->triangle_count; t++) {
         const uint32_t *v = scene->triangles[t].vertex;
         rad_vec3 a = scene->positions[v[0]];
@@ -492,18 +541,51 @@ rad_status rad_pathtrace(const rad_scene *scene, const rad_camera *camera,
 
     uint64_t tiles_x = (c.width - 1) / TILE + 1, tiles_y = (c.height - 1) / TILE + 1;
     uint64_t tiles = tiles_x * tiles_y;
-    render_progress progress =
-        render_progress_start(options->progress, options->progress_user, "pathtrace", tiles);
+    /* over several ranks: who traces which tile (owner NULL: this process, all), decided
+     * by rank 0 alone so that no rank can disagree */
+    int rank = ranks_rank();
+    if (ranks_count() > 1) {
+        double *cost = rank == 0 ? rad_alloc_array(tiles, sizeof(double)) : NULL;
+        owner = rad_alloc_array(tiles, sizeof(uint32_t));
+        bool failed = (rank == 0 && !cost) || !owner || tiles > UINT32_MAX;
+        if (!failed && rank == 0) {
+            estimate_tile_costs(&c, tiles, &workspaces[0], cost);
+            failed = partition_by_cost(cost, (uint32_t)tiles, ranks_count(), owner, error) !=
+                     RAD_OK;
+        }
+        free(cost);
+        if (ranks_failures(failed))
+            goto nomem;
+        ranks_broadcast(owner, tiles * sizeof(uint32_t));
+    }
+    uint64_t rank_tiles = 0;
+    for (uint64_t tile = 0; tile < tiles; tile++)
+        rank_tiles += !owner || owner[tile] == (uint32_t)rank;
+    render_progress progress = render_progress_start(options->progress, options->progress_user,
+                                                     "pathtrace", rank_tiles);
     uint64_t rays = 0;
+    double tiles_start = rad_clock_seconds();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : rays)
     for (uint64_t tile = 0; tile < tiles; tile++) {
+        if (owner && owner[tile] != (uint32_t)rank)
+            continue;
         trace_tile(&c, &workspaces[omp_get_thread_num()], tile, image, standard_error, &rays);
         render_progress_step(&progress);
+    }
+    double rank_seconds = rad_clock_seconds() - tiles_start;
+    if (owner) {
+        rad_image *images[2] = {image, standard_error};
+        status = ranks_gather_tiles(images, standard_error ? 2 : 1, TILE, owner, error);
+        ranks_sum(&rays, 1);
+        if (status != RAD_OK)
+            goto done;
     }
     render_progress_finish(&progress);
     if (report) {
         report->rays = rays;
         report->seconds = rad_clock_seconds() - start;
+        report->rank_tiles = rank_tiles;
+        report->rank_seconds = rank_seconds;
     }
     goto done;
 nomem:
@@ -513,6 +595,7 @@ done:
         for (int t = 0; t < threads; t++)
             workspace_free(&workspaces[t]);
     free(workspaces);
+    free(owner);
     free(normals);
     rad_tracer_destroy(tracer);
     emitters_free(&emitters);

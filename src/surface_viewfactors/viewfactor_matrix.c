@@ -15,6 +15,11 @@
  * so the result is bitwise the same for any thread count. With a memory budget set
  * (rad_memory_budget_set), the matrix is refused up front when its bound cannot fit
  * (matrix_bound_bytes).
+ *
+ * Over several MPI ranks (parallel/ranks.h) the rows are shared by estimated cost (its
+ * polygon pairs, weighted by what a few sampled pairs of the row would cost: facing or not,
+ * how many occluders stand between them), each rank computes its rows with its threads,
+ * and rank 0 gathers them and assembles the same matrix, bitwise, as one process would.
  */
 #include <math.h>
 #include <omp.h>
@@ -26,6 +31,8 @@
 #include "core/error.h"
 #include "core/random.h"
 #include "core/vec3.h"
+#include "parallel/partition.h"
+#include "parallel/ranks.h"
 #include "surface_viewfactors/matrix_entry.h"
 #include "surface_viewfactors/occluder_tree.h"
 #include "surface_viewfactors/pair_transfer.h"
@@ -245,6 +252,162 @@ static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_work
     return true;
 }
 
+/* Sampled pairs per row for its cost estimate. */
+#define COST_SAMPLES 8u
+
+/* What one polygon pair of the sample costs, in units of the first look's few dozen rays:
+ * nothing much when they face away, the first look, then the analytic integral, the exact
+ * shadow clipping of 1 to 4 occluders, or sampling behind more. */
+static double pair_cost_estimate(const engine *e, const vf_surface *a, const vf_surface *b,
+                                 shadow_occluder *occluders)
+{
+    const vf_geometry *g = e->geometry;
+    if (surfaces_face_away(g, a, b))
+        return 0.05;
+    const vf_polygon *p = &g->polygons[a->first_polygon + a->polygon_count / 2];
+    const vf_polygon *q = &g->polygons[b->first_polygon + b->polygon_count / 2];
+    double eps = g->plane_epsilon;
+    if (!vf_polygon_in_front(q, p->normal, v3_dot(p->normal, p->vertex[0]), eps) ||
+        !vf_polygon_in_front(p, q->normal, v3_dot(q->normal, q->vertex[0]), eps))
+        return 0.05;
+    uint32_t count = occluder_tree_collect(e->tree, p, q, eps, occluders,
+                                           PAIR_EXACT_MAX_OCCLUDERS);
+    if (count == 0)
+        return 1.5;
+    return count <= PAIR_EXACT_MAX_OCCLUDERS ? 2.0 + count : 8.0;
+}
+
+/* cost[I]: row I's polygon pairs times the mean estimated cost of COST_SAMPLES of its
+ * surface pairs, spread over J >= I. False when out of memory. */
+static bool estimate_row_costs(const engine *e, int threads, double *cost)
+{
+    const vf_geometry *g = e->geometry;
+    uint32_t n = g->surface_count;
+    double *polygons_after = rad_alloc_array((size_t)n + 1, sizeof(double));
+    if (!polygons_after)
+        return false;
+    for (uint32_t I = n; I-- > 0;)
+        polygons_after[I] = polygons_after[I + 1] + g->surfaces[I].polygon_count;
+#pragma omp parallel for schedule(dynamic, 16) num_threads(threads)
+    for (uint32_t I = 0; I < n; I++) {
+        const vf_surface *a = &g->surfaces[I];
+        double p = a->polygon_count;
+        double pairs = p * (polygons_after[I] - p);
+        if (!a->planar)
+            pairs += 0.5 * p * (p - 1);
+        if (a->polygon_count == 0 || !(pairs > 0)) {
+            cost[I] = 0;
+            continue;
+        }
+        shadow_occluder occluders[PAIR_EXACT_MAX_OCCLUDERS];
+        double sum = 0;
+        uint32_t samples = 0;
+        for (uint32_t k = 0; k < COST_SAMPLES; k++) {
+            uint32_t J = I + (uint32_t)(((uint64_t)(n - I) * (2 * k + 1)) / (2 * COST_SAMPLES));
+            if (J >= n || g->surfaces[J].polygon_count == 0 || J == I)
+                continue;
+            sum += pair_cost_estimate(e, a, &g->surfaces[J], occluders);
+            samples++;
+        }
+        cost[I] = pairs * (samples ? sum / samples : 1.0);
+    }
+    free(polygons_after);
+    return true;
+}
+
+/* Row I's record in the bytes sent to rank 0: I, count, then count (column, transfer,
+ * bound). */
+static uint64_t packed_row_size(const pending_row *r)
+{
+    return 2 * sizeof(uint32_t) +
+           (uint64_t)r->count * (sizeof(uint32_t) + 2 * sizeof(double));
+}
+
+static unsigned char *pack_row(unsigned char *at, uint32_t I, const pending_row *r)
+{
+    memcpy(at, &I, sizeof(I)), at += sizeof(I);
+    memcpy(at, &r->count, sizeof(r->count)), at += sizeof(r->count);
+    for (uint32_t k = 0; k < r->count; k++) {
+        memcpy(at, &r->entries[k].column, sizeof(uint32_t)), at += sizeof(uint32_t);
+        memcpy(at, &r->entries[k].transfer, sizeof(double)), at += sizeof(double);
+        memcpy(at, &r->entries[k].bound, sizeof(double)), at += sizeof(double);
+    }
+    return at;
+}
+
+/* Reads the rows of `size` packed bytes into rows[] (which must not hold them yet). False
+ * when out of memory or the bytes are not whole records of rows below n. */
+static bool unpack_rows(const unsigned char *at, uint64_t size, pending_row *rows, uint32_t n)
+{
+    const unsigned char *end = at + size;
+    while (at < end) {
+        uint32_t I, count;
+        if ((uint64_t)(end - at) < 2 * sizeof(uint32_t))
+            return false;
+        memcpy(&I, at, sizeof(I)), at += sizeof(I);
+        memcpy(&count, at, sizeof(count)), at += sizeof(count);
+        uint64_t record = (uint64_t)count * (sizeof(uint32_t) + 2 * sizeof(double));
+        if (I >= n || rows[I].entries || (uint64_t)(end - at) < record)
+            return false;
+        if (count) {
+            rows[I].entries = rad_alloc_array(count, sizeof(row_entry));
+            if (!rows[I].entries)
+                return false;
+        }
+        rows[I].count = rows[I].capacity = count;
+        for (uint32_t k = 0; k < count; k++) {
+            memcpy(&rows[I].entries[k].column, at, sizeof(uint32_t)), at += sizeof(uint32_t);
+            memcpy(&rows[I].entries[k].transfer, at, sizeof(double)), at += sizeof(double);
+            memcpy(&rows[I].entries[k].bound, at, sizeof(double)), at += sizeof(double);
+        }
+    }
+    return true;
+}
+
+/* Sends this rank's rows to rank 0, which puts every rank's rows in rows[] (the others'
+ * rows are freed there). Collective. */
+static rad_status gather_rows(pending_row *rows, const uint32_t *owner, uint32_t n,
+                              rad_error *error)
+{
+    int rank = ranks_rank(), count = ranks_count();
+    uint64_t size = 0;
+    for (uint32_t I = 0; I < n; I++)
+        if (owner[I] == (uint32_t)rank && rank != 0)
+            size += packed_row_size(&rows[I]);
+    unsigned char *mine = rad_alloc_array(size ? size : 1, 1);
+    uint64_t *sizes = rad_alloc_array((size_t)count, sizeof(uint64_t));
+    bool failed = !mine || !sizes;
+    if (ranks_failures(failed)) {
+        free(mine);
+        free(sizes);
+        return rad_fail(error, RAD_ERR_NOMEM, failed ? "out of memory packing view-factor rows"
+                                                     : "another rank ran out of memory");
+    }
+    unsigned char *at = mine;
+    for (uint32_t I = 0; I < n; I++)
+        if (owner[I] == (uint32_t)rank && rank != 0) /* rank 0 keeps its own in place */
+            at = pack_row(at, I, &rows[I]);
+    for (uint32_t I = 0; I < n; I++)
+        if (rank != 0 && owner[I] == (uint32_t)rank) {
+            free(rows[I].entries);
+            rows[I] = (pending_row){0};
+        }
+    void *gathered = NULL;
+    rad_status status = ranks_gather(mine, size, &gathered, sizes, error);
+    free(mine);
+    uint64_t total = 0;
+    for (int r = 0; status == RAD_OK && rank == 0 && r < count; r++)
+        total += sizes[r];
+    if (status == RAD_OK && rank == 0 && !unpack_rows(gathered, total, rows, n))
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory (or a malformed message) "
+                                                "assembling the rows of %d ranks", count);
+    free(gathered);
+    free(sizes);
+    if (ranks_failures(status != RAD_OK) && status == RAD_OK)
+        status = rad_fail(error, RAD_ERR_NOMEM, "rank 0 could not assemble the view factors");
+    return status;
+}
+
 static rad_viewfactor_matrix *assemble(const vf_geometry *g, pending_row *rows, uint32_t n)
 {
     rad_viewfactor_matrix *m = rad_alloc_array(1, sizeof(*m));
@@ -327,21 +490,16 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     rad_tracer *occluders = NULL;
     pending_row *rows = NULL;
     rad_status status = vf_geometry_build(scene, &geometry, error);
-    if (status != RAD_OK)
-        return status;
-    if (rad_memory_budget()) {
+    if (status == RAD_OK && rad_memory_budget()) {
         uint64_t pairs, bound = matrix_bound_bytes(&geometry, &pairs);
         char what[128];
         snprintf(what, sizeof(what),
                  "the view-factor matrix of %u surfaces (%llu pairs that face each other)",
                  scene->surface_count, (unsigned long long)pairs);
         status = rad_memory_budget_need(bound, what, error);
-        if (status != RAD_OK) {
-            vf_geometry_free(&geometry);
-            return status;
-        }
     }
-    status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
+    if (status == RAD_OK)
+        status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
     uint32_t n = scene->surface_count;
@@ -350,7 +508,9 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         if (!rows)
             status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u rows", n);
     }
+    status = ranks_agree(status, "view factors", error);
     if (status != RAD_OK) {
+        free(rows);
         rad_tracer_destroy(occluders);
         occluder_tree_destroy(tree);
         vf_geometry_free(&geometry);
@@ -360,18 +520,47 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     e.tree = tree;
     e.occluders = occluders;
 
-    /* polygon pairs (I, J >= I) the rows will visit */
+    /* over several ranks: who computes which row (owner NULL: this process, all), decided
+     * by rank 0 alone so that no rank can disagree */
+    uint32_t *owner = NULL;
+    int rank = ranks_rank();
+    if (ranks_count() > 1) {
+        double *cost = rank == 0 ? rad_alloc_array(n ? n : 1, sizeof(double)) : NULL;
+        owner = rad_alloc_array(n ? n : 1, sizeof(uint32_t));
+        bool failed = (rank == 0 && !cost) || !owner;
+        if (!failed && rank == 0)
+            failed = !estimate_row_costs(&e, threads, cost) ||
+                     partition_by_cost(cost, n, ranks_count(), owner, error) != RAD_OK;
+        free(cost);
+        if (ranks_failures(failed)) {
+            free(owner);
+            free(rows);
+            rad_tracer_destroy(occluders);
+            occluder_tree_destroy(tree);
+            vf_geometry_free(&geometry);
+            return rad_fail(error, RAD_ERR_NOMEM, "out of memory sharing %u rows over %d ranks",
+                            n, ranks_count());
+        }
+        ranks_broadcast(owner, (uint64_t)n * sizeof(uint32_t));
+    }
+
+    /* polygon pairs (I, J >= I) the rows of this rank will visit */
     pair_progress progress = {options->progress, options->progress_user, 0, 0, 0};
     double polygons_after = 0;
+    uint32_t rank_rows = 0;
     for (uint32_t I = n; I-- > 0;) {
         double p = geometry.surfaces[I].polygon_count;
         double self = geometry.surfaces[I].planar ? 0 : 0.5 * p * (p - 1);
-        progress.total += p * polygons_after + self;
+        if (!owner || owner[I] == (uint32_t)rank) {
+            progress.total += p * polygons_after + self;
+            rank_rows++;
+        }
         polygons_after += p;
     }
     e.progress = &progress;
     pair_counts totals = {0};
     bool out_of_memory = false;
+    double rows_start = now_seconds();
 #pragma omp parallel num_threads(threads)
     {
         pair_workspace w;
@@ -386,7 +575,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
             bool failed;
 #pragma omp atomic read
             failed = out_of_memory;
-            if (failed || !ready)
+            if (failed || !ready || (owner && owner[I] != (uint32_t)rank))
                 continue;
             if (!compute_row(&e, I, &rows[I], &w, &counts)) {
 #pragma omp atomic write
@@ -405,14 +594,34 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
             totals.rays += counts.rays;
         }
     }
-    rad_viewfactor_matrix *matrix = out_of_memory ? NULL : assemble(&geometry, rows, n);
+    double rank_seconds = now_seconds() - rows_start;
+    rad_tracer_destroy(occluders);
+    occluder_tree_destroy(tree);
+    rad_viewfactor_matrix *matrix = NULL;
+    if (owner) {
+        status = ranks_failures(out_of_memory)
+                     ? rad_fail(error, RAD_ERR_NOMEM,
+                                out_of_memory ? "out of memory for view-factor rows"
+                                              : "another rank ran out of memory")
+                     : gather_rows(rows, owner, n, error);
+        uint64_t sums[7] = {totals.surface_pairs, totals.polygon_pairs, totals.hidden_pairs,
+                            totals.obstructed_pairs, totals.sampled_pairs,
+                            totals.capped_pairs, totals.rays};
+        ranks_sum(sums, 7);
+        totals = (pair_counts){sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6]};
+        free(owner);
+        if (status == RAD_OK && rank == 0)
+            matrix = assemble(&geometry, rows, n);
+    } else if (!out_of_memory) {
+        matrix = assemble(&geometry, rows, n);
+    }
     for (uint32_t I = 0; I < n; I++)
         free(rows[I].entries);
     free(rows);
-    rad_tracer_destroy(occluders);
-    occluder_tree_destroy(tree);
     vf_geometry_free(&geometry);
-    if (!matrix)
+    if (status != RAD_OK)
+        return status;
+    if (!matrix && rank == 0)
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the view factors of %u surfaces",
                         n);
     if (options->progress)
@@ -426,12 +635,14 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         report->sampled_pairs = totals.sampled_pairs;
         report->capped_pairs = totals.capped_pairs;
         report->rays = totals.rays;
-        report->nonzeros = matrix->row_start[n];
-        for (uint64_t k = 0; k < matrix->row_start[n]; k++)
+        for (uint64_t k = 0; matrix && k < matrix->row_start[n]; k++)
             report->largest_error_bound =
                 fmax(report->largest_error_bound, matrix->error_bound[k]);
+        report->nonzeros = matrix ? matrix->row_start[n] : 0;
         report->seconds = now_seconds() - start;
         report->threads = threads;
+        report->rank_rows = rank_rows;
+        report->rank_seconds = rank_seconds;
     }
     *out = matrix;
     return RAD_OK;

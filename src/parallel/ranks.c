@@ -1,0 +1,224 @@
+/*
+ * ranks.c - the processes of an MPI job (ranks.h, and the rad_ranks_* functions of
+ * radiosity.h): the one file that includes mpi.h. Built without RAD_MPI (the default) it is
+ * a single rank and every collective step is a copy. With RAD_MPI, MPI is started only when
+ * the process was launched by mpirun or srun (their environment says so), so the same
+ * binary run by hand stays an ordinary serial program. Only the calling thread uses MPI
+ * (MPI_THREAD_FUNNELED); OpenMP threads never do.
+ *
+ * It counts the bytes this rank sends and receives, for the run summary. It is not a
+ * scheduler and knows nothing of view factors or images.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "parallel/ranks.h"
+
+#ifdef RAD_MPI
+#include <mpi.h>
+#endif
+
+static int rank_index = 0, rank_total = 1;
+static uint64_t bytes_communicated = 0;
+
+int ranks_rank(void) { return rank_index; }
+int ranks_count(void) { return rank_total; }
+int rad_rank(void) { return rank_index; }
+int rad_rank_count(void) { return rank_total; }
+uint64_t rad_ranks_bytes_communicated(void) { return bytes_communicated; }
+
+/* One rank: the gathered bytes are a copy of its own. */
+static rad_status gather_own(const void *data, uint64_t size, void **gathered, uint64_t *sizes,
+                             rad_error *error)
+{
+    sizes[0] = size;
+    *gathered = rad_alloc_array(size ? size : 1, 1);
+    if (!*gathered)
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for %llu bytes of results",
+                        (unsigned long long)size);
+    memcpy(*gathered, data, size);
+    return RAD_OK;
+}
+
+#ifdef RAD_MPI
+
+static bool joined = false; /* MPI_Init ran here */
+
+/* Messages of at most 1 GiB: MPI counts are ints. */
+#define CHUNK_BYTES ((uint64_t)1 << 30)
+
+/* Open MPI's mpirun, PMIx (srun --mpi=pmix, Open MPI 4) and PMI-2 (srun --mpi=pmi2). */
+static bool launched_by_mpi(void)
+{
+    return getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMIX_RANK") || getenv("PMI_RANK");
+}
+
+int rad_ranks_begin(void)
+{
+    int initialized = 0;
+    MPI_Initialized(&initialized);
+    if (joined || !launched_by_mpi())
+        return rank_total;
+    if (!initialized) {
+        int provided;
+        if (MPI_Init_thread(NULL, NULL, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
+            return rank_total;
+        joined = true;
+    }
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_index);
+    MPI_Comm_size(MPI_COMM_WORLD, &rank_total);
+    return rank_total;
+}
+
+void rad_ranks_end(void)
+{
+    if (joined)
+        MPI_Finalize();
+    joined = false;
+    rank_index = 0;
+    rank_total = 1;
+}
+
+void rad_ranks_abort(int exit_code)
+{
+    if (rank_total > 1)
+        MPI_Abort(MPI_COMM_WORLD, exit_code);
+    exit(exit_code);
+}
+
+int ranks_failures(bool failed)
+{
+    int mine = failed ? 1 : 0, total = mine;
+    if (rank_total > 1) {
+        MPI_Allreduce(&mine, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+        bytes_communicated += 2 * sizeof(int);
+    }
+    return total;
+}
+
+void ranks_sum(uint64_t *values, int count)
+{
+    if (rank_total > 1 && count > 0) {
+        MPI_Allreduce(MPI_IN_PLACE, values, count, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+        bytes_communicated += 2 * (uint64_t)count * sizeof(uint64_t);
+    }
+}
+
+void ranks_broadcast(void *data, uint64_t size)
+{
+    if (rank_total == 1)
+        return;
+    for (uint64_t at = 0; at < size; at += CHUNK_BYTES) {
+        uint64_t part = size - at < CHUNK_BYTES ? size - at : CHUNK_BYTES;
+        MPI_Bcast((unsigned char *)data + at, (int)part, MPI_BYTE, 0, MPI_COMM_WORLD);
+    }
+    bytes_communicated += size;
+}
+
+/* Sends or receives `size` bytes in chunks of at most CHUNK_BYTES. */
+static void send_bytes(const unsigned char *data, uint64_t size)
+{
+    for (uint64_t at = 0; at < size; at += CHUNK_BYTES) {
+        uint64_t part = size - at < CHUNK_BYTES ? size - at : CHUNK_BYTES;
+        MPI_Send(data + at, (int)part, MPI_BYTE, 0, 0, MPI_COMM_WORLD);
+    }
+    bytes_communicated += size;
+}
+
+static void receive_bytes(unsigned char *data, uint64_t size, int from)
+{
+    for (uint64_t at = 0; at < size; at += CHUNK_BYTES) {
+        uint64_t part = size - at < CHUNK_BYTES ? size - at : CHUNK_BYTES;
+        MPI_Recv(data + at, (int)part, MPI_BYTE, from, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    }
+    bytes_communicated += size;
+}
+
+rad_status ranks_gather(const void *data, uint64_t size, void **gathered, uint64_t *sizes,
+                        rad_error *error)
+{
+    *gathered = NULL;
+    if (rank_total == 1)
+        return gather_own(data, size, gathered, sizes, error);
+    uint64_t mine = size;
+    MPI_Gather(&mine, 1, MPI_UINT64_T, sizes, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+    bytes_communicated += sizeof(uint64_t);
+    unsigned char *all = NULL;
+    uint64_t total = 0;
+    if (rank_index == 0) {
+        for (int r = 0; r < rank_total; r++)
+            total += sizes[r];
+        all = rad_alloc_array(total ? total : 1, 1);
+    }
+    /* rank 0 tells whether it has room before anyone sends */
+    int ready = rank_index != 0 || all != NULL;
+    MPI_Bcast(&ready, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    bytes_communicated += sizeof(int);
+    if (!ready)
+        return rad_fail(error, RAD_ERR_NOMEM,
+                        "rank 0 is out of memory for the %llu bytes of every rank's results",
+                        (unsigned long long)total);
+    if (rank_index != 0) {
+        send_bytes(data, size);
+        return RAD_OK;
+    }
+    memcpy(all, data, size);
+    uint64_t at = size;
+    for (int r = 1; r < rank_total; r++) {
+        receive_bytes(all + at, sizes[r], r);
+        at += sizes[r];
+    }
+    *gathered = all;
+    return RAD_OK;
+}
+
+#else /* one rank */
+
+int rad_ranks_begin(void) { return 1; }
+void rad_ranks_end(void) {}
+void rad_ranks_abort(int exit_code) { exit(exit_code); }
+int ranks_failures(bool failed) { return failed ? 1 : 0; }
+void ranks_broadcast(void *data, uint64_t size)
+{
+    (void)data;
+    (void)size;
+}
+void ranks_sum(uint64_t *values, int count)
+{
+    (void)values;
+    (void)count;
+}
+
+rad_status ranks_gather(const void *data, uint64_t size, void **gathered, uint64_t *sizes,
+                        rad_error *error)
+{
+    return gather_own(data, size, gathered, sizes, error);
+}
+
+#endif
+
+rad_status rad_ranks_gather_reports(const rad_rank_report *mine, rad_rank_report *all,
+                                    rad_error *error)
+{
+    void *gathered = NULL;
+    uint64_t *sizes = rad_alloc_array((size_t)rank_total, sizeof(uint64_t));
+    if (!sizes)
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for %d rank reports", rank_total);
+    rad_status status = ranks_gather(mine, sizeof(*mine), &gathered, sizes, error);
+    if (status == RAD_OK && gathered)
+        memcpy(all, gathered, (size_t)rank_total * sizeof(*mine));
+    free(gathered);
+    free(sizes);
+    return status;
+}
+
+int rad_ranks_failures(bool failed) { return ranks_failures(failed); }
+
+rad_status ranks_agree(rad_status status, const char *what, rad_error *error)
+{
+    if (ranks_failures(status != RAD_OK) && status == RAD_OK)
+        return rad_fail(error, RAD_ERR_INVALID, "%s: another rank failed", what);
+    return status;
+}

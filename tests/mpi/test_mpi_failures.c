@@ -1,0 +1,47 @@
+/*
+ * test_mpi_failures.c - a rank that fails ends the whole job: non-zero exit, a clear
+ * message, no output file. Rank 1 reads a malformed scene while rank 0 reads a good one
+ * (mpirun's "A : B" form makes that deterministic): rank 1's message names itself, the
+ * file and the line. Rank 1 killed (SIGKILL) a moment after its start, while rank 0 works:
+ * mpirun reports the signal. Every rank reading the same bad file: one message (rank 0's),
+ * exit 1.
+ */
+#include <string.h>
+
+#include "mpi_run.h"
+
+int main(void)
+{
+    test_write_city(1000, "city.obj");
+    test_write_file("bad.obj", "o wall\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+
+    /* bad input on rank 1 only */
+    char other[4200];
+    snprintf(other, sizeof(other), "'%s' viewfactors bad.obj -o out.mtx", RAD_TOOL);
+    CHECK(test_run_mpi(1, "viewfactors city.obj -o out.mtx", 1, other) != 0);
+    const char *err = test_read_text(test_path("stderr.txt"));
+    CHECK(strstr(err, "radiosity: rank 1 of 2: bad.obj:5: ") != NULL);
+    CHECK(!test_file_exists(test_path("out.mtx")));
+    CHECK(test_count_files("out") == 0);
+
+    /* the same bad input on every rank: one message, from rank 0 */
+    CHECK(test_run_mpi(3, "viewfactors bad.obj -o out.mtx", 0, NULL) == 1);
+    err = test_read_text(test_path("stderr.txt"));
+    const char *message = "radiosity: bad.obj:5: ";
+    const char *first = strstr(err, message);
+    CHECK(first != NULL);
+    CHECK(first && strstr(first + strlen(message), "bad.obj:5") == NULL);
+    CHECK(strstr(err, "rank 1 of") == NULL);
+    CHECK(!test_file_exists(test_path("out.mtx")));
+
+    /* rank 1 killed early in a run that takes seconds: the city's 1014 surfaces, one
+     * thread per rank */
+    snprintf(other, sizeof(other), "timeout -s KILL 0.5 '%s' viewfactors city.obj -o out.mtx "
+             "--threads 1", RAD_TOOL);
+    CHECK(test_run_mpi(1, "viewfactors city.obj -o out.mtx --threads 1", 1, other) != 0);
+    err = test_read_text(test_path("stderr.txt"));
+    CHECK(strstr(err, "signal 9") != NULL);
+    CHECK(!test_file_exists(test_path("out.mtx")));
+    CHECK(test_count_files("out") == 0);
+    return test_finish("test_mpi_failures");
+}

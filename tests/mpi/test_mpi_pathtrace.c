@@ -1,0 +1,51 @@
+/*
+ * test_mpi_pathtrace.c - `mpirun -np N radiosity pathtrace` for N = 1 to 4 writes the same
+ * image and standard-error image, byte for byte, as the serial run: the built-in Cornell
+ * box at 70 x 45 (partial tiles at the right and bottom edges), 8 samples per pixel; and
+ * rank 0's summary accounts for every 16 x 16 tile once (5 x 3 = 15).
+ */
+#include <string.h>
+
+#include "mpi_run.h"
+
+static bool same_bytes(const char *a_path, const char *b_path)
+{
+    size_t a_size, b_size;
+    uint8_t *a = test_read_bytes(a_path, &a_size), *b = test_read_bytes(b_path, &b_size);
+    bool same = a && b && a_size == b_size && a_size > 0 && memcmp(a, b, a_size) == 0;
+    free(a);
+    free(b);
+    return same;
+}
+
+int main(void)
+{
+    const char *options = "--size 70x45 --spp 8";
+    char arguments[512];
+    snprintf(arguments, sizeof(arguments),
+             "pathtrace -o serial.pfm --standard-error serial-se.pfm --threads 2 %s", options);
+    CHECK(test_run_tool(arguments) == 0);
+    for (int ranks = 1; ranks <= 4; ranks++) {
+        char image[32], error[32];
+        snprintf(image, sizeof(image), "ranks%d.pfm", ranks);
+        snprintf(error, sizeof(error), "ranks%d-se.pfm", ranks);
+        snprintf(arguments, sizeof(arguments),
+                 "pathtrace -o %s --standard-error %s --threads 1 %s", image, error, options);
+        CHECK(test_run_mpi(ranks, arguments, 0, NULL) == 0);
+        CHECK(same_bytes(test_path("serial.pfm"), test_path(image)));
+        CHECK(same_bytes(test_path("serial-se.pfm"), test_path(error)));
+        const char *err = test_read_text(test_path("stderr.txt"));
+        long long tiles = 0;
+        for (int r = 0; r < ranks && ranks > 1; r++) {
+            char key[64];
+            snprintf(key, sizeof(key), "rank %d of %d: ", r, ranks);
+            const char *line = strstr(err, key);
+            CHECK(line != NULL);
+            long long mine = line ? strtoll(line + strlen(key), NULL, 10) : 0;
+            CHECK(mine > 0);
+            tiles += mine;
+        }
+        CHECK(ranks == 1 || tiles == 15);
+    }
+    return test_finish("test_mpi_pathtrace");
+}

@@ -1,0 +1,81 @@
+/*
+ * test_mpi_viewfactors.c - `mpirun -np N radiosity viewfactors` for N = 1 to 4 writes the
+ * same bytes as the serial run (Matrix Market to a file; CSV to standard output with 3 ranks), on a
+ * generated city whose rows are obstructed (checked: obstructed and sampled pairs occur),
+ * and rank 0's summary accounts for every row once. The ranks run one thread each, the
+ * serial run two: the matrix depends on neither.
+ */
+#include <string.h>
+
+#include "mpi_run.h"
+
+/* The integer after "KEY": in a --stats file; -1 when missing. */
+static long long stats_integer_of(const char *text, const char *key)
+{
+    char quoted[128];
+    snprintf(quoted, sizeof(quoted), "\"%s\":", key);
+    const char *at = strstr(text, quoted);
+    return at ? strtoll(at + strlen(quoted), NULL, 10) : -1;
+}
+
+static bool same_bytes(const char *a_path, const char *b_path)
+{
+    size_t a_size, b_size;
+    uint8_t *a = test_read_bytes(a_path, &a_size), *b = test_read_bytes(b_path, &b_size);
+    bool same = a && b && a_size == b_size && a_size > 0 && memcmp(a, b, a_size) == 0;
+    free(a);
+    free(b);
+    return same;
+}
+
+int main(void)
+{
+    test_write_city(300, "city.obj");
+    CHECK(test_run_tool("viewfactors city.obj -o serial.mtx --threads 2 --stats serial.json") ==
+          0);
+    const char *stats = test_read_text(test_path("serial.json"));
+    long long surfaces = stats_integer_of(stats, "surfaces");
+    CHECK(surfaces == 384); /* 64 buildings: 4 walls, a roof, a ground tile each */
+    CHECK(stats_integer_of(stats, "obstructed_pairs") > 1000);
+    CHECK(stats_integer_of(stats, "sampled_pairs") > 1000);
+    CHECK(test_run_tool("viewfactors city.obj --threads 2 --quiet") == 0);
+    size_t csv_size;
+    uint8_t *serial_csv = test_read_bytes(test_path("stdout.txt"), &csv_size);
+    CHECK(serial_csv && csv_size > 1000);
+
+    for (int ranks = 1; ranks <= 4; ranks++) {
+        char arguments[256], name[32];
+        snprintf(name, sizeof(name), "ranks%d.mtx", ranks);
+        snprintf(arguments, sizeof(arguments), "viewfactors city.obj -o %s --threads 1", name);
+        CHECK(test_run_mpi(ranks, arguments, 0, NULL) == 0);
+        CHECK(same_bytes(test_path("serial.mtx"), test_path(name)));
+        const char *err = test_read_text(test_path("stderr.txt"));
+        long long rows = 0;
+        for (int r = 0; r < ranks && ranks > 1; r++) {
+            char key[64];
+            snprintf(key, sizeof(key), "rank %d of %d: ", r, ranks);
+            const char *line = strstr(err, key);
+            CHECK(line != NULL);
+            long long mine = line ? strtoll(line + strlen(key), NULL, 10) : 0;
+            CHECK(mine > 0);
+            rows += mine;
+        }
+        if (ranks > 1) {
+            CHECK(rows == surfaces);
+            CHECK(strstr(err, "load imbalance") != NULL);
+        } else {
+            CHECK(strstr(err, "rank 0 of") == NULL); /* one rank: the serial summary */
+        }
+
+        /* CSV on standard output: rank 0 alone prints it (3 ranks: an odd share) */
+        if (ranks != 3)
+            continue;
+        CHECK(test_run_mpi(ranks, "viewfactors city.obj --threads 1 --quiet", 0, NULL) == 0);
+        size_t size;
+        uint8_t *csv = test_read_bytes(test_path("stdout.txt"), &size);
+        CHECK(csv && serial_csv && size == csv_size && memcmp(csv, serial_csv, size) == 0);
+        free(csv);
+    }
+    free(serial_csv);
+    return test_finish("test_mpi_viewfactors");
+}

@@ -1,0 +1,78 @@
+/*
+ * cli_ranks.c - the tool's side of a run over MPI ranks (cli_ranks.h): agreement on
+ * failure, the per-rank summary. It does not share work (the library does) and never
+ * calls MPI itself (the rad_ranks_* functions of radiosity.h do).
+ */
+#include <stdlib.h>
+
+#include "cli_ranks.h"
+
+int cli_ranks_begin(void) { return rad_ranks_begin(); }
+
+bool cli_ranks_ok(rad_status status, const rad_error *error)
+{
+    int failures = rad_ranks_failures(status != RAD_OK);
+    if (failures == 0)
+        return true;
+    if (failures == rad_rank_count())
+        return false;
+    if (status != RAD_OK) {
+        cli_error("rank %d of %d: %s", rad_rank(), rad_rank_count(), error->message);
+        rad_ranks_abort(EXIT_ERROR);
+    }
+    rad_ranks_end(); /* MPI_Abort of the failed rank ends this one here or in there */
+    exit(EXIT_ERROR);
+}
+
+int cli_ranks_failed(const rad_error *error)
+{
+    return rad_rank() == 0 ? cli_failed(error) : EXIT_ERROR;
+}
+
+static void megabytes(char *text, size_t size, uint64_t bytes)
+{
+    snprintf(text, size, "%.1f MB", (double)bytes / 1e6);
+}
+
+bool cli_ranks_summary(const rad_rank_report *mine, const char *unit, double *imbalance,
+                       rad_error *error)
+{
+    int count = rad_rank_count();
+    *imbalance = 1;
+    if (count == 1)
+        return true;
+    rad_rank_report *all = rad_alloc_array((size_t)count, sizeof(*all));
+    bool ok = all != NULL;
+    if (cli_ranks_ok(ok ? RAD_OK : RAD_ERR_NOMEM, error) && ok) {
+        rad_rank_report report = *mine;
+        report.peak_memory = rad_peak_memory_bytes();
+        report.bytes_communicated = rad_ranks_bytes_communicated();
+        ok = rad_ranks_gather_reports(&report, all, error) == RAD_OK;
+    } else {
+        ok = false;
+    }
+    if (ok && rad_rank() == 0) {
+        double total = 0, slowest = 0;
+        for (int r = 0; r < count; r++) {
+            char peak[32], sent[32];
+            megabytes(peak, sizeof(peak), all[r].peak_memory);
+            megabytes(sent, sizeof(sent), all[r].bytes_communicated);
+            cli_summary("rank %d of %d: %llu %s, %.2f s, peak memory %s, communicated %s", r,
+                        count, (unsigned long long)all[r].work, unit, all[r].seconds, peak,
+                        sent);
+            total += all[r].seconds;
+            slowest = all[r].seconds > slowest ? all[r].seconds : slowest;
+        }
+        *imbalance = total > 0 ? slowest / (total / count) : 1;
+        cli_summary("%d ranks: load imbalance %.3f (the slowest rank's time over the mean)",
+                    count, *imbalance);
+    }
+    free(all);
+    return ok;
+}
+
+int cli_ranks_end(int exit_code)
+{
+    rad_ranks_end();
+    return exit_code;
+}
