@@ -430,11 +430,13 @@ static void check_interpenetrating(void)
             double L = mean_radiance(mesh, B, surface_index(scene, shown[k]));
             printf(" %s %.5f", shown[k], L);
             /* the hierarchical solver's links are coarser where a face runs into another
-             * box (the part inside it gets light it should not): 3 %, a known limit */
+             * box (the part inside it gets light it should not): 2 % (the sunk box's top,
+             * 1.8 %; 3.0 % before its final gather traced wholly visible ancestors' links
+             * from the leaf), a known limit */
             if (solver == RAD_SOLVER_DIRECT)
                 direct[k] = L;
             else
-                CHECK_NEAR(L, direct[k], solver == RAD_SOLVER_HIERARCHICAL ? 3e-2 : 1e-2);
+                CHECK_NEAR(L, direct[k], solver == RAD_SOLVER_HIERARCHICAL ? 2e-2 : 1e-2);
         }
         double outside = mean_radiance(mesh, B, below);
         printf(", below the floor %.2e\n", outside);
