@@ -682,8 +682,8 @@ void rad_tracer_intersect(const rad_tracer *tracer, const rad_ray *rays, uint32_
 
 typedef struct rad_formfactor_options {
     uint32_t quadrature;     /* each patch is split m x m for the analytic part; 0 = 1 */
-    uint32_t visibility_rays; /* most rays per patch pair (rounded to a square); 0 = 16.
-                                 4 go first; only pairs they find partly occluded get all */
+    uint32_t visibility_rays; /* rays per patch pair that something may block (rounded to
+                                 a square); 0 = 16. Pairs nothing can block get none */
     uint64_t seed;            /* seeds the stratified sample points */
     int threads;              /* 0 = all cores */
     rad_progress_fn progress;
@@ -694,7 +694,10 @@ typedef struct rad_formfactor_options {
 typedef struct rad_formfactor_report {
     uint64_t pairs;            /* patch pairs considered (i < j) */
     uint64_t pairs_facing;     /* pairs that face each other and needed work */
-    uint64_t pairs_refined;    /* pairs the first 2 x 2 segments found partly occluded */
+    uint64_t pairs_refined;    /* pairs whose visibility was sampled with the full set of
+                                  segments */
+    uint64_t pairs_clear;      /* pairs nothing can come between: no segment needed */
+    uint64_t pairs_exact;      /* close pairs settled by exact shadow clipping */
     uint64_t rays;             /* occlusion rays cast */
     double seconds;            /* wall-clock time of the whole computation */
     double tracing_seconds;    /* time spent tracing, summed over threads */
@@ -716,12 +719,15 @@ typedef struct rad_formfactors {
 /* Computes every F_ij of the mesh. `occluders` is a tracer over the scene's triangles (any
  * backend). The unoccluded point-to-patch factor is analytic (Lambert's contour formula,
  * integrated over the smaller patch: an m x m midpoint rule for pairs far apart, 4 x 4
- * for pairs close by, adaptive for touching pairs); visibility is the fraction of
- * unoccluded rays between stratified points of the two patches (4 first, the full count
- * where those 4 disagree), with surfaces within a hair of either end tested in double
- * precision. No row sums to more than 1 + RAD_ROW_SUM_SLACK: a row that came out above
- * (sampled visibility next to occluders or through a slot) is scaled back to 1, each F_ij
- * and F_ji by the same factor, and counted in the report. */
+ * for pairs close by, adaptive for touching pairs). A pair whose hull no triangle of
+ * `occluders` cuts is visible as a whole, with no ray cast; a touching pair that at most
+ * four triangles cut (a wall through a patch, a box on a floor) gets the exact visible
+ * factor by shadow clipping, as the view-factor engine does; any other pair's visibility
+ * is the kernel-weighted fraction of unoccluded rays between stratified points of the two
+ * patches, with surfaces within a hair of either end tested in double precision. Rows
+ * then sum to what the patch sees within RAD_ROW_SUM_SLACK. As a last guard, a row above
+ * 1 + RAD_ROW_SUM_SLACK is scaled back to 1, each F_ij and F_ji by the same factor, and
+ * counted in the report (rows_trimmed, largest_row_sum). */
 rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occluders,
                                    const rad_formfactor_options *options,
                                    rad_formfactors **out, rad_formfactor_report *report,
@@ -984,10 +990,12 @@ typedef struct rad_solve_report {
 rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
                      rad_rgb *B, rad_solve_report *report, rad_error *error);
 
-/* The stated accuracy of a row sum of patch form factors: rad_formfactors_compute scales
- * rows above 1 + this back to 1 (below it, the rows' sampling error is left alone: cutting
- * only the high side of it would darken every scene), and rad_solve refuses a system whose
- * rho_i x sum_j F_ij exceeds 1 + this. */
+/* The stated accuracy of a row sum of patch form factors: rad_formfactors_compute's rows
+ * sum to what each patch sees within this (closed scenes with occluders, touching and
+ * interpenetrating surfaces included; tests/test_near_surfaces.c, test_hierarchical.c);
+ * as a last guard it scales a row above 1 + this back to 1 and reports it (below, the
+ * rows' sampling error is left alone: cutting only the high side of it would darken every
+ * scene); rad_solve refuses a system whose rho_i x sum_j F_ij exceeds 1 + this. */
 #define RAD_ROW_SUM_SLACK 1e-2
 
 /* Largest system the direct solver takes. */

@@ -398,8 +398,11 @@ static void test_energy(void)
         }
         printf("closed room, point light, %s: absorbed %.3f lm, flux %.3f lm\n",
                rad_solver_name(solvers[k]), absorbed, 4 * PI * 100);
-        /* the dense solvers to 0.5 %; the hierarchical one's links estimate their factors
-         * to about 1 % (the feature matrix's bound for it) */
+        /* the dense solvers to 0.5 %; the hierarchical one to 1 %: it loses 0.58 % here
+         * because its final gather takes far planar nodes as point-to-disk kernels
+         * A cos cos / (pi r^2 + A), low seen obliquely (gathered exactly it is within
+         * +0.14 %); that fix alone overshoots the furnished room of test_hierarchical by
+         * 1.6 %, an over-transfer there that the low kernel hides (docs/DESIGN.md) */
         CHECK_NEAR(absorbed, 4 * PI * 100, solvers[k] == RAD_SOLVER_HIERARCHICAL ? 0.01 : 0.005);
         free(B);
     }

@@ -185,6 +185,89 @@ static rad_formfactors *formfactors_of(const rad_scene *scene, const rad_mesh *m
     return ff;
 }
 
+/* The share of cosine-distributed rays from patch i that first meet the front of some
+ * face: what sum_j F_ij must be, found without the form-factor engine. */
+static double traced_row(const rad_tracer *tracer, const rad_mesh *mesh, uint32_t i,
+                         uint32_t rays)
+{
+    const rad_patch *p = &mesh->patches[i];
+    rad_vec3 n = p->normal;
+    rad_vec3 a = fabs(n.x) > 0.5 ? (rad_vec3){0, 1, 0} : (rad_vec3){1, 0, 0};
+    rad_vec3 t1 = {a.y * n.z - a.z * n.y, a.z * n.x - a.x * n.z, a.x * n.y - a.y * n.x};
+    double l = sqrt(t1.x * t1.x + t1.y * t1.y + t1.z * t1.z);
+    t1 = (rad_vec3){t1.x / l, t1.y / l, t1.z / l};
+    rad_vec3 t2 = {n.y * t1.z - n.z * t1.y, n.z * t1.x - n.x * t1.z, n.x * t1.y - n.y * t1.x};
+    const rad_vec3 *c[4];
+    for (unsigned k = 0; k < p->vertex_count; k++)
+        c[k] = &mesh->vertices[p->vertex[k]];
+    rad_ray *ray = malloc(sizeof(rad_ray) * rays);
+    rad_hit *hit = malloc(sizeof(rad_hit) * rays);
+    uint32_t side = (uint32_t)sqrt((double)rays);
+    uint64_t state = 0x1234567 + i;
+    for (uint32_t k = 0; k < rays; k++) {
+        double u[4];
+        for (int d = 0; d < 4; d++) {
+            state = state * 6364136223846793005ull + 1442695040888963407ull;
+            u[d] = (double)(state >> 11) / 9007199254740992.0;
+        }
+        /* a bilinear point of the (quad) patch, stratified */
+        double s = (k % side + u[0]) / side, t = (k / side % side + u[1]) / side;
+        rad_vec3 x = {0, 0, 0};
+        double w[4] = {(1 - s) * (1 - t), s * (1 - t), s * t, (1 - s) * t};
+        for (int m = 0; m < 4; m++) {
+            x.x += w[m] * c[m]->x;
+            x.y += w[m] * c[m]->y;
+            x.z += w[m] * c[m]->z;
+        }
+        double r = sqrt(u[2]), phi = 2 * PI * u[3], z = sqrt(1 - u[2]);
+        double dx = r * cos(phi), dy = r * sin(phi);
+        ray[k] = (rad_ray){{(float)(x.x + 2e-6 * n.x), (float)(x.y + 2e-6 * n.y),
+                            (float)(x.z + 2e-6 * n.z)},
+                           0,
+                           {(float)(dx * t1.x + dy * t2.x + z * n.x),
+                            (float)(dx * t1.y + dy * t2.y + z * n.y),
+                            (float)(dx * t1.z + dy * t2.z + z * n.z)},
+                           INFINITY};
+    }
+    rad_tracer_intersect(tracer, ray, rays, hit);
+    uint32_t front = 0;
+    for (uint32_t k = 0; k < rays; k++)
+        front += hit[k].triangle != RAD_NO_HIT && hit[k].front;
+    free(ray);
+    free(hit);
+    return (double)front / rays;
+}
+
+/* Rows of patches that a box's wall cuts or encloses (the floor inside the sunk box, the
+ * crossing box's bottom) against traced_row: within RAD_ROW_SUM_SLACK. */
+static void check_split_rows(const rad_scene *scene, const rad_mesh *mesh,
+                             const rad_formfactors *ff)
+{
+    rad_tracer *tracer = NULL;
+    rad_error error = {0};
+    CHECK(rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &tracer, &error) == RAD_OK);
+    int floor = surface_index(scene, "room_bottom"), bottom = surface_index(scene, "cross_bottom");
+    uint32_t n = mesh->patch_count, checked = 0;
+    double worst = 0;
+    for (uint32_t i = 0; tracer && i < n; i++) {
+        const rad_patch *p = &mesh->patches[i];
+        bool under_sunk = (int)p->surface == floor && p->centroid.x > 0.3 && p->centroid.x < 0.6 &&
+                          p->centroid.y > 0.3 && p->centroid.y < 0.6;
+        if (!under_sunk && (int)p->surface != bottom)
+            continue;
+        double row = 0;
+        for (uint32_t j = 0; j < n; j++)
+            row += ff->F[(size_t)i * n + j];
+        double traced = traced_row(tracer, mesh, i, 1u << 16);
+        CHECK_ABS(row, traced, RAD_ROW_SUM_SLACK);
+        worst = fmax(worst, fabs(row - traced));
+        checked++;
+    }
+    printf("  %u rows cut or enclosed by a box: largest |row - traced| %.4f\n", checked, worst);
+    CHECK(checked == 21);
+    rad_tracer_destroy(tracer);
+}
+
 static void check_box_in_box(double gap)
 {
     rad_scene *scene = load(write_box_in_box(gap));
@@ -319,8 +402,15 @@ static void check_interpenetrating(void)
            n, smallest, highest, ff_report.largest_row_sum, ff_report.rows_trimmed, ceiling_low,
            ceiling_high);
     CHECK(smallest >= 0);
+    /* right before any trimming, which stays a last guard: nothing was scaled back */
+    CHECK(ff_report.largest_row_sum <= 1 + RAD_ROW_SUM_SLACK);
+    CHECK(ff_report.rows_trimmed == 0);
     CHECK(highest <= 1 + RAD_ROW_SUM_SLACK);
     CHECK(fabs(ceiling_low - 1) <= RAD_ROW_SUM_SLACK && fabs(ceiling_high - 1) <= RAD_ROW_SUM_SLACK);
+    /* a floor patch wholly inside the sunk box sees only the crossing box's faces inside
+     * it; cut by the sunk box's wall, those faces used to be credited with what lies
+     * outside the wall (row 0.555 where 0.505 is right) */
+    check_split_rows(scene, mesh, ff);
     rad_formfactors_destroy(ff);
 
     const char *shown[] = {"room_bottom", "room_left", "sunk_top", "cross_top", "cross_left"};
@@ -340,11 +430,13 @@ static void check_interpenetrating(void)
             double L = mean_radiance(mesh, B, surface_index(scene, shown[k]));
             printf(" %s %.5f", shown[k], L);
             /* the hierarchical solver's links are coarser where a face runs into another
-             * box (the part inside it gets light it should not): 3 %, a known limit */
+             * box (the part inside it gets light it should not): 2 % (the sunk box's top,
+             * 1.8 %; 3.0 % before its final gather traced wholly visible ancestors' links
+             * from the leaf), a known limit */
             if (solver == RAD_SOLVER_DIRECT)
                 direct[k] = L;
             else
-                CHECK_NEAR(L, direct[k], solver == RAD_SOLVER_HIERARCHICAL ? 3e-2 : 1e-2);
+                CHECK_NEAR(L, direct[k], solver == RAD_SOLVER_HIERARCHICAL ? 2e-2 : 1e-2);
         }
         double outside = mean_radiance(mesh, B, below);
         printf(", below the floor %.2e\n", outside);

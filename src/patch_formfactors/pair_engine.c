@@ -5,11 +5,14 @@
  *   - the unoccluded transfer G_ij = A_i Fhat_ij is Lambert's contour formula (contour.c)
  *     integrated over the smaller patch: the midpoint rule on an m x m split, a 4 x 4 one
  *     for pairs close by, adaptive quadrature (polygon_integral.c) for touching pairs;
- *   - visibility is the fraction of segments between jittered stratified points of the
- *     two patches that no triangle of the scene blocks: 2 x 2 segments first; when they
- *     disagree (a shadow boundary crosses the pair) the full k x k set decides. Surfaces
- *     within a hair of either end, where the tracer does not look, are tested in double
- *     precision (near_contacts.c).
+ *   - a pair that no triangle can come between (exact_pairs.h: its hull is clear) needs
+ *     no visibility; a touching pair that at most four triangles cut is settled by exact
+ *     shadow clipping;
+ *   - otherwise visibility is the kernel-weighted fraction of k x k segments between
+ *     jittered stratified points of the two patches that no triangle of the scene blocks.
+ *     (A folded patch, which the hull test does not cover, gets 2 x 2 segments first and
+ *     the full set only when they disagree.) Surfaces within a hair of either end, where
+ *     the tracer does not look, are tested in double precision (near_contacts.c).
  * Pairs where either patch is wholly behind the other's plane need no work (G = 0).
  *
  * Random numbers come from (seed, i, j), so the result is the same for any thread count.
@@ -32,6 +35,7 @@
 #include "geometry/contour.h"
 #include "geometry/polygon_integral.h"
 #include "mesh/near_contacts.h"
+#include "patch_formfactors/exact_pairs.h"
 #include "trace/ray.h"
 
 #define MAX_QUADRATURE 8u
@@ -51,6 +55,12 @@
 #define TOUCHING_DISTANCE 1.0
 #define TOUCHING_ACCURACY 1e-3
 #define TOUCHING_MAX_DEPTH 4
+/* Close pairs (closer than EXACT_DISTANCE x the sum of their radii) that few triangles
+ * obstruct are settled by exact shadow clipping (exact_pairs.h) to EXACT_ACCURACY: there
+ * the kernel varies too fast across the pair for kernel-weighted segments to be right
+ * (a box sunk into the floor: rows 4 % too high). */
+#define EXACT_DISTANCE 3.0
+#define EXACT_ACCURACY 1e-2
 
 /* Everything the kernel needs about one patch, precomputed. */
 typedef struct patch_geometry {
@@ -87,6 +97,7 @@ typedef struct engine {
     uint64_t seed;
     double plane_epsilon;
     near_contacts contacts; /* what the segments' left-out ends could miss */
+    exact_pairs exact;      /* what may stand between two patches */
     pair_sink_fn sink;
     void *sink_data;
 } engine;
@@ -262,7 +273,7 @@ typedef struct batch {
 typedef struct thread_work {
     batch first;  /* every facing pair, first_strata^2 segments */
     batch refine; /* pairs the first pass found partly visible, strata^2 segments */
-    uint64_t rays_cast, pairs_facing, pairs_refined;
+    uint64_t rays_cast, pairs_facing, pairs_refined, pairs_clear, pairs_exact;
     double tracing_seconds; /* this thread's time inside rad_tracer_occluded */
 } thread_work;
 
@@ -406,9 +417,28 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
         if (!(G > 0))
             continue;
         w->pairs_facing++;
-        if (w->first.ray_count + k * k > BATCH_RAYS)
-            flush_first(e, w, thread, i);
-        batch_add(e, &w->first, i, j, G, k, 0);
+        double settled;
+        exact_outcome outcome = exact_pairs_transfer(
+            &e->exact, i, j, distance < EXACT_DISTANCE * radii, EXACT_ACCURACY, &settled);
+        if (outcome == EXACT_CLEAR) {
+            w->pairs_clear++;
+            e->sink(e->sink_data, thread, i, j, G);
+        } else if (outcome == EXACT_SETTLED) {
+            w->pairs_exact++;
+            if (settled > 0)
+                e->sink(e->sink_data, thread, i, j, settled);
+        } else if (e->exact.polygons[i].count && e->exact.polygons[j].count) {
+            /* something may block: the full set of segments at once (a first pass of four
+             * would call a pair wholly visible when a small shadow escapes all four) */
+            if (w->refine.ray_count + e->strata * e->strata > BATCH_RAYS)
+                flush_refine(e, w, thread, i);
+            batch_add(e, &w->refine, i, j, G, e->strata, 1);
+            w->pairs_refined++;
+        } else {
+            if (w->first.ray_count + k * k > BATCH_RAYS)
+                flush_first(e, w, thread, i);
+            batch_add(e, &w->first, i, j, G, k, 0);
+        }
     }
     flush_first(e, w, thread, i);
     flush_refine(e, w, thread, i);
@@ -493,6 +523,8 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
 
     status = near_contacts_build(mesh, near_contacts_reach(mesh), e.plane_epsilon, &e.contacts,
                                  error);
+    if (status == RAD_OK)
+        status = exact_pairs_build(mesh, occluders, e.plane_epsilon, &e.exact, error);
     if (status != RAD_OK)
         goto done;
     double start = rad_clock_seconds();
@@ -524,6 +556,8 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
             report->rays += work[t].rays_cast;
             report->pairs_facing += work[t].pairs_facing;
             report->pairs_refined += work[t].pairs_refined;
+            report->pairs_clear += work[t].pairs_clear;
+            report->pairs_exact += work[t].pairs_exact;
             report->tracing_seconds += work[t].tracing_seconds;
         }
         report->seconds = end - start;
@@ -551,5 +585,6 @@ done:
     free(e.near_points);
     free(e.near_weights);
     near_contacts_free(&e.contacts);
+    exact_pairs_free(&e.exact);
     return status;
 }

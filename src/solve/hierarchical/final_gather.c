@@ -5,10 +5,11 @@
  * kernel's variation across the receiver and the shadow edges inside it are averaged
  * away. After the hierarchical solution has converged, each leaf gathers every link of
  * its ancestors again: the irradiance at its own centre from the link's source, at a finer
- * resolution of the source too (hier_leaf_gather), times the link's visible fraction when that is 0 or 1, or times
- * its own, traced with `rays` segments from the leaf to the source (weighted by the kernel
- * and the source's radiosity where each ends: hier_visible_share), when the link is partly
- * visible. What comes out is a correction per leaf: this irradiance
+ * resolution of the source too (hier_leaf_gather), times the leaf's own visible fraction,
+ * traced with `rays` segments from the leaf to the source (weighted by the kernel and the
+ * source's radiosity where each ends: hier_visible_share), for a visible link that brings
+ * a large enough share of the light (a hidden one brings none; the others keep their
+ * link's fraction). What comes out is a correction per leaf: this irradiance
  * minus what the ancestors' links handed down. The solver keeps it fixed and sweeps again
  * (the correction moves with B only to second order). Parallel over leaves; every random
  * number comes from (seed, leaf, source), so the result does not depend on the thread
@@ -22,8 +23,8 @@
 #include "core/vec3.h"
 #include "solve/hierarchical/final_gather.h"
 
-/* A partly visible link whose unoccluded irradiance is at least this share of all the
- * partly visible links' has its shadow traced from the leaf. */
+/* A visible ancestor's link whose unoccluded irradiance is at least this share of all
+ * those links' has its shadow traced from the leaf. */
 #define TRACED_SHARE 0.01
 
 typedef struct shadowed {
@@ -86,7 +87,7 @@ static bool gather_leaf(const final_gather_context *c, uint32_t k, gather_buffer
     const hlink *links = c->links;
     rad_rgb sum = {0, 0, 0}, coarse = {0, 0, 0};
     size_t pending = 0;
-    double unoccluded = 0; /* sum over partly visible links, for the share that is traced */
+    double unoccluded = 0; /* sum over the ancestors' visible links, for the share traced */
     for (uint32_t a = k; a != HNODE_NONE; a = t->nodes[a].parent)
         for (size_t l = c->offsets[a]; l < c->offsets[a + 1]; l++) {
             float visibility = (float)link_visibility(&links[l]);
@@ -99,8 +100,11 @@ static bool gather_leaf(const final_gather_context *c, uint32_t k, gather_buffer
             rad_rgb h = hier_leaf_gather(c->mesh, t, c->node_B, k, source);
             if (!(h.r + h.g + h.b > 0))
                 continue;
-            /* the leaf's own link traced its visibility from the leaf already */
-            if (visibility >= 1 || c->rays == 0 || a == k) {
+            /* the leaf's own link traced its visibility from the leaf already; an
+             * ancestor's link found wholly visible by a few segments between two large
+             * nodes says little about this leaf, which may lie in a shadow they missed: it
+             * is traced from the leaf like a partly visible one */
+            if (c->rays == 0 || a == k) {
                 rgb_add_to(&sum, rgb_scale(h, visibility));
                 continue;
             }

@@ -1,0 +1,458 @@
+/*
+ * exact_pairs.c - pairs settled without sampling, see exact_pairs.h.
+ *
+ * An occluder that passes through the smaller patch (interpenetrating surfaces: a box
+ * sunk into a floor, two boxes through each other) makes the visible factor jump along
+ * the line where it cuts the patch, and adaptive quadrature would chase that line to its
+ * depth limit. So the smaller patch is first cut by the plane of every such occluder, and
+ * each piece, on one side of it, is integrated on its own.
+ */
+#include "patch_formfactors/exact_pairs.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/vec3.h"
+#include "surface_viewfactors/pair_transfer.h"
+#include "trace/tracer_internal.h"
+
+/* Most pieces the smaller patch is cut into (at most PAIR_EXACT_MAX_OCCLUDERS planes). */
+#define MAX_PIECES 16u
+
+/* The screening tree: leaves of at most SCREEN_LEAF triangles, at most SCREEN_DEPTH deep. */
+#define SCREEN_LEAF 4u
+#define SCREEN_DEPTH 48u
+
+struct screen_node {
+    double lo[3], hi[3];
+    uint32_t first, count; /* a leaf when count > 0; else children at first, first + 1 */
+};
+
+struct screen_triangle {
+    rad_vec3 corner[3];
+    rad_vec3 normal; /* unit, or zero for a degenerate triangle */
+    double offset;
+    double lo[3], hi[3];
+};
+
+static double coordinate(rad_vec3 v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+
+static void screen_build(exact_pairs *pairs, uint32_t node, uint32_t first, uint32_t count,
+                         unsigned depth)
+{
+    screen_node *n = &pairs->screen_nodes[node];
+    double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int a = 0; a < 3; a++) {
+        n->lo[a] = INFINITY;
+        n->hi[a] = -INFINITY;
+    }
+    for (uint32_t t = first; t < first + count; t++) {
+        const screen_triangle *tt = &pairs->screen_triangles[t];
+        for (int a = 0; a < 3; a++) {
+            n->lo[a] = fmin(n->lo[a], tt->lo[a]);
+            n->hi[a] = fmax(n->hi[a], tt->hi[a]);
+            double centre = 0.5 * (tt->lo[a] + tt->hi[a]);
+            clo[a] = fmin(clo[a], centre);
+            chi[a] = fmax(chi[a], centre);
+        }
+    }
+    if (count <= SCREEN_LEAF || depth >= SCREEN_DEPTH) {
+        n->first = first;
+        n->count = count;
+        return;
+    }
+    int split = 0;
+    for (int a = 1; a < 3; a++)
+        if (chi[a] - clo[a] > chi[split] - clo[split])
+            split = a;
+    double middle = 0.5 * (clo[split] + chi[split]);
+    uint32_t i = first, j = first + count;
+    while (i < j) {
+        const screen_triangle *tt = &pairs->screen_triangles[i];
+        if (0.5 * (tt->lo[split] + tt->hi[split]) < middle) {
+            i++;
+        } else {
+            j--;
+            screen_triangle swap = pairs->screen_triangles[i];
+            pairs->screen_triangles[i] = pairs->screen_triangles[j];
+            pairs->screen_triangles[j] = swap;
+        }
+    }
+    uint32_t left = i - first;
+    if (left == 0 || left == count)
+        left = count / 2;
+    uint32_t children = pairs->screen_node_count;
+    pairs->screen_node_count += 2;
+    n->first = children;
+    n->count = 0;
+    screen_build(pairs, children, first, left, depth + 1);
+    screen_build(pairs, children + 1, first + left, count - left, depth + 1);
+}
+
+/* Most side planes of a pair's hull: through an edge of one patch and a corner of the
+ * other. */
+#define MAX_SIDES (2u * VF_MAX_VERTICES * VF_MAX_VERTICES)
+
+/* What screening needs of a pair: the box of its corners and the two patches' planes
+ * (segments that carry light run in front of both); the hull's side planes are found only
+ * for a pair with a triangle that passes those. */
+typedef struct screen_query {
+    const vf_polygon *p, *q;
+    double lo[3], hi[3];
+    double epsilon;
+    bool have_sides;
+    unsigned side_count;
+    rad_vec3 side_normal[MAX_SIDES]; /* outward */
+    double side_offset[MAX_SIDES];
+} screen_query;
+
+/* The planes through an edge of one patch and a corner of the other that have every
+ * corner of both on one side: with the two patches' planes, the faces of their hull. */
+static void find_sides(screen_query *s)
+{
+    s->have_sides = true;
+    s->side_count = 0;
+    const vf_polygon *polygon[2] = {s->p, s->q};
+    for (int side = 0; side < 2; side++) {
+        const vf_polygon *a = polygon[side], *b = polygon[1 - side];
+        for (unsigned e = 0; e < a->count; e++) {
+            rad_vec3 e0 = a->vertex[e], e1 = a->vertex[(e + 1) % a->count];
+            for (unsigned c = 0; c < b->count; c++) {
+                rad_vec3 normal = v3_cross(v3_sub(e1, e0), v3_sub(b->vertex[c], e0));
+                double length = v3_length(normal);
+                if (!(length > 0))
+                    continue;
+                normal = v3_scale(normal, 1 / length);
+                double offset = v3_dot(normal, e0);
+                bool below = true, above = true;
+                for (int k = 0; k < 2 && (below || above); k++)
+                    for (unsigned m = 0; m < polygon[k]->count; m++) {
+                        double d = v3_dot(normal, polygon[k]->vertex[m]) - offset;
+                        below = below && d <= s->epsilon;
+                        above = above && d >= -s->epsilon;
+                    }
+                if (below == above)
+                    continue; /* straddles, or (degenerate) all on it */
+                if (above) {
+                    normal = v3_scale(normal, -1);
+                    offset = -offset;
+                }
+                s->side_normal[s->side_count] = normal;
+                s->side_offset[s->side_count++] = offset;
+            }
+        }
+    }
+}
+
+/* True when the box lies wholly behind (or on) the plane n . x = offset. */
+static bool box_behind(const double lo[3], const double hi[3], rad_vec3 n, double offset,
+                       double epsilon)
+{
+    double farthest = n.x * (n.x > 0 ? hi[0] : lo[0]) + n.y * (n.y > 0 ? hi[1] : lo[1]) +
+                      n.z * (n.z > 0 ? hi[2] : lo[2]);
+    return farthest - offset <= epsilon;
+}
+
+static bool box_apart(const screen_query *s, const double lo[3], const double hi[3])
+{
+    for (int a = 0; a < 3; a++)
+        if (lo[a] > s->hi[a] + s->epsilon || hi[a] < s->lo[a] - s->epsilon)
+            return true;
+    return box_behind(lo, hi, s->p->normal, v3_dot(s->p->normal, s->p->vertex[0]), s->epsilon) ||
+           box_behind(lo, hi, s->q->normal, v3_dot(s->q->normal, s->q->vertex[0]), s->epsilon);
+}
+
+/* May the triangle cut the pair's hull? Its box must meet the hull's box in front of both
+ * planes, its plane must have corners of the pair strictly on both sides, and no side
+ * plane of the hull may have it wholly outside. */
+static bool may_cut(screen_query *s, const screen_triangle *t)
+{
+    if (box_apart(s, t->lo, t->hi))
+        return false;
+    bool below = false, above = false;
+    const vf_polygon *polygon[2] = {s->p, s->q};
+    for (int k = 0; k < 2; k++)
+        for (unsigned c = 0; c < polygon[k]->count; c++) {
+            double d = v3_dot(t->normal, polygon[k]->vertex[c]) - t->offset;
+            below = below || d < -s->epsilon;
+            above = above || d > s->epsilon;
+        }
+    if (!(below && above))
+        return false;
+    if (!s->have_sides)
+        find_sides(s);
+    for (unsigned k = 0; k < s->side_count; k++) {
+        rad_vec3 n = s->side_normal[k];
+        double o = s->side_offset[k];
+        if (v3_dot(n, t->corner[0]) - o >= -s->epsilon &&
+            v3_dot(n, t->corner[1]) - o >= -s->epsilon &&
+            v3_dot(n, t->corner[2]) - o >= -s->epsilon)
+            return false;
+    }
+    return true;
+}
+
+/* False when no triangle can cut the hull of p and q (then the pair is clear). */
+static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, const vf_polygon *q)
+{
+    if (pairs->screen_node_count == 0)
+        return false;
+    screen_query s;
+    s.p = p;
+    s.q = q;
+    s.epsilon = pairs->epsilon;
+    s.have_sides = false;
+    for (int a = 0; a < 3; a++) {
+        s.lo[a] = INFINITY;
+        s.hi[a] = -INFINITY;
+    }
+    for (int k = 0; k < 2; k++) {
+        const vf_polygon *polygon = k ? q : p;
+        for (unsigned c = 0; c < polygon->count; c++)
+            for (int a = 0; a < 3; a++) {
+                s.lo[a] = fmin(s.lo[a], coordinate(polygon->vertex[c], a));
+                s.hi[a] = fmax(s.hi[a], coordinate(polygon->vertex[c], a));
+            }
+    }
+    uint32_t stack[2 * SCREEN_DEPTH + 2];
+    unsigned top = 0;
+    stack[top++] = 0;
+    while (top) {
+        const screen_node *node = &pairs->screen_nodes[stack[--top]];
+        if (box_apart(&s, node->lo, node->hi))
+            continue;
+        if (node->count) {
+            for (uint32_t t = node->first; t < node->first + node->count; t++)
+                if (may_cut(&s, &pairs->screen_triangles[t]))
+                    return true;
+        } else {
+            stack[top++] = node->first;
+            stack[top++] = node->first + 1;
+        }
+    }
+    return false;
+}
+
+/* Area, normal-free extras (centroid, radius, fan) of a polygon whose corners are set. */
+static void polygon_finish(vf_polygon *polygon)
+{
+    rad_vec3 sum = {0, 0, 0}, cross = {0, 0, 0};
+    for (unsigned k = 0; k < polygon->count; k++) {
+        sum = v3_add(sum, polygon->vertex[k]);
+        cross = v3_add(cross, v3_cross(polygon->vertex[k],
+                                       polygon->vertex[(k + 1) % polygon->count]));
+    }
+    polygon->area = 0.5 * fabs(v3_dot(cross, polygon->normal));
+    polygon->centroid = v3_scale(sum, 1.0 / polygon->count);
+    polygon->radius = 0;
+    for (unsigned k = 0; k < polygon->count; k++)
+        polygon->radius =
+            fmax(polygon->radius, v3_length(v3_sub(polygon->vertex[k], polygon->centroid)));
+    double running = 0;
+    rad_vec3 a = polygon->vertex[0];
+    for (unsigned k = 1; k + 1 < polygon->count; k++) {
+        running += 0.5 * v3_length(v3_cross(v3_sub(polygon->vertex[k], a),
+                                            v3_sub(polygon->vertex[k + 1], a)));
+        polygon->fan[k - 1] = polygon->area > 0 ? fmin(running / polygon->area, 1) : 1;
+    }
+    polygon->fan[polygon->count - 3] = 1;
+}
+
+rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
+                             double plane_epsilon, exact_pairs *out, rad_error *error)
+{
+    *out = (exact_pairs){.plane_epsilon = plane_epsilon};
+    uint32_t vertex_count = occluders->vertex_count, triangle_count = occluders->triangle_count;
+    rad_vec3 *positions = rad_alloc_array(vertex_count ? vertex_count : 1, sizeof(*positions));
+    rad_triangle *triangles =
+        rad_alloc_array(triangle_count ? triangle_count : 1, sizeof(*triangles));
+    uint32_t *source = rad_alloc_array(triangle_count ? triangle_count : 1, sizeof(*source));
+    out->polygons = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1,
+                                    sizeof(*out->polygons));
+    rad_status status = RAD_OK;
+    if (!positions || !triangles || !source || !out->polygons) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the occluder tree");
+        goto done;
+    }
+    /* the triangles exactly as the tracer tests them (float corners) */
+    double largest = 0;
+    for (uint32_t v = 0; v < vertex_count; v++) {
+        const float *x = &occluders->vertices[3 * (size_t)v];
+        positions[v] = v3(x[0], x[1], x[2]);
+        largest = fmax(largest, fmax(fabs(x[0]), fmax(fabs(x[1]), fabs(x[2]))));
+    }
+    for (uint32_t t = 0; t < triangle_count; t++) {
+        for (int c = 0; c < 3; c++)
+            triangles[t].vertex[c] = occluders->indices[3 * (size_t)t + c];
+        source[t] = UINT32_MAX; /* a patch's own triangles lie in its plane: never cut */
+    }
+    /* rounded to float, a patch's own triangles lie up to this far off its plane */
+    out->epsilon = plane_epsilon + 4.0 * FLT_EPSILON * largest;
+    rad_scene scene = {0};
+    scene.positions = positions;
+    scene.position_count = vertex_count;
+    scene.triangles = triangles;
+    scene.triangle_count = triangle_count;
+    status = occluder_tree_build(&scene, source, &out->tree, error);
+    if (status != RAD_OK)
+        goto done;
+    out->screen_triangles =
+        rad_alloc_array(triangle_count ? triangle_count : 1, sizeof(*out->screen_triangles));
+    out->screen_nodes =
+        rad_alloc_array(2 * (size_t)(triangle_count ? triangle_count : 1), sizeof(*out->screen_nodes));
+    if (!out->screen_triangles || !out->screen_nodes) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the occluder tree");
+        goto done;
+    }
+    for (uint32_t t = 0; t < triangle_count; t++) {
+        screen_triangle *tt = &out->screen_triangles[t];
+        for (int c = 0; c < 3; c++)
+            tt->corner[c] = positions[triangles[t].vertex[c]];
+        rad_vec3 n = v3_cross(v3_sub(tt->corner[1], tt->corner[0]),
+                              v3_sub(tt->corner[2], tt->corner[0]));
+        double length = v3_length(n);
+        tt->normal = length > 0 ? v3_scale(n, 1 / length) : v3(0, 0, 0);
+        tt->offset = v3_dot(tt->normal, tt->corner[0]);
+        for (int a = 0; a < 3; a++) {
+            tt->lo[a] = fmin(coordinate(tt->corner[0], a),
+                             fmin(coordinate(tt->corner[1], a), coordinate(tt->corner[2], a)));
+            tt->hi[a] = fmax(coordinate(tt->corner[0], a),
+                             fmax(coordinate(tt->corner[1], a), coordinate(tt->corner[2], a)));
+        }
+    }
+    out->screen_node_count = triangle_count ? 1 : 0;
+    if (triangle_count)
+        screen_build(out, 0, 0, triangle_count, 0);
+    for (uint32_t i = 0; i < mesh->patch_count; i++) {
+        const rad_patch *patch = &mesh->patches[i];
+        vf_polygon *polygon = &out->polygons[i];
+        polygon->count = patch->bulge > 0 ? 0 : patch->vertex_count;
+        polygon->surface = patch->surface;
+        polygon->source = i; /* never UINT32_MAX, the triangles' source */
+        polygon->normal = patch->normal;
+        if (polygon->count == 0)
+            continue;
+        for (unsigned k = 0; k < patch->vertex_count; k++)
+            polygon->vertex[k] = mesh->vertices[patch->vertex[k]];
+        polygon_finish(polygon);
+        polygon->area = patch->area;
+    }
+done:
+    free(positions);
+    free(triangles);
+    free(source);
+    if (status != RAD_OK)
+        exact_pairs_free(out);
+    return status;
+}
+
+void exact_pairs_free(exact_pairs *pairs)
+{
+    occluder_tree_destroy(pairs->tree);
+    free(pairs->polygons);
+    free(pairs->screen_nodes);
+    free(pairs->screen_triangles);
+    pairs->tree = NULL;
+    pairs->polygons = NULL;
+    pairs->screen_nodes = NULL;
+    pairs->screen_triangles = NULL;
+}
+
+/* The part of `in` on the side `sign` of the plane n . x = offset; false when it has more
+ * corners than a polygon holds or no area. */
+static bool clip_polygon(const vf_polygon *in, rad_vec3 n, double offset, double sign,
+                         vf_polygon *out)
+{
+    *out = *in;
+    out->count = 0;
+    for (unsigned k = 0; k < in->count; k++) {
+        rad_vec3 a = in->vertex[k], b = in->vertex[(k + 1) % in->count];
+        double da = sign * (v3_dot(n, a) - offset), db = sign * (v3_dot(n, b) - offset);
+        bool crosses = (da > 0 && db < 0) || (da < 0 && db > 0);
+        if (out->count + (da >= 0) + crosses > VF_MAX_VERTICES)
+            return false;
+        if (da >= 0)
+            out->vertex[out->count++] = a;
+        if (crosses)
+            out->vertex[out->count++] = v3_lerp(a, b, da / (da - db));
+    }
+    if (out->count < 3)
+        return false;
+    polygon_finish(out);
+    return out->area > 0;
+}
+
+/* Cuts `outer` by the plane of every occluder that passes through it; false when a piece
+ * would have too many corners. */
+static bool cut_by_occluders(const vf_polygon *outer, const shadow_occluder *occluders,
+                             uint32_t count, double epsilon, vf_polygon *pieces,
+                             unsigned *piece_count)
+{
+    pieces[0] = *outer;
+    *piece_count = 1;
+    for (uint32_t o = 0; o < count; o++) {
+        const rad_vec3 *c = occluders[o].corner;
+        rad_vec3 n = v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0]));
+        double length = v3_length(n);
+        if (!(length > 0))
+            continue;
+        n = v3_scale(n, 1 / length);
+        double offset = v3_dot(n, c[0]);
+        unsigned before = *piece_count;
+        for (unsigned p = 0; p < before; p++) {
+            bool below = false, above = false;
+            for (unsigned k = 0; k < pieces[p].count; k++) {
+                double d = v3_dot(n, pieces[p].vertex[k]) - offset;
+                below = below || d < -epsilon;
+                above = above || d > epsilon;
+            }
+            if (!(below && above))
+                continue;
+            vf_polygon front, back;
+            if (*piece_count >= MAX_PIECES || !clip_polygon(&pieces[p], n, offset, 1, &front) ||
+                !clip_polygon(&pieces[p], n, offset, -1, &back))
+                return false;
+            pieces[p] = front;
+            pieces[(*piece_count)++] = back;
+        }
+    }
+    return true;
+}
+
+exact_outcome exact_pairs_transfer(const exact_pairs *pairs, uint32_t i, uint32_t j, bool clip,
+                                   double accuracy, double *G)
+{
+    const vf_polygon *p = &pairs->polygons[i], *q = &pairs->polygons[j];
+    if (p->count == 0 || q->count == 0)
+        return EXACT_SAMPLE;
+    if (!screen_may_block(pairs, p, q))
+        return EXACT_CLEAR;
+    if (!clip)
+        return EXACT_SAMPLE; /* the hull's faces might still prove it clear: not worth it */
+    shadow_occluder between[PAIR_EXACT_MAX_OCCLUDERS];
+    uint32_t count = occluder_tree_collect(pairs->tree, p, q, pairs->epsilon, between,
+                                           PAIR_EXACT_MAX_OCCLUDERS);
+    if (count == 0)
+        return EXACT_CLEAR;
+    if (count > PAIR_EXACT_MAX_OCCLUDERS)
+        return EXACT_SAMPLE;
+    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
+    vf_polygon pieces[MAX_PIECES];
+    unsigned piece_count;
+    if (!cut_by_occluders(outer, between, count, pairs->epsilon, pieces, &piece_count))
+        return EXACT_SAMPLE;
+    double total = 0;
+    for (unsigned k = 0; k < piece_count; k++) {
+        double value, bound;
+        /* a piece is never larger than the inner patch, so it stays the outer polygon */
+        if (!pair_obstructed_exact(&pieces[k], inner, between, count, accuracy,
+                                   pairs->plane_epsilon, &value, &bound))
+            return EXACT_SAMPLE;
+        total += value;
+    }
+    *G = total;
+    return EXACT_SETTLED;
+}

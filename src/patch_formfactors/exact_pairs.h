@@ -1,0 +1,51 @@
+/*
+ * exact_pairs.h - the patch pairs that need no sampled visibility: what may stand between
+ * two patches, and the exact obstructed transfer where few triangles do.
+ *
+ * The view-factor engine's methods (src/surface_viewfactors/) applied to patches: the
+ * occluder tree over the tracer's own triangles answers "can anything block a segment
+ * between these two patches?" exactly (conservatively); when nothing can, the analytic
+ * transfer is the answer and no ray is cast. When at most PAIR_EXACT_MAX_OCCLUDERS
+ * triangles can, shadow clipping gives each point's visible factor exactly. Not here: the
+ * unoccluded transfer and the sampled visibility (pair_engine.c).
+ */
+#ifndef RAD_FORMFACTOR_EXACT_PAIRS_H
+#define RAD_FORMFACTOR_EXACT_PAIRS_H
+
+#include "radiosity.h"
+#include "surface_viewfactors/occluder_tree.h"
+#include "surface_viewfactors/vf_geometry.h"
+
+typedef struct screen_node screen_node;
+typedef struct screen_triangle screen_triangle;
+
+typedef struct exact_pairs {
+    occluder_tree *tree;  /* the tracer's triangles */
+    /* the same triangles in a cheaper tree that only screens: a pair whose hull's bounding
+     * box and two planes leave no triangle straddling is clear without the hull's faces */
+    screen_node *screen_nodes;
+    screen_triangle *screen_triangles;
+    uint32_t screen_node_count;
+    vf_polygon *polygons; /* per patch; count 0 for a folded (bulging) patch: never exact */
+    double epsilon;       /* touching a pair's hull within this does not count */
+    double plane_epsilon; /* in front of a plane means beyond this (scene units) */
+} exact_pairs;
+
+rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
+                             double plane_epsilon, exact_pairs *out, rad_error *error);
+void exact_pairs_free(exact_pairs *pairs);
+
+typedef enum exact_outcome {
+    EXACT_CLEAR,    /* nothing can block: the unoccluded transfer is the answer */
+    EXACT_SETTLED,  /* *G holds the exact obstructed transfer */
+    EXACT_SAMPLE    /* too many occluders (or a folded patch, or the clipping gave up):
+                       sample visibility */
+} exact_outcome;
+
+/* Classifies the pair (i, j); with `clip` (pairs close enough for their kernel to vary
+ * fast across them) also settles a pair that few triangles obstruct, to relative
+ * accuracy `accuracy`. Thread-safe. */
+exact_outcome exact_pairs_transfer(const exact_pairs *pairs, uint32_t i, uint32_t j, bool clip,
+                                   double accuracy, double *G);
+
+#endif
