@@ -94,7 +94,7 @@ static void screen_build(exact_pairs *pairs, uint32_t node, uint32_t first, uint
 
 /* Most side planes of a pair's hull: through an edge of one patch and a corner of the
  * other. */
-#define MAX_SIDES (2u * VF_MAX_VERTICES * VF_MAX_VERTICES)
+#define MAX_SIDES OCCLUDER_HULL_MAX_SIDES
 
 /* What screening needs of a pair: the box of its corners and the two patches' planes
  * (segments that carry light run in front of both); the hull's side planes are found only
@@ -109,42 +109,11 @@ typedef struct screen_query {
     double side_offset[MAX_SIDES];
 } screen_query;
 
-/* The planes through an edge of one patch and a corner of the other that have every
- * corner of both on one side: with the two patches' planes, the faces of their hull. */
+/* The faces of the pair's hull besides the patches' own planes (occluder_hull_sides). */
 static void find_sides(screen_query *s)
 {
     s->have_sides = true;
-    s->side_count = 0;
-    const vf_polygon *polygon[2] = {s->p, s->q};
-    for (int side = 0; side < 2; side++) {
-        const vf_polygon *a = polygon[side], *b = polygon[1 - side];
-        for (unsigned e = 0; e < a->count; e++) {
-            rad_vec3 e0 = a->vertex[e], e1 = a->vertex[(e + 1) % a->count];
-            for (unsigned c = 0; c < b->count; c++) {
-                rad_vec3 normal = v3_cross(v3_sub(e1, e0), v3_sub(b->vertex[c], e0));
-                double length = v3_length(normal);
-                if (!(length > 0))
-                    continue;
-                normal = v3_scale(normal, 1 / length);
-                double offset = v3_dot(normal, e0);
-                bool below = true, above = true;
-                for (int k = 0; k < 2 && (below || above); k++)
-                    for (unsigned m = 0; m < polygon[k]->count; m++) {
-                        double d = v3_dot(normal, polygon[k]->vertex[m]) - offset;
-                        below = below && d <= s->epsilon;
-                        above = above && d >= -s->epsilon;
-                    }
-                if (below == above)
-                    continue; /* straddles, or (degenerate) all on it */
-                if (above) {
-                    normal = v3_scale(normal, -1);
-                    offset = -offset;
-                }
-                s->side_normal[s->side_count] = normal;
-                s->side_offset[s->side_count++] = offset;
-            }
-        }
-    }
+    s->side_count = occluder_hull_sides(s->p, s->q, s->epsilon, s->side_normal, s->side_offset);
 }
 
 /* True when the box lies wholly behind (or on) the plane n . x = offset. */
@@ -236,30 +205,6 @@ static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, cons
     return false;
 }
 
-/* Area, normal-free extras (centroid, radius, fan) of a polygon whose corners are set. */
-static void polygon_finish(vf_polygon *polygon)
-{
-    rad_vec3 sum = {0, 0, 0}, cross = {0, 0, 0};
-    for (unsigned k = 0; k < polygon->count; k++) {
-        sum = v3_add(sum, polygon->vertex[k]);
-        cross = v3_add(cross, v3_cross(polygon->vertex[k],
-                                       polygon->vertex[(k + 1) % polygon->count]));
-    }
-    polygon->area = 0.5 * fabs(v3_dot(cross, polygon->normal));
-    polygon->centroid = v3_scale(sum, 1.0 / polygon->count);
-    polygon->radius = 0;
-    for (unsigned k = 0; k < polygon->count; k++)
-        polygon->radius =
-            fmax(polygon->radius, v3_length(v3_sub(polygon->vertex[k], polygon->centroid)));
-    double running = 0;
-    rad_vec3 a = polygon->vertex[0];
-    for (unsigned k = 1; k + 1 < polygon->count; k++) {
-        running += 0.5 * v3_length(v3_cross(v3_sub(polygon->vertex[k], a),
-                                            v3_sub(polygon->vertex[k + 1], a)));
-        polygon->fan[k - 1] = polygon->area > 0 ? fmin(running / polygon->area, 1) : 1;
-    }
-    polygon->fan[polygon->count - 3] = 1;
-}
 
 rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
                              double plane_epsilon, exact_pairs *out, rad_error *error)
@@ -337,7 +282,7 @@ rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
             continue;
         for (unsigned k = 0; k < patch->vertex_count; k++)
             polygon->vertex[k] = mesh->vertices[patch->vertex[k]];
-        polygon_finish(polygon);
+        vf_polygon_finish(polygon);
         polygon->area = patch->area;
     }
 done:
@@ -381,7 +326,7 @@ static bool clip_polygon(const vf_polygon *in, rad_vec3 n, double offset, double
     }
     if (out->count < 3)
         return false;
-    polygon_finish(out);
+    vf_polygon_finish(out);
     return out->area > 0;
 }
 

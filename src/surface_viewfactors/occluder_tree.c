@@ -151,6 +151,43 @@ void occluder_tree_destroy(occluder_tree *tree)
     free(tree);
 }
 
+unsigned occluder_hull_sides(const vf_polygon *p, const vf_polygon *q, double epsilon,
+                             rad_vec3 *normal_out, double *offset_out)
+{
+    unsigned count = 0;
+    const vf_polygon *polygon[2] = {p, q};
+    for (int side = 0; side < 2; side++) {
+        const vf_polygon *a = polygon[side], *b = polygon[1 - side];
+        for (unsigned e = 0; e < a->count; e++) {
+            rad_vec3 e0 = a->vertex[e], e1 = a->vertex[(e + 1) % a->count];
+            for (unsigned c = 0; c < b->count; c++) {
+                rad_vec3 normal = v3_cross(v3_sub(e1, e0), v3_sub(b->vertex[c], e0));
+                double length = v3_length(normal);
+                if (!(length > 0))
+                    continue;
+                normal = v3_scale(normal, 1 / length);
+                double offset = v3_dot(normal, e0);
+                bool below = true, above = true;
+                for (int k = 0; k < 2 && (below || above); k++)
+                    for (unsigned m = 0; m < polygon[k]->count && (below || above); m++) {
+                        double d = v3_dot(normal, polygon[k]->vertex[m]) - offset;
+                        below = below && d <= epsilon;
+                        above = above && d >= -epsilon;
+                    }
+                if (below == above)
+                    continue; /* straddles, or (degenerate) all on it */
+                if (above) {
+                    normal = v3_scale(normal, -1);
+                    offset = -offset;
+                }
+                normal_out[count] = normal;
+                offset_out[count++] = offset;
+            }
+        }
+    }
+    return count;
+}
+
 static void make_hull(hull *h, const vf_polygon *p, const vf_polygon *q, double epsilon)
 {
     h->corner_count = 0;
@@ -169,39 +206,12 @@ static void make_hull(hull *h, const vf_polygon *p, const vf_polygon *q, double 
     /* the hull's faces: the two polygons' planes, and planes through an edge of one and a
      * corner of the other that have every corner on one side */
     h->plane_count = 0;
-    unsigned n = h->corner_count;
     h->normal[h->plane_count] = v3_scale(p->normal, -1);
     h->offset[h->plane_count++] = -v3_dot(p->normal, p->vertex[0]);
     h->normal[h->plane_count] = v3_scale(q->normal, -1);
     h->offset[h->plane_count++] = -v3_dot(q->normal, q->vertex[0]);
-    for (int side = 0; side < 2; side++) {
-        const vf_polygon *a = side ? q : p, *b = side ? p : q;
-        for (unsigned e = 0; e < a->count; e++) {
-            rad_vec3 e0 = a->vertex[e], e1 = a->vertex[(e + 1) % a->count];
-            for (unsigned c = 0; c < b->count; c++) {
-                rad_vec3 normal = v3_cross(v3_sub(e1, e0), v3_sub(b->vertex[c], e0));
-                double length = v3_length(normal);
-                if (!(length > 0))
-                    continue;
-                normal = v3_scale(normal, 1 / length);
-                double offset = v3_dot(normal, e0);
-                bool below = true, above = true;
-                for (unsigned m = 0; m < n && (below || above); m++) {
-                    double d = v3_dot(normal, h->corner[m]) - offset;
-                    below = below && d <= epsilon;
-                    above = above && d >= -epsilon;
-                }
-                if (below == above)
-                    continue; /* straddles, or (degenerate) all on it */
-                if (above) {
-                    normal = v3_scale(normal, -1);
-                    offset = -offset;
-                }
-                h->normal[h->plane_count] = normal;
-                h->offset[h->plane_count++] = offset;
-            }
-        }
-    }
+    h->plane_count += occluder_hull_sides(p, q, epsilon, &h->normal[h->plane_count],
+                                          &h->offset[h->plane_count]);
 }
 
 static bool box_outside(const hull *h, const tree_node *node, double epsilon)

@@ -25,6 +25,16 @@ void occluder_tree_destroy(occluder_tree *tree);
 /* The triangles other than the polygons' own that may cut the hull of p and q (touching
  * the hull's boundary within epsilon, scene units, does not count): their corners go to
  * `out` (room for `max`); returns how many, or max + 1 when there are more. */
+/* Room for the side planes of the hull of two polygons. */
+#define OCCLUDER_HULL_MAX_SIDES (2u * VF_MAX_VERTICES * VF_MAX_VERTICES)
+
+/* The side faces of the convex hull of p and q: the planes through an edge of one and a
+ * corner of the other that have every corner of both on one side (within epsilon), as
+ * outward unit normals and offsets (n . x = offset); returns how many. With the two
+ * polygons' own planes they bound the hull. */
+unsigned occluder_hull_sides(const vf_polygon *p, const vf_polygon *q, double epsilon,
+                             rad_vec3 *normal, double *offset);
+
 uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
                                const vf_polygon *q, double epsilon, shadow_occluder *out,
                                uint32_t max);

@@ -114,7 +114,7 @@ static bool try_merge(const rad_scene *scene, draft *a, const draft *b)
     return false;
 }
 
-static void finish_polygon(vf_polygon *polygon)
+void vf_polygon_finish(vf_polygon *polygon)
 {
     rad_vec3 sum = {0, 0, 0}, cross = {0, 0, 0};
     for (unsigned k = 0; k < polygon->count; k++) {
@@ -122,21 +122,31 @@ static void finish_polygon(vf_polygon *polygon)
         cross = v3_add(cross, v3_cross(polygon->vertex[k],
                                        polygon->vertex[(k + 1) % polygon->count]));
     }
-    polygon->area = 0.5 * v3_length(cross);
-    polygon->normal = v3_normalize(cross);
+    polygon->area = 0.5 * fabs(v3_dot(cross, polygon->normal));
     polygon->centroid = v3_scale(sum, 1.0 / polygon->count);
     polygon->radius = 0;
     for (unsigned k = 0; k < polygon->count; k++)
         polygon->radius =
             fmax(polygon->radius, v3_length(v3_sub(polygon->vertex[k], polygon->centroid)));
     double running = 0;
+    rad_vec3 a = polygon->vertex[0];
     for (unsigned k = 1; k + 1 < polygon->count; k++) {
-        rad_vec3 a = polygon->vertex[0];
         running += 0.5 * v3_length(v3_cross(v3_sub(polygon->vertex[k], a),
                                             v3_sub(polygon->vertex[k + 1], a)));
-        polygon->fan[k - 1] = polygon->area > 0 ? running / polygon->area : 1;
+        polygon->fan[k - 1] = polygon->area > 0 ? fmin(running / polygon->area, 1) : 1;
     }
     polygon->fan[polygon->count - 3] = 1;
+}
+
+/* The normal from the corners' winding, then the rest (vf_polygon_finish). */
+static void finish_polygon(vf_polygon *polygon)
+{
+    rad_vec3 cross = {0, 0, 0};
+    for (unsigned k = 0; k < polygon->count; k++)
+        cross = v3_add(cross, v3_cross(polygon->vertex[k],
+                                       polygon->vertex[(k + 1) % polygon->count]));
+    polygon->normal = v3_normalize(cross);
+    vf_polygon_finish(polygon);
 }
 
 /* Polygons of one surface: its triangles merged greedily across shared edges. */

@@ -55,6 +55,10 @@ typedef struct vf_geometry {
 rad_status vf_geometry_build(const rad_scene *scene, vf_geometry *geometry, rad_error *error);
 void vf_geometry_free(vf_geometry *geometry);
 
+/* Area, centroid, bounding radius and triangle-fan shares of a convex polygon whose
+ * corners and unit normal are set. */
+void vf_polygon_finish(vf_polygon *polygon);
+
 /* True when some corner of `polygon` lies in front of the plane (n, offset) by more than
  * epsilon. */
 static inline bool vf_polygon_in_front(const vf_polygon *polygon, rad_vec3 n, double offset,
