@@ -13,7 +13,7 @@
  * the mesh smears the edge: about a quarter of a patch for an edge across a grid of
  * patches of size h, so each level of refinement should halve it. Checked:
  *   - that width for levels 0 (none) to 3, from the patch inputs and from the gather,
- *     shooting and hierarchical solutions (the hierarchical solver's leaves are the refined
+ *     Gauss-Seidel, shooting, direct (LU) and hierarchical solutions (the hierarchical solver's leaves are the refined
  *     patches), falling by at least 35 % a level; the area of the shadow (outside the
  *     footprint) stays right at every level;
  *   - that a point light without anything in its way splits nothing (smooth fall-off), and
@@ -150,8 +150,9 @@ static void test_edge_widths(void)
      * o), the square's extent across the unit vector perpendicular to o */
     double across = fabs(cos(sun_azimuth)) + fabs(sin(sun_azimuth));
     double exact_shadow = cot * across;
-    const rad_solver solvers[] = {RAD_SOLVER_JACOBI, RAD_SOLVER_SHOOT,
-                                  RAD_SOLVER_HIERARCHICAL};
+    const rad_solver solvers[] = {RAD_SOLVER_JACOBI, RAD_SOLVER_GAUSS_SEIDEL, RAD_SOLVER_SHOOT,
+                                  RAD_SOLVER_DIRECT, RAD_SOLVER_HIERARCHICAL};
+    const int solver_count = (int)(sizeof(solvers) / sizeof(solvers[0]));
     double previous[4] = {0};
     for (int levels = 0; levels <= 3; levels++) {
         rad_mesh_options options = {.patch_size = patch_size,
@@ -182,7 +183,7 @@ static void test_edge_widths(void)
         if (levels > 0)
             CHECK(width < 0.65 * previous[0]);
         previous[0] = width;
-        for (int s = 0; s < 3; s++) {
+        for (int s = 0; s < solver_count; s++) {
             rad_scene_solve_options solve = {.solver = solvers[s], .inputs = inputs};
             rad_scene_solve_report report;
             CHECK(rad_solve_scene(scene, mesh, &solve, B, &report, &error) == RAD_OK);
