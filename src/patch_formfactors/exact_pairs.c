@@ -35,6 +35,10 @@ struct screen_triangle {
     rad_vec3 corner[3];
     rad_vec3 normal; /* unit, or zero for a degenerate triangle */
     double offset;
+    /* in its plane, the inward unit normals of its edges and their offsets: a point of
+     * the plane lies inside when edge_normal[k] . x - edge_offset[k] > 0 for every k */
+    rad_vec3 edge_normal[3];
+    double edge_offset[3];
     double lo[3], hi[3];
 };
 
@@ -134,10 +138,26 @@ static bool box_apart(const screen_query *s, const double lo[3], const double hi
            box_behind(lo, hi, s->q->normal, v3_dot(s->q->normal, s->q->vertex[0]), s->epsilon);
 }
 
-/* May the triangle cut the pair's hull? Its box must meet the hull's box in front of both
- * planes, its plane must have corners of the pair strictly on both sides, and no side
- * plane of the hull may have it wholly outside. */
-static bool may_cut(screen_query *s, const screen_triangle *t)
+/* Does the segment between the two patches' centroids pass through the triangle, more
+ * than epsilon inside it? Then the triangle surely cuts the hull, and its faces are not
+ * needed to say so. */
+static bool blocks_centroids(const screen_query *s, const screen_triangle *t)
+{
+    double dp = v3_dot(t->normal, s->p->centroid) - t->offset;
+    double dq = v3_dot(t->normal, s->q->centroid) - t->offset;
+    if (!((dp > s->epsilon && dq < -s->epsilon) || (dp < -s->epsilon && dq > s->epsilon)))
+        return false;
+    rad_vec3 crossing = v3_lerp(s->p->centroid, s->q->centroid, dp / (dp - dq));
+    for (int k = 0; k < 3; k++)
+        if (v3_dot(t->edge_normal[k], crossing) - t->edge_offset[k] <= s->epsilon)
+            return false;
+    return true;
+}
+
+/* May the triangle stand between the pair at all? Its box must meet the hull's box in
+ * front of both planes, and its plane must have corners of the pair strictly on both
+ * sides. */
+static bool may_stand_between(const screen_query *s, const screen_triangle *t)
 {
     if (box_apart(s, t->lo, t->hi))
         return false;
@@ -149,8 +169,13 @@ static bool may_cut(screen_query *s, const screen_triangle *t)
             below = below || d < -s->epsilon;
             above = above || d > s->epsilon;
         }
-    if (!(below && above))
-        return false;
+    return below && above;
+}
+
+/* May a triangle that stands between the pair cut its hull? Not when a side plane of the
+ * hull has it wholly outside. */
+static bool inside_sides(screen_query *s, const screen_triangle *t)
+{
     if (!s->have_sides)
         find_sides(s);
     for (unsigned k = 0; k < s->side_count; k++) {
@@ -164,7 +189,12 @@ static bool may_cut(screen_query *s, const screen_triangle *t)
     return true;
 }
 
-/* False when no triangle can cut the hull of p and q (then the pair is clear). */
+/* Triangles kept for the second look; more are looked at as they come. */
+#define SCREEN_CANDIDATES 32u /* bits of a uint32_t */
+
+/* False when no triangle can cut the hull of p and q (then the pair is clear). The
+ * triangles that stand between the pair are gathered first: one across the centroids'
+ * segment settles it without the hull's side planes, which cost more than all the rest. */
 static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, const vf_polygon *q)
 {
     if (pairs->screen_node_count == 0)
@@ -186,6 +216,8 @@ static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, cons
                 s.hi[a] = fmax(s.hi[a], coordinate(polygon->vertex[c], a));
             }
     }
+    const screen_triangle *candidate[SCREEN_CANDIDATES];
+    unsigned candidate_count = 0;
     uint32_t stack[2 * SCREEN_DEPTH + 2];
     unsigned top = 0;
     stack[top++] = 0;
@@ -194,17 +226,40 @@ static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, cons
         if (box_apart(&s, node->lo, node->hi))
             continue;
         if (node->count) {
-            for (uint32_t t = node->first; t < node->first + node->count; t++)
-                if (may_cut(&s, &pairs->screen_triangles[t]))
+            for (uint32_t t = node->first; t < node->first + node->count; t++) {
+                const screen_triangle *tt = &pairs->screen_triangles[t];
+                if (!may_stand_between(&s, tt))
+                    continue;
+                if (blocks_centroids(&s, tt))
                     return true;
+                if (candidate_count < SCREEN_CANDIDATES)
+                    candidate[candidate_count++] = tt;
+                else if (inside_sides(&s, tt))
+                    return true;
+            }
         } else {
             stack[top++] = node->first;
             stack[top++] = node->first + 1;
         }
     }
-    return false;
+    /* the hull's side planes one edge at a time, dropping the triangles each has wholly
+     * outside: a clear pair usually stops long before the last edge */
+    uint32_t alive = candidate_count == 32 ? UINT32_MAX : (UINT32_C(1) << candidate_count) - 1;
+    for (unsigned edge = 0; alive && edge < p->count + q->count; edge++) {
+        rad_vec3 normal[2];
+        double offset[2];
+        unsigned faces = occluder_hull_edge_sides(p, q, edge, s.epsilon, normal, offset);
+        for (unsigned f = 0; f < faces; f++)
+            for (unsigned k = 0; k < candidate_count; k++) {
+                const rad_vec3 *c = candidate[k]->corner;
+                if ((alive >> k & 1u) && v3_dot(normal[f], c[0]) - offset[f] >= -s.epsilon &&
+                    v3_dot(normal[f], c[1]) - offset[f] >= -s.epsilon &&
+                    v3_dot(normal[f], c[2]) - offset[f] >= -s.epsilon)
+                    alive &= ~(UINT32_C(1) << k);
+            }
+    }
+    return alive != 0;
 }
-
 
 rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
                              double plane_epsilon, exact_pairs *out, rad_error *error)
@@ -261,6 +316,15 @@ rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
         double length = v3_length(n);
         tt->normal = length > 0 ? v3_scale(n, 1 / length) : v3(0, 0, 0);
         tt->offset = v3_dot(tt->normal, tt->corner[0]);
+        for (int k = 0; k < 3; k++) {
+            rad_vec3 a = tt->corner[k], b = tt->corner[(k + 1) % 3];
+            rad_vec3 inward = v3_cross(tt->normal, v3_sub(b, a));
+            double inward_length = v3_length(inward);
+            /* a degenerate triangle has no inside: no point passes its edge tests */
+            tt->edge_normal[k] = inward_length > 0 ? v3_scale(inward, 1 / inward_length)
+                                                   : v3(0, 0, 0);
+            tt->edge_offset[k] = inward_length > 0 ? v3_dot(tt->edge_normal[k], a) : INFINITY;
+        }
         for (int a = 0; a < 3; a++) {
             tt->lo[a] = fmin(coordinate(tt->corner[0], a),
                              fmin(coordinate(tt->corner[1], a), coordinate(tt->corner[2], a)));

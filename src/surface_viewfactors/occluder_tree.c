@@ -151,40 +151,97 @@ void occluder_tree_destroy(occluder_tree *tree)
     free(tree);
 }
 
+/* 2-D cross product of (ax, ay) and (bx, by). */
+static double cross2(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
+
+/* The hull faces through one edge (e0, e1) of a polygon: seen along the edge, every other
+ * corner is a direction in the plane across it, and the faces are the planes through the
+ * edge and the two extreme directions, when all of them lie within half a turn. Each
+ * corner is looked at once per edge, instead of once per candidate plane. */
+static unsigned edge_faces(rad_vec3 e0, rad_vec3 e1, const vf_polygon *const polygon[2],
+                           rad_vec3 inside, double epsilon, rad_vec3 *normal_out,
+                           double *offset_out)
+{
+    rad_vec3 u = v3_sub(e1, e0);
+    double length = v3_length(u);
+    if (!(length > 0))
+        return 0;
+    u = v3_scale(u, 1 / length);
+    /* an orthonormal frame across the edge: w towards the polygon's inside, v = u x w */
+    rad_vec3 w = v3_sub(inside, e0);
+    w = v3_sub(w, v3_scale(u, v3_dot(w, u)));
+    double w_length = v3_length(w);
+    if (!(w_length > 0))
+        return 0;
+    w = v3_scale(w, 1 / w_length);
+    rad_vec3 v = v3_cross(u, w);
+    double x[2 * VF_MAX_VERTICES], y[2 * VF_MAX_VERTICES];
+    unsigned count = 0;
+    for (int k = 0; k < 2; k++)
+        for (unsigned m = 0; m < polygon[k]->count; m++) {
+            rad_vec3 r = v3_sub(polygon[k]->vertex[m], e0);
+            x[count] = v3_dot(r, w);
+            y[count] = v3_dot(r, v);
+            count++;
+        }
+    /* the most counter-clockwise and most clockwise directions: exact when every
+     * direction lies within half a turn, which the check below makes sure of */
+    unsigned ccw = UINT32_MAX, cw = UINT32_MAX;
+    double tiny = epsilon * epsilon;
+    for (unsigned k = 0; k < count; k++) {
+        if (x[k] * x[k] + y[k] * y[k] <= tiny)
+            continue; /* on the edge's line: in every plane through it */
+        if (ccw == UINT32_MAX) {
+            ccw = cw = k;
+            continue;
+        }
+        if (cross2(x[ccw], y[ccw], x[k], y[k]) > 0)
+            ccw = k;
+        if (cross2(x[cw], y[cw], x[k], y[k]) < 0)
+            cw = k;
+    }
+    if (ccw == UINT32_MAX)
+        return 0;
+    unsigned made = 0;
+    unsigned extreme[2] = {ccw, cw};
+    for (int side = 0; side < 2; side++) {
+        unsigned d = extreme[side];
+        double d_length = sqrt(x[d] * x[d] + y[d] * y[d]);
+        /* outward: every corner at signed distance <= 0 (within epsilon) */
+        double sign = side == 0 ? 1.0 : -1.0;
+        bool all_on_it = true, fits = true;
+        for (unsigned k = 0; k < count && fits; k++) {
+            double distance = sign * cross2(x[d], y[d], x[k], y[k]) / d_length;
+            fits = distance <= epsilon;
+            all_on_it = all_on_it && distance >= -epsilon;
+        }
+        if (!fits || all_on_it)
+            continue; /* more than half a turn, or (degenerate) all on the plane */
+        rad_vec3 normal = v3_scale(v3_add(v3_scale(w, -y[d]), v3_scale(v, x[d])),
+                                   sign / d_length);
+        normal_out[made] = normal;
+        offset_out[made++] = v3_dot(normal, e0);
+    }
+    return made;
+}
+
+unsigned occluder_hull_edge_sides(const vf_polygon *p, const vf_polygon *q, unsigned edge,
+                                  double epsilon, rad_vec3 *normal_out, double *offset_out)
+{
+    const vf_polygon *polygon[2] = {p, q};
+    const vf_polygon *a = edge < p->count ? p : q;
+    unsigned e = edge < p->count ? edge : edge - p->count;
+    return edge_faces(a->vertex[e], a->vertex[(e + 1) % a->count], polygon, a->centroid,
+                      epsilon, normal_out, offset_out);
+}
+
 unsigned occluder_hull_sides(const vf_polygon *p, const vf_polygon *q, double epsilon,
                              rad_vec3 *normal_out, double *offset_out)
 {
     unsigned count = 0;
-    const vf_polygon *polygon[2] = {p, q};
-    for (int side = 0; side < 2; side++) {
-        const vf_polygon *a = polygon[side], *b = polygon[1 - side];
-        for (unsigned e = 0; e < a->count; e++) {
-            rad_vec3 e0 = a->vertex[e], e1 = a->vertex[(e + 1) % a->count];
-            for (unsigned c = 0; c < b->count; c++) {
-                rad_vec3 normal = v3_cross(v3_sub(e1, e0), v3_sub(b->vertex[c], e0));
-                double length = v3_length(normal);
-                if (!(length > 0))
-                    continue;
-                normal = v3_scale(normal, 1 / length);
-                double offset = v3_dot(normal, e0);
-                bool below = true, above = true;
-                for (int k = 0; k < 2 && (below || above); k++)
-                    for (unsigned m = 0; m < polygon[k]->count && (below || above); m++) {
-                        double d = v3_dot(normal, polygon[k]->vertex[m]) - offset;
-                        below = below && d <= epsilon;
-                        above = above && d >= -epsilon;
-                    }
-                if (below == above)
-                    continue; /* straddles, or (degenerate) all on it */
-                if (above) {
-                    normal = v3_scale(normal, -1);
-                    offset = -offset;
-                }
-                normal_out[count] = normal;
-                offset_out[count++] = offset;
-            }
-        }
-    }
+    for (unsigned edge = 0; edge < p->count + q->count; edge++)
+        count += occluder_hull_edge_sides(p, q, edge, epsilon, &normal_out[count],
+                                          &offset_out[count]);
     return count;
 }
 

@@ -22,19 +22,26 @@ rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_
                                occluder_tree **out, rad_error *error);
 void occluder_tree_destroy(occluder_tree *tree);
 
-/* The triangles other than the polygons' own that may cut the hull of p and q (touching
- * the hull's boundary within epsilon, scene units, does not count): their corners go to
- * `out` (room for `max`); returns how many, or max + 1 when there are more. */
-/* Room for the side planes of the hull of two polygons. */
-#define OCCLUDER_HULL_MAX_SIDES (2u * VF_MAX_VERTICES * VF_MAX_VERTICES)
+/* Room for the side planes of the hull of two polygons (at most two per edge). */
+#define OCCLUDER_HULL_MAX_SIDES (4u * VF_MAX_VERTICES)
 
-/* The side faces of the convex hull of p and q: the planes through an edge of one and a
- * corner of the other that have every corner of both on one side (within epsilon), as
- * outward unit normals and offsets (n . x = offset); returns how many. With the two
- * polygons' own planes they bound the hull. */
+/* The side faces of the convex hull of p and q: the planes through an edge of one that
+ * have every corner of both on one side (within epsilon) and touch a corner besides the
+ * edge's, as outward unit normals and offsets (n . x = offset); returns how many. With
+ * the two polygons' own planes they bound the hull. A pair that wraps more than half a
+ * turn around an edge gives no face there: the hull is then looser, never too tight. */
 unsigned occluder_hull_sides(const vf_polygon *p, const vf_polygon *q, double epsilon,
                              rad_vec3 *normal, double *offset);
 
+/* The same faces, only those through one edge: edges 0 .. p->count - 1 are p's, the next
+ * q->count are q's; at most two faces (room for two). For a caller that can stop as soon
+ * as the faces found so far settle its question. */
+unsigned occluder_hull_edge_sides(const vf_polygon *p, const vf_polygon *q, unsigned edge,
+                                  double epsilon, rad_vec3 *normal, double *offset);
+
+/* The triangles other than the polygons' own that may cut the hull of p and q (touching
+ * the hull's boundary within epsilon, scene units, does not count): their corners go to
+ * `out` (room for `max`); returns how many, or max + 1 when there are more. */
 uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
                                const vf_polygon *q, double epsilon, shadow_occluder *out,
                                uint32_t max);
