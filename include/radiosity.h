@@ -567,9 +567,13 @@ typedef struct rad_mesh {
     rad_patch *patches;
     uint32_t patch_count;
     double patch_size; /* the longest-edge limit the mesh was built with */
+    int shadow_levels, proximity_levels; /* and its rad_mesh_options' levels */
     uint32_t shadow_splits;     /* cells split where a sharp light's shadow edge crosses
                                    them (rad_mesh_options.shadow_levels) */
     bool shadow_budget_reached; /* the splits stopped at max_added_patches */
+    uint32_t proximity_splits;  /* cells split because other surfaces are near them
+                                   (rad_mesh_options.proximity_levels) */
+    bool proximity_budget_reached; /* those splits stopped at max_added_patches */
 } rad_mesh;
 
 /* A patch size that gives roughly `target_patches` patches for the scene's area; 0 when
@@ -596,11 +600,27 @@ rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **
 #define RAD_SHADOW_LEVELS_DEFAULT 1
 #define RAD_SHADOW_LEVELS_MAX 6
 
+/* Proximity refinement. One patch size for a scene comes from the whole scene's extent,
+ * so a room on a ground plane twenty times its size would get patches as large as its
+ * walls. The light changes over the distance from a point to the surfaces it exchanges
+ * light with, so every cell sends 32 cosine-weighted rays from its centre (both sides for
+ * a two-sided surface): when a quarter of them or more meet a surface (the front of it:
+ * a cell under a box or inside an object is left alone) and the cell's longest edge is
+ * more than 1/3 of their mean distance, it is split in four, and the children again,
+ * `proximity_levels` times at most. Open ground under the sky keeps its size; the
+ * Cornell box keeps its default patches (its cells are a tenth of that distance). The CLI
+ * asks for RAD_PROXIMITY_LEVELS_DEFAULT when the patch size is its automatic one
+ * (rad_default_patch_size), and for none with an explicit --patch-size. */
+#define RAD_PROXIMITY_LEVELS_DEFAULT 3
+#define RAD_PROXIMITY_LEVELS_MAX 8
+
 typedef struct rad_mesh_options {
     double patch_size;          /* the longest edge of a patch (required, > 0) */
     int shadow_levels;          /* 0: RAD_SHADOW_LEVELS_DEFAULT; -1: none; at most
                                    RAD_SHADOW_LEVELS_MAX */
-    uint32_t max_added_patches; /* 0: as many as the unrefined mesh has, at least 4096 */
+    int proximity_levels;       /* 0: none; at most RAD_PROXIMITY_LEVELS_MAX */
+    uint32_t max_added_patches; /* per refinement; 0: as many as the unrefined mesh has,
+                                   at least 4096 */
 } rad_mesh_options;
 
 /* rad_mesh_build with options (rad_mesh_build is this with patch_size alone). */
@@ -1515,13 +1535,17 @@ rad_status rad_lit_mesh_triangle_patches(const rad_mesh *mesh, uint32_t **patch_
 /* A solution file: the per-patch radiosity B of one scene and meshing, so a scene is
  * solved once and rendered from many views (radiosity is view-independent). Binary,
  * little-endian: magic "\x89RADSOL\n", format version (uint32, RAD_SOLUTION_VERSION),
- * patch count (uint32), fingerprint (uint64), patch size (double), then B as patch_count x
- * 3 doubles (r, g, b), then an FNV-1a 64 checksum of every byte before it. */
-#define RAD_SOLUTION_VERSION 1
+ * patch count (uint32), fingerprint (uint64), patch size (double), the mesh's shadow and
+ * proximity levels (two int32, rad_mesh_options; version 2), then B as patch_count x 3
+ * doubles (r, g, b), then an FNV-1a 64 checksum of every byte before it. Version 1 files
+ * (no levels: the default shadow levels, no proximity refinement) are read too. */
+#define RAD_SOLUTION_VERSION 2
 
 typedef struct rad_solution {
     uint32_t patch_count;
-    double patch_size;    /* the mesh was built with rad_mesh_build(scene, patch_size) */
+    double patch_size;    /* the mesh was built with rad_mesh_build_with these options */
+    int shadow_levels;    /* rad_mesh_options.shadow_levels */
+    int proximity_levels; /* rad_mesh_options.proximity_levels */
     uint64_t fingerprint; /* rad_solution_fingerprint of that scene and mesh */
     rad_rgb *B;           /* patch_count exitances */
     char source[512];     /* the file it was read from */

@@ -315,10 +315,10 @@ int main(void)
         write_bytes("truncated.sol", bytes, size - 10);
         expect_refusal("render --solution truncated.sol -o out.pfm " VIEW, "truncated.sol",
                        "truncated");
-        bytes[8] = 2; /* format version 2 */
+        bytes[8] = 3; /* format version 3 */
         write_bytes("version.sol", bytes, size);
         expect_refusal("render --solution version.sol -o out.pfm " VIEW, "version.sol",
-                       "version 2");
+                       "version 3");
     }
     free(bytes);
     test_write_file("text.sol", "this is not a solution\n");

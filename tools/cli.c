@@ -310,6 +310,13 @@ bool cli_parse_shared(const cli_args *args, cli_shared *shared)
             return false;
         shared->shadow_levels = levels == 0 ? -1 : (int)levels;
     }
+    if (args->value[OPT_PROXIMITY_LEVELS]) {
+        uint32_t levels = 0;
+        if (!cli_parse_count("proximity-levels", args->value[OPT_PROXIMITY_LEVELS], 0,
+                             RAD_PROXIMITY_LEVELS_MAX, &levels))
+            return false;
+        shared->proximity_levels = levels == 0 ? -1 : (int)levels;
+    }
     if (!cli_parse_count("visibility-rays", args->value[OPT_VISIBILITY_RAYS], 0, 256,
                          &shared->formfactor.visibility_rays) ||
         !cli_parse_count("quadrature", args->value[OPT_QUADRATURE], 0, 8,

@@ -64,6 +64,7 @@ int cli_value_count(const cli_args *args, int option);
 enum {
     OPT_OUTPUT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_QUIET, OPT_HELP, /* BASE */
     OPT_PATCH_SIZE, OPT_VISIBILITY_RAYS, OPT_QUADRATURE, OPT_SHADOW_LEVELS, /* FORMFACTOR */
+    OPT_PROXIMITY_LEVELS,
     OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE, /* VIEW */
     OPT_EXR_FLOAT,
     OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_SOLUTION,        /* SOLVE */
@@ -105,7 +106,8 @@ enum {
     [OPT_PATCH_SIZE] = {"patch-size", 0, true},                                            \
     [OPT_VISIBILITY_RAYS] = {"visibility-rays", 0, true},                                  \
     [OPT_QUADRATURE] = {"quadrature", 0, true},                                            \
-    [OPT_SHADOW_LEVELS] = {"shadow-levels", 0, true}
+    [OPT_SHADOW_LEVELS] = {"shadow-levels", 0, true},                                      \
+    [OPT_PROXIMITY_LEVELS] = {"proximity-levels", 0, true}
 
 #define CLI_VIEW_OPTIONS                                                                   \
     [OPT_EYE] = {"eye", 0, true}, [OPT_TARGET] = {"target", 0, true},                      \
@@ -127,7 +129,13 @@ enum {
     "  --shadow-levels N    split a patch that a point, spot, luminaire or sun shadow\n"   \
     "                       edge crosses into four, and its children again, N times\n"    \
     "                       (default " CLI_STR(RAD_SHADOW_LEVELS_DEFAULT) ", at most "        \
-    CLI_STR(RAD_SHADOW_LEVELS_MAX) ", 0 = none)\n"
+    CLI_STR(RAD_SHADOW_LEVELS_MAX) ", 0 = none)\n"                                          \
+    "  --proximity-levels N split a patch larger than 1/3 of the mean distance to the\n"   \
+    "                       surfaces it sees into four, and its children again, N times\n" \
+    "                       (at most " CLI_STR(RAD_PROXIMITY_LEVELS_MAX) ", 0 = none; default "  \
+    CLI_STR(RAD_PROXIMITY_LEVELS_DEFAULT) " with the dense solvers' automatic patch\n"       \
+    "                       size, 0 with --patch-size or --solver hierarchical): rooms\n"  \
+    "                       get patches of their own size\n"
 
 #define CLI_SOLVE_HELP                                                                     \
     "Solution:\n"                                                                          \
@@ -243,6 +251,7 @@ typedef struct cli_shared {
     const char *output, *stats_path;
     double patch_size;
     int shadow_levels; /* rad_mesh_options.shadow_levels: 0 default, -1 none */
+    int proximity_levels; /* rad_mesh_options.proximity_levels: 0 default, -1 none */
     rad_formfactor_options formfactor; /* quadrature, visibility rays, threads, seed, progress */
     int threads;
     unsigned long seed;

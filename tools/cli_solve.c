@@ -165,8 +165,22 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         snprintf(error->message, sizeof(error->message), "out of memory");
         goto done;
     }
+    /* the proximity refinement serves the dense solvers' automatic patch size (a scene's
+     * extent says little about its rooms); an explicit --patch-size is taken as it is,
+     * and the hierarchical solver's own default leaves are ten times finer already */
+    int proximity_levels =
+        shared->proximity_levels < 0                             ? 0
+        : shared->proximity_levels > 0                           ? shared->proximity_levels
+        : solution                                               ? solution->proximity_levels
+        : shared->patch_size > 0                                 ? 0
+        : solve->options.solver == RAD_SOLVER_HIERARCHICAL       ? 0
+                                                                 : RAD_PROXIMITY_LEVELS_DEFAULT;
+    /* a solution file's mesh is rebuilt as it was made, unless the command line says */
+    int shadow_levels = shared->shadow_levels == 0 && solution ? solution->shadow_levels
+                                                               : shared->shadow_levels;
     rad_mesh_options mesh_options = {.patch_size = patch_size,
-                                     .shadow_levels = shared->shadow_levels};
+                                     .shadow_levels = shadow_levels,
+                                     .proximity_levels = proximity_levels};
     status = rad_mesh_build_with(out->scene, &mesh_options, &out->mesh, error);
     if (status != RAD_OK)
         goto done;
@@ -241,6 +255,7 @@ void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *st
     stats_integer(stats, "patches", s->mesh->patch_count);
     stats_number(stats, "patch_size", s->mesh->patch_size);
     stats_integer(stats, "shadow_splits", s->mesh->shadow_splits);
+    stats_integer(stats, "proximity_splits", s->mesh->proximity_splits);
     stats_bool(stats, "shadow_budget_reached", s->mesh->shadow_budget_reached);
     stats_number(stats, "seconds_load", s->seconds_load);
     stats_number(stats, "seconds_mesh", s->seconds_mesh);

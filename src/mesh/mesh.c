@@ -29,6 +29,7 @@
 #include "core/union_find.h"
 #include "core/vec3.h"
 #include "core/weld.h"
+#include "mesh/proximity_refine.h"
 #include "mesh/shadow_refine.h"
 
 /* Refuse meshes beyond this many patches: the dense form-factor matrix would not fit. */
@@ -114,6 +115,7 @@ typedef struct mesh_output {
     rad_patch *patches;
     size_t patch_count, patch_capacity;
     shadow_refiner *refiner; /* splits cells crossed by sharp shadows (shadow_refine.h) */
+    proximity_refiner *near; /* splits cells near other surfaces (proximity_refine.h) */
     bool two_sided;          /* the polygon being subdivided */
 } mesh_output;
 
@@ -170,18 +172,26 @@ static int add_patch(mesh_output *out, const polygon *poly, const rad_vec3 *p, u
     return 1;
 }
 
-/* A cell of a polygon's grid: a patch, or, where a sharp light's shadow edge crosses it
- * (shadow_refine.h), its four children, tested again down to the refiner's levels. An
- * edge's midpoint is the sum of its ends halved, the same bits from either cell that
- * shares the edge, so split neighbours weld their midpoints; an unsplit neighbour leaves a
- * T-vertex, which the display mesh makes continuous (display_mesh.h). */
+/* A cell of a polygon's grid: a patch, or, where other surfaces are near it
+ * (proximity_refine.h) or a sharp light's shadow edge crosses it (shadow_refine.h), its
+ * four children, tested again down to each refiner's levels (`near_level` and
+ * `shadow_level` count the splits each has made above this cell). An edge's midpoint is
+ * the sum of its ends halved, the same bits from either cell that shares the edge, so
+ * split neighbours weld their midpoints; an unsplit neighbour leaves a T-vertex, which the
+ * display mesh makes continuous (display_mesh.h). */
 static int emit_cell(mesh_output *out, const polygon *poly, const rad_vec3 *p, uint32_t count,
-                     uint32_t level)
+                     uint32_t near_level, uint32_t shadow_level)
 {
+    rad_vec3 normal = out->in->normal[poly->triangle];
+    proximity_refiner *near = out->near;
     shadow_refiner *refiner = out->refiner;
-    if (!refiner || level >= refiner->levels ||
-        !shadow_refiner_splits(refiner, p, count, out->in->normal[poly->triangle], poly->bulge,
-                               out->two_sided))
+    if (near && near_level < near->levels &&
+        proximity_refiner_splits(near, p, count, normal, out->two_sided))
+        near_level++;
+    else if (refiner && shadow_level < refiner->levels &&
+             shadow_refiner_splits(refiner, p, count, normal, poly->bulge, out->two_sided))
+        shadow_level++;
+    else
         return add_patch(out, poly, p, count);
     rad_vec3 m[4];
     for (uint32_t k = 0; k < count; k++)
@@ -190,7 +200,7 @@ static int emit_cell(mesh_output *out, const polygon *poly, const rad_vec3 *p, u
         rad_vec3 children[4][3] = {
             {p[0], m[0], m[2]}, {m[0], p[1], m[1]}, {m[2], m[1], p[2]}, {m[0], m[1], m[2]}};
         for (int k = 0; k < 4; k++)
-            if (!emit_cell(out, poly, children[k], 3, level + 1))
+            if (!emit_cell(out, poly, children[k], 3, near_level, shadow_level))
                 return 0;
         return 1;
     }
@@ -200,7 +210,7 @@ static int emit_cell(mesh_output *out, const polygon *poly, const rad_vec3 *p, u
                                {centre, m[1], p[2], m[2]},
                                {m[3], centre, m[2], p[3]}};
     for (int k = 0; k < 4; k++)
-        if (!emit_cell(out, poly, children[k], 4, level + 1))
+        if (!emit_cell(out, poly, children[k], 4, near_level, shadow_level))
             return 0;
     return 1;
 }
@@ -246,11 +256,11 @@ static int subdivide_triangle(mesh_output *out, const polygon *poly, double patc
     for (uint32_t j = 0; j < n; j++)
         for (uint32_t i = 0; i + j < n; i++) {
             rad_vec3 up[3] = {GRID(i, j), GRID(i + 1, j), GRID(i, j + 1)};
-            if (!emit_cell(out, poly, up, 3, 0))
+            if (!emit_cell(out, poly, up, 3, 0, 0))
                 return 0;
             if (i + j + 1 < n) {
                 rad_vec3 down[3] = {GRID(i + 1, j), GRID(i + 1, j + 1), GRID(i, j + 1)};
-                if (!emit_cell(out, poly, down, 3, 0))
+                if (!emit_cell(out, poly, down, 3, 0, 0))
                     return 0;
             }
         }
@@ -278,7 +288,7 @@ static int subdivide_quad(mesh_output *out, const polygon *poly, double patch_si
     for (uint32_t j = 0; j < nv; j++)
         for (uint32_t i = 0; i < nu; i++) {
             rad_vec3 cell[4] = {GRID(i, j), GRID(i + 1, j), GRID(i + 1, j + 1), GRID(i, j + 1)};
-            if (!emit_cell(out, poly, cell, 4, 0))
+            if (!emit_cell(out, poly, cell, 4, 0, 0))
                 return 0;
         }
 #undef GRID
@@ -539,12 +549,16 @@ rad_status rad_mesh_build_with(const rad_scene *scene, const rad_mesh_options *o
         return rad_fail(error, RAD_ERR_INVALID,
                         "shadow levels must be from 1 to %d, 0 for the default or -1 for none",
                         RAD_SHADOW_LEVELS_MAX);
+    if (options->proximity_levels < 0 || options->proximity_levels > RAD_PROXIMITY_LEVELS_MAX)
+        return rad_fail(error, RAD_ERR_INVALID, "proximity levels must be from 0 (none) to %d",
+                        RAD_PROXIMITY_LEVELS_MAX);
     mesh_plan plan;
     rad_status status = plan_build(scene, &plan, error);
     if (status != RAD_OK)
         return status;
     shadow_refiner refiner = {0};
-    mesh_output result = {&plan.in, {0}, NULL, 0, 0, NULL, false};
+    proximity_refiner near = {0};
+    mesh_output result = {&plan.in, {0}, NULL, 0, 0, NULL, NULL, false};
     rad_mesh *mesh = rad_alloc_array(1, sizeof(*mesh));
     if (!mesh || !rad_weld_init(&result.weld, 16))
         goto nomem;
@@ -567,6 +581,11 @@ rad_status rad_mesh_build_with(const rad_scene *scene, const rad_mesh_options *o
     if (status != RAD_OK)
         goto done;
     result.refiner = refiner.tracer ? &refiner : NULL;
+    status = proximity_refiner_init(&near, scene, (uint32_t)options->proximity_levels, budget,
+                                    error);
+    if (status != RAD_OK)
+        goto done;
+    result.near = near.tracer ? &near : NULL;
     size_t *first_patch = rad_alloc_array(plan.polygon_count + 1, sizeof(*first_patch));
     if (!first_patch)
         goto nomem;
@@ -605,8 +624,12 @@ rad_status rad_mesh_build_with(const rad_scene *scene, const rad_mesh_options *o
     mesh->vertex_count = result.weld.count;
     mesh->vertices = rad_weld_take_positions(&result.weld);
     mesh->patch_size = patch_size;
+    mesh->shadow_levels = options->shadow_levels;
+    mesh->proximity_levels = options->proximity_levels;
     mesh->shadow_splits = refiner.split;
     mesh->shadow_budget_reached = refiner.budget_reached;
+    mesh->proximity_splits = near.split;
+    mesh->proximity_budget_reached = near.budget_reached;
     *out = mesh;
     mesh = NULL;
     goto done;
@@ -614,6 +637,7 @@ nomem:
     status = rad_fail(error, RAD_ERR_NOMEM, "out of memory while building patches");
 done:
     shadow_refiner_free(&refiner);
+    proximity_refiner_free(&near);
     rad_weld_free(&result.weld);
     free(result.patches);
     plan_free(&plan);

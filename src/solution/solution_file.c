@@ -21,7 +21,8 @@
 static const uint8_t solution_magic[8] = {0x89, 'R', 'A', 'D', 'S', 'O', 'L', '\n'};
 
 enum {
-    HEADER_BYTES = 32,   /* magic, version, patch count, fingerprint, patch size */
+    HEADER_BYTES = 40,   /* magic, version, patch count, fingerprint, patch size, levels */
+    HEADER_BYTES_V1 = 32, /* without the levels */
     PATCH_BYTES = 24,    /* r, g, b as doubles */
     CHECKSUM_BYTES = 8
 };
@@ -45,6 +46,8 @@ rad_status rad_solution_write(const rad_scene *scene, const rad_mesh *mesh, cons
     bytes_put_u32(bytes + 12, n);
     bytes_put_u64(bytes + 16, fingerprint);
     bytes_put_f64(bytes + 24, mesh->patch_size);
+    bytes_put_u32(bytes + 32, (uint32_t)mesh->shadow_levels);
+    bytes_put_u32(bytes + 36, (uint32_t)mesh->proximity_levels);
     uint8_t *p = bytes + HEADER_BYTES;
     for (uint32_t i = 0; i < n; i++, p += PATCH_BYTES) {
         bytes_put_f64(p, B[i].r);
@@ -63,17 +66,18 @@ static rad_status parse_solution(const char *path, const uint8_t *bytes, size_t 
 {
     if (size < sizeof(solution_magic) || memcmp(bytes, solution_magic, sizeof(solution_magic)))
         return rad_fail(error, RAD_ERR_PARSE, "%s: not a radiosity solution file", path);
-    if (size < HEADER_BYTES + CHECKSUM_BYTES)
+    if (size < HEADER_BYTES_V1 + CHECKSUM_BYTES)
         return rad_fail(error, RAD_ERR_PARSE, "%s: truncated solution file (%zu bytes)", path,
                         size);
     uint32_t version = bytes_get_u32(bytes + 8);
-    if (version != RAD_SOLUTION_VERSION)
+    if (version != RAD_SOLUTION_VERSION && version != 1)
         return rad_fail(error, RAD_ERR_PARSE,
-                        "%s: solution file format version %u; this build reads version %d",
+                        "%s: solution file format version %u; this build reads versions 1 to %d",
                         path, version, RAD_SOLUTION_VERSION);
+    size_t header = version == 1 ? HEADER_BYTES_V1 : HEADER_BYTES;
     uint32_t n = bytes_get_u32(bytes + 12);
     /* fits: n < 2^32, so this is below 2^37 */
-    uint64_t expected = HEADER_BYTES + (uint64_t)n * PATCH_BYTES + CHECKSUM_BYTES;
+    uint64_t expected = header + (uint64_t)n * PATCH_BYTES + CHECKSUM_BYTES;
     if ((uint64_t)size < expected)
         return rad_fail(error, RAD_ERR_PARSE,
                         "%s: truncated solution file (%zu bytes, %u patches need %llu)", path,
@@ -92,10 +96,16 @@ static rad_status parse_solution(const char *path, const uint8_t *bytes, size_t 
     if (!(solution->patch_size > 0 && isfinite(solution->patch_size)))
         return rad_fail(error, RAD_ERR_PARSE, "%s: patch size %g is not a positive number",
                         path, solution->patch_size);
+    solution->shadow_levels = version == 1 ? 0 : (int32_t)bytes_get_u32(bytes + 32);
+    solution->proximity_levels = version == 1 ? 0 : (int32_t)bytes_get_u32(bytes + 36);
+    if (solution->shadow_levels < -1 || solution->shadow_levels > RAD_SHADOW_LEVELS_MAX ||
+        solution->proximity_levels < 0 || solution->proximity_levels > RAD_PROXIMITY_LEVELS_MAX)
+        return rad_fail(error, RAD_ERR_PARSE, "%s: mesh levels %d and %d are out of range",
+                        path, solution->shadow_levels, solution->proximity_levels);
     solution->B = rad_alloc_array(n, sizeof(*solution->B));
     if (!solution->B)
         return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for %u patches", path, n);
-    const uint8_t *p = bytes + HEADER_BYTES;
+    const uint8_t *p = bytes + header;
     for (uint32_t i = 0; i < n; i++, p += PATCH_BYTES) {
         rad_rgb b = {bytes_get_f64(p), bytes_get_f64(p + 8), bytes_get_f64(p + 16)};
         if (!(b.r >= 0 && b.g >= 0 && b.b >= 0 && isfinite(b.r) && isfinite(b.g) &&

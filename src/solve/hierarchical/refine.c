@@ -27,7 +27,7 @@
 #define PARTIAL_FACTOR 0.25 /* partly visible links refine at a quarter of the threshold */
 #define SETTLED_SHARE 0.25  /* a link whose error is under this share of its threshold is
                                settled until the next full check */
-#define HIDDEN_FACTOR 0.125 /* a pair of nodes all of whose 16 segments were blocked likely
+#define HIDDEN_FACTOR 1.0 /* a pair of nodes all of whose 16 segments were blocked likely
                                lets through less than 1/8 of its bound */
 
 enum { KEEP = 0, SPLIT_RECEIVER = 1, SPLIT_SOURCE = 2, SPLIT_SELF = 3 };
