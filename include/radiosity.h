@@ -778,6 +778,20 @@ typedef struct rad_viewfactor_options {
     int threads;         /* 0 = all cores */
     rad_progress_fn progress;
     void *progress_user;
+    /* Long runs (see rad_viewfactor_matrix_compute): */
+    const char *checkpoint;     /* NULL: none. Restart file of the rows done so far, written
+                                   atomically (rank 0 of an MPI job writes every rank's rows)
+                                   when checkpoint_interval seconds have passed since the last
+                                   one (checked between rounds of rows) and when stopped */
+    double checkpoint_interval; /* seconds; 0: after every round (1/64 of the rows) */
+    const char *resume;         /* NULL: none. A checkpoint of this job (same scene geometry
+                                   and surfaces, accuracy, max_rays, seed) whose rows are taken
+                                   as done; another job's is refused (RAD_ERR_INVALID naming
+                                   the file). May be the checkpoint file itself */
+    const volatile int *stop;   /* NULL: none. When it becomes non-zero (a signal handler),
+                                   the run stops after the current round of rows, writes the
+                                   checkpoint (when one is set) and returns RAD_OK with no
+                                   matrix and report.interrupted */
 } rad_viewfactor_options;
 
 typedef struct rad_viewfactor_report {
@@ -797,6 +811,10 @@ typedef struct rad_viewfactor_report {
     uint32_t rank_rows;          /* rows this process computed: all of them unless the work
                                     was shared over MPI ranks (rad_ranks_begin) */
     double rank_seconds;         /* this process's time computing its rows (no waiting) */
+    uint32_t resumed_rows;       /* rows read from options.resume, not computed */
+    uint32_t checkpoint_rows;    /* rows in the last checkpoint written (0: none written) */
+    bool interrupted;            /* options.stop was raised: no matrix (*out NULL); the
+                                    checkpoint holds checkpoint_rows rows */
 } rad_viewfactor_report;
 
 /* Computes the view factors between the scene's surfaces, each surface taken as a whole
@@ -808,7 +826,12 @@ typedef struct rad_viewfactor_report {
  * calls it with the same scene and options, computes the rows given to it by estimated
  * cost (their obstruction), and rank 0 gets the whole matrix, bitwise the same as a serial
  * run, and the report's counts summed over the ranks; the other ranks get *out = NULL (and
- * RAD_OK). A failure on any rank fails it on every rank. */
+ * RAD_OK). A failure on any rank fails it on every rank.
+ * With options.checkpoint the rows go in 64 rounds (each rank's rows in 64 slices) and a
+ * checkpoint may be written between two; options.resume continues a checkpointed job: the
+ * matrix is then bitwise the one an uninterrupted run gives (the rows are independent of
+ * one another and of who computes them), for any rank and thread counts on either side.
+ * The report's pair and ray counts are then those of the rows computed in this run. */
 rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
                                          const rad_viewfactor_options *options,
                                          rad_viewfactor_matrix **out,

@@ -222,3 +222,20 @@ rad_status ranks_agree(rad_status status, const char *what, rad_error *error)
         return rad_fail(error, RAD_ERR_INVALID, "%s: another rank failed", what);
     return status;
 }
+
+rad_status ranks_share_status(rad_status status, rad_error *error)
+{
+    if (ranks_count() == 1)
+        return status;
+    int shared = (int)status;
+    ranks_broadcast(&shared, sizeof(shared));
+    if (shared != RAD_OK) {
+        rad_error message = {0};
+        if (ranks_rank() == 0)
+            message = *error;
+        ranks_broadcast(&message, sizeof(message));
+        *error = message;
+        error->status = (rad_status)shared;
+    }
+    return (rad_status)shared;
+}

@@ -28,6 +28,10 @@ int ranks_failures(bool failed);
  * step that may fail on one rank before the ranks work together. */
 rad_status ranks_agree(rad_status status, const char *what, rad_error *error);
 
+/* Collective: every rank gets rank 0's status, and its message when that is a failure;
+ * returns it. For a step rank 0 alone does (writing a file) whose outcome all must share. */
+rad_status ranks_share_status(rad_status status, rad_error *error);
+
 /* Collective: values[k] becomes the sum over ranks of values[k], on every rank. */
 void ranks_sum(uint64_t *values, int count);
 
