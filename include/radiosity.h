@@ -707,6 +707,9 @@ typedef struct rad_formfactor_report {
                                   keeping reciprocity */
     double largest_row_sum;    /* the largest row sum before that */
     uint32_t largest_row;      /* its patch */
+    uint32_t rank_rows;        /* rows i (with their pairs j > i) this process computed:
+                                  all of them unless shared over MPI ranks */
+    double rank_seconds;       /* this process's time computing its pairs (no waiting) */
 } rad_formfactor_report;
 
 /* The dense n x n matrix, row-major: F[i * n + j] = F_ij. Reciprocity holds exactly by
