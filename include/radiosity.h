@@ -730,7 +730,11 @@ typedef struct rad_formfactors {
  * patches, with surfaces within a hair of either end tested in double precision. Rows
  * then sum to what the patch sees within RAD_ROW_SUM_SLACK. As a last guard, a row above
  * 1 + RAD_ROW_SUM_SLACK is scaled back to 1, each F_ij and F_ji by the same factor, and
- * counted in the report (rows_trimmed, largest_row_sum). */
+ * counted in the report (rows_trimmed, largest_row_sum). After rad_ranks_begin joined a
+ * job of several MPI ranks this is collective: every rank calls it with the same mesh and
+ * options, computes the rows i (pairs j > i) given to it by their pair count, and every
+ * rank gets the whole matrix, bitwise the serial one, with the report's counts summed
+ * (rank_rows, rank_seconds: its own). A failure on any rank fails it on every rank. */
 rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occluders,
                                    const rad_formfactor_options *options,
                                    rad_formfactors **out, rad_formfactor_report *report,
@@ -1012,7 +1016,11 @@ typedef struct rad_solve_report {
  * refuses more than RAD_DIRECT_MAX_PATCHES patches (RAD_ERR_UNSUPPORTED) and a singular system
  * (RAD_ERR_INVALID), and reports iterations 0. Shooting derives F_ji from F_ij by
  * reciprocity, so its residual levels off near float precision (about 1e-7). With the
- * ambient term on, `residual` measures B including it. */
+ * ambient term on, `residual` measures B including it. After rad_ranks_begin joined a job
+ * of several MPI ranks, the Jacobi solver (RAD_SOLVER_JACOBI) is collective: every rank
+ * calls it with the same whole system, sweeps its block of rows and exchanges B after
+ * each sweep; every rank gets B, bitwise the serial one. The other solvers do not talk to
+ * other ranks. */
 rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
                      rad_rgb *B, rad_solve_report *report, rad_error *error);
 
