@@ -4,8 +4,9 @@
  * ranks, and across rank counts (a 3-rank checkpoint resumed by 2 ranks, then by a plain
  * serial run). The stop comes after a known number of checkpoints
  * (RADIOSITY_STOP_AFTER_CHECKPOINTS, which acts as SIGTERM there), so no timing is
- * involved. A refused checkpoint (another --accuracy) under 3 ranks prints its one line
- * once, naming the file, and writes nothing.
+ * involved. A real SIGTERM after the first checkpoint, to the serial tool and to mpirun,
+ * stops the run with a checkpoint that resumes the same way. A refused checkpoint (another
+ * --accuracy) under 3 ranks prints its one line once, naming the file, and writes nothing.
  */
 #include <string.h>
 
@@ -78,6 +79,32 @@ int main(void)
     CHECK(!test_file_exists(test_path("mixed.mtx")));
     CHECK(test_run_tool("viewfactors city.obj -o mixed.mtx --threads 2 --resume mixed.bin") == 0);
     CHECK(same_bytes(test_path("serial.mtx"), test_path("mixed.mtx")));
+
+    /* a real SIGTERM once the first checkpoint exists (a 64th of the rows done; the rest
+     * takes about a second): to the serial tool, which stops with status 130, and to
+     * mpirun, which passes it to its 3 ranks (mpirun itself then ends non-zero); either
+     * checkpoint resumes to the serial matrix */
+    for (int ranks = 0; ranks <= 3; ranks += 3) {
+        char command[8000];
+        snprintf(command, sizeof(command),
+                 "cd '%s' && sh -c \"%s%s%s '%s' viewfactors city.obj -o term.mtx --threads %d "
+                 "--checkpoint term.bin --checkpoint-interval 0 & pid=\\$!; "
+                 "while [ ! -e term.bin ]; do sleep 0.01; done; kill -TERM \\$pid; "
+                 "wait \\$pid\" >'%s' 2>'%s' </dev/null",
+                 test_tmpdir(), ranks ? RAD_MPIEXEC : "",
+                 ranks ? " --oversubscribe --allow-run-as-root -np 3" : "", ranks ? "" : "exec",
+                 RAD_TOOL, ranks ? 1 : 2, test_path("stdout.txt"), test_path("stderr.txt"));
+        int status = system(command);
+        CHECK(WIFEXITED(status) && WEXITSTATUS(status) == (ranks ? 1 : 130));
+        long held = rows_held("term.bin");
+        CHECK(held > 0 && held < 384);
+        CHECK(!test_file_exists(test_path("term.mtx")));
+        CHECK(test_run_tool("viewfactors city.obj -o term.mtx --threads 2 --resume term.bin") ==
+              0);
+        CHECK(same_bytes(test_path("serial.mtx"), test_path("term.mtx")));
+        remove(test_path("term.mtx"));
+        remove(test_path("term.bin"));
+    }
 
     /* another job's checkpoint: refused by every rank, said once, nothing written */
     CHECK(test_run_mpi(3, "viewfactors city.obj -o refused.mtx --resume ck3.bin --accuracy 3e-4",
