@@ -796,9 +796,10 @@ typedef struct rad_viewfactor_options {
                                    as done; another job's is refused (RAD_ERR_INVALID naming
                                    the file). May be the checkpoint file itself */
     const volatile int *stop;   /* NULL: none. When it becomes non-zero (a signal handler),
-                                   the run stops after the current round of rows, writes the
-                                   checkpoint (when one is set) and returns RAD_OK with no
-                                   matrix and report.interrupted */
+                                   the run stops once the rows in progress are done (the
+                                   round's others are left for later), writes the checkpoint
+                                   (when one is set) and returns RAD_OK with no matrix and
+                                   report.interrupted; during the last round it is ignored */
 } rad_viewfactor_options;
 
 typedef struct rad_viewfactor_report {

@@ -20,6 +20,10 @@
  * polygon pairs, weighted by what a few sampled pairs of the row would cost: facing or not,
  * how many occluders stand between them), each rank computes its rows with its threads,
  * and rank 0 gathers them and assembles the same matrix, bitwise, as one process would.
+ *
+ * With checkpoints (checkpoint.h) each rank's rows go in 64 rounds, with a collective
+ * checkpoint step between two (checkpoint_step); a resumed run starts with the rows of its
+ * checkpoint at rank 0 and shares only the others.
  */
 #include <math.h>
 #include <omp.h>
@@ -664,12 +668,16 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         for (uint32_t round = 0; round < rounds; round++) {
             uint32_t begin = (uint32_t)((uint64_t)rank_rows * round / rounds);
             uint32_t end = (uint32_t)((uint64_t)rank_rows * (round + 1) / rounds);
+            /* a stop leaves the round's other rows pending (the checkpoint after it has
+             * the rows done), so it takes effect within a row; not in the last round,
+             * after which no checkpoint step comes */
+            bool stoppable = options->stop && round + 1 < rounds;
 #pragma omp for schedule(dynamic, 1)
             for (uint32_t k = begin; k < end; k++) {
                 bool failed;
 #pragma omp atomic read
                 failed = out_of_memory;
-                if (failed || !ready)
+                if (failed || !ready || (stoppable && *options->stop))
                     continue;
                 if (!compute_row(&e, mine[k], &rows[mine[k]], &w, &counts)) {
 #pragma omp atomic write
