@@ -727,6 +727,9 @@ typedef struct rad_formfactor_report {
                                   keeping reciprocity */
     double largest_row_sum;    /* the largest row sum before that */
     uint32_t largest_row;      /* its patch */
+    uint32_t rank_rows;        /* rows i (with their pairs j > i) this process computed:
+                                  all of them unless shared over MPI ranks */
+    double rank_seconds;       /* this process's time computing its pairs (no waiting) */
 } rad_formfactor_report;
 
 /* The dense n x n matrix, row-major: F[i * n + j] = F_ij. Reciprocity holds exactly by
@@ -747,7 +750,11 @@ typedef struct rad_formfactors {
  * patches, with surfaces within a hair of either end tested in double precision. Rows
  * then sum to what the patch sees within RAD_ROW_SUM_SLACK. As a last guard, a row above
  * 1 + RAD_ROW_SUM_SLACK is scaled back to 1, each F_ij and F_ji by the same factor, and
- * counted in the report (rows_trimmed, largest_row_sum). */
+ * counted in the report (rows_trimmed, largest_row_sum). After rad_ranks_begin joined a
+ * job of several MPI ranks this is collective: every rank calls it with the same mesh and
+ * options, computes the rows i (pairs j > i) given to it by their pair count, and every
+ * rank gets the whole matrix, bitwise the serial one, with the report's counts summed
+ * (rank_rows, rank_seconds: its own). A failure on any rank fails it on every rank. */
 rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occluders,
                                    const rad_formfactor_options *options,
                                    rad_formfactors **out, rad_formfactor_report *report,
@@ -798,6 +805,21 @@ typedef struct rad_viewfactor_options {
     int threads;         /* 0 = all cores */
     rad_progress_fn progress;
     void *progress_user;
+    /* Long runs (see rad_viewfactor_matrix_compute): */
+    const char *checkpoint;     /* NULL: none. Restart file of the rows done so far, written
+                                   atomically (rank 0 of an MPI job writes every rank's rows)
+                                   when checkpoint_interval seconds have passed since the last
+                                   one (checked between rounds of rows) and when stopped */
+    double checkpoint_interval; /* seconds; 0: after every round (1/64 of the rows) */
+    const char *resume;         /* NULL: none. A checkpoint of this job (same scene geometry
+                                   and surfaces, accuracy, max_rays, seed) whose rows are taken
+                                   as done; another job's is refused (RAD_ERR_INVALID naming
+                                   the file). May be the checkpoint file itself */
+    const volatile int *stop;   /* NULL: none. When it becomes non-zero (a signal handler),
+                                   the run stops once the rows in progress are done (the
+                                   round's others are left for later), writes the checkpoint
+                                   (when one is set) and returns RAD_OK with no matrix and
+                                   report.interrupted; during the last round it is ignored */
 } rad_viewfactor_options;
 
 typedef struct rad_viewfactor_report {
@@ -817,6 +839,10 @@ typedef struct rad_viewfactor_report {
     uint32_t rank_rows;          /* rows this process computed: all of them unless the work
                                     was shared over MPI ranks (rad_ranks_begin) */
     double rank_seconds;         /* this process's time computing its rows (no waiting) */
+    uint32_t resumed_rows;       /* rows read from options.resume, not computed */
+    uint32_t checkpoint_rows;    /* rows in the last checkpoint written (0: none written) */
+    bool interrupted;            /* options.stop was raised: no matrix (*out NULL); the
+                                    checkpoint holds checkpoint_rows rows */
 } rad_viewfactor_report;
 
 /* Computes the view factors between the scene's surfaces, each surface taken as a whole
@@ -828,7 +854,12 @@ typedef struct rad_viewfactor_report {
  * calls it with the same scene and options, computes the rows given to it by estimated
  * cost (their obstruction), and rank 0 gets the whole matrix, bitwise the same as a serial
  * run, and the report's counts summed over the ranks; the other ranks get *out = NULL (and
- * RAD_OK). A failure on any rank fails it on every rank. */
+ * RAD_OK). A failure on any rank fails it on every rank.
+ * With options.checkpoint the rows go in 64 rounds (each rank's rows in 64 slices) and a
+ * checkpoint may be written between two; options.resume continues a checkpointed job: the
+ * matrix is then bitwise the one an uninterrupted run gives (the rows are independent of
+ * one another and of who computes them), for any rank and thread counts on either side.
+ * The report's pair and ray counts are then those of the rows computed in this run. */
 rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
                                          const rad_viewfactor_options *options,
                                          rad_viewfactor_matrix **out,
@@ -1006,7 +1037,11 @@ typedef struct rad_solve_report {
  * refuses more than RAD_DIRECT_MAX_PATCHES patches (RAD_ERR_UNSUPPORTED) and a singular system
  * (RAD_ERR_INVALID), and reports iterations 0. Shooting derives F_ji from F_ij by
  * reciprocity, so its residual levels off near float precision (about 1e-7). With the
- * ambient term on, `residual` measures B including it. */
+ * ambient term on, `residual` measures B including it. After rad_ranks_begin joined a job
+ * of several MPI ranks, the Jacobi solver (RAD_SOLVER_JACOBI) is collective: every rank
+ * calls it with the same whole system, sweeps its block of rows and exchanges B after
+ * each sweep; every rank gets B, bitwise the serial one. The other solvers do not talk to
+ * other ranks. */
 rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
                      rad_rgb *B, rad_solve_report *report, rad_error *error);
 

@@ -71,6 +71,30 @@ bool cli_ranks_summary(const rad_rank_report *mine, const char *unit, double *im
     return ok;
 }
 
+void cli_ranks_solve_quiet(cli_solve *solve)
+{
+    if (rad_rank() == 0)
+        return;
+    solve->options.progress = NULL;
+    solve->options.log = NULL;
+    solve->save_solution_path = NULL;
+}
+
+bool cli_ranks_solve_summary(const cli_solved *solved, double *imbalance, rad_error *error)
+{
+    const rad_scene_solve_report *r = &solved->report;
+    bool dense = !solved->from_file && r->solver != RAD_SOLVER_HIERARCHICAL;
+    if (rad_rank_count() > 1 && rad_rank() == 0 && !dense && !solved->from_file)
+        cli_warn("the hierarchical solver is not shared over MPI ranks yet: each of the %d "
+                 "ranks solved the whole scene",
+                 rad_rank_count());
+    rad_rank_report mine = {dense ? r->formfactors.rank_rows : 0,
+                            dense ? r->formfactors.rank_seconds + r->seconds_solve
+                                  : r->seconds_solve,
+                            0, 0};
+    return cli_ranks_summary(&mine, "form-factor rows", imbalance, error);
+}
+
 int cli_ranks_end(int exit_code)
 {
     rad_ranks_end();

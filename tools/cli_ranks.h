@@ -32,6 +32,16 @@ int cli_ranks_failed(const rad_error *error);
 bool cli_ranks_summary(const rad_rank_report *mine, const char *unit, double *imbalance,
                        rad_error *error);
 
+/* `solve` and `render` over ranks: ranks other than 0 show no progress and no warnings
+ * and do not write --save-solution (rank 0 does). Call after cli_ranks_begin. */
+void cli_ranks_solve_quiet(cli_solve *solve);
+
+/* Collective, after cli_solve_scene: the per-rank summary of the solve (cli_ranks_summary
+ * with the dense form-factor rows each rank computed, and its time on them plus the
+ * solve's); rank 0 warns when the solver was not shared over the ranks (hierarchical:
+ * every rank solved the whole scene; a solution file read: nothing was solved). */
+bool cli_ranks_solve_summary(const cli_solved *solved, double *imbalance, rad_error *error);
+
 /* Leaves the job; returns exit_code. */
 int cli_ranks_end(int exit_code);
 

@@ -9,6 +9,7 @@
 #include <stdio.h>
 
 #include "cli.h"
+#include "cli_ranks.h"
 
 static const char usage[] =
     "usage: radiosity render [SCENE] -o OUT [options]\n"
@@ -179,11 +180,20 @@ int command_render(int argc, char **argv)
     rad_status status;
     cli_solved solved;
     rad_image *image = NULL;
-    double t0 = rad_clock_seconds(), t_solved, t_render, t_write;
+    double t0 = rad_clock_seconds(), t_solved, t_render, t_write, imbalance = 1;
 
+    cli_ranks_begin(); /* under mpirun: the ranks share the form factors and sweeps */
+    cli_ranks_solve_quiet(&s.solve);
     status = cli_solve_scene(s.scene_path, &s.shared, &s.solve, &solved, &error);
-    if (status != RAD_OK)
-        goto fail;
+    if (!cli_ranks_ok(status, &error) ||
+        !cli_ranks_solve_summary(&solved, &imbalance, &error)) {
+        exit_code = cli_ranks_failed(&error);
+        goto done;
+    }
+    if (rad_rank() != 0) { /* rank 0 renders and writes */
+        exit_code = EXIT_OK;
+        goto done;
+    }
     t_solved = rad_clock_seconds();
     rad_camera camera = cli_view_camera(&s.view, solved.scene);
     if (s.specular)
@@ -232,6 +242,10 @@ int command_render(int argc, char **argv)
     stats_number(&stats, "seconds_total", t_write - t0);
     stats_integer(&stats, "width", s.view.width);
     stats_integer(&stats, "height", s.view.height);
+    if (rad_rank_count() > 1) {
+        stats_integer(&stats, "ranks", (unsigned long long)rad_rank_count());
+        stats_number(&stats, "load_imbalance", imbalance);
+    }
     char summary[384];
     cli_solved_summary(&solved, &s.solve, summary, sizeof(summary));
     exit_code = cli_finish(&stats, s.stats_path, "%s, %.2f s: wrote %s", summary, t_write - t0,
@@ -245,5 +259,5 @@ done:
     cli_progress_end();
     rad_image_destroy(image);
     cli_solved_free(&solved); /* cli_solve_scene always leaves it freeable */
-    return exit_code;
+    return cli_ranks_end(exit_code);
 }

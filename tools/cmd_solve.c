@@ -7,6 +7,7 @@
 #include <strings.h>
 
 #include "cli.h"
+#include "cli_ranks.h"
 
 static const char usage[] =
     "usage: radiosity solve [SCENE] [-o OUT] [--save-solution FILE] [options]\n"
@@ -87,8 +88,19 @@ int command_solve(int argc, char **argv)
     rad_error error = {0};
     cli_solved solved;
     double t0 = rad_clock_seconds();
+    cli_ranks_begin(); /* under mpirun: the ranks share the form factors and sweeps */
+    cli_ranks_solve_quiet(&solve);
     rad_status status = cli_solve_scene(scene_path, &shared, &solve, &solved, &error);
-    double t_solved = rad_clock_seconds();
+    double t_solved = rad_clock_seconds(), imbalance = 1;
+    if (!cli_ranks_ok(status, &error) ||
+        !cli_ranks_solve_summary(&solved, &imbalance, &error)) {
+        exit_code = cli_ranks_failed(&error);
+        goto done;
+    }
+    if (rad_rank() != 0) { /* rank 0 writes */
+        exit_code = EXIT_OK;
+        goto done;
+    }
     if (status == RAD_OK && shared.output) {
         write.inputs = solved.inputs; /* the vertices' illuminance */
         status = rad_lit_mesh_write(solved.mesh, solved.B, shared.output, &write, &error);
@@ -102,6 +114,10 @@ int command_solve(int argc, char **argv)
     stats_begin(&stats);
     cli_solved_stats(&solved, &solve, &stats);
     stats_integer(&stats, "vertices", solved.mesh->vertex_count);
+    if (rad_rank_count() > 1) {
+        stats_integer(&stats, "ranks", (unsigned long long)rad_rank_count());
+        stats_number(&stats, "load_imbalance", imbalance);
+    }
     stats_number(&stats, "seconds_write", t_write - t_solved);
     stats_number(&stats, "seconds_total", t_write - t0);
     char summary[384];
@@ -113,5 +129,5 @@ int command_solve(int argc, char **argv)
 done:
     cli_progress_end();
     cli_solved_free(&solved);
-    return exit_code;
+    return cli_ranks_end(exit_code);
 }

@@ -6,6 +6,7 @@
  * share the rows (the library does) and rank 0 alone does the rest and writes.
  */
 #include <math.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -50,11 +51,21 @@ static const char usage[] =
     "                       bound cannot fit (24 bytes per pair of surfaces that do not\n"
     "                       face away, plus 20 per factor); anything else that would\n"
     "                       exceed it ends the run with an error (default: no budget)\n"
+    "  --checkpoint FILE    write the rows done so far to FILE (atomically) every\n"
+    "                       --checkpoint-interval seconds, and on SIGINT or SIGTERM, which\n"
+    "                       then end the run (status 130, no output)\n"
+    "  --checkpoint-interval S  seconds between checkpoints (default 600; 0: after each\n"
+    "                       1/64 of the rows)\n"
+    "  --resume FILE        continue the job of this checkpoint (same scene, --accuracy,\n"
+    "                       --max-rays, --seed; others are refused): the output is the\n"
+    "                       one an uninterrupted run writes. Checkpoints go on to FILE\n"
+    "                       unless --checkpoint names another\n"
     CLI_BASE_HELP("counts, times, invariants and error bounds");
 
 enum {
     OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_FORMAT, OPT_ENCLOSURE, OPT_SCRIPT_F,
-    OPT_OBSTRUCTION, OPT_TWO_SIDED, OPT_COUNT
+    OPT_OBSTRUCTION, OPT_TWO_SIDED, OPT_CHECKPOINT, OPT_CHECKPOINT_INTERVAL, OPT_RESUME,
+    OPT_COUNT
 };
 
 static const cli_option options[OPT_COUNT] = {
@@ -62,7 +73,40 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_MAX_RAYS] = {"max-rays", 0, true},   [OPT_FORMAT] = {"format", 0, true},
     [OPT_ENCLOSURE] = {"enclosure", 0, false}, [OPT_SCRIPT_F] = {"script-f", 0, false},
     [OPT_OBSTRUCTION] = {"obstruction", 0, true}, [OPT_TWO_SIDED] = {"two-sided", 0, true},
-    [OPT_MAX_MEMORY] = {"max-memory", 0, true}};
+    [OPT_MAX_MEMORY] = {"max-memory", 0, true}, [OPT_CHECKPOINT] = {"checkpoint", 0, true},
+    [OPT_CHECKPOINT_INTERVAL] = {"checkpoint-interval", 0, true},
+    [OPT_RESUME] = {"resume", 0, true}};
+
+/* Seconds between checkpoints unless --checkpoint-interval says. */
+#define DEFAULT_CHECKPOINT_INTERVAL 600.0
+
+/* SIGINT or SIGTERM with --checkpoint: stop after the current round of rows. */
+static volatile sig_atomic_t stop_requested;
+
+static void on_stop_signal(int signal_number)
+{
+    stop_requested = 1;
+    signal(signal_number, SIG_DFL); /* a second one ends the run at once */
+}
+
+/* The progress of a checkpointed run: "checkpoint" reports are counted, not drawn. For
+ * tests, RADIOSITY_STOP_AFTER_CHECKPOINTS=K acts as SIGTERM once K checkpoints are
+ * written, so that a run can be interrupted at a known point without timing. */
+typedef struct checkpoint_progress {
+    long stop_after; /* 0: never */
+    long written;
+} checkpoint_progress;
+
+static void progress_with_checkpoints(void *user, const char *phase, double fraction)
+{
+    checkpoint_progress *c = user;
+    if (strcmp(phase, "checkpoint") != 0) {
+        cli_progress(NULL, phase, fraction);
+        return;
+    }
+    if (c->stop_after > 0 && ++c->written >= c->stop_after)
+        stop_requested = 1;
+}
 
 /* --obstruction files at most; as many SCENE files (cli_args.positional). */
 #define MAX_FILES 256
@@ -131,6 +175,26 @@ int command_viewfactors(int argc, char **argv)
         !cli_parse_bytes("max-memory", args.value[OPT_MAX_MEMORY], &max_memory))
         return EXIT_USAGE;
     cli_memory_budget(max_memory);
+    vf.resume = args.value[OPT_RESUME];
+    vf.checkpoint = args.value[OPT_CHECKPOINT] ? args.value[OPT_CHECKPOINT] : vf.resume;
+    vf.checkpoint_interval = DEFAULT_CHECKPOINT_INTERVAL;
+    if (args.value[OPT_CHECKPOINT_INTERVAL]) {
+        if (!vf.checkpoint) {
+            cli_error("--checkpoint-interval: give --checkpoint FILE (or --resume FILE) too");
+            return EXIT_USAGE;
+        }
+        if (!cli_parse_double("checkpoint-interval", args.value[OPT_CHECKPOINT_INTERVAL],
+                              &vf.checkpoint_interval))
+            return EXIT_USAGE;
+        if (!(vf.checkpoint_interval >= 0 && vf.checkpoint_interval <= 1e9)) {
+            cli_error("--checkpoint-interval: must be between 0 and 1e9 seconds");
+            return EXIT_USAGE;
+        }
+    }
+    checkpoint_progress checkpoints = {0, 0};
+    const char *stop_after = getenv("RADIOSITY_STOP_AFTER_CHECKPOINTS");
+    if (stop_after)
+        checkpoints.stop_after = strtol(stop_after, NULL, 10);
     const char *output = shared.output, *stats_path = shared.stats_path;
     rad_viewfactor_write_options write = {RAD_VIEWFACTOR_CSV, false, false};
     if (output)
@@ -148,7 +212,7 @@ int command_viewfactors(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if (!cli_outputs_writable((const char *[]){output, stats_path}, 2))
+    if (!cli_outputs_writable((const char *[]){output, stats_path, vf.checkpoint}, 3))
         return EXIT_ERROR;
 
     rad_error error = {0};
@@ -181,10 +245,36 @@ int command_viewfactors(int argc, char **argv)
     if (!cli_ranks_ok(status, &error))
         goto fail;
     cli_progress_mark();
+    void (*previous_int)(int) = SIG_DFL, (*previous_term)(int) = SIG_DFL;
+    if (vf.checkpoint) {
+        stop_requested = 0;
+        vf.stop = &stop_requested;
+        vf.progress_user = &checkpoints;
+        if (vf.progress) /* rank 0 (the library tells only rank 0 of checkpoints) */
+            vf.progress = progress_with_checkpoints;
+        previous_int = signal(SIGINT, on_stop_signal);
+        previous_term = signal(SIGTERM, on_stop_signal);
+    }
     status = rad_viewfactor_matrix_compute(scene, &vf, &matrix, &report, &error);
+    if (vf.checkpoint) {
+        signal(SIGINT, previous_int == SIG_ERR ? SIG_DFL : previous_int);
+        signal(SIGTERM, previous_term == SIG_ERR ? SIG_DFL : previous_term);
+    }
     if (!cli_ranks_ok(status, &error))
         goto fail;
     cli_progress_end();
+    if (report.resumed_rows && rad_rank() == 0)
+        cli_summary("resumed from %s: %u of %u rows were done", vf.resume, report.resumed_rows,
+                    scene->surface_count);
+    if (report.interrupted) {
+        if (rad_rank() == 0)
+            cli_error("viewfactors: interrupted: %s holds %u of %u rows; continue with "
+                      "--resume %s",
+                      vf.checkpoint, report.checkpoint_rows, scene->surface_count,
+                      vf.checkpoint);
+        exit_code = EXIT_INTERRUPTED;
+        goto done;
+    }
     rad_rank_report rank_report = {report.rank_rows, report.rank_seconds, 0, 0};
     double imbalance = 1;
     if (!cli_ranks_summary(&rank_report, "rows", &imbalance, &error))

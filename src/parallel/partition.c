@@ -55,3 +55,9 @@ rad_status partition_by_cost(const double *cost, uint32_t n, int ranks, uint32_t
     free(load);
     return RAD_OK;
 }
+
+void partition_block(uint32_t n, int ranks, int rank, uint32_t *begin, uint32_t *end)
+{
+    *begin = (uint32_t)((uint64_t)n * (uint64_t)rank / (uint64_t)ranks);
+    *end = (uint32_t)((uint64_t)n * (uint64_t)(rank + 1) / (uint64_t)ranks);
+}

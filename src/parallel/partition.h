@@ -17,4 +17,7 @@
 rad_status partition_by_cost(const double *cost, uint32_t n, int ranks, uint32_t *owner,
                              rad_error *error);
 
+/* Rank `rank`'s contiguous share of n items of equal cost: [*begin, *end). */
+void partition_block(uint32_t n, int ranks, int rank, uint32_t *begin, uint32_t *end);
+
 #endif

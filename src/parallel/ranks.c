@@ -14,6 +14,7 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "parallel/partition.h"
 #include "parallel/ranks.h"
 
 #ifdef RAD_MPI
@@ -117,6 +118,43 @@ void ranks_broadcast(void *data, uint64_t size)
     bytes_communicated += size;
 }
 
+void ranks_sum_floats(float *values, uint64_t count)
+{
+    if (rank_total == 1)
+        return;
+    const uint64_t chunk = CHUNK_BYTES / sizeof(float);
+    for (uint64_t at = 0; at < count; at += chunk) {
+        uint64_t part = count - at < chunk ? count - at : chunk;
+        MPI_Allreduce(MPI_IN_PLACE, values + at, (int)part, MPI_FLOAT, MPI_SUM, MPI_COMM_WORLD);
+    }
+    bytes_communicated += 2 * count * sizeof(float);
+}
+
+void ranks_share_blocks(double *values, uint32_t n, uint32_t width)
+{
+    if (rank_total == 1)
+        return;
+    int *counts = rad_alloc_array((size_t)rank_total, sizeof(int));
+    int *starts = rad_alloc_array((size_t)rank_total, sizeof(int));
+    if (!counts || !starts) { /* cannot go on without the others' values */
+        free(counts);
+        free(starts);
+        rad_ranks_abort(EXIT_FAILURE);
+        return;
+    }
+    for (int r = 0; r < rank_total; r++) {
+        uint32_t begin, end;
+        partition_block(n, rank_total, r, &begin, &end);
+        starts[r] = (int)((uint64_t)begin * width);
+        counts[r] = (int)((uint64_t)(end - begin) * width);
+    }
+    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, values, counts, starts, MPI_DOUBLE,
+                   MPI_COMM_WORLD);
+    bytes_communicated += (uint64_t)n * width * sizeof(double);
+    free(counts);
+    free(starts);
+}
+
 /* Sends or receives `size` bytes in chunks of at most CHUNK_BYTES. */
 static void send_bytes(const unsigned char *data, uint64_t size)
 {
@@ -190,6 +228,17 @@ void ranks_sum(uint64_t *values, int count)
     (void)values;
     (void)count;
 }
+void ranks_sum_floats(float *values, uint64_t count)
+{
+    (void)values;
+    (void)count;
+}
+void ranks_share_blocks(double *values, uint32_t n, uint32_t width)
+{
+    (void)values;
+    (void)n;
+    (void)width;
+}
 
 rad_status ranks_gather(const void *data, uint64_t size, void **gathered, uint64_t *sizes,
                         rad_error *error)
@@ -221,4 +270,21 @@ rad_status ranks_agree(rad_status status, const char *what, rad_error *error)
     if (ranks_failures(status != RAD_OK) && status == RAD_OK)
         return rad_fail(error, RAD_ERR_INVALID, "%s: another rank failed", what);
     return status;
+}
+
+rad_status ranks_share_status(rad_status status, rad_error *error)
+{
+    if (ranks_count() == 1)
+        return status;
+    int shared = (int)status;
+    ranks_broadcast(&shared, sizeof(shared));
+    if (shared != RAD_OK) {
+        rad_error message = {0};
+        if (ranks_rank() == 0)
+            message = *error;
+        ranks_broadcast(&message, sizeof(message));
+        *error = message;
+        error->status = (rad_status)shared;
+    }
+    return (rad_status)shared;
 }

@@ -28,8 +28,20 @@ int ranks_failures(bool failed);
  * step that may fail on one rank before the ranks work together. */
 rad_status ranks_agree(rad_status status, const char *what, rad_error *error);
 
+/* Collective: every rank gets rank 0's status, and its message when that is a failure;
+ * returns it. For a step rank 0 alone does (writing a file) whose outcome all must share. */
+rad_status ranks_share_status(rad_status status, rad_error *error);
+
 /* Collective: values[k] becomes the sum over ranks of values[k], on every rank. */
 void ranks_sum(uint64_t *values, int count);
+
+/* Collective: values[k] becomes the sum over ranks of values[k], on every rank. For arrays
+ * in which each entry is non-zero on one rank at most, the sum is that entry, exactly. */
+void ranks_sum_floats(float *values, uint64_t count);
+
+/* Collective: values[] holds `width` doubles per item, n items; each rank has filled the
+ * items of its block (partition_block) and afterwards every rank has every block. */
+void ranks_share_blocks(double *values, uint32_t n, uint32_t width);
 
 /* Collective: rank 0's `size` bytes at `data` replace every other rank's. */
 void ranks_broadcast(void *data, uint64_t size);

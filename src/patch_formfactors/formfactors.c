@@ -4,6 +4,12 @@
  * A sink for the pair engine: each symmetric transfer G_ij becomes F_ij = G / A_i and
  * F_ji = G / A_j, so reciprocity holds by construction. Each pair is written by one thread
  * and to two distinct cells, so no locking is needed.
+ *
+ * Over several MPI ranks (parallel/ranks.h) the rows i (each with its pairs j > i) are
+ * shared by estimated cost, their pair count n - 1 - i; each rank fills the cells of its
+ * pairs and the ranks sum their matrices, every cell being non-zero on one rank at most, so
+ * every rank ends with the whole matrix, bitwise the serial one (a pair's value depends on
+ * the pair and the seed only). Memory per rank is therefore not divided.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -11,6 +17,8 @@
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/memory.h"
+#include "parallel/partition.h"
+#include "parallel/ranks.h"
 
 /* The dense matrix may take at most this share of the machine's physical memory. */
 #define MATRIX_MEMORY_SHARE 0.75
@@ -72,6 +80,54 @@ static rad_status trim_rows(float *F, size_t n, rad_formfactor_report *report)
     return RAD_OK;
 }
 
+/* Over several ranks: *rows = this rank's rows (rows[i] = 1), shared by estimated cost;
+ * NULL for one rank. Collective. */
+static rad_status share_rows(size_t n, uint8_t **rows, rad_error *error)
+{
+    *rows = NULL;
+    if (ranks_count() == 1)
+        return RAD_OK;
+    double *cost = rad_alloc_array(n, sizeof(*cost));
+    uint32_t *owner = rad_alloc_array(n, sizeof(*owner));
+    *rows = rad_alloc_array(n, 1);
+    rad_status status = cost && owner && *rows ? RAD_OK : RAD_ERR_NOMEM;
+    for (size_t i = 0; status == RAD_OK && i < n; i++)
+        cost[i] = (double)(n - 1 - i) + 1; /* its pairs, and the row itself */
+    if (status == RAD_OK)
+        status = partition_by_cost(cost, (uint32_t)n, ranks_count(), owner, error);
+    for (size_t i = 0; status == RAD_OK && i < n; i++)
+        (*rows)[i] = owner[i] == (uint32_t)ranks_rank();
+    free(cost);
+    free(owner);
+    if (status != RAD_OK)
+        rad_fail(error, RAD_ERR_NOMEM, "out of memory sharing %zu rows over %d ranks", n,
+                 ranks_count());
+    return ranks_agree(status, "form factors", error);
+}
+
+/* Over several ranks: every rank gets the whole matrix (the sum of the ranks' cells) and
+ * the report's counts summed; report->rank_rows is this rank's share. Collective. */
+static rad_status gather_matrix(float *F, size_t n, const uint8_t *rows, rad_status status,
+                                rad_formfactor_report *report, rad_error *error)
+{
+    status = ranks_agree(status, "form factors", error);
+    if (status != RAD_OK)
+        return status;
+    ranks_sum_floats(F, (uint64_t)n * n);
+    uint64_t counts[5] = {report->pairs_facing, report->pairs_refined, report->pairs_clear,
+                          report->pairs_exact, report->rays};
+    ranks_sum(counts, 5);
+    report->pairs_facing = counts[0];
+    report->pairs_refined = counts[1];
+    report->pairs_clear = counts[2];
+    report->pairs_exact = counts[3];
+    report->rays = counts[4];
+    report->rank_rows = 0;
+    for (size_t i = 0; i < n; i++)
+        report->rank_rows += rows[i];
+    return RAD_OK;
+}
+
 rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occluders,
                                    const rad_formfactor_options *options,
                                    rad_formfactors **out, rad_formfactor_report *report,
@@ -86,29 +142,51 @@ rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occlu
     /* calloc may succeed lazily and the kernel kill the process later: refuse up front */
     uint64_t physical = rad_physical_memory_bytes();
     double bytes = (double)n * n * sizeof(float);
-    if (physical && bytes > MATRIX_MEMORY_SHARE * (double)physical)
-        return rad_fail(error, RAD_ERR_NOMEM,
-                        "%zu patches need a %.1f GB form-factor matrix and this machine has "
-                        "%.1f GB: use a larger --patch-size",
-                        n, bytes / 1e9, (double)physical / 1e9);
-    rad_formfactors *result = rad_alloc_array(1, sizeof(*result));
-    float *F = rad_alloc_array(n * n, sizeof(*F));
-    if (!result || !F) {
+    rad_formfactors *result = NULL;
+    float *F = NULL;
+    rad_status status = RAD_OK;
+    if (physical && bytes > MATRIX_MEMORY_SHARE * (double)physical) {
+        status = rad_fail(error, RAD_ERR_NOMEM,
+                          "%zu patches need a %.1f GB form-factor matrix and this machine has "
+                          "%.1f GB: use a larger --patch-size",
+                          n, bytes / 1e9, (double)physical / 1e9);
+    } else {
+        result = rad_alloc_array(1, sizeof(*result));
+        F = rad_alloc_array(n * n, sizeof(*F));
+        if (!result || !F)
+            status = rad_fail(error, RAD_ERR_NOMEM,
+                              "out of memory for the %zu x %zu form-factor matrix (%.1f GB): "
+                              "use a larger --patch-size",
+                              n, n, (double)n * n * sizeof(float) / 1e9);
+    }
+    status = ranks_agree(status, "form factors", error); /* every rank, or none, goes on */
+    if (status != RAD_OK) {
         free(result);
         free(F);
-        return rad_fail(error, RAD_ERR_NOMEM,
-                        "out of memory for the %zu x %zu form-factor matrix (%.1f GB): use a "
-                        "larger --patch-size",
-                        n, n, (double)n * n * sizeof(float) / 1e9);
+        return status;
     }
     dense_sink sink = {F, mesh->patches, n};
     rad_formfactor_report local;
     if (!report)
         report = &local;
-    rad_status status = pair_engine_run(mesh, occluders, options, store_pair, &sink, report, error);
+    uint8_t *rows = NULL;
+    status = share_rows(n, &rows, error);
+    double start = rad_clock_seconds();
+    if (status == RAD_OK)
+        status = pair_engine_run(mesh, occluders, options, rows, store_pair, &sink, report,
+                                 error);
+    double rank_seconds = rad_clock_seconds() - start;
+    if (rows)
+        status = gather_matrix(F, n, rows, status, report, error);
+    else if (status == RAD_OK)
+        report->rank_rows = (uint32_t)n;
+    report->rank_seconds = rank_seconds;
     if (status == RAD_OK && trim_rows(F, n, report) != RAD_OK)
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the row sums of %zu patches",
                           n);
+    if (rows)
+        status = ranks_agree(status, "form factors", error);
+    free(rows);
     if (status != RAD_OK) {
         free(F);
         free(result);

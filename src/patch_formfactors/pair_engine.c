@@ -453,8 +453,9 @@ static unsigned strata_for(uint32_t rays)
 }
 
 rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
-                           const rad_formfactor_options *options, pair_sink_fn sink,
-                           void *sink_data, rad_formfactor_report *report, rad_error *error)
+                           const rad_formfactor_options *options, const uint8_t *rows,
+                           pair_sink_fn sink, void *sink_data, rad_formfactor_report *report,
+                           rad_error *error)
 {
     rad_formfactor_options defaults = {0};
     if (!options)
@@ -535,7 +536,8 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
         int thread = omp_get_thread_num();
 #pragma omp for schedule(dynamic, 1)
         for (uint32_t i = 0; i < n; i++) {
-            row(&e, &work[thread], thread, i);
+            if (!rows || rows[i])
+                row(&e, &work[thread], thread, i);
             uint64_t done;
 #pragma omp atomic capture
             done = ++rows_done;

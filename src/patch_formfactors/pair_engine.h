@@ -18,8 +18,11 @@ typedef void (*pair_sink_fn)(void *sink, int thread, uint32_t i, uint32_t j, dou
 /* The number of threads pair_engine_run will use for these options. */
 int pair_engine_threads(const rad_formfactor_options *options);
 
+/* rows: NULL for every pair, else only the pairs (i, j > i) of the rows i with rows[i]
+ * (an MPI rank's share). */
 rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
-                           const rad_formfactor_options *options, pair_sink_fn sink,
-                           void *sink_data, rad_formfactor_report *report, rad_error *error);
+                           const rad_formfactor_options *options, const uint8_t *rows,
+                           pair_sink_fn sink, void *sink_data, rad_formfactor_report *report,
+                           rad_error *error);
 
 #endif

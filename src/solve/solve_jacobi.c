@@ -10,12 +10,19 @@
  * thread's dot product and the criterion is summed in patch order, so the answer does not
  * depend on the thread count. The channels are kept as three separate arrays (structure
  * of arrays) so the row dot product vectorises.
+ *
+ * Over several MPI ranks (parallel/ranks.h; every rank holds the whole F) each rank sweeps
+ * its contiguous block of rows and the ranks then exchange their blocks of the new B; a
+ * row's dot product and the criterion's sum in patch order are the same whoever computes
+ * them, so B is bitwise the serial one.
  */
 #include <math.h>
 #include <stdlib.h>
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "parallel/partition.h"
+#include "parallel/ranks.h"
 #include "solve/solve_internal.h"
 
 rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb *B,
@@ -44,13 +51,14 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
     const int threads = params->threads;
     (void)threads; /* unused without OpenMP */
     double criterion = INFINITY, smallest = INFINITY;
-    uint32_t sweeps = 0;
+    uint32_t sweeps = 0, first_row, end_row; /* this rank's rows */
+    partition_block(n, ranks_count(), ranks_rank(), &first_row, &end_row);
     while (sweeps < params->max_iterations) {
         const double *x0 = old[0], *x1 = old[1], *x2 = old[2];
         double *y0 = cur[0], *y1 = cur[1], *y2 = cur[2];
 #pragma omp parallel for schedule(dynamic, 16) num_threads(threads) \
     if (n >= SOLVE_PARALLEL_MIN)
-        for (uint32_t i = 0; i < n; i++) {
+        for (uint32_t i = first_row; i < end_row; i++) {
             double s[3];
             solve_row_dot(F + (size_t)i * n, x0, x1, x2, 0, n, s);
             y0[i] = E[i].r + rho[i].r * s[0];
@@ -58,6 +66,15 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
             y2[i] = E[i].b + rho[i].b * s[2];
             change[i] = area[i] * (fabs(y0[i] - x0[i]) + fabs(y1[i] - x1[i]) +
                                    fabs(y2[i] - x2[i]));
+        }
+        if (ranks_count() > 1) {
+            ranks_share_blocks(y0, n, 1);
+            ranks_share_blocks(y1, n, 1);
+            ranks_share_blocks(y2, n, 1);
+            for (uint32_t i = 0; i < n; i++)
+                if (i < first_row || i >= end_row)
+                    change[i] = area[i] * (fabs(y0[i] - x0[i]) + fabs(y1[i] - x1[i]) +
+                                           fabs(y2[i] - x2[i]));
         }
         sweeps++;
 

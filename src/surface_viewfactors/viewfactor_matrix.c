@@ -20,6 +20,10 @@
  * polygon pairs, weighted by what a few sampled pairs of the row would cost: facing or not,
  * how many occluders stand between them), each rank computes its rows with its threads,
  * and rank 0 gathers them and assembles the same matrix, bitwise, as one process would.
+ *
+ * With checkpoints (checkpoint.h) each rank's rows go in 64 rounds, with a collective
+ * checkpoint step between two (checkpoint_step); a resumed run starts with the rows of its
+ * checkpoint at rank 0 and shares only the others.
  */
 #include <math.h>
 #include <omp.h>
@@ -33,22 +37,13 @@
 #include "core/vec3.h"
 #include "parallel/partition.h"
 #include "parallel/ranks.h"
+#include "surface_viewfactors/checkpoint.h"
 #include "surface_viewfactors/matrix_entry.h"
 #include "surface_viewfactors/occluder_tree.h"
 #include "surface_viewfactors/pair_transfer.h"
+#include "surface_viewfactors/pending_row.h"
 #include "surface_viewfactors/vf_geometry.h"
 
-
-typedef struct row_entry {
-    uint32_t column;
-    double transfer; /* G_IJ */
-    double bound;    /* its estimated absolute error */
-} row_entry;
-
-typedef struct pending_row {
-    row_entry *entries;
-    uint32_t count, capacity;
-} pending_row;
 
 typedef struct pair_counts {
     uint64_t surface_pairs, polygon_pairs, hidden_pairs, obstructed_pairs, sampled_pairs,
@@ -252,6 +247,14 @@ static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_work
     return true;
 }
 
+/* Where a row is (state[], one byte per row): not computed yet; whole at rank 0 (computed
+ * there, sent there or read from a checkpoint); computed here on another rank and not sent
+ * yet. */
+enum { ROW_PENDING = 0, ROW_AT_ROOT = 1, ROW_HERE = 2 };
+
+/* Rounds of rows when checkpoints may be written: each rank's rows in this many slices. */
+#define CHECKPOINT_ROUNDS 64u
+
 /* Sampled pairs per row for its cost estimate. */
 #define COST_SAMPLES 8u
 
@@ -337,7 +340,8 @@ static unsigned char *pack_row(unsigned char *at, uint32_t I, const pending_row 
 
 /* Reads the rows of `size` packed bytes into rows[] (which must not hold them yet). False
  * when out of memory or the bytes are not whole records of rows below n. */
-static bool unpack_rows(const unsigned char *at, uint64_t size, pending_row *rows, uint32_t n)
+static bool unpack_rows(const unsigned char *at, uint64_t size, pending_row *rows, uint8_t *state,
+                        uint32_t n)
 {
     const unsigned char *end = at + size;
     while (at < end) {
@@ -355,6 +359,7 @@ static bool unpack_rows(const unsigned char *at, uint64_t size, pending_row *row
                 return false;
         }
         rows[I].count = rows[I].capacity = count;
+        state[I] = ROW_AT_ROOT;
         for (uint32_t k = 0; k < count; k++) {
             memcpy(&rows[I].entries[k].column, at, sizeof(uint32_t)), at += sizeof(uint32_t);
             memcpy(&rows[I].entries[k].transfer, at, sizeof(double)), at += sizeof(double);
@@ -364,15 +369,15 @@ static bool unpack_rows(const unsigned char *at, uint64_t size, pending_row *row
     return true;
 }
 
-/* Sends this rank's rows to rank 0, which puts every rank's rows in rows[] (the others'
- * rows are freed there). Collective. */
-static rad_status gather_rows(pending_row *rows, const uint32_t *owner, uint32_t n,
-                              rad_error *error)
+/* Sends the rows this rank computed since the last call (state ROW_HERE) to rank 0, which
+ * puts them in rows[]; they are freed here and become ROW_AT_ROOT on both sides.
+ * Collective. */
+static rad_status gather_rows(pending_row *rows, uint8_t *state, uint32_t n, rad_error *error)
 {
     int rank = ranks_rank(), count = ranks_count();
     uint64_t size = 0;
     for (uint32_t I = 0; I < n; I++)
-        if (owner[I] == (uint32_t)rank && rank != 0)
+        if (state[I] == ROW_HERE)
             size += packed_row_size(&rows[I]);
     unsigned char *mine = rad_alloc_array(size ? size : 1, 1);
     uint64_t *sizes = rad_alloc_array((size_t)count, sizeof(uint64_t));
@@ -385,12 +390,11 @@ static rad_status gather_rows(pending_row *rows, const uint32_t *owner, uint32_t
     }
     unsigned char *at = mine;
     for (uint32_t I = 0; I < n; I++)
-        if (owner[I] == (uint32_t)rank && rank != 0) /* rank 0 keeps its own in place */
+        if (state[I] == ROW_HERE) { /* rank 0 keeps its own in place */
             at = pack_row(at, I, &rows[I]);
-    for (uint32_t I = 0; I < n; I++)
-        if (rank != 0 && owner[I] == (uint32_t)rank) {
             free(rows[I].entries);
             rows[I] = (pending_row){0};
+            state[I] = ROW_AT_ROOT;
         }
     void *gathered = NULL;
     rad_status status = ranks_gather(mine, size, &gathered, sizes, error);
@@ -398,7 +402,7 @@ static rad_status gather_rows(pending_row *rows, const uint32_t *owner, uint32_t
     uint64_t total = 0;
     for (int r = 0; status == RAD_OK && rank == 0 && r < count; r++)
         total += sizes[r];
-    if (status == RAD_OK && rank == 0 && !unpack_rows(gathered, total, rows, n))
+    if (status == RAD_OK && rank == 0 && !unpack_rows(gathered, total, rows, state, n))
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory (or a malformed message) "
                                                 "assembling the rows of %d ranks", count);
     free(gathered);
@@ -406,6 +410,56 @@ static rad_status gather_rows(pending_row *rows, const uint32_t *owner, uint32_t
     if (ranks_failures(status != RAD_OK) && status == RAD_OK)
         status = rad_fail(error, RAD_ERR_NOMEM, "rank 0 could not assemble the view factors");
     return status;
+}
+
+/* Checkpoints of a run (rad_viewfactor_options.checkpoint): after each round of rows every
+ * rank takes part in checkpoint_step, which writes one when the interval has passed (by
+ * rank 0's clock) or a stop was asked for on any rank. */
+typedef struct checkpointing {
+    const char *path;            /* NULL: none (a run that only stops) */
+    double interval, last;       /* seconds; rank 0's clock at the last write */
+    const volatile int *stop;
+    vf_checkpoint_job job;
+    rad_progress_fn progress;    /* rank 0: told "checkpoint" with the share of rows in it */
+    void *progress_user;
+    uint32_t rows_written;       /* rows in the last checkpoint written */
+    bool interrupted;            /* stopped on request, the checkpoint written */
+    rad_status status;           /* a checkpoint could not be written: every rank stops */
+    rad_error error;
+} checkpointing;
+
+/* Collective, from one thread of each rank. True when the rows should stop: a stop was
+ * asked for, a rank ran out of memory, or a checkpoint could not be written. */
+static bool checkpoint_step(checkpointing *cp, pending_row *rows, uint8_t *state, uint32_t n,
+                            bool out_of_memory)
+{
+    uint64_t flags[2] = {cp->stop && *cp->stop, out_of_memory};
+    ranks_sum(flags, 2);
+    if (flags[1])
+        return true;
+    int write = ranks_rank() == 0 && cp->path &&
+                (flags[0] || now_seconds() - cp->last >= cp->interval);
+    ranks_broadcast(&write, sizeof(write));
+    if (write) {
+        rad_status status = ranks_count() > 1 ? gather_rows(rows, state, n, &cp->error) : RAD_OK;
+        uint32_t done = 0;
+        for (uint32_t I = 0; I < n; I++)
+            done += state[I] == ROW_AT_ROOT;
+        if (status == RAD_OK && ranks_rank() == 0)
+            status = vf_checkpoint_write(cp->path, &cp->job, rows, state, &cp->error);
+        status = ranks_share_status(status, &cp->error);
+        if (status != RAD_OK) {
+            cp->status = status;
+            return true;
+        }
+        cp->last = now_seconds();
+        cp->rows_written = done;
+        if (ranks_rank() == 0 && cp->progress)
+            cp->progress(cp->progress_user, "checkpoint", n ? (double)done / n : 1);
+    }
+    if (flags[0])
+        cp->interrupted = true;
+    return flags[0] != 0;
 }
 
 static rad_viewfactor_matrix *assemble(const vf_geometry *g, pending_row *rows, uint32_t n)
@@ -503,14 +557,35 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
     uint32_t n = scene->surface_count;
+    uint8_t *state = NULL;
+    uint32_t *mine = NULL;
     if (status == RAD_OK) {
         rows = rad_alloc_array(n ? n : 1, sizeof(pending_row));
-        if (!rows)
+        state = rad_alloc_array(n ? n : 1, 1);
+        mine = rad_alloc_array(n ? n : 1, sizeof(uint32_t));
+        if (!rows || !state || !mine)
             status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u rows", n);
     }
     status = ranks_agree(status, "view factors", error);
+    int rank = ranks_rank();
+    /* a resumed run: rank 0 reads the rows done, and every rank learns which they are */
+    vf_checkpoint_job job = {vf_checkpoint_fingerprint(scene), n, e.accuracy, e.max_rays, e.seed};
+    uint32_t resumed = 0;
+    if (status == RAD_OK && options->resume) {
+        if (rank == 0)
+            status = vf_checkpoint_read(options->resume, &job, rows, state, &resumed, error);
+        status = ranks_share_status(status, error);
+        if (status == RAD_OK) {
+            ranks_broadcast(state, n);
+            ranks_broadcast(&resumed, sizeof(resumed));
+        }
+    }
     if (status != RAD_OK) {
+        for (uint32_t I = 0; rows && I < n; I++)
+            free(rows[I].entries);
         free(rows);
+        free(state);
+        free(mine);
         rad_tracer_destroy(occluders);
         occluder_tree_destroy(tree);
         vf_geometry_free(&geometry);
@@ -521,20 +596,30 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     e.occluders = occluders;
 
     /* over several ranks: who computes which row (owner NULL: this process, all), decided
-     * by rank 0 alone so that no rank can disagree */
+     * by rank 0 alone so that no rank can disagree; resumed rows are rank 0's already */
     uint32_t *owner = NULL;
-    int rank = ranks_rank();
     if (ranks_count() > 1) {
         double *cost = rank == 0 ? rad_alloc_array(n ? n : 1, sizeof(double)) : NULL;
         owner = rad_alloc_array(n ? n : 1, sizeof(uint32_t));
         bool failed = (rank == 0 && !cost) || !owner;
-        if (!failed && rank == 0)
-            failed = !estimate_row_costs(&e, threads, cost) ||
-                     partition_by_cost(cost, n, ranks_count(), owner, error) != RAD_OK;
+        if (!failed && rank == 0) {
+            failed = !estimate_row_costs(&e, threads, cost);
+            for (uint32_t I = 0; !failed && I < n; I++)
+                if (state[I] != ROW_PENDING)
+                    cost[I] = 0;
+            failed = failed || partition_by_cost(cost, n, ranks_count(), owner, error) != RAD_OK;
+            for (uint32_t I = 0; !failed && I < n; I++)
+                if (state[I] != ROW_PENDING)
+                    owner[I] = 0;
+        }
         free(cost);
         if (ranks_failures(failed)) {
             free(owner);
+            for (uint32_t I = 0; I < n; I++)
+                free(rows[I].entries);
             free(rows);
+            free(state);
+            free(mine);
             rad_tracer_destroy(occluders);
             occluder_tree_destroy(tree);
             vf_geometry_free(&geometry);
@@ -544,22 +629,32 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         ranks_broadcast(owner, (uint64_t)n * sizeof(uint32_t));
     }
 
-    /* polygon pairs (I, J >= I) the rows of this rank will visit */
+    /* the rows this rank computes, and the polygon pairs (I, J >= I) they will visit */
     pair_progress progress = {options->progress, options->progress_user, 0, 0, 0};
     double polygons_after = 0;
     uint32_t rank_rows = 0;
     for (uint32_t I = n; I-- > 0;) {
         double p = geometry.surfaces[I].polygon_count;
         double self = geometry.surfaces[I].planar ? 0 : 0.5 * p * (p - 1);
-        if (!owner || owner[I] == (uint32_t)rank) {
+        if ((!owner || owner[I] == (uint32_t)rank) && state[I] == ROW_PENDING) {
             progress.total += p * polygons_after + self;
             rank_rows++;
         }
         polygons_after += p;
     }
+    for (uint32_t I = 0, k = 0; I < n; I++)
+        if ((!owner || owner[I] == (uint32_t)rank) && state[I] == ROW_PENDING)
+            mine[k++] = I;
     e.progress = &progress;
+    /* with checkpoints (or a stop to watch), the rows go in rounds with a checkpoint step
+     * between two; else in one */
+    checkpointing cp = {options->checkpoint, options->checkpoint_interval, now_seconds(),
+                        options->stop, job, options->progress, options->progress_user,
+                        0, false, RAD_OK, {0}};
+    uint32_t rounds = options->checkpoint || options->stop ? CHECKPOINT_ROUNDS : 1;
+    uint8_t computed_state = owner && rank != 0 ? ROW_HERE : ROW_AT_ROOT;
     pair_counts totals = {0};
-    bool out_of_memory = false;
+    bool out_of_memory = false, stopped = false;
     double rows_start = now_seconds();
 #pragma omp parallel num_threads(threads)
     {
@@ -570,17 +665,37 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
 #pragma omp atomic write
             out_of_memory = true;
         }
+        for (uint32_t round = 0; round < rounds; round++) {
+            uint32_t begin = (uint32_t)((uint64_t)rank_rows * round / rounds);
+            uint32_t end = (uint32_t)((uint64_t)rank_rows * (round + 1) / rounds);
+            /* a stop leaves the round's other rows pending (the checkpoint after it has
+             * the rows done), so it takes effect within a row; not in the last round,
+             * after which no checkpoint step comes */
+            bool stoppable = options->stop && round + 1 < rounds;
 #pragma omp for schedule(dynamic, 1)
-        for (uint32_t I = 0; I < n; I++) {
-            bool failed;
+            for (uint32_t k = begin; k < end; k++) {
+                bool failed;
 #pragma omp atomic read
-            failed = out_of_memory;
-            if (failed || !ready || (owner && owner[I] != (uint32_t)rank))
-                continue;
-            if (!compute_row(&e, I, &rows[I], &w, &counts)) {
+                failed = out_of_memory;
+                if (failed || !ready || (stoppable && *options->stop))
+                    continue;
+                if (!compute_row(&e, mine[k], &rows[mine[k]], &w, &counts)) {
 #pragma omp atomic write
-                out_of_memory = true;
+                    out_of_memory = true;
+                } else {
+                    state[mine[k]] = computed_state;
+                }
             }
+            if (round + 1 == rounds)
+                break;
+            /* MPI from the master thread only; the barrier publishes its answer, and no
+             * thread writes `stopped` again before every thread has passed the next round's
+             * closing barrier */
+#pragma omp master
+            stopped = checkpoint_step(&cp, rows, state, n, out_of_memory);
+#pragma omp barrier
+            if (stopped)
+                break;
         }
         pair_workspace_free(&w);
 #pragma omp critical
@@ -598,33 +713,43 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     rad_tracer_destroy(occluders);
     occluder_tree_destroy(tree);
     rad_viewfactor_matrix *matrix = NULL;
+    if (cp.status != RAD_OK) {
+        status = cp.status;
+        *error = cp.error;
+    }
     if (owner) {
-        status = ranks_failures(out_of_memory)
-                     ? rad_fail(error, RAD_ERR_NOMEM,
-                                out_of_memory ? "out of memory for view-factor rows"
-                                              : "another rank ran out of memory")
-                     : gather_rows(rows, owner, n, error);
+        if (status == RAD_OK)
+            status = ranks_failures(out_of_memory)
+                         ? rad_fail(error, RAD_ERR_NOMEM,
+                                    out_of_memory ? "out of memory for view-factor rows"
+                                                  : "another rank ran out of memory")
+                     : cp.interrupted ? RAD_OK
+                                      : gather_rows(rows, state, n, error);
         uint64_t sums[7] = {totals.surface_pairs, totals.polygon_pairs, totals.hidden_pairs,
                             totals.obstructed_pairs, totals.sampled_pairs,
                             totals.capped_pairs, totals.rays};
         ranks_sum(sums, 7);
         totals = (pair_counts){sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6]};
         free(owner);
-        if (status == RAD_OK && rank == 0)
+        if (status == RAD_OK && rank == 0 && !cp.interrupted)
             matrix = assemble(&geometry, rows, n);
-    } else if (!out_of_memory) {
+    } else if (status == RAD_OK && out_of_memory) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for view-factor rows");
+    } else if (status == RAD_OK && !cp.interrupted) {
         matrix = assemble(&geometry, rows, n);
     }
     for (uint32_t I = 0; I < n; I++)
         free(rows[I].entries);
     free(rows);
+    free(state);
+    free(mine);
     vf_geometry_free(&geometry);
     if (status != RAD_OK)
         return status;
-    if (!matrix && rank == 0)
+    if (!matrix && rank == 0 && !cp.interrupted)
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the view factors of %u surfaces",
                         n);
-    if (options->progress)
+    if (options->progress && !cp.interrupted)
         options->progress(options->progress_user, "view factors", 1.0);
     if (report) {
         memset(report, 0, sizeof(*report));
@@ -643,6 +768,9 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         report->threads = threads;
         report->rank_rows = rank_rows;
         report->rank_seconds = rank_seconds;
+        report->resumed_rows = resumed;
+        report->checkpoint_rows = cp.rows_written;
+        report->interrupted = cp.interrupted;
     }
     *out = matrix;
     return RAD_OK;

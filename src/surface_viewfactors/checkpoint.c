@@ -1,0 +1,227 @@
+/*
+ * checkpoint.c - the restart file of a view-factor run (checkpoint.h).
+ *
+ * Layout, little-endian: the magic "\x89RADVFC\n", format version (u32), surface count
+ * (u32), scene fingerprint (u64), accuracy (f64), ray cap (u32), seed (u64), rows in the
+ * file (u32); then per row, in increasing row order, the row I (u32), its entry count (u32)
+ * and per entry the column J >= I (u32, increasing), the transfer G_IJ (f64, > 0) and its
+ * error bound (f64, >= 0); last the FNV-1a checksum of every byte before it (u64). The
+ * whole file is checked before any row is used. Written atomically (core/atomic_file.h),
+ * so a run killed while writing leaves the previous checkpoint whole.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/alloc.h"
+#include "core/atomic_file.h"
+#include "core/bytes.h"
+#include "core/error.h"
+#include "core/hash.h"
+#include "surface_viewfactors/checkpoint.h"
+
+static const uint8_t checkpoint_magic[8] = {0x89, 'R', 'A', 'D', 'V', 'F', 'C', '\n'};
+
+enum {
+    CHECKPOINT_VERSION = 1,
+    HEADER_BYTES = 48,  /* magic, version, rows, fingerprint, accuracy, rays, seed, count */
+    ROW_BYTES = 8,      /* row, entry count */
+    ENTRY_BYTES = 20,   /* column, transfer, bound */
+    CHECKSUM_BYTES = 8
+};
+
+uint64_t vf_checkpoint_fingerprint(const rad_scene *scene)
+{
+    uint64_t h = RAD_HASH_START;
+    h = hash_u32(h, scene->position_count);
+    for (uint32_t v = 0; v < scene->position_count; v++) {
+        h = hash_f64(h, scene->positions[v].x);
+        h = hash_f64(h, scene->positions[v].y);
+        h = hash_f64(h, scene->positions[v].z);
+    }
+    h = hash_u32(h, scene->triangle_count);
+    for (uint32_t t = 0; t < scene->triangle_count; t++) {
+        for (int k = 0; k < 3; k++)
+            h = hash_u32(h, scene->triangles[t].vertex[k]);
+        h = hash_u32(h, scene->triangles[t].surface);
+    }
+    h = hash_u32(h, scene->surface_count);
+    for (uint32_t s = 0; s < scene->surface_count; s++) {
+        h = hash_u32(h, scene->surfaces[s].first_triangle);
+        h = hash_u32(h, scene->surfaces[s].triangle_count);
+        h = hash_u32(h, scene->surfaces[s].flags);
+    }
+    return h;
+}
+
+rad_status vf_checkpoint_write(const char *path, const vf_checkpoint_job *job,
+                               const pending_row *rows, const uint8_t *done, rad_error *error)
+{
+    uint64_t size = HEADER_BYTES + CHECKSUM_BYTES;
+    uint32_t count = 0;
+    for (uint32_t I = 0; I < job->rows; I++)
+        if (done[I]) {
+            size += ROW_BYTES + (uint64_t)rows[I].count * ENTRY_BYTES;
+            count++;
+        }
+    if (size > SIZE_MAX / 2)
+        return rad_fail(error, RAD_ERR_NOMEM, "%s: a checkpoint of %llu bytes is too large",
+                        path, (unsigned long long)size);
+    uint8_t *bytes = rad_alloc_array((size_t)size, 1);
+    if (!bytes)
+        return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for a checkpoint of %llu bytes",
+                        path, (unsigned long long)size);
+    memcpy(bytes, checkpoint_magic, sizeof(checkpoint_magic));
+    bytes_put_u32(bytes + 8, CHECKPOINT_VERSION);
+    bytes_put_u32(bytes + 12, job->rows);
+    bytes_put_u64(bytes + 16, job->fingerprint);
+    bytes_put_f64(bytes + 24, job->accuracy);
+    bytes_put_u32(bytes + 32, job->max_rays);
+    bytes_put_u64(bytes + 36, job->seed);
+    bytes_put_u32(bytes + 44, count);
+    uint8_t *p = bytes + HEADER_BYTES;
+    for (uint32_t I = 0; I < job->rows; I++) {
+        if (!done[I])
+            continue;
+        bytes_put_u32(p, I);
+        bytes_put_u32(p + 4, rows[I].count);
+        p += ROW_BYTES;
+        for (uint32_t k = 0; k < rows[I].count; k++, p += ENTRY_BYTES) {
+            bytes_put_u32(p, rows[I].entries[k].column);
+            bytes_put_f64(p + 4, rows[I].entries[k].transfer);
+            bytes_put_f64(p + 12, rows[I].entries[k].bound);
+        }
+    }
+    bytes_put_u64(p, hash_bytes(RAD_HASH_START, bytes, (size_t)size - CHECKSUM_BYTES));
+    rad_status status = rad_write_file_atomic(path, bytes, (size_t)size, error);
+    free(bytes);
+    return status;
+}
+
+/* The header's job against this run's; RAD_ERR_INVALID naming what differs. */
+static rad_status match_job(const char *path, const uint8_t *bytes, const vf_checkpoint_job *job,
+                            rad_error *error)
+{
+    uint32_t rows = bytes_get_u32(bytes + 12);
+    if (rows != job->rows || bytes_get_u64(bytes + 16) != job->fingerprint)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "%s: a checkpoint of another scene (%u surfaces, fingerprint %016llx; "
+                        "this one: %u, %016llx)",
+                        path, rows, (unsigned long long)bytes_get_u64(bytes + 16), job->rows,
+                        (unsigned long long)job->fingerprint);
+    double accuracy = bytes_get_f64(bytes + 24);
+    uint32_t max_rays = bytes_get_u32(bytes + 32);
+    uint64_t seed = bytes_get_u64(bytes + 36);
+    if (accuracy != job->accuracy || max_rays != job->max_rays || seed != job->seed)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "%s: a checkpoint made with other options (--accuracy %.17g, "
+                        "--max-rays %u, --seed %llu; this run: %.17g, %u, %llu)",
+                        path, accuracy, max_rays, (unsigned long long)seed, job->accuracy,
+                        job->max_rays, (unsigned long long)job->seed);
+    return RAD_OK;
+}
+
+/* Checks the bytes of a whole file and fills rows[] and done[] from them. */
+static rad_status parse_checkpoint(const char *path, const uint8_t *bytes, size_t size,
+                                   const vf_checkpoint_job *job, pending_row *rows,
+                                   uint8_t *done, uint32_t *count, rad_error *error)
+{
+    if (size < sizeof(checkpoint_magic) ||
+        memcmp(bytes, checkpoint_magic, sizeof(checkpoint_magic)))
+        return rad_fail(error, RAD_ERR_PARSE, "%s: not a view-factor checkpoint", path);
+    if (size < HEADER_BYTES + CHECKSUM_BYTES)
+        return rad_fail(error, RAD_ERR_PARSE, "%s: truncated checkpoint (%zu bytes)", path,
+                        size);
+    uint32_t version = bytes_get_u32(bytes + 8);
+    if (version != CHECKPOINT_VERSION)
+        return rad_fail(error, RAD_ERR_PARSE,
+                        "%s: checkpoint format version %u; this build reads version %d", path,
+                        version, CHECKPOINT_VERSION);
+    if (hash_bytes(RAD_HASH_START, bytes, size - CHECKSUM_BYTES) !=
+        bytes_get_u64(bytes + size - CHECKSUM_BYTES))
+        return rad_fail(error, RAD_ERR_PARSE,
+                        "%s: corrupted checkpoint (its checksum does not match)", path);
+    rad_status status = match_job(path, bytes, job, error);
+    if (status != RAD_OK)
+        return status;
+    uint32_t listed = bytes_get_u32(bytes + 44), n = job->rows;
+    const uint8_t *p = bytes + HEADER_BYTES, *end = bytes + size - CHECKSUM_BYTES;
+    int64_t previous = -1;
+    for (uint32_t r = 0; r < listed; r++) {
+        if (end - p < ROW_BYTES)
+            return rad_fail(error, RAD_ERR_PARSE, "%s: truncated checkpoint (row %u of %u)",
+                            path, r, listed);
+        uint32_t I = bytes_get_u32(p), entries = bytes_get_u32(p + 4);
+        p += ROW_BYTES;
+        if (I >= n || (int64_t)I <= previous)
+            return rad_fail(error, RAD_ERR_PARSE,
+                            "%s: row %u out of order or beyond the %u surfaces", path, I, n);
+        previous = I;
+        if ((uint64_t)(end - p) < (uint64_t)entries * ENTRY_BYTES)
+            return rad_fail(error, RAD_ERR_PARSE, "%s: truncated checkpoint (row %u)", path, I);
+        if (entries) {
+            rows[I].entries = rad_alloc_array(entries, sizeof(row_entry));
+            if (!rows[I].entries)
+                return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for row %u", path, I);
+        }
+        rows[I].count = rows[I].capacity = entries;
+        done[I] = 1;
+        int64_t column_before = (int64_t)I - 1;
+        for (uint32_t k = 0; k < entries; k++, p += ENTRY_BYTES) {
+            row_entry e = {bytes_get_u32(p), bytes_get_f64(p + 4), bytes_get_f64(p + 12)};
+            if (e.column >= n || (int64_t)e.column <= column_before ||
+                !(e.transfer > 0 && isfinite(e.transfer)) ||
+                !(e.bound >= 0 && isfinite(e.bound)))
+                return rad_fail(error, RAD_ERR_PARSE,
+                                "%s: row %u: entry %u is out of range or not a finite number",
+                                path, I, k);
+            column_before = e.column;
+            rows[I].entries[k] = e;
+        }
+    }
+    if (p != end)
+        return rad_fail(error, RAD_ERR_PARSE, "%s: %lld unexpected bytes after the last row",
+                        path, (long long)(end - p));
+    *count = listed;
+    return RAD_OK;
+}
+
+rad_status vf_checkpoint_read(const char *path, const vf_checkpoint_job *job,
+                              pending_row *rows, uint8_t *done, uint32_t *count,
+                              rad_error *error)
+{
+    *count = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return rad_fail(error, RAD_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    rad_status status = RAD_OK;
+    uint8_t *bytes = NULL;
+    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+        status = rad_fail(error, RAD_ERR_IO, "%s: not a regular file", path);
+        goto done;
+    }
+    size_t size = (size_t)st.st_size;
+    bytes = rad_alloc_array(size ? size : 1, 1);
+    if (!bytes) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory (%zu bytes)", path, size);
+        goto done;
+    }
+    if (size && fread(bytes, 1, size, f) != size) {
+        status = rad_fail(error, RAD_ERR_IO, "%s: read failed", path);
+        goto done;
+    }
+    status = parse_checkpoint(path, bytes, size, job, rows, done, count, error);
+    if (status != RAD_OK)
+        for (uint32_t I = 0; I < job->rows; I++) {
+            free(rows[I].entries);
+            rows[I] = (pending_row){0};
+            done[I] = 0;
+        }
+done:
+    fclose(f);
+    free(bytes);
+    return status;
+}
