@@ -50,6 +50,8 @@ static const char usage[] =
     "                       bound cannot fit (24 bytes per pair of surfaces that do not\n"
     "                       face away, plus 20 per factor); anything else that would\n"
     "                       exceed it ends the run with an error (default: no budget)\n"
+    "  --plot FILE.svg      the fraction of polygon pairs left against time (log scale):\n"
+    "                       the computation's progress; it has no iteration to converge\n"
     CLI_BASE_HELP("counts, times, invariants and error bounds");
 
 enum {
@@ -62,7 +64,7 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_MAX_RAYS] = {"max-rays", 0, true},   [OPT_FORMAT] = {"format", 0, true},
     [OPT_ENCLOSURE] = {"enclosure", 0, false}, [OPT_SCRIPT_F] = {"script-f", 0, false},
     [OPT_OBSTRUCTION] = {"obstruction", 0, true}, [OPT_TWO_SIDED] = {"two-sided", 0, true},
-    [OPT_MAX_MEMORY] = {"max-memory", 0, true}};
+    [OPT_MAX_MEMORY] = {"max-memory", 0, true}, [OPT_PLOT] = {"plot", 0, true}};
 
 /* --obstruction files at most; as many SCENE files (cli_args.positional). */
 #define MAX_FILES 256
@@ -148,7 +150,10 @@ int command_viewfactors(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if (!cli_outputs_writable((const char *[]){output, stats_path}, 2))
+    const char *plot_path = args.value[OPT_PLOT];
+    if (!cli_convergence_paths_ok(plot_path, NULL))
+        return EXIT_USAGE;
+    if (!cli_outputs_writable((const char *[]){output, stats_path, plot_path}, 3))
         return EXIT_ERROR;
 
     rad_error error = {0};
@@ -162,6 +167,8 @@ int command_viewfactors(int argc, char **argv)
     double t0 = rad_clock_seconds();
     if (cli_ranks_begin() > 1 && rad_rank() != 0)
         vf.progress = NULL; /* rank 0 shows its own rows' progress */
+    cli_viewfactor_plot plot;
+    cli_viewfactor_plot_begin(&plot, plot_path, &vf);
     rad_status status = load_surfaces(&args, &scene, &control, &is_vs3, &error);
     int cursor = 0;
     for (const char *name; status == RAD_OK && (name = cli_next_value(&args, OPT_TWO_SIDED, &cursor));)
@@ -252,6 +259,8 @@ int command_viewfactors(int argc, char **argv)
     }
     status = output ? rad_viewfactor_matrix_write(scene, matrix, output, &write, &error)
                     : rad_viewfactor_matrix_print(scene, matrix, stdout, &write, &error);
+    if (status == RAD_OK)
+        status = cli_viewfactor_plot_end(&plot, scene->source, (uint32_t)S, &error);
     if (status != RAD_OK)
         goto fail;
     double seconds = rad_clock_seconds() - t0;
@@ -303,6 +312,7 @@ int command_viewfactors(int argc, char **argv)
 fail:
     exit_code = cli_ranks_failed(&error);
 done:
+    rad_convergence_free(&plot.history);
     free(emissivity);
     rad_viewfactor_matrix_destroy(matrix);
     rad_scene_destroy(scene);
