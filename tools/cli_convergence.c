@@ -90,7 +90,7 @@ rad_status cli_convergence_end(cli_convergence *c, rad_status solved, rad_error 
         char title[512];
         snprintf(title, sizeof(title), "%s: %s solver, %u patches", base_name(c->scene),
                  rad_solver_name(c->solver), c->patches);
-        rad_convergence_plot_options plot = {title, "sweeps", true, NULL, NULL};
+        rad_convergence_plot_options plot = {title, "sweeps", true, NULL, NULL, NULL};
         switch (c->solver) {
         case RAD_SOLVER_SHOOT:
             plot.step_label = "shots";
@@ -118,7 +118,8 @@ static void viewfactor_progress(void *user, const char *phase, double fraction)
 {
     cli_viewfactor_plot *p = user;
     cli_progress(NULL, phase, fraction);
-    if (p->status != RAD_OK || strcmp(phase, "view factors") != 0)
+    /* the library reports at most 0.999 until the end: a report there is no measurement */
+    if (p->status != RAD_OK || strcmp(phase, "view factors") != 0 || fraction >= 0.999)
         return;
     rad_solve_step step = {0};
     step.step = (uint32_t)p->history.count;
@@ -164,7 +165,8 @@ rad_status cli_viewfactor_plot_end(cli_viewfactor_plot *p, const char *scene,
         snprintf(title, sizeof(title), "%s: view factors, %u surfaces (work left, not an error)",
                  base_name(scene), surfaces);
         rad_convergence_plot_options plot = {title, NULL, false, "fraction of polygon pairs left",
-                                             "polygon pairs left / all pairs (1)"};
+                                             "polygon pairs left / all pairs (1)",
+                                             "time since the view factors began (s)"};
         if (status == RAD_OK)
             status = rad_convergence_plot_write(&p->history, p->path, &plot, error);
     }

@@ -172,8 +172,10 @@ rad_status rad_convergence_plot_write(const rad_convergence *history, const char
     }
     int decade_lo = -1, decade_hi = 0; /* nothing positive: an empty frame */
     if (hi > 0) {
-        decade_lo = (int)floor(log10(lo));
-        decade_hi = (int)ceil(log10(hi));
+        /* a value a rounding error above a power of ten (an unshot fraction of 1) does not
+         * open a decade of its own */
+        decade_lo = (int)floor(log10(lo) + 1e-9);
+        decade_hi = (int)ceil(log10(hi) - 1e-9);
         if (decade_hi <= decade_lo)
             decade_hi = decade_lo + 1;
     }
@@ -186,7 +188,7 @@ rad_status rad_convergence_plot_write(const rad_convergence *history, const char
         top += PANEL_HEIGHT + PANEL_GAP;
     }
     panels[count++] = (panel){top, seconds > 0 ? seconds : 1, decade_lo, decade_hi,
-                              "solver time (s)", "time"};
+                              o->time_label ? o->time_label : "solver time (s)", "time"};
     int height = (int)(top + PANEL_HEIGHT + 56);
 
     svg_text t = {0};
