@@ -973,7 +973,7 @@ rad_system rad_system_of(const rad_patch_inputs *inputs, const rad_formfactors *
  * residual of B_k is the change of the sweep that follows it (the snapshot is handed over
  * one sweep late, with a copy of B: O(n)); Gauss-Seidel and shooting pay one pass over F
  * (O(n^2), one Jacobi sweep's work) per call for the residual; copying B to the
- * observer's layout is O(n). `seconds` leaves that cost out. */
+ * observer's layout is O(n). `seconds` leaves that cost out (the reports' seconds do not). */
 typedef struct rad_solve_step {
     uint32_t step;           /* iterations done: sweeps, or shots for shooting */
     const char *phase;       /* "gather", "gauss-seidel", "shoot", "direct"; hierarchical:
@@ -1175,7 +1175,8 @@ rad_status rad_convergence_plot_write(const rad_convergence *history, const char
  * snapshot's text, about 16 n bytes), as JSON:
  *   {"format":"radiosity-record","version":1,"scene":S,"solver":V,"patches":n,
  *    "snapshots":[{"step":k,"seconds":s,"criterion":c,"residual":r,"unshot":u|null,
- *                  "shooting_patch":p|null,"final":true|false,"radiosity":"BASE64"},...]}
+ *                  "shooting_patch":p|null,"final":true|false,"phase":"...",
+ *                  "radiosity":"BASE64"},...]}
  * where BASE64 holds n x 3 float32 little-endian (R, G, B radiosity, W/m^2 or the
  * scene's unit, per patch in the mesh's patch order) and a NaN number is null. The file
  * appears, whole, at rad_solve_record_commit; rad_solve_record_abort (or an error) leaves
