@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/alloc.h"
+#include "core/error.h"
 #include "testlib.h"
 
 enum { MAX_CALLS = 4096 };
@@ -264,6 +266,89 @@ static void check_history(void)
           RAD_ERR_INVALID);
 }
 
+/* An observer that records every step and keeps the history: what `solve --record
+ * --plot` does, for the allocation-failure sweep below. */
+typedef struct outputs {
+    rad_solve_record *record;
+    rad_convergence history;
+    rad_status status;
+    rad_error error;
+} outputs;
+
+static void record_observer(void *user, const rad_solve_step *step)
+{
+    outputs *o = user;
+    if (o->status == RAD_OK)
+        o->status = rad_convergence_add(&o->history, step, &o->error);
+    if (o->status == RAD_OK)
+        o->status = rad_solve_record_add(o->record, step, &o->error);
+}
+
+/* Solve, record and plot (the record is committed before the plot is written). */
+static rad_status observed_run(const random_system *r, rad_solver solver, rad_error *error)
+{
+    outputs o = {0};
+    rad_status status = rad_solve_record_open(test_path("sweep.json"), "random", "x", r->s.n,
+                                              &o.record, error);
+    if (status != RAD_OK)
+        return status;
+    rad_rgb *B = rad_alloc_array(r->s.n, sizeof(rad_rgb));
+    if (!B) {
+        rad_solve_record_abort(o.record);
+        return rad_fail(error, RAD_ERR_NOMEM, "no B");
+    }
+    rad_solve_options opt = {0};
+    opt.solver = solver;
+    opt.observer = record_observer;
+    opt.observer_user = &o;
+    opt.threads = 1;
+    status = rad_solve(&r->s, &opt, B, NULL, error);
+    if (status == RAD_OK && o.status != RAD_OK) {
+        *error = o.error;
+        status = o.status;
+    }
+    if (status == RAD_OK)
+        status = rad_solve_record_commit(o.record, error);
+    else
+        rad_solve_record_abort(o.record);
+    rad_convergence_plot_options plot = {"sweep", "sweeps", true, "criterion", NULL, NULL};
+    if (status == RAD_OK)
+        status = rad_convergence_plot_write(&o.history, test_path("sweep.svg"), &plot, error);
+    rad_convergence_free(&o.history);
+    free(B);
+    return status;
+}
+
+/* Every allocation of an observed solve, its record and its plot failing in turn: a clean
+ * RAD_ERR_NOMEM each time, no temporary file and no plot left; then the run succeeds. */
+static void check_allocation_failures(const random_system *r, rad_solver solver)
+{
+    rad_error error = {0};
+    for (uint64_t n = 1; n < 10000; n++) {
+        remove(test_path("sweep.json"));
+        remove(test_path("sweep.svg"));
+        rad_alloc_fail_nth(n);
+        rad_status status = observed_run(r, solver, &error);
+        bool injected = rad_alloc_failure_injected();
+        rad_alloc_fail_nth(0);
+        if (!injected) {
+            CHECK(status == RAD_OK);
+            CHECK(test_file_exists(test_path("sweep.json")) &&
+                  test_file_exists(test_path("sweep.svg")));
+            CHECK(n > 4);
+            return;
+        }
+        /* no temporary left; the record may stand, whole, when the plot failed after it */
+        CHECK(status == RAD_ERR_NOMEM);
+        CHECK(test_count_files("sweep.json.tmp") == 0 && test_count_files("sweep.svg") == 0);
+        if (status != RAD_ERR_NOMEM || test_count_files("sweep.json.tmp") != 0 ||
+            test_count_files("sweep.svg") != 0)
+            fprintf(stderr, "%s: allocation %llu failed: %s\n", rad_solver_name(solver),
+                    (unsigned long long)n, rad_status_name(status));
+    }
+    CHECK(!"the sweep did not end");
+}
+
 int main(void)
 {
     test_tmpdir();
@@ -275,6 +360,11 @@ int main(void)
     check_dense(&r, RAD_SOLVER_SHOOT, 7);
     check_dense(&r, RAD_SOLVER_SHOOT, 1);
     check_dense(&r, RAD_SOLVER_DIRECT, 0);
+    random_system_free(&r);
+    random_system_make(&r, 40, 11);
+    check_allocation_failures(&r, RAD_SOLVER_JACOBI);
+    check_allocation_failures(&r, RAD_SOLVER_GAUSS_SEIDEL);
+    check_allocation_failures(&r, RAD_SOLVER_SHOOT);
     random_system_free(&r);
     check_hierarchical();
     check_history();
