@@ -138,7 +138,9 @@ static void check_dense(const random_system *r, rad_solver solver, uint32_t ever
     if (solver == RAD_SOLVER_DIRECT)
         expected = 1;
     if (solver == RAD_SOLVER_SHOOT) {
-        uint32_t k = every ? every : (n / RAD_OBSERVE_SHOTS_DIVISOR ? n / RAD_OBSERVE_SHOTS_DIVISOR : 1);
+        uint32_t k = every ? every : n / RAD_OBSERVE_SHOTS_DIVISOR;
+        if (k == 0)
+            k = 1;
         expected = (report.iterations + k - 1) / k + 1; /* 0, k, 2k, ... below S, and S */
         for (uint32_t c = 0; c + 1 < s->calls && c < MAX_CALLS; c++)
             CHECK(s->step[c] == c * k);

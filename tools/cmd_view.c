@@ -37,13 +37,14 @@ static const char usage[] =
     "a click shows the surface picked (name, area, material, mean radiance). SCENE is\n"
     "solved first, as `radiosity solve` does, with the same options (none = the built-in\n"
     "Cornell box); a LIT.glb written by `radiosity solve -o LIT.glb` is shown as it is\n"
-    "(it has no surface names: picking then shows the values at the point).\n"
+    "(it has no surface names: picking then shows the values at the point). With --record\n"
+    "FILE the page also plays the solve back: a step slider, play, the shooting patch\n"
+    "outlined, the step's unshot energy and residual.\n"
     "\n"
     "  -o, --output FILE    the page (default: SCENE's base name + .html in the current\n"
     "                       folder; cornell_box.html for the built-in box)\n"
     "  --open               print the page's file:// address to open in a browser\n"
-    "  --record FILE        also write the solve's snapshots to FILE and play them back\n"
-    "                       in the page: a step slider, play, the shooting patch outlined\n"
+
     CLI_TWO_SIDED_HELP
     CLI_SOLVE_HELP
     "\n"
@@ -631,7 +632,8 @@ int command_view(int argc, char **argv)
     page_text(&html, "</script>\n");
     if (!lit_input && !page_triangle_surfaces(&html, solved.mesh, triangles))
         goto done;
-    if (!lit_input && solve.record_path && !page_record(&html, solve.record_path, solved.mesh, triangles))
+    if (!lit_input && solve.record_path &&
+        !page_record(&html, solve.record_path, solved.mesh, triangles))
         goto done;
     page_text(&html, "<script>");
     page_append(&html, rad_viewer_script, rad_viewer_script_size);

@@ -126,6 +126,18 @@ static void put_axes(svg_text *t, const panel *p, const char *y_label)
     put(t, "</text>\n");
 }
 
+static double value_of(const rad_convergence_point *q, size_t field)
+{
+    return *(const double *)((const char *)q + field);
+}
+
+/* A value a log axis can show. */
+static bool drawable(const rad_convergence_point *q, size_t field)
+{
+    double v = value_of(q, field);
+    return v > 0 && isfinite(v);
+}
+
 /* The curve of one field (offset into rad_convergence_point) against steps or seconds. */
 static void put_curve(svg_text *t, const panel *p, const rad_convergence *h, size_t field,
                       bool by_time, const char *class_name, const char *style)
@@ -134,16 +146,25 @@ static void put_curve(svg_text *t, const panel *p, const rad_convergence *h, siz
     bool drawing = false;
     for (size_t i = 0; i < h->count; i++) {
         const rad_convergence_point *q = &h->points[i];
-        double v = *(const double *)((const char *)q + field);
-        if (!(v > 0 && isfinite(v))) {
+        if (!drawable(q, field)) {
             drawing = false;
             continue;
         }
         double x = by_time ? q->seconds : (double)q->step;
-        put(t, "%s%.3f,%.3f", drawing ? " L" : " M", px(p, x), py(p, v));
+        put(t, "%s%.3f,%.3f", drawing ? " L" : " M", px(p, x), py(p, value_of(q, field)));
         drawing = true;
     }
     put(t, "\"/>\n");
+    /* a point with no drawn neighbour (the direct solver's one) would be invisible */
+    for (size_t i = 0; i < h->count; i++) {
+        const rad_convergence_point *q = &h->points[i];
+        if (!drawable(q, field) || (i > 0 && drawable(q - 1, field)) ||
+            (i + 1 < h->count && drawable(q + 1, field)))
+            continue;
+        double x = by_time ? q->seconds : (double)q->step;
+        put(t, "<circle class=\"%s-point\" cx=\"%.3f\" cy=\"%.3f\" r=\"3.5\" fill=\"white\" %s/>\n",
+            class_name, px(p, x), py(p, value_of(q, field)), style);
+    }
 }
 
 rad_status rad_convergence_plot_write(const rad_convergence *history, const char *path,
@@ -224,7 +245,8 @@ rad_status rad_convergence_plot_write(const rad_convergence *history, const char
         put_axes(&t, p, y_label);
         if (o->criterion_label)
             put_curve(&t, p, history, offsetof(rad_convergence_point, criterion), by_time,
-                      "criterion", "stroke=\"#d9730d\" stroke-width=\"2\" stroke-dasharray=\"6 3\"");
+                      "criterion",
+                      "stroke=\"#d9730d\" stroke-width=\"2\" stroke-dasharray=\"6 3\"");
         if (o->residual)
             put_curve(&t, p, history, offsetof(rad_convergence_point, residual), by_time,
                       "residual", "stroke=\"#1f5fbf\" stroke-width=\"2\"");

@@ -46,7 +46,9 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
     double criterion = INFINITY, smallest = INFINITY;
     uint32_t sweeps = 0;
     /* the observer gets B_k after sweep k + 1, whose change is B_k's residual */
-    rad_solve_step observed = solve_step(params, n, 0, "gather", NAN);
+    rad_solve_step observed = {0};
+    if (params->observer)
+        observed = solve_step(params, n, 0, "gather", NAN);
     while (sweeps < params->max_iterations) {
         const double *x0 = old[0], *x1 = old[1], *x2 = old[2];
         double *y0 = cur[0], *y1 = cur[1], *y2 = cur[2];
