@@ -4,7 +4,8 @@
  * run, within float32 rounding, and its residual the --stats residual); the SVG parsed by a
  * real XML parser (libxml2's xmllint; without it those checks are skipped with a message),
  * its axes labelled, and its curve's first and last points, read back through the axis
- * ticks, equal to the run's first and last residuals; viewfactors --plot; bad options.
+ * ticks, equal to the run's first and last residuals; viewfactors --plot; the record the
+ * same for 1 and 2 threads but for its times; bad options.
  */
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -362,6 +363,28 @@ static void check_viewfactors(bool xml)
     }
 }
 
+/* The record does not depend on the thread count, but for the seconds. */
+static void check_threads(void)
+{
+    CHECK(test_run_tool("solve --solver shoot --patch-size 100 --threads 1 --save-solution "
+                        "t1.sol --record t1.json --quiet") == 0);
+    CHECK(test_run_tool("solve --solver shoot --patch-size 100 --threads 2 --save-solution "
+                        "t2.sol --record t2.json --quiet") == 0);
+    cJSON *one = read_json("t1.json"), *two = read_json("t2.json");
+    CHECK(one && two);
+    if (one && two) {
+        cJSON *s;
+        cJSON_ArrayForEach(s, cJSON_GetObjectItemCaseSensitive(one, "snapshots"))
+            cJSON_DeleteItemFromObjectCaseSensitive(s, "seconds");
+        cJSON_ArrayForEach(s, cJSON_GetObjectItemCaseSensitive(two, "snapshots"))
+            cJSON_DeleteItemFromObjectCaseSensitive(s, "seconds");
+        CHECK(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(one, "snapshots")) > 2);
+        CHECK(cJSON_Compare(one, two, true));
+    }
+    cJSON_Delete(one);
+    cJSON_Delete(two);
+}
+
 static void check_bad_options(void)
 {
     CHECK(test_run_tool("solve -o x.ply --plot x.png") == 2);
@@ -389,6 +412,7 @@ int main(void)
     check_shooting_run(xml);
     check_gathering_run(xml);
     check_viewfactors(xml);
+    check_threads();
     check_bad_options();
     return test_finish("test_convergence_outputs");
 }
