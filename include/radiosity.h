@@ -1136,6 +1136,7 @@ typedef struct rad_convergence_point {
     double criterion;  /* the solver's own stopping value */
     double residual;   /* relative residual */
     double unshot;     /* shooting: unshot energy fraction */
+    const char *phase; /* rad_solve_step.phase (a string the library owns), or NULL */
 } rad_convergence_point;
 
 /* The steps seen so far; zero-initialise, add with rad_convergence_add, free with
@@ -1165,7 +1166,9 @@ typedef struct rad_convergence_plot_options {
  * and a panel against the solver time in seconds, each with a log y axis (decade ticks
  * labelled 10^k, a <line class="ytick" data-value="V"> per decade), a linear x axis, the
  * curves as <path class="residual"> and <path class="criterion"> (a non-positive or NaN
- * value breaks the line), a legend and the title. Written atomically. RAD_ERR_INVALID for
+ * value breaks the line), a legend and the title; where the phase changes after the
+ * first one (the hierarchical solver's "gather", "final gather") a dotted vertical
+ * <line class="phase"> with the new phase's name. Written atomically. RAD_ERR_INVALID for
  * an empty history. */
 rad_status rad_convergence_plot_write(const rad_convergence *history, const char *path,
                                       const rad_convergence_plot_options *options,

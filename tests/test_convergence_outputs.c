@@ -316,6 +316,40 @@ static void check_gathering_run(bool xml)
     cJSON_Delete(record);
 }
 
+/* The hierarchical solver: a snapshot per sweep and the answer; its phases marked. */
+static void check_hierarchical_run(bool xml)
+{
+    CHECK(test_run_tool("solve --solver hierarchical --patch-size 120 --threads 2 -o h.ply "
+                        "--record h.json --plot h.svg --stats h-stats.json --quiet") == 0);
+    cJSON *stats = read_json("h-stats.json");
+    cJSON *record = read_json("h.json");
+    CHECK(stats && record);
+    if (stats && record) {
+        const cJSON *snapshots = cJSON_GetObjectItemCaseSensitive(record, "snapshots");
+        int count = cJSON_GetArraySize(snapshots);
+        CHECK(count == (int)json_number(stats, "iterations") + 1);
+        const cJSON *last = cJSON_GetArrayItem(snapshots, count - 1);
+        CHECK_NEAR(json_number(last, "residual"), json_number(stats, "final_residual"), 1e-8);
+        const cJSON *phase = cJSON_GetObjectItemCaseSensitive(last, "phase");
+        CHECK(cJSON_IsString(phase) && strcmp(phase->valuestring, "final gather") == 0);
+        if (xml) {
+            const char *svg = test_path("h.svg");
+            CHECK(strstr(xpath_string(svg, "(//*[local-name()='g'][@id='steps']/"
+                                           "*[local-name()='text'][@class='phase'])[last()]"),
+                         "final gather") != NULL);
+            static double xy[4096][2];
+            axes a = read_axes(svg, "steps");
+            int points = curve_points(svg, "steps", "residual", xy, 4096);
+            CHECK(a.ok && points == count);
+            if (a.ok && points == count)
+                CHECK_NEAR(axis_y(&a, xy[points - 1][1]), json_number(stats, "final_residual"),
+                           1e-3);
+        }
+    }
+    cJSON_Delete(stats);
+    cJSON_Delete(record);
+}
+
 /* A room of 7 surfaces (6 walls and a table in the middle), one OBJ object each. */
 static void write_room(const char *name)
 {
@@ -411,6 +445,7 @@ int main(void)
                         "libxml2-utils): the SVG checks are skipped\n");
     check_shooting_run(xml);
     check_gathering_run(xml);
+    check_hierarchical_run(xml);
     check_viewfactors(xml);
     check_threads();
     check_bad_options();

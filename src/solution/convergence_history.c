@@ -18,7 +18,7 @@ rad_status rad_convergence_add(rad_convergence *history, const rad_solve_step *s
                         history->count + 1);
     history->points = points;
     history->points[history->count++] = (rad_convergence_point){
-        step->step, step->seconds, step->criterion, step->residual, step->unshot};
+        step->step, step->seconds, step->criterion, step->residual, step->unshot, step->phase};
     return RAD_OK;
 }
 

@@ -126,6 +126,25 @@ static void put_axes(svg_text *t, const panel *p, const char *y_label)
     put(t, "</text>\n");
 }
 
+/* A dotted line where the phase changes, named, except into the first phase after the
+ * start (a solver's steps all have its one phase; the hierarchical solver's change). */
+static void put_phases(svg_text *t, const panel *p, const rad_convergence *h, bool by_time)
+{
+    for (size_t i = 2; i < h->count; i++) {
+        const char *was = h->points[i - 1].phase, *now = h->points[i].phase;
+        if (!was || !now || strcmp(was, now) == 0)
+            continue;
+        double x = px(p, by_time ? h->points[i].seconds : (double)h->points[i].step);
+        put(t, "<line class=\"phase\" x1=\"%.3f\" y1=\"%.2f\" x2=\"%.3f\" y2=\"%.2f\" "
+               "stroke=\"#888\" stroke-dasharray=\"2 3\"/>\n", x, p->top, x, p->top + PANEL_HEIGHT);
+        bool left = x > PLOT_RIGHT - 90; /* near the right edge: the name to the left */
+        put(t, "<text class=\"phase\" x=\"%.2f\" y=\"%.2f\" font-size=\"11\" fill=\"#555\" "
+               "text-anchor=\"%s\">", left ? x - 3 : x + 3, p->top + 12, left ? "end" : "start");
+        put_escaped(t, now);
+        put(t, "</text>\n");
+    }
+}
+
 static double value_of(const rad_convergence_point *q, size_t field)
 {
     return *(const double *)((const char *)q + field);
@@ -243,6 +262,7 @@ rad_status rad_convergence_plot_write(const rad_convergence *history, const char
         const panel *p = &panels[k];
         bool by_time = strcmp(p->id, "time") == 0;
         put_axes(&t, p, y_label);
+        put_phases(&t, p, history, by_time);
         if (o->criterion_label)
             put_curve(&t, p, history, offsetof(rad_convergence_point, criterion), by_time,
                       "criterion",
