@@ -1006,6 +1006,49 @@ typedef struct rad_system {
  * is copied or allocated. */
 rad_system rad_system_of(const rad_patch_inputs *inputs, const rad_formfactors *formfactors);
 
+/* Watching a solver converge. Every solver (rad_solve's four, rad_solve_hierarchical, and
+ * so rad_solve_scene) calls an optional observer after each step a learner would count,
+ * with the state it has reached:
+ *   gather (Jacobi): step 0 (B = E) and every sweep;
+ *   gauss-seidel:    step 0 and every sweep;
+ *   shoot:           step 0 and every `observe_every` shots (default: n / 16 shots, about
+ *                    100 snapshots for a run of 6 n shots, as the Cornell box takes to
+ *                    1e-4), and the answer;
+ *   direct:          once, the answer (step 0);
+ *   hierarchical:    step 0 (phase "start") and every sweep (phase "refine" for the
+ *                    sweep after a refinement pass, "gather", "final gather").
+ * The last call is always the answer handed out (final = true, B as returned, with the
+ * ambient term for shooting) and its residual is the report's residual. A step number is
+ * the iterations done: sweeps, or shots for shooting; a call's step is never repeated.
+ * Cost: none without an observer. With one: Jacobi's and the hierarchical solver's
+ * residual of B_k is the change of the sweep that follows it (the snapshot is handed over
+ * one sweep late, with a copy of B: O(n)); Gauss-Seidel and shooting pay one pass over F
+ * (O(n^2), one Jacobi sweep's work) per call for the residual; copying B to the
+ * observer's layout is O(n). `seconds` leaves that cost out (the reports' seconds do not). */
+typedef struct rad_solve_step {
+    uint32_t step;           /* iterations done: sweeps, or shots for shooting */
+    const char *phase;       /* "gather", "gauss-seidel", "shoot", "direct"; hierarchical:
+                                "refine", "gather" or "final gather" (what made this B) */
+    double seconds;          /* solver time since its start, the observer's cost left out */
+    double criterion;        /* the solver's own stopping value at this step (Jacobi,
+                                Gauss-Seidel, hierarchical: the relative change of the
+                                sweep that made B, NaN at step 0; shooting: the unshot
+                                fraction; direct: the residual) */
+    double residual;         /* sum A |B - E - rho F B|_1 / sum A |E|_1 of this B, as
+                                rad_solve_report (hierarchical: rad_hierarchy_report) */
+    double unshot;           /* shooting: the unshot energy fraction; NaN for the others */
+    uint32_t shooting_patch; /* shooting: the patch of the last shot; UINT32_MAX before
+                                the first shot and for the other solvers */
+    bool final;              /* the answer handed out: the last call */
+    uint32_t n;              /* patches */
+    const rad_rgb *B;        /* the radiosity now, n values; valid during the call only */
+} rad_solve_step;
+
+typedef void (*rad_solve_observer_fn)(void *user, const rad_solve_step *step);
+
+/* The default of observe_every (shooting): n / RAD_OBSERVE_SHOTS_DIVISOR shots, at least 1. */
+#define RAD_OBSERVE_SHOTS_DIVISOR 16
+
 typedef struct rad_solve_options {
     rad_solver solver;       /* JACOBI, GAUSS_SEIDEL, SHOOT or DIRECT; AUTO = JACOBI */
     double tolerance;        /* Jacobi: relative residual; Gauss-Seidel: relative change of
@@ -1016,6 +1059,9 @@ typedef struct rad_solve_options {
     int threads;
     rad_progress_fn progress;
     void *progress_user;
+    rad_solve_observer_fn observer; /* NULL: none (no cost); see rad_solve_step */
+    void *observer_user;
+    uint32_t observe_every;  /* shooting: shots between two calls; 0 = n / 16 */
 } rad_solve_options;
 
 typedef struct rad_solve_report {
@@ -1094,6 +1140,8 @@ typedef struct rad_hierarchy_options {
     const volatile int *stop;
     rad_progress_fn progress;
     void *progress_user;
+    rad_solve_observer_fn observer; /* NULL: none (no cost); see rad_solve_step */
+    void *observer_user;
 } rad_hierarchy_options;
 
 typedef struct rad_hierarchy_report {
@@ -1132,6 +1180,79 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
                                   const rad_tracer *occluders,
                                   const rad_hierarchy_options *options, rad_rgb *B,
                                   rad_hierarchy_report *report, rad_error *error);
+
+/* ------------------------------------------------------------------------------------ */
+/* Convergence: history, plot and record of a solver's steps (rad_solve_step)           */
+
+/* One step's numbers (NaN where the step has none). */
+typedef struct rad_convergence_point {
+    uint32_t step;     /* iterations done (x of the first panel) */
+    double seconds;    /* solver time (x of the second panel) */
+    double criterion;  /* the solver's own stopping value */
+    double residual;   /* relative residual */
+    double unshot;     /* shooting: unshot energy fraction */
+    const char *phase; /* rad_solve_step.phase (a string the library owns), or NULL */
+} rad_convergence_point;
+
+/* The steps seen so far; zero-initialise, add with rad_convergence_add, free with
+ * rad_convergence_free. */
+typedef struct rad_convergence {
+    rad_convergence_point *points;
+    size_t count, capacity;
+} rad_convergence;
+
+/* Appends the step's numbers (not its B). RAD_ERR_NOMEM when it cannot grow. */
+rad_status rad_convergence_add(rad_convergence *history, const rad_solve_step *step,
+                               rad_error *error);
+void rad_convergence_free(rad_convergence *history);
+
+typedef struct rad_convergence_plot_options {
+    const char *title;           /* the first line, e.g. "cornell-box: shoot, 3010 patches" */
+    const char *step_label;      /* the first panel's x axis, e.g. "sweeps" or "shots";
+                                    NULL: no step panel, only the time panel */
+    bool residual;               /* draw the relative residual (its finite, positive points) */
+    const char *criterion_label; /* draw the criterion too, with this name in the legend
+                                    (e.g. "unshot energy fraction"); NULL: not drawn */
+    const char *y_label;         /* NULL: "relative to the emitted power sum A |E| (1)" */
+    const char *time_label;      /* the time panel's x axis; NULL: "solver time (s)" */
+} rad_convergence_plot_options;
+
+/* A standalone SVG of the history: a panel against the steps (when step_label is given)
+ * and a panel against the solver time in seconds, each with a log y axis (decade ticks
+ * labelled 10^k, a <line class="ytick" data-value="V"> per decade), a linear x axis, the
+ * curves as <path class="residual"> and <path class="criterion"> (a non-positive or NaN
+ * value breaks the line), a legend and the title; where the phase changes after the
+ * first one (the hierarchical solver's "gather", "final gather") a dotted vertical
+ * <line class="phase"> with the new phase's name. Written atomically. RAD_ERR_INVALID for
+ * an empty history. */
+rad_status rad_convergence_plot_write(const rad_convergence *history, const char *path,
+                                      const rad_convergence_plot_options *options,
+                                      rad_error *error);
+
+/* A record of a solve's snapshots, streamed to its file as they come (memory: one
+ * snapshot's text, about 16 n bytes), as JSON:
+ *   {"format":"radiosity-record","version":1,"scene":S,"solver":V,"patches":n,
+ *    "snapshots":[{"step":k,"seconds":s,"criterion":c,"residual":r,"unshot":u|null,
+ *                  "shooting_patch":p|null,"final":true|false,"phase":"...",
+ *                  "radiosity":"BASE64"},...]}
+ * where BASE64 holds n x 3 float32 little-endian (R, G, B radiosity, W/m^2 or the
+ * scene's unit, per patch in the mesh's patch order) and a NaN number is null. The file
+ * appears, whole, at rad_solve_record_commit; rad_solve_record_abort (or an error) leaves
+ * none. The snapshot text is refused up front (RAD_ERR_NOMEM, "--record: ...") when it
+ * does not fit the run's memory budget. */
+typedef struct rad_solve_record rad_solve_record;
+
+rad_status rad_solve_record_open(const char *path, const char *scene, const char *solver,
+                                 uint32_t patches, rad_solve_record **out, rad_error *error);
+/* Appends one snapshot (step->n must be the record's patches). */
+rad_status rad_solve_record_add(rad_solve_record *record, const rad_solve_step *step,
+                                rad_error *error);
+/* Closes the JSON and renames the file into place; frees the record either way. */
+rad_status rad_solve_record_commit(rad_solve_record *record, rad_error *error);
+/* Removes the temporary file and frees the record (NULL: nothing). */
+void rad_solve_record_abort(rad_solve_record *record);
+/* Snapshots added so far. */
+uint32_t rad_solve_record_count(const rad_solve_record *record);
 
 /* ------------------------------------------------------------------------------------ */
 /* From a scene to its solution: the one entry point                                     */
@@ -1178,6 +1299,9 @@ typedef struct rad_scene_solve_options {
     void *log_user;
     rad_progress_fn progress;  /* "form factors", "solve", "refine", "gather", ... */
     void *progress_user;
+    rad_solve_observer_fn observer; /* every solver's steps (rad_solve_step); NULL: none */
+    void *observer_user;
+    uint32_t observe_every;    /* shooting: shots between two calls; 0 = n / 16 */
 } rad_scene_solve_options;
 
 typedef struct rad_scene_solve_report {

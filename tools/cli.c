@@ -460,6 +460,8 @@ bool cli_begin(const char *command, const char *usage, int argc, char **argv,
         fputs(usage, stdout);
         if (options[OPT_SHADOW_LEVELS].name)
             fputs("\nMeshing:\n" CLI_MESH_HELP, stdout);
+        if (options[OPT_RECORD].name)
+            fputs("\nConvergence:\n" CLI_CONVERGENCE_HELP, stdout);
         if (options[OPT_POINT].name) {
             fputs("\nScene:\n" CLI_SCENE_HELP, stdout);
             fputs(CLI_LIGHT_HELP, stdout);

@@ -68,7 +68,7 @@ enum {
     OPT_EYE, OPT_TARGET, OPT_UP, OPT_FOV, OPT_SIZE, OPT_SPP, OPT_EXPOSURE, /* VIEW */
     OPT_EXR_FLOAT,
     OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_SOLUTION,        /* SOLVE */
-    OPT_SAVE_SOLUTION, OPT_REFINE_THRESHOLD, OPT_MAX_MEMORY,
+    OPT_SAVE_SOLUTION, OPT_REFINE_THRESHOLD, OPT_MAX_MEMORY, OPT_PLOT, OPT_RECORD,
     OPT_EMIT, OPT_ALBEDO,                                               /* SCENE */
     OPT_POINT, OPT_SPOT, OPT_SUN, OPT_TIME, OPT_SKY, OPT_LUMINAIRE, OPT_ENVIRONMENT,
     OPT_ENVIRONMENT_ROTATE, OPT_UNIT, OPT_NORTH,
@@ -120,7 +120,8 @@ enum {
     [OPT_MAX_ITERATIONS] = {"max-iterations", 0, true},                                    \
     [OPT_SOLUTION] = {"solution", 0, true}, [OPT_SAVE_SOLUTION] = {"save-solution", 0, true}, \
     [OPT_REFINE_THRESHOLD] = {"refine-threshold", 0, true},                                \
-    [OPT_MAX_MEMORY] = {"max-memory", 0, true}
+    [OPT_MAX_MEMORY] = {"max-memory", 0, true}, [OPT_PLOT] = {"plot", 0, true},             \
+    [OPT_RECORD] = {"record", 0, true}
 
 /* The help of the options `render` and `solve` share (SOLVE, FORMFACTOR, SCENE, BASE but
  * -o), the same for both: a solution file of one is a solution file of the other. */
@@ -178,6 +179,14 @@ enum {
     "  --quiet              no summary line at the end (warnings and errors still show)\n"  \
     "  -h, --help           this text\n"                                                    \
     "\n" CLI_INTERRUPT_HELP
+
+/* The help of --plot and --record (SOLVE group), printed after the command's own. */
+#define CLI_CONVERGENCE_HELP                                                               \
+    "  --plot FILE.svg      the convergence plot: residual (and unshot energy or change of\n" \
+    "                       a sweep) against iterations and against time, log scale\n"    \
+    "  --record FILE.json   the solution at every step (sweeps; shooting: every n/16\n"    \
+    "                       shots; hierarchical: sweeps and refinement passes) with its\n" \
+    "                       residual, as JSON (radiosity: base64 float32 RGB per patch)\n"
 
 /* What Ctrl-C does, for the help of every command that solves. */
 #define CLI_INTERRUPT_HELP                                                                 \
@@ -440,6 +449,8 @@ typedef struct cli_solve {
     const char *save_solution_path; /* --save-solution: write B to this file */
     cli_two_sided two_sided;        /* --two-sided, set by the command after cli_parse_solve;
                                        applied by cli_solve_scene before meshing */
+    const char *plot_path;          /* --plot: the convergence plot (SVG) */
+    const char *record_path;        /* --record: the snapshots (JSON) */
 } cli_solve;
 
 /* Parses the SOLVE options (after cli_parse_shared, whose threads, seed, quadrature and
@@ -476,6 +487,50 @@ void cli_solved_stats(const cli_solved *solved, const cli_solve *solve, cli_stat
 /* One line for a person watching a terminal: "N patches, M rays, K sweeps (residual R)". */
 void cli_solved_summary(const cli_solved *solved, const cli_solve *solve, char *text,
                         size_t size);
+
+/* --plot and --record (cli_convergence.c): an observer of the solve that keeps its steps
+ * for the plot and streams its snapshots to the record. */
+typedef struct cli_convergence {
+    const char *plot_path;
+    rad_solve_record *record;
+    rad_convergence history;
+    char scene[256];
+    rad_solver solver;
+    uint32_t patches;
+    rad_status status; /* the observer's first error */
+    rad_error error;
+} cli_convergence;
+
+/* False (after printing) when --plot is not a .svg name or both options name one file. */
+bool cli_convergence_paths_ok(const char *plot_path, const char *record_path);
+
+/* Opens the record (when record_path is given) and sets options->observer (when either
+ * is given). */
+rad_status cli_convergence_begin(cli_convergence *c, const char *plot_path,
+                                 const char *record_path, const char *scene, rad_solver solver,
+                                 uint32_t patches, rad_scene_solve_options *options,
+                                 rad_error *error);
+
+/* After the solve (its status `solved`): commits the record (or removes it when anything
+ * failed) and writes the plot; frees what begin made. */
+rad_status cli_convergence_end(cli_convergence *c, rad_status solved, rad_error *error);
+
+/* viewfactors --plot: the fraction of polygon pairs left against time, from the
+ * computation's progress reports (it has no iteration to watch). */
+typedef struct cli_viewfactor_plot {
+    const char *path;
+    rad_convergence history;
+    double start;
+    rad_status status;
+    rad_error error;
+} cli_viewfactor_plot;
+
+/* With a path: hooks the progress of `options` (which still reaches the terminal). */
+void cli_viewfactor_plot_begin(cli_viewfactor_plot *p, const char *path,
+                               rad_viewfactor_options *options);
+/* Writes the plot (nothing without a path); frees the history. */
+rad_status cli_viewfactor_plot_end(cli_viewfactor_plot *p, const char *scene,
+                                   uint32_t surfaces, rad_error *error);
 
 /* Prints an error and returns false when path is a folder or its folder is not writable. */
 bool cli_output_writable(const char *path);

@@ -77,6 +77,15 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
                   "is saved already");
         return false;
     }
+    solve->plot_path = args->value[OPT_PLOT];
+    solve->record_path = args->value[OPT_RECORD];
+    if (!cli_convergence_paths_ok(solve->plot_path, solve->record_path))
+        return false;
+    if (solve->solution_path && (solve->plot_path || solve->record_path)) {
+        cli_error("%s with --solution: nothing is solved, so there is no convergence to "
+                  "watch", solve->plot_path ? "--plot" : "--record");
+        return false;
+    }
     if (solve->solution_path) {
         /* nothing is solved: options of the form factors and the solver have no effect */
         static const int unused[] = {OPT_SOLVER,          OPT_TOLERANCE,  OPT_MAX_ITERATIONS,
@@ -103,7 +112,9 @@ bool cli_solve_outputs_writable(const cli_shared *shared, const cli_solve *solve
 {
     return (!shared->output || cli_output_writable(shared->output)) &&
            (!shared->stats_path || cli_output_writable(shared->stats_path)) &&
-           (!solve->save_solution_path || cli_output_writable(solve->save_solution_path));
+           (!solve->save_solution_path || cli_output_writable(solve->save_solution_path)) &&
+           (!solve->plot_path || cli_output_writable(solve->plot_path)) &&
+           (!solve->record_path || cli_output_writable(solve->record_path));
 }
 
 static volatile sig_atomic_t interrupt_requested;
@@ -210,8 +221,14 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
      * solve ends at once, as a plain program does */
     rad_scene_solve_options options = solve->options;
     options.inputs = out->inputs;
-    bool stoppable = rad_solve_scene_choice(out->mesh, &options, NULL, 0) ==
-                     RAD_SOLVER_HIERARCHICAL;
+    rad_solver solver = rad_solve_scene_choice(out->mesh, &options, NULL, 0);
+    bool stoppable = solver == RAD_SOLVER_HIERARCHICAL;
+    cli_convergence convergence;
+    status = cli_convergence_begin(&convergence, solve->plot_path, solve->record_path,
+                                   out->scene->source, solver, out->mesh->patch_count,
+                                   &options, error);
+    if (status != RAD_OK)
+        goto done;
     void (*previous)(int) = SIG_DFL;
     interrupt_requested = 0;
     if (stoppable) {
@@ -223,6 +240,7 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
     if (stoppable)
         signal(SIGINT, previous == SIG_ERR ? SIG_DFL : previous);
     cli_progress_end();
+    status = cli_convergence_end(&convergence, status, error);
     if (status != RAD_OK || !solve->save_solution_path)
         goto done;
     double t_save = rad_clock_seconds();

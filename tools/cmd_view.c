@@ -37,11 +37,14 @@ static const char usage[] =
     "a click shows the surface picked (name, area, material, mean radiance). SCENE is\n"
     "solved first, as `radiosity solve` does, with the same options (none = the built-in\n"
     "Cornell box); a LIT.glb written by `radiosity solve -o LIT.glb` is shown as it is\n"
-    "(it has no surface names: picking then shows the values at the point).\n"
+    "(it has no surface names: picking then shows the values at the point). With --record\n"
+    "FILE the page also plays the solve back: a step slider, play, the shooting patch\n"
+    "outlined, the step's unshot energy and residual.\n"
     "\n"
     "  -o, --output FILE    the page (default: SCENE's base name + .html in the current\n"
     "                       folder; cornell_box.html for the built-in box)\n"
     "  --open               print the page's file:// address to open in a browser\n"
+
     CLI_TWO_SIDED_HELP
     CLI_SOLVE_HELP
     "\n"
@@ -444,6 +447,72 @@ static bool page_triangle_surfaces(page *p, const rad_mesh *mesh, uint32_t trian
     return true;
 }
 
+/* `--record FILE` (written by this run's solve): the record's JSON, checked against the
+ * mesh, embedded for the viewer's playback (viewer/src/playback.js) with "</" written as
+ * "<\/" so that no text ends the script element early; and the patch of each lit-mesh
+ * triangle, base64 of uint32 little-endian. */
+static bool page_record(page *p, const char *path, const rad_mesh *mesh, uint32_t triangles)
+{
+    unsigned char *text = NULL;
+    size_t size = 0;
+    if (!read_whole_file(path, &text, &size))
+        return false;
+    cJSON *root = cJSON_ParseWithLength((const char *)text, size);
+    const cJSON *snapshots = cJSON_GetObjectItemCaseSensitive(root, "snapshots");
+    const cJSON *format = cJSON_GetObjectItemCaseSensitive(root, "format");
+    size_t expected = 4 * ((12 * (size_t)mesh->patch_count + 2) / 3);
+    bool ok = cJSON_IsString(format) && strcmp(format->valuestring, "radiosity-record") == 0 &&
+              cJSON_GetNumberValue(cJSON_GetObjectItemCaseSensitive(root, "patches")) ==
+                  mesh->patch_count &&
+              cJSON_GetArraySize(snapshots) > 0;
+    const cJSON *snapshot;
+    cJSON_ArrayForEach(snapshot, snapshots)
+    {
+        const cJSON *radiosity = cJSON_GetObjectItemCaseSensitive(snapshot, "radiosity");
+        if (!cJSON_IsString(radiosity) || strlen(radiosity->valuestring) != expected)
+            ok = false;
+    }
+    cJSON_Delete(root);
+    if (!ok) {
+        free(text);
+        cli_error("%s: not a record of this scene's %u patches", path, mesh->patch_count);
+        return false;
+    }
+    page_text(p, "<script type=\"application/json\" id=\"radiosity-record\">");
+    size_t from = 0;
+    for (size_t i = 1; i < size; i++)
+        if (text[i] == '/' && text[i - 1] == '<') {
+            page_append(p, text + from, i - from);
+            page_text(p, "\\");
+            from = i;
+        }
+    page_append(p, text + from, size - from);
+    page_text(p, "</script>\n");
+    free(text);
+
+    uint32_t *patch_of = NULL, count = 0;
+    rad_error error = {0};
+    if (rad_lit_mesh_triangle_patches(mesh, &patch_of, &count, &error) != RAD_OK) {
+        cli_error("%s", error.message);
+        return false;
+    }
+    unsigned char *bytes = count == triangles ? rad_alloc_array(count ? count : 1, 4) : NULL;
+    if (!bytes) {
+        free(patch_of);
+        cli_error("view: no patch table for the %u triangles", triangles);
+        return false;
+    }
+    for (uint32_t t = 0; t < count; t++)
+        for (int k = 0; k < 4; k++)
+            bytes[4 * (size_t)t + k] = (unsigned char)(patch_of[t] >> (8 * k));
+    page_text(p, "<script type=\"application/octet-stream\" id=\"radiosity-triangle-patch\">");
+    page_base64(p, bytes, 4 * (size_t)count);
+    page_text(p, "</script>\n");
+    free(bytes);
+    free(patch_of);
+    return true;
+}
+
 /* ---- the command ---------------------------------------------------------------------- */
 
 /* SCENE's base name + .html, or cornell_box.html. */
@@ -562,6 +631,9 @@ int command_view(int argc, char **argv)
     page_base64(&html, glb, glb_size);
     page_text(&html, "</script>\n");
     if (!lit_input && !page_triangle_surfaces(&html, solved.mesh, triangles))
+        goto done;
+    if (!lit_input && solve.record_path &&
+        !page_record(&html, solve.record_path, solved.mesh, triangles))
         goto done;
     page_text(&html, "<script>");
     page_append(&html, rad_viewer_script, rad_viewer_script_size);

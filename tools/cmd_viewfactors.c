@@ -60,6 +60,8 @@ static const char usage[] =
     "                       --max-rays, --seed; others are refused): the output is the\n"
     "                       one an uninterrupted run writes. Checkpoints go on to FILE\n"
     "                       unless --checkpoint names another\n"
+    "  --plot FILE.svg      the fraction of polygon pairs left against time (log scale):\n"
+    "                       the computation's progress; it has no iteration to converge\n"
     CLI_BASE_HELP("counts, times, invariants and error bounds");
 
 enum {
@@ -75,7 +77,7 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_OBSTRUCTION] = {"obstruction", 0, true}, [OPT_TWO_SIDED] = {"two-sided", 0, true},
     [OPT_MAX_MEMORY] = {"max-memory", 0, true}, [OPT_CHECKPOINT] = {"checkpoint", 0, true},
     [OPT_CHECKPOINT_INTERVAL] = {"checkpoint-interval", 0, true},
-    [OPT_RESUME] = {"resume", 0, true}};
+    [OPT_RESUME] = {"resume", 0, true}, [OPT_PLOT] = {"plot", 0, true}};
 
 /* Seconds between checkpoints unless --checkpoint-interval says. */
 #define DEFAULT_CHECKPOINT_INTERVAL 600.0
@@ -95,13 +97,15 @@ static void on_stop_signal(int signal_number)
 typedef struct checkpoint_progress {
     long stop_after; /* 0: never */
     long written;
+    rad_progress_fn next; /* gets every other report (the progress line, --plot) */
+    void *next_user;
 } checkpoint_progress;
 
 static void progress_with_checkpoints(void *user, const char *phase, double fraction)
 {
     checkpoint_progress *c = user;
     if (strcmp(phase, "checkpoint") != 0) {
-        cli_progress(NULL, phase, fraction);
+        c->next(c->next_user, phase, fraction);
         return;
     }
     if (c->stop_after > 0 && ++c->written >= c->stop_after)
@@ -191,7 +195,7 @@ int command_viewfactors(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    checkpoint_progress checkpoints = {0, 0};
+    checkpoint_progress checkpoints = {0, 0, NULL, NULL};
     const char *stop_after = getenv("RADIOSITY_STOP_AFTER_CHECKPOINTS");
     if (stop_after)
         checkpoints.stop_after = strtol(stop_after, NULL, 10);
@@ -212,7 +216,10 @@ int command_viewfactors(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    if (!cli_outputs_writable((const char *[]){output, stats_path, vf.checkpoint}, 3))
+    const char *plot_path = args.value[OPT_PLOT];
+    if (!cli_convergence_paths_ok(plot_path, NULL))
+        return EXIT_USAGE;
+    if (!cli_outputs_writable((const char *[]){output, stats_path, vf.checkpoint, plot_path}, 4))
         return EXIT_ERROR;
 
     rad_error error = {0};
@@ -226,6 +233,8 @@ int command_viewfactors(int argc, char **argv)
     double t0 = rad_clock_seconds();
     if (cli_ranks_begin() > 1 && rad_rank() != 0)
         vf.progress = NULL; /* rank 0 shows its own rows' progress */
+    cli_viewfactor_plot plot;
+    cli_viewfactor_plot_begin(&plot, plot_path, &vf);
     rad_status status = load_surfaces(&args, &scene, &control, &is_vs3, &error);
     int cursor = 0;
     for (const char *name; status == RAD_OK && (name = cli_next_value(&args, OPT_TWO_SIDED, &cursor));)
@@ -249,9 +258,12 @@ int command_viewfactors(int argc, char **argv)
     if (vf.checkpoint) {
         stop_requested = 0;
         vf.stop = &stop_requested;
-        vf.progress_user = &checkpoints;
-        if (vf.progress) /* rank 0 (the library tells only rank 0 of checkpoints) */
+        if (vf.progress) { /* rank 0 (the library tells only rank 0 of checkpoints) */
+            checkpoints.next = vf.progress;
+            checkpoints.next_user = vf.progress_user;
             vf.progress = progress_with_checkpoints;
+            vf.progress_user = &checkpoints;
+        }
         previous_int = signal(SIGINT, on_stop_signal);
         previous_term = signal(SIGTERM, on_stop_signal);
     }
@@ -342,6 +354,8 @@ int command_viewfactors(int argc, char **argv)
     }
     status = output ? rad_viewfactor_matrix_write(scene, matrix, output, &write, &error)
                     : rad_viewfactor_matrix_print(scene, matrix, stdout, &write, &error);
+    if (status == RAD_OK)
+        status = cli_viewfactor_plot_end(&plot, scene->source, (uint32_t)S, &error);
     if (status != RAD_OK)
         goto fail;
     double seconds = rad_clock_seconds() - t0;
@@ -393,6 +407,7 @@ int command_viewfactors(int argc, char **argv)
 fail:
     exit_code = cli_ranks_failed(&error);
 done:
+    rad_convergence_free(&plot.history);
     free(emissivity);
     rad_viewfactor_matrix_destroy(matrix);
     rad_scene_destroy(scene);

@@ -8,6 +8,7 @@
  * O(n) (the per-patch arrays); F is trusted, never scanned.
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include "core/clock.h"
 
@@ -15,6 +16,7 @@
 #include <omp.h>
 #endif
 
+#include "core/alloc.h"
 #include "core/error.h"
 #include "core/rgb.h"
 #include "solve/solve_internal.h"
@@ -171,6 +173,13 @@ static rad_status resolve_options(const rad_solve_options *options, uint32_t n,
     params->progress = o->progress;
     params->progress_user = o->progress_user;
     params->progress_sent = -1;
+    params->observer = o->observer;
+    params->observer_user = o->observer_user;
+    params->observe_every = o->observe_every;
+    if (params->observe_every == 0)
+        params->observe_every = n / RAD_OBSERVE_SHOTS_DIVISOR > 0 ? n / RAD_OBSERVE_SHOTS_DIVISOR
+                                                                  : 1;
+    params->last_shooter = UINT32_MAX;
     return RAD_OK;
 }
 
@@ -216,7 +225,15 @@ rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
     status = check_energy(system, params.threads, report, error);
     if (status != RAD_OK)
         return status;
+    if (params.observer) {
+        params.observed = rad_alloc_array(system->n, sizeof(rad_rgb));
+        if (!params.observed)
+            return rad_fail(error, RAD_ERR_NOMEM,
+                            "rad_solve: no memory for the observer's copy of %u patches",
+                            system->n);
+    }
     double start = wall_seconds();
+    params.start = start;
     switch (options ? options->solver : RAD_SOLVER_JACOBI) {
     case RAD_SOLVER_AUTO:
     case RAD_SOLVER_JACOBI:
@@ -234,11 +251,28 @@ rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
     case RAD_SOLVER_HIERARCHICAL: /* refused by resolve_options */
         break;
     }
-    if (status != RAD_OK)
+    if (status != RAD_OK) {
+        free(params.observed);
         return status;
+    }
 
     report->seconds = wall_seconds() - start;
     report->residual = solve_residual(system, B, params.threads);
+    if (params.observer) { /* the answer handed out */
+        rad_solver solver = options->solver == RAD_SOLVER_AUTO ? RAD_SOLVER_JACOBI
+                                                               : options->solver;
+        rad_solve_step step = solve_step(&params, system->n, report->iterations,
+                                         rad_solver_name(solver), report->criterion);
+        step.seconds = report->seconds - params.observe_seconds;
+        step.residual = report->residual;
+        step.final = true;
+        if (solver == RAD_SOLVER_SHOOT) {
+            step.unshot = report->criterion;
+            step.shooting_patch = params.last_shooter;
+        }
+        solve_observe(&params, system, step, NULL, NULL, NULL, B, false);
+        free(params.observed);
+    }
     solve_progress(&params, 0);
     return RAD_OK;
 }

@@ -48,6 +48,9 @@ rad_status solve_gauss_seidel(const rad_system *system, solve_params *params, ra
     const double scale = solve_criterion_scale(system);
     double criterion = INFINITY, smallest = INFINITY;
     uint32_t sweeps = 0;
+    if (params->observer)
+        solve_observe(params, system, solve_step(params, n, 0, "gauss-seidel", NAN), x0, x1, x2,
+                      NULL, true);
     while (sweeps < params->max_iterations) {
         double sum = 0, largest = -1;
         uint32_t worst = 0;
@@ -79,6 +82,9 @@ rad_status solve_gauss_seidel(const rad_system *system, solve_params *params, ra
         solve_progress(params, criterion);
         if (criterion <= params->tolerance)
             break;
+        if (params->observer && sweeps < params->max_iterations) /* the last: rad_solve's */
+            solve_observe(params, system, solve_step(params, n, sweeps, "gauss-seidel", criterion),
+                          x0, x1, x2, NULL, true);
     }
 
     for (uint32_t i = 0; i < n; i++)

@@ -28,6 +28,14 @@ typedef struct solve_params {
     rad_progress_fn progress;
     void *progress_user;
     double progress_sent;    /* last fraction passed to progress (solve_progress only) */
+    /* the observer (solve_observe.c); observer NULL: none of these is used */
+    rad_solve_observer_fn observer;
+    void *observer_user;
+    uint32_t observe_every;  /* > 0: shooting, shots between two calls */
+    double start;            /* clock at the solver's start */
+    double observe_seconds;  /* spent observing, left out of rad_solve_step.seconds */
+    rad_rgb *observed;       /* n values: B in the observer's layout (Jacobi, Gauss-Seidel) */
+    uint32_t last_shooter;   /* shooting: the patch of the last shot, or UINT32_MAX */
 } solve_params;
 
 /* Sums across patches are split into at most this many contiguous blocks of rows, each
@@ -93,6 +101,22 @@ double solve_residual(const rad_system *system, const rad_rgb *B, int threads);
 /* Reports progress from the criterion: the fraction is log(criterion) / log(tolerance)
  * clamped to [0,1], sent only when it grew by at least 1% (or reached 1). */
 void solve_progress(solve_params *params, double criterion);
+
+/* The observer (solve_observe.c). A step's seconds: solver time since params->start, the
+ * observing left out. */
+double solve_elapsed(const solve_params *params);
+
+/* Hands `step` to the observer with B given as three channel arrays (copied to
+ * params->observed) or as rad_rgb (B_rgb, x0 NULL); with compute_residual the step's
+ * residual is measured first (one pass over F). Its time goes to params->observe_seconds.
+ * Nothing happens without an observer. */
+void solve_observe(solve_params *params, const rad_system *system, rad_solve_step step,
+                   const double *x0, const double *x1, const double *x2, const rad_rgb *B_rgb,
+                   bool compute_residual);
+
+/* A step with the fields every solver sets, the rest NaN / UINT32_MAX / false. */
+rad_solve_step solve_step(const solve_params *params, uint32_t n, uint32_t step,
+                          const char *phase, double criterion);
 
 /* A solver's criterion falls (Jacobi and shooting: never rises) when no row of rho F sums
  * above 1, which rad_solve checks first; a criterion that is not finite or has grown to

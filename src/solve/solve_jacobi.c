@@ -53,6 +53,10 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
     double criterion = INFINITY, smallest = INFINITY;
     uint32_t sweeps = 0, first_row, end_row; /* this rank's rows */
     partition_block(n, ranks_count(), ranks_rank(), &first_row, &end_row);
+    /* the observer gets B_k after sweep k + 1, whose change is B_k's residual */
+    rad_solve_step observed = {0};
+    if (params->observer)
+        observed = solve_step(params, n, 0, "gather", NAN);
     while (sweeps < params->max_iterations) {
         const double *x0 = old[0], *x1 = old[1], *x2 = old[2];
         double *y0 = cur[0], *y1 = cur[1], *y2 = cur[2];
@@ -90,6 +94,11 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
             free(work);
             return solve_fail_diverged(system, "gather", sweeps, criterion, smallest, worst,
                                        report, error);
+        }
+        if (params->observer) {
+            observed.residual = criterion;
+            solve_observe(params, system, observed, old[0], old[1], old[2], NULL, false);
+            observed = solve_step(params, n, sweeps, "gather", criterion);
         }
 
         for (int c = 0; c < 3; c++) {

@@ -164,7 +164,8 @@ static rad_status solve_dense(const rad_scene *scene, const rad_mesh *mesh, cons
     rad_system system = rad_system_of(inputs, ff);
     rad_solve_options solve_options = {solver,    o->tolerance, o->max_iterations,
                                        true,      o->threads,   o->progress,
-                                       o->progress_user};
+                                       o->progress_user, o->observer, o->observer_user,
+                                       o->observe_every};
     status = rad_solve(&system, &solve_options, B, &r->solve, error);
     rad_formfactors_destroy(ff);
     r->seconds_solve = seconds_now() - t1;
@@ -229,7 +230,7 @@ static rad_status solve_hierarchy(const rad_scene *scene, const rad_mesh *mesh, 
     rad_hierarchy_options h = {o->refine_threshold, o->visibility_rays, o->tolerance,
                                o->max_iterations,   link_budget,        o->seed,
                                o->threads,          o->stop,            o->progress,
-                               o->progress_user};
+                               o->progress_user,    o->observer,        o->observer_user};
     double t0 = seconds_now();
     r->hierarchy.patch = UINT32_MAX;
     rad_status status =

@@ -163,6 +163,12 @@ rad_status solve_shoot(const rad_system *system, solve_params *params, rad_rgb *
         solve_progress(params, criterion);
         if (criterion <= params->tolerance || shots >= params->max_iterations || !(best > 0))
             break;
+        if (params->observer && shots % params->observe_every == 0) {
+            rad_solve_step step = solve_step(params, n, shots, "shoot", criterion);
+            step.unshot = criterion;
+            step.shooting_patch = params->last_shooter;
+            solve_observe(params, system, step, NULL, NULL, NULL, B, true);
+        }
 
         const rad_rgb d = dB[shooter];
         const double a = area[shooter];
@@ -174,6 +180,7 @@ rad_status solve_shoot(const rad_system *system, solve_params *params, rad_rgb *
             block[b] = shoot_range(row, power, w, area, B, dB, solve_block_begin(n, blocks, b),
                                    solve_block_begin(n, blocks, b + 1));
         shots++;
+        params->last_shooter = shooter;
     }
 
     if (params->ambient)

@@ -17,6 +17,7 @@ import {
   TONE_CLAMP, TONE_REINHARD,
 } from './shader.js';
 import { STYLE } from './style.js';
+import { startPlayback } from './playback.js';
 
 function element(tag, attributes = {}, text = '') {
   const e = document.createElement(tag);
@@ -282,6 +283,9 @@ function start() {
     render();
   });
 
+  const recordText = embedded('radiosity-record'); // `view SCENE --record FILE`: playback.js
+  if (recordText) startPlayback({ recordText, trianglePatchText: embedded('radiosity-triangle-patch'),
+    mesh, scene, object, material, panel, render });
   for (const control of [modeSelect, toneSelect, exposure, logBox])
     control.addEventListener('input', update);
   controls.addEventListener('change', render);

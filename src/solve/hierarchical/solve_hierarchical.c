@@ -48,6 +48,7 @@ typedef struct hsolver {
     int threads;
     bool diverged;              /* a sweep changed B by more than HIER_DIVERGED_CHANGE */
     uint32_t changed_most;      /* the patch whose B changed the most in the last sweep */
+    rad_rgb *observed;          /* per patch: the observer's copy of B, or NULL */
 } hsolver;
 
 /* A sweep whose change (relative to the emitted power) is not finite or above this has
@@ -169,6 +170,46 @@ static void hsolver_free(hsolver *s)
     free(s->offsets);
     free(s->store.links);
     free(s->store.spare);
+    free(s->observed);
+}
+
+/* The observer (rad_solve_step): B_k is handed over after sweep k + 1, whose change is
+ * B_k's residual (the same measure as rad_hierarchy_report.residual), from a copy made
+ * before that sweep. */
+typedef struct hobserver {
+    rad_solve_observer_fn fn; /* NULL: none, and nothing else is used */
+    void *user;
+    rad_rgb *before;          /* B_k */
+    rad_solve_step pending;   /* B_k's step, all but its residual */
+    double start, spent;      /* the solver's start; time spent observing */
+} hobserver;
+
+static double observed_seconds(const hobserver *ob)
+{
+    return now_seconds() - ob->start - ob->spent;
+}
+
+/* sweep(), and the observer's call for the B before it; `phase` names what this sweep
+ * follows ("refine", "gather", "final gather"). */
+static double sweep_observed(hsolver *s, hobserver *ob, const char *phase)
+{
+    if (!ob->fn)
+        return sweep(s);
+    double t = now_seconds();
+    memcpy(ob->before, s->patch_B, (size_t)s->mesh->patch_count * sizeof(rad_rgb));
+    ob->spent += now_seconds() - t;
+    double change = sweep(s);
+    t = now_seconds();
+    double seconds = observed_seconds(ob);
+    ob->pending.residual = change;
+    ob->pending.B = ob->before;
+    ob->fn(ob->user, &ob->pending);
+    ob->pending.step++;
+    ob->pending.phase = phase;
+    ob->pending.seconds = seconds;
+    ob->pending.criterion = change;
+    ob->spent += now_seconds() - t;
+    return change;
 }
 
 static bool stopped(const rad_hierarchy_options *o) { return o->stop && *o->stop; }
@@ -223,6 +264,8 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     rep.threads = s.threads;
     uint32_t n = mesh->patch_count;
     double t0 = now_seconds();
+    hobserver ob = {o.observer, o.observer_user, NULL, {0}, t0, 0};
+    ob.pending = (rad_solve_step){0, "start", 0, NAN, NAN, NAN, UINT32_MAX, false, n, NULL};
     if (n == 0) {
         if (report)
             *report = rep;
@@ -239,8 +282,10 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     s.gathered = rad_alloc_array(nodes, sizeof(rad_rgb));
     s.down = rad_alloc_array(nodes, sizeof(rad_rgb));
     s.offsets = rad_alloc_array((size_t)nodes + 1, sizeof(size_t));
+    if (ob.fn)
+        ob.before = s.observed = rad_alloc_array(n, sizeof(rad_rgb));
     if (!s.patch_B || !s.node_B || !s.gathered || !s.down ||
-        !s.offsets || !s.brightness) {
+        !s.offsets || !s.brightness || (ob.fn && !ob.before)) {
         hsolver_free(&s);
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the hierarchy");
     }
@@ -316,7 +361,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             quiet_passes = 0;
             for (unsigned k = 0; k < SWEEPS_PER_PASS && rep.iterations < max_sweeps && !s.diverged;
                  k++) {
-                sweep_change = sweep(&s);
+                sweep_change = sweep_observed(&s, &ob, "refine");
                 rep.iterations++;
             }
             rep.seconds_gather += now_seconds() - tg;
@@ -326,7 +371,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
         double first = sweep_change;
         while (sweep_change > tolerance && rep.iterations < max_sweeps && !stopped(&o) &&
                !s.diverged) {
-            sweep_change = sweep(&s);
+            sweep_change = sweep_observed(&s, &ob, "gather");
             rep.iterations++;
             if (o.progress && first > tolerance && sweep_change > 0)
                 o.progress(o.progress_user, "gather",
@@ -374,7 +419,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
         double change = s.correction ? 1 : 0;
         while (change > tolerance && rep.iterations < max_sweeps && !stopped(&o) &&
                !s.diverged) {
-            sweep_change = change = sweep(&s);
+            sweep_change = change = sweep_observed(&s, &ob, "final gather");
             rep.iterations++;
         }
         converged = converged && change <= tolerance;
@@ -388,6 +433,12 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     /* the sweep_change of the B handed out: one more sweep, measured and not applied */
     memcpy(B, s.patch_B, (size_t)n * sizeof(rad_rgb));
     rep.residual = sweep(&s);
+    if (ob.fn && !s.diverged && isfinite(sweep_change) && isfinite(rep.residual)) {
+        ob.pending.residual = rep.residual;
+        ob.pending.B = B;
+        ob.pending.final = true;
+        ob.fn(ob.user, &ob.pending);
+    }
     rep.links = s.store.count;
     for (size_t l = 0; l < s.store.count; l++)
         rep.links_partial += s.store.links[l].visible < LINK_VISIBLE;
