@@ -2,9 +2,11 @@
 // first frame, prints how long that took and how much memory the page holds, and writes a
 // screenshot: for the README's images and the load-time figures. Not a test.
 //
-//   node screenshot.mjs PAGE.html OUT.png [--mode 0|1|2] [--pick X,Y] [--size WxH]
-//     --mode   0 colour, 1 radiance in false colour, 2 illuminance in false colour
+//   node screenshot.mjs PAGE.html OUT.png [--mode M] [--pick X,Y] [--edges E] [--size WxH]
+//     --mode   0 colour, 1 radiance in false colour, 2 illuminance in false colour,
+//              viewfactors, difference, compare-b, grid (when the page has them)
 //     --pick   click the canvas at X,Y (pixels from its top left) first
+//     --edges  patches or triangles: draw those edges
 import puppeteer from 'puppeteer-core';
 import { readFileSync, readdirSync } from 'node:fs';
 import { resolve } from 'node:path';
@@ -35,7 +37,7 @@ const option = (name) => {
 };
 const [pagePath, out] = args;
 if (!pagePath || !out) {
-  console.error('usage: node screenshot.mjs PAGE.html OUT.png [--mode N] [--pick X,Y] [--size WxH]');
+  console.error('usage: node screenshot.mjs PAGE.html OUT.png [--mode M] [--pick X,Y] [--edges E] [--size WxH]');
   process.exit(2);
 }
 const [width, height] = (option('--size') || '812x512').split('x').map(Number);
@@ -62,6 +64,8 @@ try {
     `chromium's processes ${(rss / 1e6).toFixed(0)} MB resident`);
   const mode = option('--mode');
   if (mode) await page.select('#mode', mode);
+  const edges = option('--edges');
+  if (edges) await page.select('#edges', edges);
   const pick = option('--pick');
   if (pick) {
     const box = await (await page.$('#view canvas')).boundingBox();
