@@ -654,6 +654,20 @@ static bool page_grid(page *p, const char *path)
 
 /* ---- the command ---------------------------------------------------------------------- */
 
+/* The units of the shown values, by `render --false-colour`'s rule (README, "Units."):
+ * cd/m^2 and lux when every light of the scene is photometric; "relative" with emitting
+ * surfaces alone (Ke in the file's own unit), a light in no known unit or an environment
+ * map. A lit .glb does not say: "relative". */
+static void page_units(page *p, const rad_scene *scene)
+{
+    bool photometric = scene && scene->light_count > 0;
+    for (uint32_t l = 0; scene && l < scene->light_count; l++)
+        photometric = photometric && !scene->lights[l].unit_unknown &&
+                      scene->lights[l].type != RAD_LIGHT_ENVIRONMENT;
+    page_text(p, photometric ? ",\"radiance_unit\":\"cd/m\\u00b2\",\"illuminance_unit\":\"lux\","
+                             : ",\"radiance_unit\":\"relative\",\"illuminance_unit\":\"relative\",");
+}
+
 /* SCENE's base name + .html, or cornell_box.html. */
 static void default_output(const char *input, char *out, size_t size)
 {
@@ -769,7 +783,7 @@ int command_view(int argc, char **argv)
     page_text(&html, "</title>\n</head>\n<body>\n"
                      "<script type=\"application/json\" id=\"radiosity-info\">{\"source\":");
     page_json_string(&html, source);
-    page_text(&html, ",\"radiance_unit\":\"cd/m\\u00b2\",\"illuminance_unit\":\"lux\",");
+    page_units(&html, lit_input ? NULL : solved.scene);
     if (!lit_input) {
         const rad_scene *scene = solved.scene;
         page_printf(&html, "\"unit_metres\":%.9g,", scene->unit_metres);

@@ -7,6 +7,8 @@
 //              viewfactors, difference, compare-b, grid (when the page has them)
 //     --pick   click the canvas at X,Y (pixels from its top left) first
 //     --edges  patches or triangles: draw those edges
+//     --drag DX,DY   orbit first: drag the canvas DX,DY pixels from its centre
+//     --keys KEYS    then press these keys (w a s d q e: walk)
 import puppeteer from 'puppeteer-core';
 import { readFileSync, readdirSync } from 'node:fs';
 import { resolve } from 'node:path';
@@ -62,6 +64,21 @@ try {
   console.log(`${pagePath}: first frame after ${seconds.toFixed(2)} s (navigation to first frame), ` +
     `JS heap ${(metrics.JSHeapUsedSize / 1e6).toFixed(0)} MB used, ` +
     `chromium's processes ${(rss / 1e6).toFixed(0)} MB resident`);
+  const drag = option('--drag');
+  if (drag) {
+    const box = await (await page.$('#view canvas')).boundingBox();
+    const [dx, dy] = drag.split(',').map(Number);
+    const [cx, cy] = [box.x + box.width / 2, box.y + box.height / 2];
+    await page.mouse.move(cx, cy);
+    await page.mouse.down();
+    for (let k = 1; k <= 10; k++) await page.mouse.move(cx + (dx * k) / 10, cy + (dy * k) / 10);
+    await page.mouse.up();
+  }
+  const keys = option('--keys');
+  if (keys) {
+    if (!drag) await page.mouse.click(5, 5); // the page takes the keys
+    for (const key of keys) await page.keyboard.press(key);
+  }
   const mode = option('--mode');
   if (mode) await page.select('#mode', mode);
   const edges = option('--edges');

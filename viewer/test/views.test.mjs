@@ -114,6 +114,17 @@ test('a view-factor row: the box floor against the closed forms', async () => {
   await page.close();
 });
 
+test('units: cd/m² and lux when every light is photometric, else relative', () => {
+  const info = (path) => JSON.parse(readFileSync(path, 'utf8').match(
+    /<script type="application\/json" id="radiosity-info">([^<]*)<\/script>/)[1]);
+  const lit = join(tmp, 'box_point.html');
+  execFileSync(tool, ['view', boxObj, '--point', '0.5,0.4,0.5:100', '-o', lit, '--quiet']);
+  assert.equal(info(lit).radiance_unit, 'cd/m²');
+  assert.equal(info(lit).illuminance_unit, 'lux');
+  assert.equal(info(boxPage).radiance_unit, 'relative'); // the ceiling's Ke alone
+  assert.equal(info(boxPage).illuminance_unit, 'relative');
+});
+
 test('view factors: the page is the same bytes for 1 and 2 threads; a lit mesh has none', () => {
   const one = join(tmp, 'vf1.html'), two = join(tmp, 'vf2.html');
   execFileSync(tool, ['view', boxObj, '--emit', 'ceiling=1,1,1', '--viewfactors', '--threads', '1', '-o', one, '--quiet']);
@@ -231,7 +242,7 @@ test('--compare: Jacobi gathering against the direct LU solve, within the tolera
   near(ticks[0], largest, 1e-9 * largestA, 'legend top');
   near(ticks[4], -largest, 1e-9 * largestA, 'legend bottom');
   near(ticks[2], 0, 1e-12, 'legend middle');
-  assert.match(await page.$eval('#legend-title', (e) => e.textContent), /A − B, luminance \(cd\/m²\)/);
+  assert.match(await page.$eval('#legend-title', (e) => e.textContent), /A − B, luminance \(relative\)/);
   // B in colour looks as A does (the difference is far below a display level)
   await page.select('#mode', '0');
   await drawn(page);
