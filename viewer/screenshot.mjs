@@ -79,10 +79,17 @@ try {
     if (!drag) await page.mouse.click(5, 5); // the page takes the keys
     for (const key of keys) await page.keyboard.press(key);
   }
+  // a control's change, timed to the second frame after it
+  const timed = async (what, change) => {
+    const t = Date.now();
+    await change();
+    await page.evaluate(() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done))));
+    console.log(`${what} drawn after ${((Date.now() - t) / 1000).toFixed(2)} s`);
+  };
   const mode = option('--mode');
-  if (mode) await page.select('#mode', mode);
+  if (mode) await timed(`mode ${mode}`, () => page.select('#mode', mode));
   const edges = option('--edges');
-  if (edges) await page.select('#edges', edges);
+  if (edges) await timed(`${edges} edges`, () => page.select('#edges', edges));
   const pick = option('--pick');
   if (pick) {
     const box = await (await page.$('#view canvas')).boundingBox();
@@ -96,6 +103,7 @@ try {
   }
   await page.evaluate(() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done))));
   await page.screenshot({ path: out });
+  console.log(`${pagePath}: chromium's processes ${(treeResidentBytes(browser.process().pid) / 1e6).toFixed(0)} MB resident at the end`);
 } finally {
   await browser.close();
 }

@@ -60,7 +60,7 @@ export function createCompare(context) {
     context.scene.add(object);
   }
 
-  context.panel.appendChild(context.element('div', { class: 'stats', id: 'compare-summary' },
+  context.panel.appendChild(context.element('div', { class: 'summary', id: 'compare-summary' },
     `compared with ${info.compare_source || 'B'}: largest |A − B| ${formatValue(largest)} ${unit}` +
     (largestA > 0 ? ` (${formatValue((100 * largest) / largestA)} % of A's largest luminance)` : '')));
 
