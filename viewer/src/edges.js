@@ -12,47 +12,92 @@ export const EDGES_NONE = 'none';
 export const EDGES_PATCHES = 'patches';
 export const EDGES_TRIANGLES = 'triangles';
 
-// The segments (pairs of vertex indices) of the chosen kind. `trianglePatch` may be null
-// for the "triangles" kind.
-export function edgeSegments(position, index, trianglePatch, kind) {
-  const weld = new Uint32Array(position.length / 3);
-  const seen = new Map();
-  for (let v = 0; v < weld.length; v++) {
-    const key = `${position[3 * v]},${position[3 * v + 1]},${position[3 * v + 2]}`;
-    let id = seen.get(key);
-    if (id === undefined) {
-      id = seen.size;
-      seen.set(key, id);
+// An open-addressing table's slots (-1: empty) for up to `count` keys, half full at most.
+function slots(count) {
+  let capacity = 1024;
+  while (capacity < 2 * count) capacity *= 2;
+  return new Int32Array(capacity).fill(-1);
+}
+
+// Each vertex's welded id: vertices at bit-identical positions get the same one.
+export function weldByPosition(position) {
+  const bits = new Uint32Array(position.buffer, position.byteOffset, position.length);
+  const vertices = position.length / 3;
+  const weld = new Uint32Array(vertices);
+  const table = slots(vertices), mask = table.length - 1;
+  let welded = 0;
+  for (let v = 0; v < vertices; v++) {
+    const x = bits[3 * v], y = bits[3 * v + 1], z = bits[3 * v + 2];
+    let i = (Math.imul(x, 0x9e3779b1) ^ Math.imul(y, 0x85ebca77) ^ Math.imul(z, 0xc2b2ae3d)) & mask;
+    for (;;) {
+      const r = table[i];
+      if (r < 0) {
+        table[i] = v;
+        weld[v] = welded++;
+        break;
+      }
+      if (bits[3 * r] === x && bits[3 * r + 1] === y && bits[3 * r + 2] === z) {
+        weld[v] = weld[r];
+        break;
+      }
+      i = (i + 1) & mask;
     }
-    weld[v] = id;
   }
-  const welded = seen.size;
-  // per edge: its first corner pair, its first triangle's patch, and whether it is drawn
-  const edges = new Map();
-  const first = [], drawn = [];
-  const triangles = index.length / 3;
+  return weld;
+}
+
+// The segments (pairs of vertex indices) of the chosen kind: every edge for "triangles";
+// for "patches" the edges whose triangles are not all of one patch, and the edges of one
+// triangle only (open borders). `trianglePatch` may be null for the "triangles" kind.
+export function edgeSegments(position, index, trianglePatch, kind) {
+  const weld = weldByPosition(position);
+  const triangles = index.length / 3, most = 3 * triangles;
+  const table = slots(most), mask = table.length - 1;
+  // per edge: its welded ends (the key), a corner pair to draw, its first triangle's
+  // patch, how many triangles share it, and whether two of them differ in patch
+  const lo = new Uint32Array(most), hi = new Uint32Array(most);
+  const endA = new Uint32Array(most), endB = new Uint32Array(most);
+  const patchOf = new Uint32Array(most), count = new Uint32Array(most), differs = new Uint8Array(most);
+  let edges = 0;
   for (let t = 0; t < triangles; t++) {
+    const patch = trianglePatch ? trianglePatch[t] : 0;
     for (let k = 0; k < 3; k++) {
       const a = index[3 * t + k], b = index[3 * t + ((k + 1) % 3)];
-      const wa = weld[a], wb = weld[b];
+      const wa = Math.min(weld[a], weld[b]), wb = Math.max(weld[a], weld[b]);
       if (wa === wb) continue;
-      const key = Math.min(wa, wb) * welded + Math.max(wa, wb);
-      const e = edges.get(key);
-      const patch = trianglePatch ? trianglePatch[t] : 0;
-      if (e === undefined) {
-        edges.set(key, drawn.length);
-        first.push(a, b, patch, 1);
-        drawn.push(kind === EDGES_TRIANGLES);
-      } else {
-        first[4 * e + 3]++;
-        if (first[4 * e + 2] !== patch) drawn[e] = true;
+      let i = (Math.imul(wa, 0x9e3779b1) ^ Math.imul(wb, 0x85ebca77)) & mask;
+      for (;;) {
+        const e = table[i];
+        if (e < 0) {
+          table[i] = edges;
+          lo[edges] = wa;
+          hi[edges] = wb;
+          endA[edges] = a;
+          endB[edges] = b;
+          patchOf[edges] = patch;
+          count[edges] = 1;
+          edges++;
+          break;
+        }
+        if (lo[e] === wa && hi[e] === wb) {
+          count[e]++;
+          if (patchOf[e] !== patch) differs[e] = 1;
+          break;
+        }
+        i = (i + 1) & mask;
       }
     }
   }
-  const segments = [];
-  for (let e = 0; e < drawn.length; e++)
-    if (drawn[e] || first[4 * e + 3] === 1) segments.push(first[4 * e], first[4 * e + 1]);
-  return new Uint32Array(segments);
+  let drawn = 0;
+  const keep = (e) => kind === EDGES_TRIANGLES || differs[e] || count[e] === 1;
+  for (let e = 0; e < edges; e++) if (keep(e)) drawn++;
+  const segments = new Uint32Array(2 * drawn);
+  for (let e = 0, s = 0; e < edges; e++)
+    if (keep(e)) {
+      segments[s++] = endA[e];
+      segments[s++] = endB[e];
+    }
+  return segments;
 }
 
 // context: { mesh, trianglePatch, scene, element, row }. Adds the "edges" control.
