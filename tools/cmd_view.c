@@ -614,9 +614,10 @@ static bool page_grid(page *p, const char *path)
                 ok = false;
             c = after + 1;
         }
-        if (!ok || v[9] < 0) {
+        if (!ok || v[9] < 0 || (v[3] == 0 && v[4] == 0 && v[5] == 0)) {
             ok = false;
-            cli_error("%s:%u: not a row x,y,z,nx,ny,nz,E_r,E_g,E_b,E of finite numbers (E >= 0)",
+            cli_error("%s:%u: not a row x,y,z,nx,ny,nz,E_r,E_g,E_b,E of finite numbers (a "
+                      "non-zero normal, E >= 0)",
                       path, line_number);
             break;
         }

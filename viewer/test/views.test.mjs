@@ -310,6 +310,7 @@ test('--grid: a bad table is refused in one line naming the file and line, no pa
   const cases = [
     ['nan.csv', [table[0], table[1], table[2].replace(/,[^,]*$/, ',nan'), ...table.slice(3)].join('\n'), ':3:'],
     ['short.csv', [table[0], table[1], '1,2,3', ...table.slice(3)].join('\n'), ':3:'],
+    ['normal.csv', [table[0], table[1], table[2].replace(/^([^,]*,[^,]*,[^,]*),[^,]*,[^,]*,[^,]*,/, '$1,0,0,0,'), ...table.slice(3)].join('\n'), ':3:'],
     ['header.csv', ['a,b,c', ...table.slice(1)].join('\n'), ':1:'],
     ['empty.csv', `${table[0]}\n`, 'no points'],
   ];
