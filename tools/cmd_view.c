@@ -499,7 +499,7 @@ static bool page_viewfactors(page *p, const rad_scene *scene, const cli_shared *
     size_t integers = 2 + (size_t)matrix->n + 1 + (size_t)nonzeros;
     size_t values_at = (4 * integers + 7) / 8 * 8;
     size_t size = values_at + 8 * (size_t)nonzeros;
-    unsigned char *bytes = calloc(size, 1);
+    unsigned char *bytes = rad_alloc_array(size, 1); /* zeroed: the padding */
     if (!bytes) {
         cli_error("view: out of memory for %llu view factors", (unsigned long long)nonzeros);
         rad_viewfactor_matrix_destroy(matrix);

@@ -157,7 +157,6 @@ function start() {
     for (const choice of feature.modes) modeSelect.append(element('option', { value: choice.value }, choice.label));
   createEdges(context, () => render());
 
-
   const legend = element('div', { id: 'legend' });
   const legendTitle = element('div', { id: 'legend-title' });
   const legendBody = element('div', { class: 'legend-body' });
