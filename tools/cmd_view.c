@@ -8,6 +8,11 @@
  * script (viewer/, three.js bundled, compiled in with -DRAD_VIEWER=ON). It loads nothing
  * else: it opens from disk with no server and no network.
  *
+ * A SCENE's page also holds the patch of each triangle (for the patch edges); with
+ * --viewfactors the surface view-factor matrix (rad_viewfactor_matrix_compute, sparse rows);
+ * with --compare B.glb a second lit mesh of the same geometry (the viewer shows A - B); with
+ * --grid FILE.csv the points and lux of an `illuminance` table.
+ *
  * Not the viewer (viewer/src) and not the lit mesh (rad_lit_mesh_write): this file
  * solves a SCENE as `solve` does, or checks a LIT.glb, and assembles the page.
  */
@@ -37,21 +42,22 @@ static const char usage[] =
     "a click shows the surface picked (name, area, material, mean radiance). SCENE is\n"
     "solved first, as `radiosity solve` does, with the same options (none = the built-in\n"
     "Cornell box); a LIT.glb written by `radiosity solve -o LIT.glb` is shown as it is\n"
-    "(it has no surface names: picking then shows the values at the point). With --record\n"
-    "FILE the page also plays the solve back: a step slider, play, the shooting patch\n"
-    "outlined, the step's unshot energy and residual.\n"
+    "(no surface names). With --record FILE the page also plays the solve back: a step\n"
+    "slider, play, the shooting patch outlined, the step's unshot energy and residual.\n"
     "\n"
     "  -o, --output FILE    the page (default: SCENE's base name + .html in the current\n"
     "                       folder; cornell_box.html for the built-in box)\n"
     "  --open               print the page's file:// address to open in a browser\n"
-
+    "  --viewfactors        SCENE's surface view factors too: click surface i, see F_ij\n"
+    "  --compare B.glb      a lit mesh of the same geometry (`solve -o B.glb`): shows\n"
+    "                       A - B in false colour, and B\n"
+    "  --grid FILE.csv      an `illuminance` table: its points' lux in false colour\n"
     CLI_TWO_SIDED_HELP
     CLI_SOLVE_HELP
     "\n"
-    "The viewer is compiled in when the build is configured with -DRAD_VIEWER=ON (it needs\n"
-    "node and npm: scripts/install-deps --viewer).\n";
+    "Needs a build with -DRAD_VIEWER=ON (node and npm: scripts/install-deps --viewer).\n";
 
-enum { OPT_TWO_SIDED = OPT_OWN, OPT_OPEN, OPT_COUNT };
+enum { OPT_TWO_SIDED = OPT_OWN, OPT_OPEN, OPT_VIEWFACTORS, OPT_COMPARE, OPT_GRID, OPT_COUNT };
 
 static const cli_option options[OPT_COUNT] = {
     CLI_BASE_OPTIONS,
@@ -60,6 +66,9 @@ static const cli_option options[OPT_COUNT] = {
     CLI_SCENE_OPTIONS,
     [OPT_TWO_SIDED] = {"two-sided", 0, true},
     [OPT_OPEN] = {"open", 0, false},
+    [OPT_VIEWFACTORS] = {"viewfactors", 0, false},
+    [OPT_COMPARE] = {"compare", 0, true},
+    [OPT_GRID] = {"grid", 0, true},
 };
 
 #ifdef RAD_VIEWER_SCRIPT
@@ -442,6 +451,13 @@ static bool page_triangle_surfaces(page *p, const rad_mesh *mesh, uint32_t trian
     page_text(p, "<script type=\"application/octet-stream\" id=\"radiosity-triangle-surface\">");
     page_base64(p, bytes, 4 * (size_t)count);
     page_text(p, "</script>\n");
+    /* the patch of each triangle: the viewer draws lines where it changes */
+    for (uint32_t t = 0; t < count; t++)
+        for (int k = 0; k < 4; k++)
+            bytes[4 * (size_t)t + k] = (unsigned char)(patch_of[t] >> (8 * k));
+    page_text(p, "<script type=\"application/octet-stream\" id=\"radiosity-triangle-patch\">");
+    page_base64(p, bytes, 4 * (size_t)count);
+    page_text(p, "</script>\n");
     free(bytes);
     free(patch_of);
     return true;
@@ -449,9 +465,9 @@ static bool page_triangle_surfaces(page *p, const rad_mesh *mesh, uint32_t trian
 
 /* `--record FILE` (written by this run's solve): the record's JSON, checked against the
  * mesh, embedded for the viewer's playback (viewer/src/playback.js) with "</" written as
- * "<\/" so that no text ends the script element early; and the patch of each lit-mesh
- * triangle, base64 of uint32 little-endian. */
-static bool page_record(page *p, const char *path, const rad_mesh *mesh, uint32_t triangles)
+ * "<\/" so that no text ends the script element early (the patch of each triangle, which
+ * playback colours by, is page_triangle_surfaces' block). */
+static bool page_record(page *p, const char *path, const rad_mesh *mesh)
 {
     unsigned char *text = NULL;
     size_t size = 0;
@@ -489,31 +505,214 @@ static bool page_record(page *p, const char *path, const rad_mesh *mesh, uint32_
     page_append(p, text + from, size - from);
     page_text(p, "</script>\n");
     free(text);
-
-    uint32_t *patch_of = NULL, count = 0;
-    rad_error error = {0};
-    if (rad_lit_mesh_triangle_patches(mesh, &patch_of, &count, &error) != RAD_OK) {
-        cli_error("%s", error.message);
-        return false;
-    }
-    unsigned char *bytes = count == triangles ? rad_alloc_array(count ? count : 1, 4) : NULL;
-    if (!bytes) {
-        free(patch_of);
-        cli_error("view: no patch table for the %u triangles", triangles);
-        return false;
-    }
-    for (uint32_t t = 0; t < count; t++)
-        for (int k = 0; k < 4; k++)
-            bytes[4 * (size_t)t + k] = (unsigned char)(patch_of[t] >> (8 * k));
-    page_text(p, "<script type=\"application/octet-stream\" id=\"radiosity-triangle-patch\">");
-    page_base64(p, bytes, 4 * (size_t)count);
-    page_text(p, "</script>\n");
-    free(bytes);
-    free(patch_of);
     return true;
 }
 
+/* ---- view factors, a second solution, an illuminance grid ------------------------------ */
+
+static void put_u32(unsigned char *b, uint32_t v)
+{
+    for (int k = 0; k < 4; k++)
+        b[k] = (unsigned char)(v >> (8 * k));
+}
+
+/* The surface view-factor matrix of the solved scene, as a block the viewer reads
+ * (viewfactor_row.js): uint32 n and nonzeros, uint32 row_start[n + 1], uint32
+ * column[nonzeros], zero padding to a multiple of 8 bytes, float64 value[nonzeros], all
+ * little-endian. */
+static bool page_viewfactors(page *p, const rad_scene *scene, const cli_shared *shared)
+{
+    rad_viewfactor_options vf = {0};
+    CLI_SET_RUN_OPTIONS(vf, *shared);
+    rad_viewfactor_matrix *matrix = NULL;
+    rad_viewfactor_report report = {0};
+    rad_error error = {0};
+    cli_progress_mark();
+    if (rad_viewfactor_matrix_compute(scene, &vf, &matrix, &report, &error) != RAD_OK) {
+        cli_progress_end();
+        cli_error("%s", error.message);
+        return false;
+    }
+    cli_progress_end();
+    uint64_t nonzeros = matrix->row_start[matrix->n];
+    if (nonzeros > UINT32_MAX / 16 || matrix->n > UINT32_MAX / 8) {
+        cli_error("%s: %llu view factors are too many for a page", scene->source,
+                  (unsigned long long)nonzeros);
+        rad_viewfactor_matrix_destroy(matrix);
+        return false;
+    }
+    size_t integers = 2 + (size_t)matrix->n + 1 + (size_t)nonzeros;
+    size_t values_at = (4 * integers + 7) / 8 * 8;
+    size_t size = values_at + 8 * (size_t)nonzeros;
+    unsigned char *bytes = rad_alloc_array(size, 1); /* zeroed: the padding */
+    if (!bytes) {
+        cli_error("view: out of memory for %llu view factors", (unsigned long long)nonzeros);
+        rad_viewfactor_matrix_destroy(matrix);
+        return false;
+    }
+    put_u32(bytes, matrix->n);
+    put_u32(bytes + 4, (uint32_t)nonzeros);
+    for (uint32_t i = 0; i <= matrix->n; i++)
+        put_u32(bytes + 8 + 4 * (size_t)i, (uint32_t)matrix->row_start[i]);
+    unsigned char *columns = bytes + 8 + 4 * ((size_t)matrix->n + 1);
+    for (uint64_t k = 0; k < nonzeros; k++) {
+        put_u32(columns + 4 * k, matrix->column[k]);
+        uint64_t bits;
+        memcpy(&bits, &matrix->value[k], sizeof(bits));
+        for (int b = 0; b < 8; b++)
+            bytes[values_at + 8 * k + b] = (unsigned char)(bits >> (8 * b));
+    }
+    page_text(p, "<script type=\"application/octet-stream\" id=\"radiosity-viewfactors\">");
+    page_base64(p, bytes, size);
+    page_text(p, "</script>\n");
+    free(bytes);
+    rad_viewfactor_matrix_destroy(matrix);
+    return true;
+}
+
+/* The positions and triangle indices of a lit mesh check_lit_mesh accepted. */
+static void lit_mesh_geometry(const unsigned char *bytes, const unsigned char **position,
+                              uint32_t *vertices, const unsigned char **index, uint32_t *indices)
+{
+    uint32_t json_length = get_u32(bytes + 12);
+    size_t bin_at = 20 + (size_t)json_length;
+    cJSON *root = cJSON_ParseWithLength((const char *)bytes + 20, json_length);
+    const cJSON *primitive = cJSON_GetArrayItem(
+        cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(root, "meshes"), 0),
+                            "primitives"),
+        0);
+    *vertices = *indices = 0;
+    *position = glb_accessor(root, cJSON_GetObjectItem(cJSON_GetObjectItem(primitive, "attributes"), "POSITION"),
+                             5126, "VEC3", get_u32(bytes + bin_at), bytes + bin_at + 8, vertices);
+    *index = glb_accessor(root, cJSON_GetObjectItem(primitive, "indices"), 5125, "SCALAR",
+                          get_u32(bytes + bin_at), bytes + bin_at + 8, indices);
+    cJSON_Delete(root);
+}
+
+/* B (a lit mesh, checked) has A's vertices and triangles, bit for bit; else one line. */
+static bool same_geometry(const char *path_b, const unsigned char *a, const unsigned char *b)
+{
+    const unsigned char *position_a, *position_b, *index_a, *index_b;
+    uint32_t vertices_a, vertices_b, indices_a, indices_b;
+    lit_mesh_geometry(a, &position_a, &vertices_a, &index_a, &indices_a);
+    lit_mesh_geometry(b, &position_b, &vertices_b, &index_b, &indices_b);
+    if (vertices_a != vertices_b || indices_a != indices_b) {
+        cli_error("%s: --compare: %u vertices and %u triangles, the first mesh %u and %u: "
+                  "solve both with the same scene, patch size and lights",
+                  path_b, vertices_b, indices_b / 3, vertices_a, indices_a / 3);
+        return false;
+    }
+    if (memcmp(position_a, position_b, 12 * (size_t)vertices_a) != 0 ||
+        memcmp(index_a, index_b, 4 * (size_t)indices_a) != 0) {
+        cli_error("%s: --compare: the same counts but other vertices or triangles than the "
+                  "first mesh: solve both with the same scene, patch size and lights",
+                  path_b);
+        return false;
+    }
+    return true;
+}
+
+/* The table `radiosity illuminance` writes (header x,y,z,nx,ny,nz,E_r,E_g,E_b,E[,...],
+ * then a row per point) as the info block's "grid": its file, the points, normals and E
+ * in lux. False after one line naming the file (and line). */
+static bool page_grid(page *p, const char *path)
+{
+    unsigned char *bytes = NULL;
+    size_t size = 0;
+    if (!read_whole_file(path, &bytes, &size))
+        return false;
+    char *text = rad_resize_array(bytes, size + 1, 1);
+    if (!text) {
+        free(bytes);
+        cli_error("%s: out of memory", path);
+        return false;
+    }
+    text[size] = '\0';
+    static const char header[] = "x,y,z,nx,ny,nz,E_r,E_g,E_b,E";
+    bool ok = strncmp(text, header, sizeof(header) - 1) == 0;
+    if (!ok)
+        cli_error("%s:1: not a table of `radiosity illuminance` (its first line is %s...)",
+                  path, header);
+    page points = {0}, normals = {0}, lux = {0};
+    uint32_t line_number = 1, count = 0;
+    char *line = strchr(text, '\n');
+    line = line ? line + 1 : text + size;
+    while (ok && *line) {
+        line_number++;
+        char *end = strchr(line, '\n');
+        char *next = end ? end + 1 : line + strlen(line);
+        if (end)
+            *end = '\0';
+        if (*line == '\0' || *line == '\r') {
+            line = next;
+            continue;
+        }
+        double v[10];
+        char *c = line;
+        for (int k = 0; ok && k < 10; k++) {
+            char *after;
+            errno = 0;
+            v[k] = strtod(c, &after);
+            if (after == c || errno == ERANGE || !isfinite(v[k]) ||
+                (k < 9 && *after != ',') ||
+                (k == 9 && *after != ',' && *after != '\0' && *after != '\r'))
+                ok = false;
+            c = after + 1;
+        }
+        if (!ok || v[9] < 0 || (v[3] == 0 && v[4] == 0 && v[5] == 0)) {
+            ok = false;
+            cli_error("%s:%u: not a row x,y,z,nx,ny,nz,E_r,E_g,E_b,E of finite numbers (a "
+                      "non-zero normal, E >= 0)",
+                      path, line_number);
+            break;
+        }
+        page_printf(&points, "%s%.9g,%.9g,%.9g", count ? "," : "", v[0], v[1], v[2]);
+        page_printf(&normals, "%s%.6g,%.6g,%.6g", count ? "," : "", v[3], v[4], v[5]);
+        page_printf(&lux, "%s%.9g", count ? "," : "", v[9]);
+        count++;
+        line = next;
+    }
+    if (ok && count == 0) {
+        ok = false;
+        cli_error("%s: the table has no points", path);
+    }
+    if (ok && (points.failed || normals.failed || lux.failed)) {
+        ok = false;
+        cli_error("%s: out of memory for %u points", path, count);
+    }
+    if (ok) {
+        page_text(p, "\"grid\":{\"source\":");
+        page_json_string(p, path);
+        page_text(p, ",\"points\":[");
+        page_append(p, points.data, points.length);
+        page_text(p, "],\"normals\":[");
+        page_append(p, normals.data, normals.length);
+        page_text(p, "],\"lux\":[");
+        page_append(p, lux.data, lux.length);
+        page_text(p, "]},");
+    }
+    free(points.data);
+    free(normals.data);
+    free(lux.data);
+    free(text);
+    return ok;
+}
+
 /* ---- the command ---------------------------------------------------------------------- */
+
+/* The units of the shown values, by `render --false-colour`'s rule (README, "Units."):
+ * cd/m^2 and lux when every light of the scene is photometric; "relative" with emitting
+ * surfaces alone (Ke in the file's own unit), a light in no known unit or an environment
+ * map. A lit .glb does not say: "relative". */
+static void page_units(page *p, const rad_scene *scene)
+{
+    bool photometric = scene && scene->light_count > 0;
+    for (uint32_t l = 0; scene && l < scene->light_count; l++)
+        photometric = photometric && !scene->lights[l].unit_unknown &&
+                      scene->lights[l].type != RAD_LIGHT_ENVIRONMENT;
+    page_text(p, photometric ? ",\"radiance_unit\":\"cd/m\\u00b2\",\"illuminance_unit\":\"lux\","
+                             : ",\"radiance_unit\":\"relative\",\"illuminance_unit\":\"relative\",");
+}
 
 /* SCENE's base name + .html, or cornell_box.html. */
 static void default_output(const char *input, char *out, size_t size)
@@ -533,7 +732,8 @@ static void default_output(const char *input, char *out, size_t size)
 static void warn_ignored(const cli_args *args, const char *input)
 {
     for (int k = OPT_PATCH_SIZE; k < OPT_COUNT; k++)
-        if (args->value[k] && options[k].name && k != OPT_OPEN && (k < OPT_EYE || k > OPT_EXR_FLOAT))
+        if (args->value[k] && options[k].name && k != OPT_OPEN && k != OPT_COMPARE &&
+            k != OPT_GRID && (k < OPT_EYE || k > OPT_EXR_FLOAT))
             cli_warn("%s: a lit mesh, shown as it is: --%s is ignored", input, options[k].name);
 }
 #endif
@@ -581,7 +781,15 @@ int command_view(int argc, char **argv)
             glb = NULL;
         }
     }
-    uint32_t triangles = 0;
+    if (lit_input && args.value[OPT_VIEWFACTORS]) {
+        cli_error("%s: --viewfactors needs the SCENE (a lit mesh has no surfaces)", input);
+        free(glb);
+        return EXIT_USAGE;
+    }
+    uint32_t triangles = 0, compare_triangles = 0;
+    const char *compare_path = args.value[OPT_COMPARE];
+    unsigned char *compare_glb = NULL;
+    size_t compare_size = 0;
     page html = {0};
     cli_solved solved;
     memset(&solved, 0, sizeof(solved));
@@ -601,6 +809,17 @@ int command_view(int argc, char **argv)
             !check_lit_mesh("the lit mesh", glb, glb_size, &triangles))
             goto done;
     }
+    if (compare_path) {
+        if (!read_whole_file(compare_path, &compare_glb, &compare_size))
+            goto done;
+        if (!glb_is_lit_mesh(compare_glb, compare_size)) {
+            cli_error("%s: --compare: not a lit mesh of `radiosity solve -o B.glb`", compare_path);
+            goto done;
+        }
+        if (!check_lit_mesh(compare_path, compare_glb, compare_size, &compare_triangles) ||
+            !same_geometry(compare_path, glb, compare_glb))
+            goto done;
+    }
 
     const char *source = lit_input ? input : solved.scene->source;
     page_text(&html, "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
@@ -610,7 +829,7 @@ int command_view(int argc, char **argv)
     page_text(&html, "</title>\n</head>\n<body>\n"
                      "<script type=\"application/json\" id=\"radiosity-info\">{\"source\":");
     page_json_string(&html, source);
-    page_text(&html, ",\"radiance_unit\":\"cd/m\\u00b2\",\"illuminance_unit\":\"lux\",");
+    page_units(&html, lit_input ? NULL : solved.scene);
     if (!lit_input) {
         const rad_scene *scene = solved.scene;
         page_printf(&html, "\"unit_metres\":%.9g,", scene->unit_metres);
@@ -626,6 +845,13 @@ int command_view(int argc, char **argv)
         if (!page_surfaces(&html, scene, solved.mesh, solved.B))
             goto done;
     }
+    if (args.value[OPT_GRID] && !page_grid(&html, args.value[OPT_GRID]))
+        goto done;
+    if (compare_path) {
+        page_text(&html, "\"compare_source\":");
+        page_json_string(&html, compare_path);
+        page_text(&html, ",");
+    }
     page_printf(&html, "\"triangles\":%u}</script>\n", triangles);
     page_text(&html, "<script type=\"application/octet-stream\" id=\"radiosity-glb\">");
     page_base64(&html, glb, glb_size);
@@ -633,7 +859,14 @@ int command_view(int argc, char **argv)
     if (!lit_input && !page_triangle_surfaces(&html, solved.mesh, triangles))
         goto done;
     if (!lit_input && solve.record_path &&
-        !page_record(&html, solve.record_path, solved.mesh, triangles))
+        !page_record(&html, solve.record_path, solved.mesh))
+        goto done;
+    if (compare_path) {
+        page_text(&html, "<script type=\"application/octet-stream\" id=\"radiosity-compare-glb\">");
+        page_base64(&html, compare_glb, compare_size);
+        page_text(&html, "</script>\n");
+    }
+    if (args.value[OPT_VIEWFACTORS] && !page_viewfactors(&html, solved.scene, &shared))
         goto done;
     page_text(&html, "<script>");
     page_append(&html, rad_viewer_script, rad_viewer_script_size);
@@ -668,6 +901,7 @@ done:
     cli_progress_end();
     free(html.data);
     free(glb);
+    free(compare_glb);
     if (!lit_input)
         cli_solved_free(&solved);
     return exit_code;

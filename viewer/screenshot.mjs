@@ -2,9 +2,13 @@
 // first frame, prints how long that took and how much memory the page holds, and writes a
 // screenshot: for the README's images and the load-time figures. Not a test.
 //
-//   node screenshot.mjs PAGE.html OUT.png [--mode 0|1|2] [--pick X,Y] [--size WxH]
-//     --mode   0 colour, 1 radiance in false colour, 2 illuminance in false colour
+//   node screenshot.mjs PAGE.html OUT.png [--mode M] [--pick X,Y] [--edges E] [--size WxH]
+//     --mode   0 colour, 1 radiance in false colour, 2 illuminance in false colour,
+//              viewfactors, difference, compare-b, grid (when the page has them)
 //     --pick   click the canvas at X,Y (pixels from its top left) first
+//     --edges  patches or triangles: draw those edges
+//     --drag DX,DY   orbit first: drag the canvas DX,DY pixels from its centre
+//     --keys KEYS    then press these keys (w a s d q e: walk)
 import puppeteer from 'puppeteer-core';
 import { readFileSync, readdirSync } from 'node:fs';
 import { resolve } from 'node:path';
@@ -35,7 +39,7 @@ const option = (name) => {
 };
 const [pagePath, out] = args;
 if (!pagePath || !out) {
-  console.error('usage: node screenshot.mjs PAGE.html OUT.png [--mode N] [--pick X,Y] [--size WxH]');
+  console.error('usage: node screenshot.mjs PAGE.html OUT.png [--mode M] [--pick X,Y] [--edges E] [--size WxH]');
   process.exit(2);
 }
 const [width, height] = (option('--size') || '812x512').split('x').map(Number);
@@ -60,8 +64,32 @@ try {
   console.log(`${pagePath}: first frame after ${seconds.toFixed(2)} s (navigation to first frame), ` +
     `JS heap ${(metrics.JSHeapUsedSize / 1e6).toFixed(0)} MB used, ` +
     `chromium's processes ${(rss / 1e6).toFixed(0)} MB resident`);
+  const drag = option('--drag');
+  if (drag) {
+    const box = await (await page.$('#view canvas')).boundingBox();
+    const [dx, dy] = drag.split(',').map(Number);
+    const [cx, cy] = [box.x + box.width / 2, box.y + box.height / 2];
+    await page.mouse.move(cx, cy);
+    await page.mouse.down();
+    for (let k = 1; k <= 10; k++) await page.mouse.move(cx + (dx * k) / 10, cy + (dy * k) / 10);
+    await page.mouse.up();
+  }
+  const keys = option('--keys');
+  if (keys) {
+    if (!drag) await page.mouse.click(5, 5); // the page takes the keys
+    for (const key of keys) await page.keyboard.press(key);
+  }
+  // a control's change, timed to the second frame after it
+  const timed = async (what, change) => {
+    const t = Date.now();
+    await change();
+    await page.evaluate(() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done))));
+    console.log(`${what} drawn after ${((Date.now() - t) / 1000).toFixed(2)} s`);
+  };
   const mode = option('--mode');
-  if (mode) await page.select('#mode', mode);
+  if (mode) await timed(`mode ${mode}`, () => page.select('#mode', mode));
+  const edges = option('--edges');
+  if (edges) await timed(`${edges} edges`, () => page.select('#edges', edges));
   const pick = option('--pick');
   if (pick) {
     const box = await (await page.$('#view canvas')).boundingBox();
@@ -75,6 +103,7 @@ try {
   }
   await page.evaluate(() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done))));
   await page.screenshot({ path: out });
+  console.log(`${pagePath}: chromium's processes ${(treeResidentBytes(browser.process().pid) / 1e6).toFixed(0)} MB resident at the end`);
 } finally {
   await browser.close();
 }

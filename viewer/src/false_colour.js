@@ -9,16 +9,16 @@ export const SCALE_COLOURS = [
 
 export const TICKS = 6;
 
-// The legend's values, low to high: evenly spaced from lo to hi, or evenly in log10 when
-// `log` (lo > 0 then).
-export function tickValues(lo, hi, log) {
+// The legend's values, low to high: `count` evenly spaced from lo to hi, or evenly in
+// log10 when `log` (lo > 0 then).
+export function tickValues(lo, hi, log, count = TICKS) {
   const values = [];
-  for (let k = 0; k < TICKS; k++) {
-    const t = k / (TICKS - 1);
+  for (let k = 0; k < count; k++) {
+    const t = k / (count - 1);
     values.push(log ? Math.exp(Math.log(lo) + t * (Math.log(hi) - Math.log(lo))) : lo + t * (hi - lo));
   }
   values[0] = lo;
-  values[TICKS - 1] = hi;
+  values[count - 1] = hi;
   return values;
 }
 
@@ -44,4 +44,19 @@ export function luminanceRange(rgb) {
     if (y > 0 && y < positive) positive = y;
   }
   return { lo, hi, positive: positive === Infinity ? hi : positive };
+}
+
+// The signed scale of a difference: blue below zero, white at zero, red above (sRGB
+// control colours, an odd count so that zero is the middle one).
+export const DIVERGING_COLOURS = [
+  [0.13, 0.25, 0.75], [0.45, 0.62, 0.95], [0.97, 0.97, 0.97], [0.95, 0.55, 0.45],
+  [0.75, 0.08, 0.12],
+];
+
+// The colour of t in [0, 1] on a scale of control colours (as the shader interpolates).
+export function scaleColour(colours, t) {
+  const x = Math.min(Math.max(t, 0), 1) * (colours.length - 1);
+  const i = Math.min(Math.floor(x), colours.length - 2);
+  const f = x - i;
+  return colours[i].map((a, k) => (1 - f) * a + f * colours[i + 1][k]);
 }

@@ -1,8 +1,9 @@
 // main.js - the viewer `radiosity view` embeds in its HTML page: reads the lit mesh and the
 // surface table from the page's data blocks, shows the mesh with three.js (orbit, and a
 // walk with the keyboard), an exposure slider, tone mapping, false colour of radiance or
-// illuminance with its legend, and what a click picks. Not a glTF viewer for other files:
-// glb.js reads only radiosity's lit mesh.
+// illuminance with its legend, and what a click picks; the optional views are modules of
+// their own (viewfactor_row.js, compare.js, grid.js: more choices of what to show; edges.js:
+// lines on demand). Not a glTF viewer for other files: glb.js reads only radiosity's lit mesh.
 
 import {
   BufferAttribute, BufferGeometry, Color, Mesh, PerspectiveCamera, Raycaster, Scene,
@@ -11,7 +12,11 @@ import {
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { decodeBase64 } from './base64.js';
 import { parseLitMesh } from './glb.js';
-import { formatValue, luminanceAt, luminanceRange, SCALE_COLOURS, tickValues } from './false_colour.js';
+import { formatValue, luminanceAt, luminanceRange, scaleColour, SCALE_COLOURS, tickValues } from './false_colour.js';
+import { createViewFactorRow } from './viewfactor_row.js';
+import { createCompare } from './compare.js';
+import { createGrid } from './grid.js';
+import { createEdges } from './edges.js';
 import {
   litMeshMaterial, MODE_COLOUR, MODE_FALSE_ILLUMINANCE, MODE_FALSE_RADIANCE, TONE_ACES,
   TONE_CLAMP, TONE_REINHARD,
@@ -75,6 +80,10 @@ function start() {
   const triangles = mesh.index.length / 3;
   if (triangleSurface && triangleSurface.length !== triangles)
     throw new Error(`the surface table has ${triangleSurface.length} triangles, the mesh ${triangles}`);
+  const patchText = embedded('radiosity-triangle-patch');
+  const trianglePatch = patchText ? new Uint32Array(decodeBase64(patchText).buffer) : null;
+  if (trianglePatch && trianglePatch.length !== triangles)
+    throw new Error(`the patch table has ${trianglePatch.length} triangles, the mesh ${triangles}`);
 
   const geometry = new BufferGeometry();
   geometry.setAttribute('position', new BufferAttribute(mesh.position, 3));
@@ -142,6 +151,13 @@ function start() {
   const exposureRow = row('exposure', exposure, exposureText);
   const logRow = row('log scale', logBox);
 
+  // the optional views: each adds its choices to "show", its objects to the scene
+  const context = { info, mesh, geometry, material, triangleSurface, trianglePatch, scene, panel, element, embedded, row };
+  const features = [createViewFactorRow(context), createCompare(context), createGrid(context)].filter(Boolean);
+  for (const feature of features)
+    for (const choice of feature.modes) modeSelect.append(element('option', { value: choice.value }, choice.label));
+  createEdges(context, () => render());
+
   const legend = element('div', { id: 'legend' });
   const legendTitle = element('div', { id: 'legend-title' });
   const legendBody = element('div', { class: 'legend-body' });
@@ -151,13 +167,16 @@ function start() {
   legend.append(legendTitle, legendBody);
   panel.appendChild(legend);
   const barContext = bar.getContext('2d');
-  for (let y = 0; y < 200; y++) {
-    const t = (1 - y / 199) * (SCALE_COLOURS.length - 1);
-    const i = Math.min(Math.floor(t), SCALE_COLOURS.length - 2);
-    const f = t - i;
-    const c = SCALE_COLOURS[i].map((a, k) => Math.round(255 * ((1 - f) * a + f * SCALE_COLOURS[i + 1][k])));
-    barContext.fillStyle = `rgb(${c.join(',')})`;
-    barContext.fillRect(0, y, 24, 1);
+  // the legend: its title, the bar of the scale's colours, and ticks from lo to hi
+  function drawLegend({ title, lo, hi, log = false, colours = SCALE_COLOURS, ticks: count }) {
+    for (let y = 0; y < 200; y++) {
+      const c = scaleColour(colours, 1 - y / 199).map((a) => Math.round(255 * a));
+      barContext.fillStyle = `rgb(${c.join(',')})`;
+      barContext.fillRect(0, y, 24, 1);
+    }
+    legendTitle.textContent = title;
+    ticks.replaceChildren(...tickValues(lo, hi, log, count).reverse().map((v) =>
+      element('div', { class: 'tick', 'data-value': String(v) }, formatValue(v))));
   }
 
   const picked = element('div', { id: 'picked' }, 'click a surface to see what it is');
@@ -166,26 +185,34 @@ function start() {
     'drag: orbit · right-drag: pan · wheel: zoom · W A S D / arrows: walk · Q E: down, up'));
 
   function update() {
-    const mode = Number(modeSelect.value);
+    // a feature's view: its objects shown, maybe the lit mesh hidden, its legend
+    let shown = null;
+    for (const feature of features) shown = feature.show(modeSelect.value) || shown;
+    object.visible = !(shown && shown.hideMesh);
+    const mode = shown ? (shown.colour ? MODE_COLOUR : -1) : Number(modeSelect.value);
     material.uniforms.mode.value = mode;
     material.uniforms.tone.value = Number(toneSelect.value);
     material.uniforms.scale.value = autoScale * Math.pow(2, Number(exposure.value));
     exposureText.textContent = `${Number(exposure.value).toFixed(1)} EV`;
     const falseColour = mode !== MODE_COLOUR;
     toneRow.hidden = exposureRow.hidden = falseColour;
-    logRow.hidden = legend.hidden = !falseColour;
-    if (falseColour) {
+    logRow.hidden = !falseColour || Boolean(shown);
+    legend.hidden = !falseColour && !(shown && shown.legend);
+    if (shown && shown.legend) {
+      drawLegend(shown.legend);
+    } else if (falseColour) {
       const range = ranges[mode];
       const log = logBox.checked && range.hi > 0;
       const lo = log ? range.positive : range.lo;
       material.uniforms.lo.value = lo;
       material.uniforms.hi.value = range.hi;
       material.uniforms.logScale.value = log;
-      legendTitle.textContent = mode === MODE_FALSE_ILLUMINANCE
-        ? `illuminance (${info.illuminance_unit || 'lux'})`
-        : `radiance, luminance (${info.radiance_unit || 'cd/m²'})`;
-      ticks.replaceChildren(...tickValues(lo, range.hi, log).reverse().map((v) =>
-        element('div', { class: 'tick', 'data-value': String(v) }, formatValue(v))));
+      drawLegend({
+        title: mode === MODE_FALSE_ILLUMINANCE
+          ? `illuminance (${info.illuminance_unit || 'lux'})`
+          : `radiance, luminance (${info.radiance_unit || 'cd/m²'})`,
+        lo, hi: range.hi, log,
+      });
     }
     render();
   }
@@ -227,15 +254,24 @@ function start() {
 
   function showPicked(hit) {
     picked.replaceChildren();
-    if (!hit) {
-      picked.textContent = 'nothing there';
-      return;
-    }
     const line = (label, value, field) => {
       const r = element('div', { class: 'field' });
       r.append(element('span', { class: 'label' }, label), element('span', { 'data-field': field }, value));
       picked.appendChild(r);
     };
+    // the features' own lines (a grid square above the mesh, a view-factor row), after the
+    // surface's: a grid square is picked even with nothing behind it
+    const extra = [];
+    let changed = false;
+    for (const feature of features)
+      changed = feature.pick(modeSelect.value, hit, (...a) => extra.push(a), raycaster) || changed;
+    if (changed) update();
+    if (!hit) {
+      for (const a of extra) line(...a);
+      if (!extra.length) picked.textContent = 'nothing there';
+      picked.dataset.surface = '';
+      return;
+    }
     const face = hit.faceIndex;
     const corner = [0, 1, 2].map((k) => mesh.index[3 * face + k]);
     const here = (rgb) => {
@@ -257,6 +293,7 @@ function start() {
     line('here: luminance', `${formatValue(here(mesh.radiance))} ${info.radiance_unit || 'cd/m²'}`, 'point-radiance');
     if (mesh.illuminance)
       line('here: illuminance', `${formatValue(here(mesh.illuminance))} ${info.illuminance_unit || 'lux'}`, 'point-illuminance');
+    for (const a of extra) line(...a);
     picked.dataset.surface = surface ? surface.name : '';
   }
 

@@ -74,6 +74,9 @@ export function litMeshMaterial() {
     vertexShader,
     fragmentShader,
     side: FrontSide,
+    polygonOffset: true, // behind the edge lines (edges.js) at the same depth
+    polygonOffsetFactor: 1,
+    polygonOffsetUnits: 1,
     uniforms: {
       mode: { value: MODE_COLOUR },
       tone: { value: TONE_CLAMP },

@@ -7,6 +7,7 @@ html, body { margin: 0; height: 100%; background: #111; color: #ddd; font: 13px/
   padding: 10px 12px; overflow-y: auto; background: #1c1c1c; border-left: 1px solid #333; }
 #panel h1 { font-size: 16px; margin: 0 0 4px; }
 .source, .stats, .help { color: #999; word-break: break-all; margin-bottom: 6px; }
+.summary { color: #999; margin-bottom: 6px; }
 .row { display: flex; align-items: center; gap: 6px; margin: 6px 0; }
 .row label { width: 92px; color: #aaa; }
 .row select, .row input[type=range] { flex: 1; min-width: 0; }
