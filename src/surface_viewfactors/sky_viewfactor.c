@@ -1,0 +1,470 @@
+/*
+ * sky_viewfactor.c - the sky view factor of each surface, see radiosity.h: the fraction of
+ * its hemisphere (cosine-weighted) from which a ray leaves the scene without meeting any
+ * triangle, integrated directly, not taken as 1 - row sum.
+ *
+ * The sky is an inward-facing box around the whole scene (every triangle, obstructions
+ * included) that blocks nothing. A ray from a point of the scene leaves the scene exactly
+ * when its segment to the box is unblocked, because nothing lies beyond the box: the
+ * factor from x to the visible part of the box is the sky fraction of x's hemisphere for
+ * any box that encloses the scene, so its size adds no error (there is no
+ * finite-distance term to bound).
+ *
+ * For each polygon p of a surface, the box's faces are tiles, split in four (a quadtree,
+ * SKY_MAX_LEVEL levels) while the occluder tree finds more than SKY_EXACT_MAX_OCCLUDERS
+ * triangles in the hull of p and the tile. The tiles with few enough are integrated
+ * together, as one point function over p (the sky fraction seen from x through them,
+ * each tile's part exact by shadow clipping, shadow_clip.h), so that the kinks where one
+ * tile's shadows cross its edge, which the neighbouring tile's cancel, do not make the
+ * quadrature refine; a long polygon is cut into strips of aspect about 1 first. The
+ * tiles with too many occluders at the last level are sampled pair by pair as the
+ * engine samples (pair_transfer.h: the unobstructed value times the visible fraction, to
+ * accuracy x sqrt(F) or max_rays). No shortcut drops a pair as hidden. Error bounds add
+ * in quadrature, as in the matrix's rows.
+ *
+ * Not here: the matrix (viewfactor_matrix.c); the writer (sky_viewfactor_writer.c).
+ */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/random.h"
+#include "core/vec3.h"
+#include "geometry/polygon_integral.h"
+#include "surface_viewfactors/occluder_tree.h"
+#include "surface_viewfactors/pair_transfer.h"
+#include "surface_viewfactors/vf_geometry.h"
+
+/* A tile is clipped exactly when its hull with the polygon holds at most this many
+ * triangles (a closed room's floor sees 10 others); otherwise it is split, down to
+ * SKY_MAX_LEVEL (8 x 8 tiles a face), and sampled there. */
+#define SKY_EXACT_MAX_OCCLUDERS 16u
+#define SKY_MAX_LEVEL 3u
+#define SKY_MAX_TILES (6u * 64u)
+
+/* Occluder clippings one strip's exact integrand may spend (about a quarter of a second)
+ * before the polygon's obstructed tiles are sampled instead, and the deepest split of its
+ * quadrature (4^8 cells of each fan triangle). */
+#define SKY_WORK_BUDGET (1u << 20)
+#define SKY_MAX_DEPTH 8
+
+/* A polygon longer than this many times its mean width is cut into strips. */
+#define SKY_MAX_STRIPS 64u
+
+/* The tiles' `source`: no scene triangle has it (obstructions have UINT32_MAX), so none is
+ * excluded from the tiles' hulls. */
+#define SKY_SOURCE (UINT32_MAX - 1u)
+
+/* The box: the scene's bounds grown by this fraction of their diagonal (any margin is
+ * exact; a small one keeps the sampled segments short, so their end offsets stay small). */
+#define SKY_MARGIN 0.05
+
+typedef struct sky_counts {
+    uint64_t polygon_pairs, obstructed_pairs, exact_pairs, sampled_pairs, capped_pairs, rays;
+} sky_counts;
+
+enum { TILE_EXACT = 1, TILE_SAMPLED };
+
+typedef struct sky_tile {
+    vf_polygon polygon;
+    uint32_t id; /* (face, level, i, j): its random stream */
+    uint32_t occluder_count;
+    uint8_t state;
+    shadow_occluder occluders[SKY_EXACT_MAX_OCCLUDERS];
+} sky_tile;
+
+/* Per thread: the tiles for the polygon at hand. */
+typedef struct sky_workspace {
+    pair_workspace pair;
+    sky_tile tiles[SKY_MAX_TILES];
+    uint32_t tile_count;
+} sky_workspace;
+
+typedef struct sky_box {
+    double lo[3], hi[3];
+} sky_box;
+
+/* Tile (i, j) of level `level` of face `face` (axis face / 2, high side when odd), facing
+ * into the box. */
+static void make_tile(const sky_box *box, unsigned face, unsigned level, unsigned i,
+                      unsigned j, vf_polygon *t)
+{
+    unsigned axis = face / 2, side = face % 2, u = (axis + 1) % 3, v = (axis + 2) % 3;
+    double cells = (double)(1u << level);
+    double u0 = box->lo[u] + (box->hi[u] - box->lo[u]) * i / cells;
+    double u1 = box->lo[u] + (box->hi[u] - box->lo[u]) * (i + 1) / cells;
+    double v0 = box->lo[v] + (box->hi[v] - box->lo[v]) * j / cells;
+    double v1 = box->lo[v] + (box->hi[v] - box->lo[v]) * (j + 1) / cells;
+    double corner[4][2] = {{u0, v0}, {u1, v0}, {u1, v1}, {u0, v1}};
+    memset(t, 0, sizeof(*t));
+    t->count = 4;
+    for (int k = 0; k < 4; k++) {
+        /* (u, v, axis) is right-handed: counter-clockwise about +axis as listed, so the
+         * high face (normal -axis) runs them backwards */
+        int c = side ? 3 - k : k;
+        double x[3];
+        x[axis] = side ? box->hi[axis] : box->lo[axis];
+        x[u] = corner[c][0];
+        x[v] = corner[c][1];
+        t->vertex[k] = v3(x[0], x[1], x[2]);
+    }
+    double n[3] = {0, 0, 0};
+    n[axis] = side ? -1 : 1;
+    t->normal = v3(n[0], n[1], n[2]);
+    t->surface = SKY_SOURCE;
+    t->source = SKY_SOURCE;
+    vf_polygon_finish(t);
+}
+
+typedef struct sky_context {
+    const sky_box *box;
+    const occluder_tree *tree;
+    const rad_tracer *tracer;
+    double accuracy, eps;
+    uint32_t max_rays;
+    uint64_t seed;
+} sky_context;
+
+/* The tiles of face `face` under (level, i, j) that p faces, split while they have too
+ * many occluders. */
+static void add_tiles(const sky_context *c, const vf_polygon *p, sky_workspace *w,
+                      sky_counts *counts, unsigned face, unsigned level, unsigned i, unsigned j)
+{
+    sky_tile *tile = &w->tiles[w->tile_count];
+    make_tile(c->box, face, level, i, j, &tile->polygon);
+    const vf_polygon *t = &tile->polygon;
+    if (!vf_polygon_in_front(t, p->normal, v3_dot(p->normal, p->vertex[0]), c->eps) ||
+        !vf_polygon_in_front(p, t->normal, v3_dot(t->normal, t->vertex[0]), c->eps))
+        return;
+    uint32_t count = occluder_tree_collect(c->tree, p, t, c->eps, tile->occluders,
+                                           SKY_EXACT_MAX_OCCLUDERS);
+    if (count > SKY_EXACT_MAX_OCCLUDERS && level < SKY_MAX_LEVEL) {
+        for (unsigned k = 0; k < 4; k++)
+            add_tiles(c, p, w, counts, face, level + 1, 2 * i + k % 2, 2 * j + k / 2);
+        return;
+    }
+    counts->polygon_pairs++;
+    counts->obstructed_pairs += count > 0;
+    tile->occluder_count = count;
+    tile->state = count <= SKY_EXACT_MAX_OCCLUDERS ? TILE_EXACT : TILE_SAMPLED;
+    tile->id = (face << 24) | (level << 20) | (i << 10) | j;
+    w->tile_count++;
+}
+
+/* The exact integrand: x on a strip of the polygon (normal n) to every TILE_EXACT tile, as
+ * far as its occluders leave it visible. */
+typedef struct sky_integrand {
+    sky_workspace *w;
+    rad_vec3 normal;
+    double plane_epsilon;
+    uint64_t work_left;   /* occluder clippings left */
+    uint32_t failed_tile; /* the tile whose visible part broke into too many pieces, or
+                             UINT32_MAX when the work ran out */
+    bool failed;
+} sky_integrand;
+
+static double sky_point(void *context, rad_vec3 x)
+{
+    sky_integrand *c = context;
+    double sum = 0;
+    for (uint32_t k = 0; k < c->w->tile_count && !c->failed; k++) {
+        const sky_tile *tile = &c->w->tiles[k];
+        if (tile->state != TILE_EXACT)
+            continue;
+        if (c->work_left < tile->occluder_count) {
+            c->failed = true;
+            c->failed_tile = UINT32_MAX;
+            break;
+        }
+        c->work_left -= tile->occluder_count;
+        double f = shadow_visible_factor(x, c->normal, &tile->polygon, tile->occluders,
+                                         tile->occluder_count, c->plane_epsilon);
+        if (f < 0) {
+            c->failed = true;
+            c->failed_tile = k;
+            break;
+        }
+        sum += f;
+    }
+    return sum;
+}
+
+/* The convex polygon p cut into strips across its longest extent, each of aspect about 1:
+ * strips[] receives them (room for SKY_MAX_STRIPS); returns how many. */
+static unsigned cut_strips(const vf_polygon *p, vf_polygon *strips)
+{
+    rad_vec3 a = p->vertex[0], b = p->vertex[0];
+    double longest = 0;
+    for (unsigned i = 0; i < p->count; i++)
+        for (unsigned j = i + 1; j < p->count; j++) {
+            double d = v3_length(v3_sub(p->vertex[i], p->vertex[j]));
+            if (d > longest)
+                longest = d, a = p->vertex[i], b = p->vertex[j];
+        }
+    double width = longest > 0 ? p->area / longest : 0;
+    unsigned n = width > 0 ? (unsigned)fmin(ceil(longest / width), SKY_MAX_STRIPS) : 1;
+    if (n <= 1) {
+        strips[0] = *p;
+        return 1;
+    }
+    rad_vec3 axis = v3_scale(v3_sub(b, a), 1 / longest);
+    double start = v3_dot(axis, a);
+    unsigned made = 0;
+    for (unsigned s = 0; s < n; s++) {
+        double from = start + longest * s / n, to = start + longest * (s + 1) / n;
+        /* the part of p with from <= axis . x <= to */
+        rad_vec3 out[VF_MAX_VERTICES + 2];
+        unsigned count = 0;
+        for (unsigned k = 0; k < p->count; k++) {
+            rad_vec3 x = p->vertex[k], y = p->vertex[(k + 1) % p->count];
+            double dx = v3_dot(axis, x), dy = v3_dot(axis, y);
+            double lo[2] = {from, to};
+            if (dx >= from && dx <= to && count < VF_MAX_VERTICES + 2)
+                out[count++] = x;
+            /* crossings of the two cut planes along x -> y, in order */
+            double t0 = dy != dx ? (lo[0] - dx) / (dy - dx) : -1;
+            double t1 = dy != dx ? (lo[1] - dx) / (dy - dx) : -1;
+            double first = fmin(t0, t1), second = fmax(t0, t1);
+            if (first > 0 && first < 1 && count < VF_MAX_VERTICES + 2)
+                out[count++] = v3_lerp(x, y, first);
+            if (second > 0 && second < 1 && count < VF_MAX_VERTICES + 2)
+                out[count++] = v3_lerp(x, y, second);
+        }
+        if (count < 3 || count > VF_MAX_VERTICES) {
+            /* a slab of a convex hexagon has at most 8 corners: keep p whole then */
+            strips[0] = *p;
+            return 1;
+        }
+        vf_polygon *strip = &strips[made];
+        *strip = *p;
+        strip->count = count;
+        memcpy(strip->vertex, out, count * sizeof(rad_vec3));
+        vf_polygon_finish(strip);
+        if (strip->area > 0)
+            made++;
+    }
+    return made;
+}
+
+/* The transfer from polygon p (index pi) to the sky, with its error bound in *bound. */
+static double sky_polygon(const sky_context *c, const vf_polygon *p, uint32_t pi,
+                          sky_workspace *w, vf_polygon *strips, sky_counts *counts,
+                          double *bound)
+{
+    w->tile_count = 0;
+    for (unsigned face = 0; face < 6; face++)
+        add_tiles(c, p, w, counts, face, 0, 0, 0);
+    bool any_exact = false;
+    for (uint32_t k = 0; k < w->tile_count; k++)
+        any_exact = any_exact || w->tiles[k].state == TILE_EXACT;
+    double transfer = 0, variance = 0;
+    unsigned strip_count = any_exact ? cut_strips(p, strips) : 0;
+    while (any_exact) {
+        double value = 0, error2 = 0;
+        sky_integrand integrand = {w, p->normal, c->eps, 0, 0, false};
+        for (unsigned s = 0; s < strip_count && !integrand.failed; s++) {
+            integrand.work_left = SKY_WORK_BUDGET;
+            polygon_integral integral = {sky_point, &integrand, SKY_MAX_DEPTH,
+                                         &integrand.failed};
+            double error;
+            value += polygon_integrate(&integral, strips[s].vertex, strips[s].count,
+                                       0.25 * c->accuracy, &error);
+            error2 += error * error;
+        }
+        if (!integrand.failed) {
+            transfer += fmax(value, 0);
+            variance += error2;
+            break;
+        }
+        /* too many pieces behind one tile: sample that tile; out of work: sample every
+         * obstructed tile */
+        any_exact = false;
+        for (uint32_t k = 0; k < w->tile_count; k++) {
+            sky_tile *tile = &w->tiles[k];
+            if (tile->state == TILE_EXACT &&
+                (k == integrand.failed_tile ||
+                 (integrand.failed_tile == UINT32_MAX && tile->occluder_count)))
+                tile->state = TILE_SAMPLED;
+            any_exact = any_exact || tile->state == TILE_EXACT;
+        }
+    }
+    for (uint32_t k = 0; k < w->tile_count; k++) {
+        const sky_tile *tile = &w->tiles[k];
+        if (tile->state == TILE_EXACT) {
+            counts->exact_pairs += tile->occluder_count > 0;
+            continue;
+        }
+        counts->sampled_pairs++;
+        double quadrature_error;
+        double unobstructed = pair_unobstructed(p, &tile->polygon, 0.25 * c->accuracy, c->eps,
+                                                &quadrature_error);
+        if (!(unobstructed > 0))
+            continue;
+        double f0 = fmin(unobstructed / fmin(p->area, tile->polygon.area), 1);
+        /* the sky's own stream of random numbers: (seed, polygon, tile) */
+        uint64_t stream =
+            rad_mix64(c->seed ^ rad_mix64((0x736b79ull << 40) ^ ((uint64_t)pi << 32) ^ tile->id));
+        pair_visibility visibility;
+        pair_sample_visibility(p, &tile->polygon, c->tracer, c->accuracy / sqrt(f0),
+                               c->max_rays, stream, &w->pair, &visibility);
+        counts->rays += visibility.rays;
+        counts->capped_pairs += visibility.capped;
+        double b = quadrature_error + visibility.bound * unobstructed;
+        transfer += unobstructed * visibility.fraction;
+        variance += b * b;
+    }
+    *bound = sqrt(variance);
+    return transfer;
+}
+
+/* The box around every triangle of the scene, grown by SKY_MARGIN. */
+static void scene_box(const rad_scene *scene, sky_box *box)
+{
+    for (int a = 0; a < 3; a++)
+        box->lo[a] = INFINITY, box->hi[a] = -INFINITY;
+    for (uint32_t t = 0; t < scene->triangle_count; t++)
+        for (int k = 0; k < 3; k++) {
+            rad_vec3 x = scene->positions[scene->triangles[t].vertex[k]];
+            double c[3] = {x.x, x.y, x.z};
+            for (int a = 0; a < 3; a++) {
+                box->lo[a] = fmin(box->lo[a], c[a]);
+                box->hi[a] = fmax(box->hi[a], c[a]);
+            }
+        }
+    double d2 = 0;
+    for (int a = 0; a < 3; a++)
+        d2 += (box->hi[a] - box->lo[a]) * (box->hi[a] - box->lo[a]);
+    double margin = SKY_MARGIN * sqrt(d2) + 1e-9;
+    for (int a = 0; a < 3; a++)
+        box->lo[a] -= margin, box->hi[a] += margin;
+}
+
+rad_status rad_sky_viewfactors_compute(const rad_scene *scene,
+                                       const rad_viewfactor_options *options, double *sky,
+                                       double *bound, rad_sky_report *report, rad_error *error)
+{
+    rad_viewfactor_options defaults = {0};
+    if (!options)
+        options = &defaults;
+    if (options->threads < 0 || !(options->accuracy >= 0) || options->accuracy >= 1)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "sky view factors: threads must be >= 0 and accuracy in [0, 1)");
+    double start = rad_clock_seconds();
+    uint32_t n = scene->surface_count;
+    for (uint32_t I = 0; I < n; I++)
+        sky[I] = bound[I] = 0;
+    if (report)
+        memset(report, 0, sizeof(*report));
+    if (scene->triangle_count == 0)
+        return RAD_OK;
+    int threads = options->threads > 0 ? options->threads : omp_get_max_threads();
+    uint32_t max_rays = options->max_rays ? options->max_rays : RAD_DEFAULT_MAX_RAYS;
+    sky_box box;
+    scene_box(scene, &box);
+    sky_context c = {&box, NULL, NULL,
+                     options->accuracy > 0 ? options->accuracy : RAD_DEFAULT_ACCURACY, 0,
+                     max_rays < 64 ? 64 : max_rays, options->seed};
+    vf_geometry geometry;
+    occluder_tree *tree = NULL;
+    rad_tracer *tracer = NULL;
+    rad_status status = vf_geometry_build(scene, &geometry, error);
+    if (status != RAD_OK)
+        return status;
+    status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
+    if (status == RAD_OK)
+        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &tracer, error);
+    if (status != RAD_OK) {
+        occluder_tree_destroy(tree);
+        vf_geometry_free(&geometry);
+        return status;
+    }
+    c.tree = tree;
+    c.tracer = tracer;
+    c.eps = geometry.plane_epsilon;
+    sky_counts totals = {0};
+    bool out_of_memory = false;
+#pragma omp parallel num_threads(threads)
+    {
+        sky_counts counts = {0};
+        sky_workspace *w = rad_alloc_array(1, sizeof(*w));
+        vf_polygon *strips = rad_alloc_array(SKY_MAX_STRIPS, sizeof(*strips));
+        bool ready = w && strips && pair_workspace_init(&w->pair, c.max_rays);
+        if (!ready) {
+#pragma omp atomic write
+            out_of_memory = true;
+        }
+#pragma omp for schedule(dynamic, 1)
+        for (uint32_t I = 0; I < n; I++) {
+            const vf_surface *s = &geometry.surfaces[I];
+            if (!ready || s->polygon_count == 0 || !(s->area > 0))
+                continue;
+            double transfer = 0, variance = 0;
+            for (uint32_t k = 0; k < s->polygon_count; k++) {
+                uint32_t pi = s->first_polygon + k;
+                double b;
+                transfer += sky_polygon(&c, &geometry.polygons[pi], pi, w, strips, &counts, &b);
+                variance += b * b;
+            }
+            sky[I] = fmin(fmax(transfer / s->area, 0), 1);
+            bound[I] = sqrt(variance) / s->area;
+        }
+        if (w)
+            pair_workspace_free(&w->pair);
+        free(w);
+        free(strips);
+#pragma omp critical
+        {
+            totals.polygon_pairs += counts.polygon_pairs;
+            totals.obstructed_pairs += counts.obstructed_pairs;
+            totals.exact_pairs += counts.exact_pairs;
+            totals.sampled_pairs += counts.sampled_pairs;
+            totals.capped_pairs += counts.capped_pairs;
+            totals.rays += counts.rays;
+        }
+    }
+    rad_tracer_destroy(tracer);
+    occluder_tree_destroy(tree);
+    vf_geometry_free(&geometry);
+    if (out_of_memory)
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the sky view factors");
+    if (report) {
+        report->polygon_pairs = totals.polygon_pairs;
+        report->obstructed_pairs = totals.obstructed_pairs;
+        report->exact_pairs = totals.exact_pairs;
+        report->sampled_pairs = totals.sampled_pairs;
+        report->capped_pairs = totals.capped_pairs;
+        report->rays = totals.rays;
+        for (uint32_t I = 0; I < n; I++)
+            report->largest_error_bound = fmax(report->largest_error_bound, bound[I]);
+        report->seconds = rad_clock_seconds() - start;
+        report->threads = threads;
+    }
+    return RAD_OK;
+}
+
+void rad_sky_viewfactor_check(const rad_viewfactor_matrix *matrix, const rad_scene *scene,
+                              const double *sky, const double *bound, rad_sky_check *check)
+{
+    memset(check, 0, sizeof(*check));
+    check->worst_surface = UINT32_MAX;
+    for (uint32_t I = 0; I < matrix->n; I++) {
+        if ((scene->surfaces[I].flags & RAD_SURFACE_OBSTRUCTION) || !(matrix->area[I] > 0))
+            continue;
+        double sum = 0, variance = 0;
+        for (uint64_t k = matrix->row_start[I]; k < matrix->row_start[I + 1]; k++) {
+            sum += matrix->value[k];
+            variance += matrix->error_bound[k] * matrix->error_bound[k];
+        }
+        double deviation = fabs(sum + sky[I] - 1);
+        if (check->worst_surface == UINT32_MAX || deviation > check->largest_deviation) {
+            check->largest_deviation = deviation;
+            check->worst_surface = I;
+            check->worst_row_sum = sum;
+            check->worst_row_bound = sqrt(variance);
+            check->worst_sky_bound = bound[I];
+        }
+    }
+}
