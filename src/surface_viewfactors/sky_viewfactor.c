@@ -51,6 +51,12 @@
 #define SKY_WORK_BUDGET (1u << 20)
 #define SKY_MAX_DEPTH 8
 
+/* The integrand is the sky fraction plus this constant, subtracted again: the quadrature's
+ * relative tolerance then has an absolute floor of accuracy x SKY_FLOOR / 4, so a polygon
+ * that sees (almost) no sky, where clipping leaves slivers of 1e-12, does not refine
+ * forever. */
+#define SKY_FLOOR 0.01
+
 /* A polygon longer than this many times its mean width is cut into strips. */
 #define SKY_MAX_STRIPS 64u
 
@@ -174,14 +180,15 @@ static double sky_point(void *context, rad_vec3 x)
         const sky_tile *tile = &c->w->tiles[k];
         if (tile->state != TILE_EXACT)
             continue;
-        if (c->work_left < tile->occluder_count) {
+        uint32_t count = tile->occluder_count;
+        if (c->work_left < count) {
             c->failed = true;
             c->failed_tile = UINT32_MAX;
             break;
         }
-        c->work_left -= tile->occluder_count;
-        double f = shadow_visible_factor(x, c->normal, &tile->polygon, tile->occluders,
-                                         tile->occluder_count, c->plane_epsilon);
+        c->work_left -= count;
+        double f = shadow_visible_factor(x, c->normal, &tile->polygon, tile->occluders, count,
+                                         c->plane_epsilon);
         if (f < 0) {
             c->failed = true;
             c->failed_tile = k;
@@ -189,7 +196,7 @@ static double sky_point(void *context, rad_vec3 x)
         }
         sum += f;
     }
-    return sum;
+    return sum + SKY_FLOOR;
 }
 
 /* The convex polygon p cut into strips across its longest extent, each of aspect about 1:
@@ -271,7 +278,8 @@ static double sky_polygon(const sky_context *c, const vf_polygon *p, uint32_t pi
                                          &integrand.failed};
             double error;
             value += polygon_integrate(&integral, strips[s].vertex, strips[s].count,
-                                       0.25 * c->accuracy, &error);
+                                       0.25 * c->accuracy, &error) -
+                     SKY_FLOOR * strips[s].area;
             error2 += error * error;
         }
         if (!integrand.failed) {
@@ -337,9 +345,15 @@ static void scene_box(const rad_scene *scene, sky_box *box)
     double d2 = 0;
     for (int a = 0; a < 3; a++)
         d2 += (box->hi[a] - box->lo[a]) * (box->hi[a] - box->lo[a]);
+    /* uneven margins: no tile corner in a plane of symmetry of the scene, where a shadow's
+     * edge would pass exactly through it (shadow clipping can leave a sliver there) */
+    static const double unevenness[6] = {0.1458980, 0.3819660, 0.0901699,
+                                         0.2360680, 0.4721360, 0.0557281};
     double margin = SKY_MARGIN * sqrt(d2) + 1e-9;
-    for (int a = 0; a < 3; a++)
-        box->lo[a] -= margin, box->hi[a] += margin;
+    for (int a = 0; a < 3; a++) {
+        box->lo[a] -= margin * (1 + unevenness[2 * a]);
+        box->hi[a] += margin * (1 + unevenness[2 * a + 1]);
+    }
 }
 
 rad_status rad_sky_viewfactors_compute(const rad_scene *scene,
