@@ -45,10 +45,11 @@
 #define SKY_MAX_LEVEL 3u
 #define SKY_MAX_TILES (6u * 64u)
 
-/* Occluder clippings one strip's exact integrand may spend (about a quarter of a second)
- * before the polygon's obstructed tiles are sampled instead, and the deepest split of its
+/* Occluder clippings one strip's exact integrand may spend (a few milliseconds) before
+ * the polygon's obstructed tiles are sampled instead: where many shadows cross, the
+ * quadrature chases their edges and sampling is cheaper; and the deepest split of its
  * quadrature (4^8 cells of each fan triangle). */
-#define SKY_WORK_BUDGET (1u << 20)
+#define SKY_WORK_BUDGET (1u << 16)
 #define SKY_MAX_DEPTH 8
 
 /* The integrand is the sky fraction plus this constant, subtracted again: the quadrature's
@@ -135,29 +136,45 @@ typedef struct sky_context {
 } sky_context;
 
 /* The tiles of face `face` under (level, i, j) that p faces, split while they have too
- * many occluders. */
-static void add_tiles(const sky_context *c, const vf_polygon *p, sky_workspace *w,
-                      sky_counts *counts, unsigned face, unsigned level, unsigned i, unsigned j)
+ * many occluders; a tile whose children would all be sampled is sampled whole instead
+ * (sampling cost grows with the pairs, not with their size). Returns false when the
+ * subtree holds a tile to clip exactly. */
+static bool add_tiles(const sky_context *c, const vf_polygon *p, sky_workspace *w,
+                      unsigned face, unsigned level, unsigned i, unsigned j)
 {
-    sky_tile *tile = &w->tiles[w->tile_count];
+    uint32_t first = w->tile_count;
+    sky_tile *tile = &w->tiles[first];
     make_tile(c->box, face, level, i, j, &tile->polygon);
     const vf_polygon *t = &tile->polygon;
     if (!vf_polygon_in_front(t, p->normal, v3_dot(p->normal, p->vertex[0]), c->eps) ||
         !vf_polygon_in_front(p, t->normal, v3_dot(t->normal, t->vertex[0]), c->eps))
-        return;
+        return true;
     uint32_t count = occluder_tree_collect(c->tree, p, t, c->eps, tile->occluders,
                                            SKY_EXACT_MAX_OCCLUDERS);
-    if (count > SKY_EXACT_MAX_OCCLUDERS && level < SKY_MAX_LEVEL) {
-        for (unsigned k = 0; k < 4; k++)
-            add_tiles(c, p, w, counts, face, level + 1, 2 * i + k % 2, 2 * j + k / 2);
-        return;
-    }
-    counts->polygon_pairs++;
-    counts->obstructed_pairs += count > 0;
     tile->occluder_count = count;
-    tile->state = count <= SKY_EXACT_MAX_OCCLUDERS ? TILE_EXACT : TILE_SAMPLED;
     tile->id = (face << 24) | (level << 20) | (i << 10) | j;
+    if (count <= SKY_EXACT_MAX_OCCLUDERS) {
+        tile->state = TILE_EXACT;
+        w->tile_count++;
+        return false;
+    }
+    if (level < SKY_MAX_LEVEL) {
+        bool sampled = true;
+        for (unsigned k = 0; k < 4; k++)
+            sampled = add_tiles(c, p, w, face, level + 1, 2 * i + k % 2, 2 * j + k / 2) &&
+                      sampled;
+        if (!sampled)
+            return false;
+        /* none of them exact: this tile, sampled whole (rebuilt: the children overwrote
+         * its slot) */
+        w->tile_count = first;
+        make_tile(c->box, face, level, i, j, &tile->polygon);
+        tile->occluder_count = count;
+        tile->id = (face << 24) | (level << 20) | (i << 10) | j;
+    }
+    tile->state = TILE_SAMPLED;
     w->tile_count++;
+    return true;
 }
 
 /* The exact integrand: x on a strip of the polygon (normal n) to every TILE_EXACT tile, as
@@ -263,10 +280,13 @@ static double sky_polygon(const sky_context *c, const vf_polygon *p, uint32_t pi
 {
     w->tile_count = 0;
     for (unsigned face = 0; face < 6; face++)
-        add_tiles(c, p, w, counts, face, 0, 0, 0);
+        add_tiles(c, p, w, face, 0, 0, 0);
     bool any_exact = false;
-    for (uint32_t k = 0; k < w->tile_count; k++)
+    for (uint32_t k = 0; k < w->tile_count; k++) {
         any_exact = any_exact || w->tiles[k].state == TILE_EXACT;
+        counts->polygon_pairs++;
+        counts->obstructed_pairs += w->tiles[k].occluder_count > 0;
+    }
     double transfer = 0, variance = 0;
     unsigned strip_count = any_exact ? cut_strips(p, strips) : 0;
     while (any_exact) {
