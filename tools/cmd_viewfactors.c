@@ -143,7 +143,7 @@ static bool parse_repair_options(const cli_args *args, rad_row_repair_limits *li
  * = 1, printed. False with *error set. */
 static bool sky_view_factors(const rad_scene *scene, const rad_viewfactor_options *vf,
                              const rad_viewfactor_matrix *matrix, double **sky,
-                             rad_error *error)
+                             rad_sky_report *report, rad_sky_check *check, rad_error *error)
 {
     size_t S = scene->surface_count;
     *sky = rad_alloc_array(S ? 2 * S : 1, sizeof(double));
@@ -152,27 +152,26 @@ static bool sky_view_factors(const rad_scene *scene, const rad_viewfactor_option
                  scene->source, S);
         return false;
     }
-    rad_sky_report report;
     rad_viewfactor_options sky_options = *vf;
     sky_options.progress = NULL;
-    if (rad_sky_viewfactors_compute(scene, &sky_options, *sky, *sky + S, &report, error) != RAD_OK)
+    if (rad_sky_viewfactors_compute(scene, &sky_options, *sky, *sky + S, report, error) != RAD_OK)
         return false;
-    rad_sky_check check;
-    rad_sky_viewfactor_check(matrix, scene, *sky, *sky + S, &check);
+    rad_sky_viewfactor_check(matrix, scene, *sky, *sky + S, check);
     double accuracy = vf->accuracy > 0 ? vf->accuracy : RAD_DEFAULT_ACCURACY;
     cli_summary("sky view factors: %llu polygon-sky pairs (%llu obstructed: %llu exact, %llu "
                 "sampled, %llu reached --max-rays), largest bound %.3g, %.2f s",
-                (unsigned long long)report.polygon_pairs,
-                (unsigned long long)report.obstructed_pairs,
-                (unsigned long long)report.exact_pairs, (unsigned long long)report.sampled_pairs,
-                (unsigned long long)report.capped_pairs, report.largest_error_bound,
-                report.seconds);
-    if (check.worst_surface != UINT32_MAX)
+                (unsigned long long)report->polygon_pairs,
+                (unsigned long long)report->obstructed_pairs,
+                (unsigned long long)report->exact_pairs,
+                (unsigned long long)report->sampled_pairs,
+                (unsigned long long)report->capped_pairs, report->largest_error_bound,
+                report->seconds);
+    if (check->worst_surface != UINT32_MAX)
         cli_summary("sky view factors: largest |row sum + SVF - 1| %.3g (accuracy %.3g) at "
                     "'%s': row sum %.9f (bound %.3g), SVF %.9f (bound %.3g)",
-                    check.largest_deviation, accuracy, scene->surfaces[check.worst_surface].name,
-                    check.worst_row_sum, check.worst_row_bound, (*sky)[check.worst_surface],
-                    check.worst_sky_bound);
+                    check->largest_deviation, accuracy,
+                    scene->surfaces[check->worst_surface].name, check->worst_row_sum,
+                    check->worst_row_bound, (*sky)[check->worst_surface], check->worst_sky_bound);
     return true;
 }
 
@@ -283,6 +282,8 @@ int command_viewfactors(int argc, char **argv)
     rad_enclosure_report enclosure = {0};
     rad_row_repair_report repair = {0};
     double *sky = NULL;
+    rad_sky_report sky_report = {0};
+    rad_sky_check sky_check = {0};
     rad_vs3_control control = {0};
     bool is_vs3 = false;
     double t0 = rad_clock_seconds();
@@ -341,7 +342,7 @@ int command_viewfactors(int argc, char **argv)
         goto fail;
     }
 
-    if (sky_path && !sky_view_factors(scene, &vf, matrix, &sky, &error))
+    if (sky_path && !sky_view_factors(scene, &vf, matrix, &sky, &sky_report, &sky_check, &error))
         goto fail;
     if (is_vs3) {
         status = rad_viewfactor_matrix_apply_vs3_masks(args.positional[0], scene, &matrix, &error);
@@ -418,6 +419,12 @@ int command_viewfactors(int argc, char **argv)
                      enclosure.row_deviation_after);
     }
     stats_bool(&stats, "script_f", write.script_f);
+    if (sky_path) {
+        stats_number(&stats, "sky_seconds", sky_report.seconds);
+        stats_number(&stats, "sky_largest_error_bound", sky_report.largest_error_bound);
+        stats_number(&stats, "sky_row_sum_deviation", sky_check.largest_deviation);
+        stats_integer(&stats, "sky_sampled_pairs", sky_report.sampled_pairs);
+    }
     if (args.value[OPT_REPAIR_ROWS]) {
         stats_number(&stats, "repair_largest_change", repair.largest_change);
         stats_number(&stats, "repair_largest_relative_change", repair.largest_relative_change);

@@ -52,6 +52,9 @@
 #define SKY_WORK_BUDGET (1u << 16)
 #define SKY_MAX_DEPTH 8
 
+/* Occluders are cut this far (times the polygon's size) above its plane (lift_occluders). */
+#define SKY_LIFT 1e-6
+
 /* The integrand is the sky fraction plus this constant, subtracted again: the quadrature's
  * relative tolerance then has an absolute floor of accuracy x SKY_FLOOR / 4, so a polygon
  * that sees (almost) no sky, where clipping leaves slivers of 1e-12, does not refine
@@ -80,7 +83,7 @@ typedef struct sky_tile {
     uint32_t id; /* (face, level, i, j): its random stream */
     uint32_t occluder_count;
     uint8_t state;
-    shadow_occluder occluders[SKY_EXACT_MAX_OCCLUDERS];
+    shadow_occluder occluders[2 * SKY_EXACT_MAX_OCCLUDERS]; /* lifted: 2 triangles each */
 } sky_tile;
 
 /* Per thread: the tiles for the polygon at hand. */
@@ -135,6 +138,39 @@ typedef struct sky_context {
     uint64_t seed;
 } sky_context;
 
+/* Cuts away the part of each occluder within SKY_LIFT sqrt(A_p) of p's plane, in place
+ * (each becomes 0, 1 or 2 triangles); returns the new count. An occluder that touches p's
+ * plane (a wall standing on a floor) would otherwise reach the point's own height above a
+ * tile parallel to p and cast a shadow out to 1e9 times the scene, whose corners ruin the
+ * clipping's arithmetic (the quadrature then never settles). What is cut away blocks only
+ * rays that leave p at elevations below SKY_LIFT sqrt(A_p) / d from points at distance d
+ * from it: about SKY_LIFT / 2 of the SVF (the cosine-weighted share (e^2 / 2) averaged over
+ * p). */
+static uint32_t lift_occluders(const vf_polygon *p, shadow_occluder *occluders, uint32_t count)
+{
+    double offset = v3_dot(p->normal, p->vertex[0]) + SKY_LIFT * sqrt(p->area);
+    shadow_occluder kept[2 * SKY_EXACT_MAX_OCCLUDERS];
+    uint32_t made = 0;
+    for (uint32_t o = 0; o < count; o++) {
+        rad_vec3 out[4];
+        unsigned n = 0;
+        for (unsigned k = 0; k < 3; k++) {
+            rad_vec3 a = occluders[o].corner[k], b = occluders[o].corner[(k + 1) % 3];
+            double da = v3_dot(p->normal, a) - offset, db = v3_dot(p->normal, b) - offset;
+            if (da >= 0)
+                out[n++] = a;
+            if ((da > 0 && db < 0) || (da < 0 && db > 0))
+                out[n++] = v3_lerp(a, b, da / (da - db));
+        }
+        if (n >= 3)
+            kept[made++] = (shadow_occluder){{out[0], out[1], out[2]}};
+        if (n == 4)
+            kept[made++] = (shadow_occluder){{out[0], out[2], out[3]}};
+    }
+    memcpy(occluders, kept, made * sizeof(*kept));
+    return made;
+}
+
 /* The tiles of face `face` under (level, i, j) that p faces, split while they have too
  * many occluders; a tile whose children would all be sampled is sampled whole instead
  * (sampling cost grows with the pairs, not with their size). Returns false when the
@@ -154,6 +190,7 @@ static bool add_tiles(const sky_context *c, const vf_polygon *p, sky_workspace *
     tile->occluder_count = count;
     tile->id = (face << 24) | (level << 20) | (i << 10) | j;
     if (count <= SKY_EXACT_MAX_OCCLUDERS) {
+        tile->occluder_count = lift_occluders(p, tile->occluders, count);
         tile->state = TILE_EXACT;
         w->tile_count++;
         return false;
