@@ -16,7 +16,7 @@
  * together, as one point function over p (the sky fraction seen from x through them,
  * each tile's part exact by shadow clipping, shadow_clip.h), so that the kinks where one
  * tile's shadows cross its edge, which the neighbouring tile's cancel, do not make the
- * quadrature refine; a long polygon is cut into strips of aspect about 1 first. The
+ * quadrature refine; a long polygon is cut into strips of aspect about 2 first. The
  * tiles with too many occluders at the last level are sampled pair by pair as the
  * engine samples (pair_transfer.h: the unobstructed value times the visible fraction, to
  * accuracy x sqrt(F) or max_rays). No shortcut drops a pair as hidden. Error bounds add
@@ -61,7 +61,8 @@
  * forever. */
 #define SKY_FLOOR 0.01
 
-/* A polygon longer than this many times its mean width is cut into strips. */
+/* A polygon longer than twice its mean width is cut into strips of aspect about 2, at most
+ * this many. */
 #define SKY_MAX_STRIPS 64u
 
 /* The tiles' `source`: no scene triangle has it (obstructions have UINT32_MAX), so none is
@@ -266,7 +267,7 @@ static unsigned cut_strips(const vf_polygon *p, vf_polygon *strips)
                 longest = d, a = p->vertex[i], b = p->vertex[j];
         }
     double width = longest > 0 ? p->area / longest : 0;
-    unsigned n = width > 0 ? (unsigned)fmin(ceil(longest / width), SKY_MAX_STRIPS) : 1;
+    unsigned n = width > 0 ? (unsigned)fmin(ceil(0.5 * longest / width - 1e-9), SKY_MAX_STRIPS) : 1;
     if (n <= 1) {
         strips[0] = *p;
         return 1;
