@@ -970,6 +970,7 @@ typedef struct rad_row_repair_report {
     uint32_t largest_change_row, largest_change_column;
     double largest_change_before, largest_change_after; /* that factor's values */
     double largest_relative_change; /* max |F'_IJ - F_IJ| / F_IJ */
+    uint32_t largest_relative_row, largest_relative_column; /* its I and J */
     double removed_share;           /* (sum A_I F_IJ - sum A_I F'_IJ) / sum A_I F_IJ */
     double reciprocity_after;       /* max |A_I F_IJ - A_J F_JI| / max(A_I F_IJ, A_J F_JI) */
     uint32_t sweeps;

@@ -197,11 +197,10 @@ static bool repair_rows(const rad_scene *scene, rad_viewfactor_matrix *matrix,
     if (repair->refused == RAD_ROW_REPAIR_REFUSED_CHANGE)
         snprintf(error->message, sizeof(error->message),
                  "%s: --repair-rows refused: F from '%s' to '%s' would change by %.3g of its "
-                 "value (%.9g to %.9g), more than --repair-max-change %g; nothing written",
-                 scene->source, scene->surfaces[repair->largest_change_row].name,
-                 scene->surfaces[repair->largest_change_column].name,
-                 repair->largest_relative_change, repair->largest_change_before,
-                 repair->largest_change_after, limits->max_relative_change);
+                 "value, more than --repair-max-change %g; nothing written",
+                 scene->source, scene->surfaces[repair->largest_relative_row].name,
+                 scene->surfaces[repair->largest_relative_column].name,
+                 repair->largest_relative_change, limits->max_relative_change);
     else if (repair->refused == RAD_ROW_REPAIR_REFUSED_REMOVED)
         snprintf(error->message, sizeof(error->message),
                  "%s: --repair-rows refused: it would remove %.3g of the exchange, more than "

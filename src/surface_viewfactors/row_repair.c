@@ -145,9 +145,11 @@ rad_status rad_viewfactor_matrix_repair_rows(rad_viewfactor_matrix *matrix,
                 report->largest_change_before = m->value[k];
                 report->largest_change_after = repaired;
             }
-            if (m->value[k] > 0)
-                report->largest_relative_change =
-                    fmax(report->largest_relative_change, change / m->value[k]);
+            if (m->value[k] > 0 && change / m->value[k] > report->largest_relative_change) {
+                report->largest_relative_change = change / m->value[k];
+                report->largest_relative_row = I;
+                report->largest_relative_column = J;
+            }
         }
     report->removed_share = exchange > 0 ? removed / exchange : 0;
     double max_change = limits && limits->max_relative_change > 0 ? limits->max_relative_change

@@ -254,7 +254,7 @@ static double sky_point(void *context, rad_vec3 x)
     return sum + SKY_FLOOR;
 }
 
-/* The convex polygon p cut into strips across its longest extent, each of aspect about 1:
+/* The convex polygon p cut into strips across its longest extent, each of aspect about 2:
  * strips[] receives them (room for SKY_MAX_STRIPS); returns how many. */
 static unsigned cut_strips(const vf_polygon *p, vf_polygon *strips)
 {
