@@ -37,6 +37,7 @@
 #include "surface_viewfactors/occluder_tree.h"
 #include "surface_viewfactors/pair_transfer.h"
 #include "surface_viewfactors/vf_geometry.h"
+#include "trace/ray.h"
 
 /* A tile is clipped exactly when its hull with the polygon holds at most this many
  * triangles (a closed room's floor sees 10 others); otherwise it is split, down to
@@ -64,6 +65,13 @@
 /* A polygon longer than twice its mean width is cut into strips of aspect about 2, at most
  * this many. */
 #define SKY_MAX_STRIPS 64u
+
+/* Sampled sky: independent replicates, rays per polygon at most this many times max_rays,
+ * and how far above its point (along the polygon's normal) each ray starts, as a fraction
+ * of the box's diagonal (above the float rounding of the tracer's coordinates). */
+#define SKY_REPLICATES 8u
+#define SKY_RAY_FACTOR 16u
+#define SKY_RAY_OFFSET 1e-6
 
 /* The tiles' `source`: no scene triangle has it (obstructions have UINT32_MAX), so none is
  * excluded from the tiles' hulls. */
@@ -135,6 +143,7 @@ typedef struct sky_context {
     const occluder_tree *tree;
     const rad_tracer *tracer;
     double accuracy, eps;
+    double ray_offset; /* sampled rays start this far above their point (scene units) */
     uint32_t max_rays;
     uint64_t seed;
 } sky_context;
@@ -311,6 +320,123 @@ static unsigned cut_strips(const vf_polygon *p, vf_polygon *strips)
     return made;
 }
 
+/* A uniform point of the convex polygon from (s, t) in the unit square. */
+static rad_vec3 polygon_sample(const vf_polygon *p, double s, double t)
+{
+    unsigned k = 0;
+    while (k + 3 < p->count && s >= p->fan[k])
+        k++;
+    double low = k ? p->fan[k - 1] : 0, high = p->fan[k];
+    s = high > low ? (s - low) / (high - low) : 0;
+    double r = sqrt(fmin(fmax(s, 0), 1));
+    return v3_add(v3_add(v3_scale(p->vertex[0], 1 - r), v3_scale(p->vertex[k + 1], r * (1 - t))),
+                  v3_scale(p->vertex[k + 2], r * t));
+}
+
+/* The sampled tile the ray from x along d leaves the box through, or false. */
+static bool lands_on_sampled(const sky_context *c, const sky_workspace *w, rad_vec3 x,
+                             rad_vec3 d, rad_vec3 *exit)
+{
+    double o[3] = {x.x, x.y, x.z}, v[3] = {d.x, d.y, d.z}, t = INFINITY;
+    int axis = 0;
+    for (int a = 0; a < 3; a++) {
+        if (v[a] == 0)
+            continue;
+        double ta = ((v[a] > 0 ? c->box->hi[a] : c->box->lo[a]) - o[a]) / v[a];
+        if (ta < t)
+            t = ta, axis = a;
+    }
+    unsigned face = 2u * (unsigned)axis + (v[axis] > 0);
+    *exit = v3_add(x, v3_scale(d, t));
+    double y[3] = {exit->x, exit->y, exit->z};
+    int u = (axis + 1) % 3, vv = (axis + 2) % 3;
+    for (uint32_t k = 0; k < w->tile_count; k++) {
+        const sky_tile *tile = &w->tiles[k];
+        if (tile->state != TILE_SAMPLED || tile->id >> 24 != face)
+            continue;
+        unsigned level = (tile->id >> 20) & 15u, i = (tile->id >> 10) & 1023u, j = tile->id & 1023u;
+        double cells = (double)(1u << level);
+        double u0 = c->box->lo[u] + (c->box->hi[u] - c->box->lo[u]) * i / cells;
+        double u1 = c->box->lo[u] + (c->box->hi[u] - c->box->lo[u]) * (i + 1) / cells;
+        double v0 = c->box->lo[vv] + (c->box->hi[vv] - c->box->lo[vv]) * j / cells;
+        double v1 = c->box->lo[vv] + (c->box->hi[vv] - c->box->lo[vv]) * (j + 1) / cells;
+        if (y[u] >= u0 && y[u] <= u1 && y[vv] >= v0 && y[vv] <= v1)
+            return true;
+    }
+    return false;
+}
+
+/* The part of p's sky seen through its sampled tiles (share: their unobstructed F), by
+ * cosine-distributed rays from uniform points of p: a ray counts when it leaves the box
+ * through a sampled tile with nothing in its way. Sampling directions, not tile points,
+ * keeps the estimate's spread that of a coin toss however large the tiles are. The
+ * estimate is the mean of SKY_REPLICATES independent ones; its bound a 95 % Student t of
+ * their spread, or, when no ray escaped, the rule of three (3 / rays that landed, times
+ * the share). Rounds of twice the rays until the bound is accuracy x sqrt(share) or
+ * SKY_RAY_FACTOR x max_rays were cast. */
+static double sample_sky(const sky_context *c, const vf_polygon *p, uint32_t pi,
+                         sky_workspace *w, double share, sky_counts *counts, double *bound)
+{
+    rad_vec3 n = p->normal;
+    rad_vec3 t1 = v3_normalize(v3_cross(n, fabs(n.x) > 0.5 ? v3(0, 1, 0) : v3(1, 0, 0)));
+    rad_vec3 t2 = v3_cross(n, t1);
+    uint64_t escaped[SKY_REPLICATES] = {0}, cast[SKY_REPLICATES] = {0}, landed = 0;
+    uint64_t budget = (uint64_t)SKY_RAY_FACTOR * c->max_rays, total = 0;
+    double target = c->accuracy * sqrt(share), mean = 0;
+    uint32_t per_replicate = 16;
+    rad_vec3 exit;
+    for (unsigned round = 0;; round++, per_replicate *= 2) {
+        for (unsigned r = 0; r < SKY_REPLICATES; r++) {
+            rad_rng rng = rad_rng_seed(c->seed ^ 0x736b79u, ((uint64_t)pi << 8) | round, r);
+            for (uint32_t done = 0; done < per_replicate;) {
+                uint32_t batch = 0;
+                for (; done < per_replicate && batch < w->pair.capacity; done++) {
+                    rad_vec3 x = polygon_sample(p, rad_rng_uniform(&rng), rad_rng_uniform(&rng));
+                    double q = rad_rng_uniform(&rng), phi = 2 * RAD_PI * rad_rng_uniform(&rng);
+                    double radius = sqrt(q);
+                    rad_vec3 d = v3_add(v3_add(v3_scale(t1, radius * cos(phi)),
+                                               v3_scale(t2, radius * sin(phi))),
+                                        v3_scale(n, sqrt(1 - q)));
+                    cast[r]++;
+                    if (!lands_on_sampled(c, w, x, d, &exit))
+                        continue;
+                    /* lifted off p along its normal, not along the ray: a point
+                     * closer to a wall than the offset must not start beyond it */
+                    rad_vec3 start = v3_add(x, v3_scale(n, c->ray_offset));
+                    ray_set(&w->pair.rays[batch++], start, v3_sub(exit, start), 0, 1.0);
+                }
+                if (batch == 0)
+                    continue;
+                rad_tracer_occluded(c->tracer, w->pair.rays, batch, w->pair.occluded);
+                landed += batch;
+                for (uint32_t k = 0; k < batch; k++)
+                    escaped[r] += !w->pair.occluded[k];
+            }
+        }
+        total += (uint64_t)SKY_REPLICATES * per_replicate;
+        double estimate[SKY_REPLICATES], spread = 0;
+        uint64_t any = 0;
+        mean = 0;
+        for (unsigned r = 0; r < SKY_REPLICATES; r++) {
+            estimate[r] = (double)escaped[r] / (double)cast[r];
+            mean += estimate[r] / SKY_REPLICATES;
+            any += escaped[r];
+        }
+        for (unsigned r = 0; r < SKY_REPLICATES; r++)
+            spread += (estimate[r] - mean) * (estimate[r] - mean);
+        *bound = any ? PAIR_STUDENT_T * sqrt(spread / (SKY_REPLICATES - 1) / SKY_REPLICATES)
+                     : share * fmin(3.0 / (double)(landed ? landed : 1), 1);
+        if (*bound <= target)
+            break;
+        if (total + 2 * (uint64_t)SKY_REPLICATES * per_replicate > budget) {
+            counts->capped_pairs++;
+            break;
+        }
+    }
+    counts->rays += landed;
+    return fmin(mean, share);
+}
+
 /* The transfer from polygon p (index pi) to the sky, with its error bound in *bound. */
 static double sky_polygon(const sky_context *c, const vf_polygon *p, uint32_t pi,
                           sky_workspace *w, vf_polygon *strips, sky_counts *counts,
@@ -357,6 +483,7 @@ static double sky_polygon(const sky_context *c, const vf_polygon *p, uint32_t pi
             any_exact = any_exact || tile->state == TILE_EXACT;
         }
     }
+    double sampled_share = 0, share_error = 0; /* unobstructed F to the sampled tiles */
     for (uint32_t k = 0; k < w->tile_count; k++) {
         const sky_tile *tile = &w->tiles[k];
         if (tile->state == TILE_EXACT) {
@@ -365,22 +492,16 @@ static double sky_polygon(const sky_context *c, const vf_polygon *p, uint32_t pi
         }
         counts->sampled_pairs++;
         double quadrature_error;
-        double unobstructed = pair_unobstructed(p, &tile->polygon, 0.25 * c->accuracy, c->eps,
-                                                &quadrature_error);
-        if (!(unobstructed > 0))
-            continue;
-        double f0 = fmin(unobstructed / fmin(p->area, tile->polygon.area), 1);
-        /* the sky's own stream of random numbers: (seed, polygon, tile) */
-        uint64_t stream =
-            rad_mix64(c->seed ^ rad_mix64((0x736b79ull << 40) ^ ((uint64_t)pi << 32) ^ tile->id));
-        pair_visibility visibility;
-        pair_sample_visibility(p, &tile->polygon, c->tracer, c->accuracy / sqrt(f0),
-                               c->max_rays, stream, &w->pair, &visibility);
-        counts->rays += visibility.rays;
-        counts->capped_pairs += visibility.capped;
-        double b = quadrature_error + visibility.bound * unobstructed;
-        transfer += unobstructed * visibility.fraction;
-        variance += b * b;
+        sampled_share += pair_unobstructed(p, &tile->polygon, 0.25 * c->accuracy, c->eps,
+                                           &quadrature_error) / p->area;
+        share_error += quadrature_error / p->area;
+    }
+    if (sampled_share > 0) {
+        double sampled_bound;
+        double sampled = sample_sky(c, p, pi, w, fmin(sampled_share, 1), counts, &sampled_bound);
+        transfer += sampled * p->area;
+        variance += (sampled_bound + share_error) * p->area * (sampled_bound + share_error) *
+                    p->area;
     }
     *bound = sqrt(variance);
     return transfer;
@@ -437,7 +558,7 @@ rad_status rad_sky_viewfactors_compute(const rad_scene *scene,
     sky_box box;
     scene_box(scene, &box);
     sky_context c = {&box, NULL, NULL,
-                     options->accuracy > 0 ? options->accuracy : RAD_DEFAULT_ACCURACY, 0,
+                     options->accuracy > 0 ? options->accuracy : RAD_DEFAULT_ACCURACY, 0, 0,
                      max_rays < 64 ? 64 : max_rays, options->seed};
     vf_geometry geometry;
     occluder_tree *tree = NULL;
@@ -447,7 +568,7 @@ rad_status rad_sky_viewfactors_compute(const rad_scene *scene,
         return status;
     status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
     if (status == RAD_OK)
-        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &tracer, error);
+        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &tracer, error);
     if (status != RAD_OK) {
         occluder_tree_destroy(tree);
         vf_geometry_free(&geometry);
@@ -456,6 +577,9 @@ rad_status rad_sky_viewfactors_compute(const rad_scene *scene,
     c.tree = tree;
     c.tracer = tracer;
     c.eps = geometry.plane_epsilon;
+    c.ray_offset = SKY_RAY_OFFSET * sqrt((box.hi[0] - box.lo[0]) * (box.hi[0] - box.lo[0]) +
+                                         (box.hi[1] - box.lo[1]) * (box.hi[1] - box.lo[1]) +
+                                         (box.hi[2] - box.lo[2]) * (box.hi[2] - box.lo[2]));
     sky_counts totals = {0};
     bool out_of_memory = false;
 #pragma omp parallel num_threads(threads)
