@@ -902,18 +902,20 @@ rad_status rad_viewfactor_matrix_apply_vs3_masks(const char *path, rad_scene *sc
  * included), averaged over the surface; integrated directly, not taken as 1 - row sum.
  * The sky is an inward-facing box around the whole scene cut into 96 tiles that block
  * nothing; since nothing lies beyond it, the visible part of the box is exactly the sky
- * for any box that encloses the scene (no finite-distance error). SVF_I is the sum of
- * I's polygons' transfers to the tiles by the engine's methods: analytic where nothing
- * stands in between, exact shadow clipping behind up to 16 triangles, sampled visibility
- * behind more (to accuracy x sqrt(F), or max_rays), with no shortcut that drops a pair
- * as hidden. Its error bound adds the pairs' bounds in quadrature, as a row's do. */
+ * for any box that encloses the scene (no finite-distance error). SVF_I sums I's
+ * polygons' transfers to the tiles: analytic where nothing stands in between, exact
+ * shadow clipping (the tiles with up to 16 triangles in between integrated together by
+ * adaptive quadrature to `accuracy`), and through the other tiles cosine-distributed
+ * rays from the polygon (to accuracy x sqrt(their share), or 16 x max_rays a polygon),
+ * with no shortcut that drops anything as hidden. Its error bound adds the parts' bounds
+ * in quadrature, as a row's do. */
 typedef struct rad_sky_report {
     uint64_t polygon_pairs;    /* (polygon, sky tile) pairs that face each other */
     uint64_t obstructed_pairs; /* of those, pairs with a triangle in between */
     uint64_t exact_pairs;      /* of those, clipped exactly */
-    uint64_t sampled_pairs;    /* of those, sampled */
-    uint64_t capped_pairs;     /* sampled pairs that reached max_rays first */
-    uint64_t rays;
+    uint64_t sampled_pairs;    /* of those, sampled by rays */
+    uint64_t capped_pairs;     /* polygons whose rays reached 16 x max_rays first */
+    uint64_t rays;             /* rays that reached a sampled tile's direction, traced */
     double largest_error_bound; /* max_I of SVF_I's bound (absolute) */
     double seconds;
     int threads;

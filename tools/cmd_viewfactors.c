@@ -159,7 +159,7 @@ static bool sky_view_factors(const rad_scene *scene, const rad_viewfactor_option
     rad_sky_viewfactor_check(matrix, scene, *sky, *sky + S, check);
     double accuracy = vf->accuracy > 0 ? vf->accuracy : RAD_DEFAULT_ACCURACY;
     cli_summary("sky view factors: %llu polygon-sky pairs (%llu obstructed: %llu exact, %llu "
-                "sampled, %llu reached --max-rays), largest bound %.3g, %.2f s",
+                "sampled; %llu polygons reached 16 x --max-rays), largest bound %.3g, %.2f s",
                 (unsigned long long)report->polygon_pairs,
                 (unsigned long long)report->obstructed_pairs,
                 (unsigned long long)report->exact_pairs,

@@ -17,10 +17,10 @@
  * each tile's part exact by shadow clipping, shadow_clip.h), so that the kinks where one
  * tile's shadows cross its edge, which the neighbouring tile's cancel, do not make the
  * quadrature refine; a long polygon is cut into strips of aspect about 2 first. The
- * tiles with too many occluders at the last level are sampled pair by pair as the
- * engine samples (pair_transfer.h: the unobstructed value times the visible fraction, to
- * accuracy x sqrt(F) or max_rays). No shortcut drops a pair as hidden. Error bounds add
- * in quadrature, as in the matrix's rows.
+ * tiles with too many occluders at the last level (and a polygon's obstructed tiles when
+ * its exact integral does not settle within its work budget) are counted by
+ * cosine-distributed rays from the polygon (sample_sky). No shortcut drops anything as
+ * hidden. Error bounds add in quadrature, as in the matrix's rows.
  *
  * Not here: the matrix (viewfactor_matrix.c); the writer (sky_viewfactor_writer.c).
  */
