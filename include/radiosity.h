@@ -948,6 +948,98 @@ rad_status rad_viewfactor_matrix_apply_vs3_masks(const char *path, rad_scene *sc
                                                  rad_viewfactor_matrix **matrix,
                                                  rad_error *error);
 
+/* Sky view factors (open scenes): SVF_I, the fraction of surface I's cosine-weighted
+ * hemisphere from which a ray leaves the scene without meeting any triangle (obstructions
+ * included), averaged over the surface; integrated directly, not taken as 1 - row sum.
+ * The sky is an inward-facing box around the whole scene cut into 96 tiles that block
+ * nothing; since nothing lies beyond it, the visible part of the box is exactly the sky
+ * for any box that encloses the scene (no finite-distance error). SVF_I sums I's
+ * polygons' transfers to the tiles: analytic where nothing stands in between, exact
+ * shadow clipping (the tiles with up to 16 triangles in between integrated together by
+ * adaptive quadrature to `accuracy`), and through the other tiles cosine-distributed
+ * rays from the polygon (to accuracy x sqrt(their share), or 16 x max_rays a polygon),
+ * with no shortcut that drops anything as hidden. Its error bound adds the parts' bounds
+ * in quadrature, as a row's do. */
+typedef struct rad_sky_report {
+    uint64_t polygon_pairs;    /* (polygon, sky tile) pairs that face each other */
+    uint64_t obstructed_pairs; /* of those, pairs with a triangle in between */
+    uint64_t exact_pairs;      /* of those, clipped exactly */
+    uint64_t sampled_pairs;    /* of those, sampled by rays */
+    uint64_t capped_pairs;     /* polygons whose rays reached 16 x max_rays first */
+    uint64_t rays;             /* rays that reached a sampled tile's direction, traced */
+    double largest_error_bound; /* max_I of SVF_I's bound (absolute) */
+    double seconds;
+    int threads;
+} rad_sky_report;
+
+/* sky[I] and bound[I] for every surface I < scene->surface_count (0 and 0 for obstruction
+ * surfaces and surfaces without area). options as for rad_viewfactor_matrix_compute
+ * (accuracy, max_rays, seed, threads; no progress); the same for any thread count. Not
+ * collective: call it on one rank. report may be NULL. */
+rad_status rad_sky_viewfactors_compute(const rad_scene *scene,
+                                       const rad_viewfactor_options *options, double *sky,
+                                       double *bound, rad_sky_report *report,
+                                       rad_error *error);
+
+/* The consistency check: row sum + SVF = 1 for every radiating surface. */
+typedef struct rad_sky_check {
+    double largest_deviation; /* max_I |sum_J F_IJ + SVF_I - 1| */
+    uint32_t worst_surface;   /* its I (UINT32_MAX when there is no radiating surface) */
+    double worst_row_sum;     /* its row sum */
+    double worst_row_bound;   /* its row's error bound (the factors' in quadrature) */
+    double worst_sky_bound;   /* its SVF's bound */
+} rad_sky_check;
+
+void rad_sky_viewfactor_check(const rad_viewfactor_matrix *matrix, const rad_scene *scene,
+                              const double *sky, const double *bound, rad_sky_check *check);
+
+/* Writes sky[] and bound[] atomically: a path ending in .mtx gets a Matrix Market column
+ * vector ("%%MatrixMarket matrix array real general", "% sky K BOUND NAME" comments, "N 1",
+ * one value a line), the companion of a .mtx matrix; anything else CSV,
+ * "index,surface,sky_view_factor,error_bound". Both leave obstruction surfaces out and
+ * number the others from 1 as the matrix writers do. */
+rad_status rad_sky_viewfactors_write(const rad_scene *scene, const double *sky,
+                                     const double *bound, const char *path, rad_error *error);
+
+/* Row repair (open and closed scenes): trims the rows that sum above 1, keeping
+ * reciprocity. With G_IJ = A_I F_IJ (the mean of both directions where they differ) each
+ * surface gets a scale s_I in (0, 1], the fixed point of "row I sums to 1, or s_I = 1 if
+ * it then stays at or below 1" (Gauss-Seidel sweeps to 1e-15), and F'_IJ = s_I s_J G_IJ /
+ * A_I, so A_I F'_IJ = A_J F'_JI to rounding (about 1e-16 relative). Rows at or below 1
+ * change only through their neighbours' scales and never rise; curved surfaces' F_II
+ * scale by s_I^2. Limits: 0 = none. */
+typedef struct rad_row_repair_limits {
+    double max_relative_change; /* largest |F'_IJ - F_IJ| / F_IJ allowed */
+    double max_removed_share;   /* largest share of the exchange sum_IJ A_I F_IJ removed */
+} rad_row_repair_limits;
+
+enum { RAD_ROW_REPAIR_REFUSED_CHANGE = 1, RAD_ROW_REPAIR_REFUSED_REMOVED = 2 };
+
+typedef struct rad_row_repair_report {
+    uint32_t rows_above_one;        /* rows that summed above 1 before */
+    uint32_t rows_trimmed;          /* rows whose scale is below 1 */
+    double largest_row_sum_before, largest_row_sum_after;
+    double largest_change;          /* max |F'_IJ - F_IJ| (absolute) */
+    uint32_t largest_change_row, largest_change_column;
+    double largest_change_before, largest_change_after; /* that factor's values */
+    double largest_relative_change; /* max |F'_IJ - F_IJ| / F_IJ */
+    uint32_t largest_relative_row, largest_relative_column; /* its I and J */
+    double removed_share;           /* (sum A_I F_IJ - sum A_I F'_IJ) / sum A_I F_IJ */
+    double reciprocity_after;       /* max |A_I F_IJ - A_J F_JI| / max(A_I F_IJ, A_J F_JI) */
+    uint32_t sweeps;
+    int refused;                    /* 0, or RAD_ROW_REPAIR_REFUSED_* */
+} rad_row_repair_report;
+
+/* Repairs `matrix` in place (values only; areas, pattern and error bounds stay). Surfaces
+ * flagged RAD_SURFACE_OBSTRUCTION in `scene` (NULL: none) are left out. The report is
+ * filled before the limits are checked: past a limit, RAD_ERR_INVALID with the matrix
+ * untouched and report->refused set; also RAD_ERR_INVALID, untouched, when a non-zero
+ * F_IJ is stored without F_JI. */
+rad_status rad_viewfactor_matrix_repair_rows(rad_viewfactor_matrix *matrix,
+                                             const rad_scene *scene,
+                                             const rad_row_repair_limits *limits,
+                                             rad_row_repair_report *report, rad_error *error);
+
 /* ------------------------------------------------------------------------------------ */
 /* Solvers for (I - diag(rho) F) B = E                                                   */
 

@@ -46,6 +46,17 @@ static const char usage[] =
     CLI_STR(RAD_DEFAULT_ACCURACY) ")\n"
     "  --max-rays N         visibility rays per sampled polygon pair at most\n"
     "                       (default " CLI_STR(RAD_DEFAULT_MAX_RAYS) ")\n"
+    "  --sky-view-factor FILE  each surface's sky view factor (the share of its\n"
+    "                       hemisphere that sees no surface, integrated like the factors)\n"
+    "                       and its error bound: CSV, or a Matrix Market column for a\n"
+    "                       .mtx name; prints the largest |row sum + SVF - 1|\n"
+    "  --repair-rows        trim rows that sum above 1 keeping reciprocity (symmetric\n"
+    "                       scaling of A_i F_ij); reports the largest change, the share\n"
+    "                       of exchange removed and the reciprocity residual\n"
+    "  --repair-max-change R   refuse the repair (no output) when a factor would change\n"
+    "                       by more than R of its value (default 0.05)\n"
+    "  --repair-max-removed S  refuse it when it would remove more than S of the\n"
+    "                       exchange sum A_i F_ij (default 0.01)\n"
     "  --max-memory SIZE    bytes the whole run may hold (K, M, G): scene, occluders,\n"
     "                       per-thread buffers, matrix. Refused up front when the matrix's\n"
     "                       bound cannot fit (24 bytes per pair of surfaces that do not\n"
@@ -67,6 +78,7 @@ static const char usage[] =
 enum {
     OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_FORMAT, OPT_ENCLOSURE, OPT_SCRIPT_F,
     OPT_OBSTRUCTION, OPT_TWO_SIDED, OPT_CHECKPOINT, OPT_CHECKPOINT_INTERVAL, OPT_RESUME,
+    OPT_SKY_VIEW_FACTOR, OPT_REPAIR_ROWS, OPT_REPAIR_MAX_CHANGE, OPT_REPAIR_MAX_REMOVED,
     OPT_COUNT
 };
 
@@ -77,7 +89,11 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_OBSTRUCTION] = {"obstruction", 0, true}, [OPT_TWO_SIDED] = {"two-sided", 0, true},
     [OPT_MAX_MEMORY] = {"max-memory", 0, true}, [OPT_CHECKPOINT] = {"checkpoint", 0, true},
     [OPT_CHECKPOINT_INTERVAL] = {"checkpoint-interval", 0, true},
-    [OPT_RESUME] = {"resume", 0, true}, [OPT_PLOT] = {"plot", 0, true}};
+    [OPT_RESUME] = {"resume", 0, true}, [OPT_PLOT] = {"plot", 0, true},
+    [OPT_SKY_VIEW_FACTOR] = {"sky-view-factor", 0, true},
+    [OPT_REPAIR_ROWS] = {"repair-rows", 0, false},
+    [OPT_REPAIR_MAX_CHANGE] = {"repair-max-change", 0, true},
+    [OPT_REPAIR_MAX_REMOVED] = {"repair-max-removed", 0, true}};
 
 /* Seconds between checkpoints unless --checkpoint-interval says. */
 #define DEFAULT_CHECKPOINT_INTERVAL 600.0
@@ -112,6 +128,10 @@ static void progress_with_checkpoints(void *user, const char *phase, double frac
         stop_requested = 1;
 }
 
+/* --repair-rows' default limits (relative change of a factor, share of exchange). */
+#define REPAIR_MAX_CHANGE 0.05
+#define REPAIR_MAX_REMOVED 0.01
+
 /* --obstruction files at most; as many SCENE files (cli_args.positional). */
 #define MAX_FILES 256
 
@@ -137,6 +157,104 @@ static rad_status load_surfaces(const cli_args *args, rad_scene **scene,
     for (const char *path; (path = cli_next_value(args, OPT_OBSTRUCTION, &cursor));)
         files[count++] = (rad_scene_file){path, RAD_SURFACE_OBSTRUCTION, false};
     return rad_scene_load_files(files, count, &load, scene, error);
+}
+
+/* --repair-rows and its limits; false (after a message) on a usage error. */
+static bool parse_repair_options(const cli_args *args, rad_row_repair_limits *limits)
+{
+    const int limit_options[2] = {OPT_REPAIR_MAX_CHANGE, OPT_REPAIR_MAX_REMOVED};
+    double *limit_values[2] = {&limits->max_relative_change, &limits->max_removed_share};
+    for (int k = 0; k < 2; k++) {
+        const char *text = args->value[limit_options[k]], *name = options[limit_options[k]].name;
+        if (!text)
+            continue;
+        if (!args->value[OPT_REPAIR_ROWS]) {
+            cli_error("--%s: applies to --repair-rows only", name);
+            return false;
+        }
+        if (!cli_parse_double(name, text, limit_values[k]))
+            return false;
+        if (!(*limit_values[k] > 0 && *limit_values[k] <= 1)) {
+            cli_error("--%s: must be in (0, 1]", name);
+            return false;
+        }
+    }
+    if (args->value[OPT_REPAIR_ROWS] && args->value[OPT_ENCLOSURE]) {
+        cli_error("viewfactors: --repair-rows and --enclosure: choose one (--enclosure closes "
+                  "every row to 1, --repair-rows only trims rows above 1)");
+        return false;
+    }
+    return true;
+}
+
+/* The sky view factors (*sky: S values, then their S bounds) and the check row sum + SVF
+ * = 1, printed. False with *error set. */
+static bool sky_view_factors(const rad_scene *scene, const rad_viewfactor_options *vf,
+                             const rad_viewfactor_matrix *matrix, double **sky,
+                             rad_sky_report *report, rad_sky_check *check, rad_error *error)
+{
+    size_t S = scene->surface_count;
+    *sky = rad_alloc_array(S ? 2 * S : 1, sizeof(double));
+    if (!*sky) {
+        snprintf(error->message, sizeof(error->message), "%s: out of memory for %zu surfaces",
+                 scene->source, S);
+        return false;
+    }
+    rad_viewfactor_options sky_options = *vf;
+    sky_options.progress = NULL;
+    if (rad_sky_viewfactors_compute(scene, &sky_options, *sky, *sky + S, report, error) != RAD_OK)
+        return false;
+    rad_sky_viewfactor_check(matrix, scene, *sky, *sky + S, check);
+    double accuracy = vf->accuracy > 0 ? vf->accuracy : RAD_DEFAULT_ACCURACY;
+    cli_summary("sky view factors: %llu polygon-sky pairs (%llu obstructed: %llu exact, %llu "
+                "sampled; %llu polygons reached 16 x --max-rays), largest bound %.3g, %.2f s",
+                (unsigned long long)report->polygon_pairs,
+                (unsigned long long)report->obstructed_pairs,
+                (unsigned long long)report->exact_pairs,
+                (unsigned long long)report->sampled_pairs,
+                (unsigned long long)report->capped_pairs, report->largest_error_bound,
+                report->seconds);
+    if (check->worst_surface != UINT32_MAX)
+        cli_summary("sky view factors: largest |row sum + SVF - 1| %.3g (accuracy %.3g) at "
+                    "'%s': row sum %.9f (bound %.3g), SVF %.9f (bound %.3g)",
+                    check->largest_deviation, accuracy,
+                    scene->surfaces[check->worst_surface].name, check->worst_row_sum,
+                    check->worst_row_bound, (*sky)[check->worst_surface], check->worst_sky_bound);
+    return true;
+}
+
+/* --repair-rows: the repair and its report, or its refusal naming the limit's option. */
+static bool repair_rows(const rad_scene *scene, rad_viewfactor_matrix *matrix,
+                        const rad_row_repair_limits *limits, rad_row_repair_report *repair,
+                        rad_error *error)
+{
+    rad_status status = rad_viewfactor_matrix_repair_rows(matrix, scene, limits, repair, error);
+    if (status == RAD_OK) {
+        cli_summary("row repair: %u rows above 1 (largest sum %.9f, %.9f after), %u rows "
+                    "scaled; largest change of a factor %.3g ('%s' to '%s', %.9g to %.9g; "
+                    "largest relative %.3g); exchange removed %.3g; reciprocity residual %.2g",
+                    repair->rows_above_one, repair->largest_row_sum_before,
+                    repair->largest_row_sum_after, repair->rows_trimmed, repair->largest_change,
+                    scene->surfaces[repair->largest_change_row].name,
+                    scene->surfaces[repair->largest_change_column].name,
+                    repair->largest_change_before, repair->largest_change_after,
+                    repair->largest_relative_change, repair->removed_share,
+                    repair->reciprocity_after);
+        return true;
+    }
+    if (repair->refused == RAD_ROW_REPAIR_REFUSED_CHANGE)
+        snprintf(error->message, sizeof(error->message),
+                 "%s: --repair-rows refused: F from '%s' to '%s' would change by %.3g of its "
+                 "value, more than --repair-max-change %g; nothing written",
+                 scene->source, scene->surfaces[repair->largest_relative_row].name,
+                 scene->surfaces[repair->largest_relative_column].name,
+                 repair->largest_relative_change, limits->max_relative_change);
+    else if (repair->refused == RAD_ROW_REPAIR_REFUSED_REMOVED)
+        snprintf(error->message, sizeof(error->message),
+                 "%s: --repair-rows refused: it would remove %.3g of the exchange, more than "
+                 "--repair-max-removed %g; nothing written",
+                 scene->source, repair->removed_share, limits->max_removed_share);
+    return false;
 }
 
 int command_viewfactors(int argc, char **argv)
@@ -219,7 +337,12 @@ int command_viewfactors(int argc, char **argv)
     const char *plot_path = args.value[OPT_PLOT];
     if (!cli_convergence_paths_ok(plot_path, NULL))
         return EXIT_USAGE;
-    if (!cli_outputs_writable((const char *[]){output, stats_path, vf.checkpoint, plot_path}, 4))
+    const char *sky_path = args.value[OPT_SKY_VIEW_FACTOR];
+    rad_row_repair_limits repair_limits = {REPAIR_MAX_CHANGE, REPAIR_MAX_REMOVED};
+    if (!parse_repair_options(&args, &repair_limits))
+        return EXIT_USAGE;
+    if (!cli_outputs_writable(
+            (const char *[]){output, stats_path, vf.checkpoint, plot_path, sky_path}, 5))
         return EXIT_ERROR;
 
     rad_error error = {0};
@@ -228,6 +351,10 @@ int command_viewfactors(int argc, char **argv)
     double *emissivity = NULL;
     rad_viewfactor_report report = {0};
     rad_enclosure_report enclosure = {0};
+    rad_row_repair_report repair = {0};
+    double *sky = NULL;
+    rad_sky_report sky_report = {0};
+    rad_sky_check sky_check = {0};
     rad_vs3_control control = {0};
     bool is_vs3 = false;
     double t0 = rad_clock_seconds();
@@ -317,6 +444,8 @@ int command_viewfactors(int argc, char **argv)
         goto fail;
     }
 
+    if (sky_path && !sky_view_factors(scene, &vf, matrix, &sky, &sky_report, &sky_check, &error))
+        goto fail;
     if (is_vs3) {
         status = rad_viewfactor_matrix_apply_vs3_masks(args.positional[0], scene, &matrix, &error);
         if (status != RAD_OK)
@@ -335,6 +464,8 @@ int command_viewfactors(int argc, char **argv)
                     enclosure.largest_relative_change, enclosure.row_deviation_before,
                 enclosure.row_deviation_after, enclosure.reciprocity_after);
     }
+    if (args.value[OPT_REPAIR_ROWS] && !repair_rows(scene, matrix, &repair_limits, &repair, &error))
+        goto fail;
     if (write.script_f) {
         emissivity = rad_alloc_array(S ? S : 1, sizeof(*emissivity));
         if (!emissivity) {
@@ -352,6 +483,9 @@ int command_viewfactors(int argc, char **argv)
         matrix = exchange;
         cli_summary("script-F total exchange factors with the surfaces' emissivities");
     }
+    if (sky_path &&
+        rad_sky_viewfactors_write(scene, sky, sky + S, sky_path, &error) != RAD_OK)
+        goto fail;
     status = output ? rad_viewfactor_matrix_write(scene, matrix, output, &write, &error)
                     : rad_viewfactor_matrix_print(scene, matrix, stdout, &write, &error);
     if (status == RAD_OK)
@@ -389,6 +523,19 @@ int command_viewfactors(int argc, char **argv)
                      enclosure.row_deviation_after);
     }
     stats_bool(&stats, "script_f", write.script_f);
+    if (sky_path) {
+        stats_number(&stats, "sky_seconds", sky_report.seconds);
+        stats_number(&stats, "sky_largest_error_bound", sky_report.largest_error_bound);
+        stats_number(&stats, "sky_row_sum_deviation", sky_check.largest_deviation);
+        stats_integer(&stats, "sky_sampled_pairs", sky_report.sampled_pairs);
+    }
+    if (args.value[OPT_REPAIR_ROWS]) {
+        stats_number(&stats, "repair_largest_change", repair.largest_change);
+        stats_number(&stats, "repair_largest_relative_change", repair.largest_relative_change);
+        stats_number(&stats, "repair_removed_share", repair.removed_share);
+        stats_number(&stats, "repair_reciprocity_after", repair.reciprocity_after);
+        stats_integer(&stats, "repair_rows_trimmed", repair.rows_trimmed);
+    }
     if (rad_rank_count() > 1) {
         stats_integer(&stats, "ranks", (unsigned long long)rad_rank_count());
         stats_number(&stats, "load_imbalance", imbalance);
@@ -408,6 +555,7 @@ fail:
     exit_code = cli_ranks_failed(&error);
 done:
     rad_convergence_free(&plot.history);
+    free(sky);
     free(emissivity);
     rad_viewfactor_matrix_destroy(matrix);
     rad_scene_destroy(scene);
