@@ -46,6 +46,11 @@ static const char usage[] =
     CLI_STR(RAD_DEFAULT_ACCURACY) ")\n"
     "  --max-rays N         visibility rays per sampled polygon pair at most\n"
     "                       (default " CLI_STR(RAD_DEFAULT_MAX_RAYS) ")\n"
+    CLI_BASE_HELP("counts, times, invariants and error bounds");
+
+/* The rest of the help (one string may hold 4095 characters in C17), after the scene's. */
+static const char usage_more[] =
+    "\nSky, repair, memory and long runs:\n"
     "  --sky-view-factor FILE  each surface's sky view factor (the share of its\n"
     "                       hemisphere that sees no surface, integrated like the factors)\n"
     "                       and its error bound: CSV, or a Matrix Market column for a\n"
@@ -72,8 +77,7 @@ static const char usage[] =
     "                       one an uninterrupted run writes. Checkpoints go on to FILE\n"
     "                       unless --checkpoint names another\n"
     "  --plot FILE.svg      the fraction of polygon pairs left against time (log scale):\n"
-    "                       the computation's progress; it has no iteration to converge\n"
-    CLI_BASE_HELP("counts, times, invariants and error bounds");
+    "                       the computation's progress; it has no iteration to converge\n";
 
 enum {
     OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_FORMAT, OPT_ENCLOSURE, OPT_SCRIPT_F,
@@ -263,8 +267,11 @@ int command_viewfactors(int argc, char **argv)
     cli_shared shared;
     int exit_code;
     if (!cli_begin("viewfactors", usage, argc, argv, options, OPT_COUNT, &args, &shared,
-                   &exit_code))
+                   &exit_code)) {
+        if (exit_code == EXIT_OK && args.value[OPT_HELP])
+            fputs(usage_more, stdout);
         return exit_code;
+    }
     if (args.positional_count < 1) {
         cli_error("viewfactors: give a SCENE or mesh files (see 'radiosity viewfactors --help')");
         return EXIT_USAGE;
