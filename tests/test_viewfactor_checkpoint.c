@@ -57,16 +57,6 @@ static void write_blocks(const char *name, double shift)
     test_write_file(name, text);
 }
 
-static bool same_bytes(const char *a_path, const char *b_path)
-{
-    size_t a_size, b_size;
-    uint8_t *a = test_read_bytes(a_path, &a_size), *b = test_read_bytes(b_path, &b_size);
-    bool same = a && b && a_size == b_size && a_size > 0 && memcmp(a, b, a_size) == 0;
-    free(a);
-    free(b);
-    return same;
-}
-
 /* stderr is one line that contains `path` and `what`. */
 static void check_refusal(const char *what, const char *path)
 {
@@ -104,7 +94,7 @@ int main(void)
 
     /* resumed with one thread: the bytes of the uninterrupted run */
     CHECK(test_run_tool("viewfactors blocks.obj -o part.mtx --threads 1 --resume ck.bin") == 0);
-    CHECK(same_bytes(test_path("full.mtx"), test_path("part.mtx")));
+    CHECK(test_same_bytes(test_path("full.mtx"), test_path("part.mtx")));
     char resumed[64];
     snprintf(resumed, sizeof(resumed), "%ld of 96 rows were done", done);
     CHECK(strstr(test_read_text(test_path("stderr.txt")), resumed) != NULL);
@@ -144,7 +134,7 @@ int main(void)
     CHECK(!test_file_exists(test_path("other.mtx")));
     /* the refused runs left the checkpoint as it was: it still resumes */
     CHECK(test_run_tool("viewfactors blocks.obj -o again.mtx --resume ck.bin --quiet") == 0);
-    CHECK(same_bytes(test_path("full.mtx"), test_path("again.mtx")));
+    CHECK(test_same_bytes(test_path("full.mtx"), test_path("again.mtx")));
 
     CHECK(test_run_tool("viewfactors blocks.obj --checkpoint-interval 5") == 2);
     CHECK(test_run_tool("viewfactors blocks.obj --checkpoint ck2.bin --checkpoint-interval -1") ==

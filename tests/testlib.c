@@ -248,3 +248,13 @@ void test_solution_surface_means(const rad_scene *scene, const rad_mesh *mesh, c
             out->mean[s] = (rad_rgb){out->mean[s].r / area[s], out->mean[s].g / area[s],
                                      out->mean[s].b / area[s]};
 }
+
+bool test_same_bytes(const char *a_path, const char *b_path)
+{
+    size_t a_size, b_size;
+    uint8_t *a = test_read_bytes(a_path, &a_size), *b = test_read_bytes(b_path, &b_size);
+    bool same = a && b && a_size == b_size && a_size > 0 && memcmp(a, b, a_size) == 0;
+    free(a);
+    free(b);
+    return same;
+}

@@ -73,6 +73,9 @@ uint8_t *test_read_bytes(const char *path, size_t *size);
 
 bool test_file_exists(const char *path);
 
+/* True when both files can be read, are not empty and hold the same bytes. */
+bool test_same_bytes(const char *a_path, const char *b_path);
+
 /* A new black image (exits the test on failure), and pixel access. */
 rad_image *test_new_image(uint32_t width, uint32_t height);
 float *test_pixel(const rad_image *image, uint32_t x, uint32_t y);

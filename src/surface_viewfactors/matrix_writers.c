@@ -12,6 +12,7 @@
 #include "core/alloc.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "surface_viewfactors/surface_names.h"
 
 /* The version View3D's header names: the layout matches its 3.3 text output (SaveF0). */
 #define VIEW3D_VERSION "3.3"
@@ -23,26 +24,6 @@ rad_viewfactor_format rad_viewfactor_format_for_path(const char *path)
     size_t n = strlen(path);
     return n >= 4 && strcasecmp(path + n - 4, ".mtx") == 0 ? RAD_VIEWFACTOR_MATRIX_MARKET
                                                            : RAD_VIEWFACTOR_CSV;
-}
-
-static bool listed(const rad_scene *scene, uint32_t surface)
-{
-    return !(scene->surfaces[surface].flags & RAD_SURFACE_OBSTRUCTION);
-}
-
-static void write_name(FILE *f, const char *name)
-{
-    if (strpbrk(name, ",\"\n\r") == NULL) {
-        fputs(name, f);
-        return;
-    }
-    fputc('"', f);
-    for (; *name; name++) {
-        if (*name == '"')
-            fputc('"', f);
-        fputc(*name, f);
-    }
-    fputc('"', f);
 }
 
 /* Row I expanded into `dense` (n values). */
@@ -58,18 +39,18 @@ static void write_csv(const rad_scene *scene, const rad_viewfactor_matrix *m, do
 {
     fputs("surface", f);
     for (uint32_t J = 0; J < m->n; J++)
-        if (listed(scene, J)) {
+        if (vf_surface_listed(scene, J)) {
             fputc(',', f);
-            write_name(f, scene->surfaces[J].name);
+            vf_write_csv_name(f, scene->surfaces[J].name);
         }
     fputc('\n', f);
     for (uint32_t I = 0; I < m->n; I++) {
-        if (!listed(scene, I))
+        if (!vf_surface_listed(scene, I))
             continue;
         expand_row(m, I, dense);
-        write_name(f, scene->surfaces[I].name);
+        vf_write_csv_name(f, scene->surfaces[I].name);
         for (uint32_t J = 0; J < m->n; J++)
-            if (listed(scene, J))
+            if (vf_surface_listed(scene, J))
                 fprintf(f, ",%.9g", dense[J]);
         fputc('\n', f);
     }
@@ -81,7 +62,7 @@ static void write_matrix_market(const rad_scene *scene, const rad_viewfactor_mat
     uint32_t count = 0;
     uint64_t nonzeros = 0;
     for (uint32_t I = 0; I < m->n; I++)
-        number[I] = listed(scene, I) ? ++count : 0;
+        number[I] = vf_surface_listed(scene, I) ? ++count : 0;
     for (uint32_t I = 0; I < m->n; I++)
         for (uint64_t k = m->row_start[I]; number[I] && k < m->row_start[I + 1]; k++)
             nonzeros += number[m->column[k]] && m->value[k] != 0;
@@ -103,7 +84,7 @@ static void write_view3d(const rad_scene *scene, const rad_viewfactor_matrix *m,
 {
     uint32_t count = 0;
     for (uint32_t I = 0; I < m->n; I++)
-        count += listed(scene, I);
+        count += vf_surface_listed(scene, I);
     char header[64];
     int length = snprintf(header, sizeof(header), "View3D %s 0 %d %d %u", VIEW3D_VERSION,
                           options->enclosure ? 1 : 0, options->script_f ? 1 : 0, count);
@@ -111,18 +92,18 @@ static void write_view3d(const rad_scene *scene, const rad_viewfactor_matrix *m,
             "");
     const char *separator = "";
     for (uint32_t I = 0; I < m->n; I++)
-        if (listed(scene, I)) {
+        if (vf_surface_listed(scene, I)) {
             fprintf(f, "%s%g", separator, m->area[I]);
             separator = " ";
         }
     fputc('\n', f);
     for (uint32_t I = 0; I < m->n; I++) {
-        if (!listed(scene, I))
+        if (!vf_surface_listed(scene, I))
             continue;
         expand_row(m, I, dense);
         separator = "";
         for (uint32_t J = 0; J < m->n; J++)
-            if (listed(scene, J)) {
+            if (vf_surface_listed(scene, J)) {
                 fprintf(f, "%s%.6f", separator, dense[J]);
                 separator = " ";
             }
@@ -130,7 +111,7 @@ static void write_view3d(const rad_scene *scene, const rad_viewfactor_matrix *m,
     }
     separator = "";
     for (uint32_t I = 0; I < m->n; I++)
-        if (listed(scene, I)) {
+        if (vf_surface_listed(scene, I)) {
             fprintf(f, "%s%.3f", separator, scene->surfaces[I].emissivity);
             separator = " ";
         }

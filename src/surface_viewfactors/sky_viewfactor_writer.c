@@ -10,36 +10,17 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
-
-static bool listed(const rad_scene *scene, uint32_t surface)
-{
-    return !(scene->surfaces[surface].flags & RAD_SURFACE_OBSTRUCTION);
-}
-
-static void write_name(FILE *f, const char *name)
-{
-    if (strpbrk(name, ",\"\n\r") == NULL) {
-        fputs(name, f);
-        return;
-    }
-    fputc('"', f);
-    for (; *name; name++) {
-        if (*name == '"')
-            fputc('"', f);
-        fputc(*name, f);
-    }
-    fputc('"', f);
-}
+#include "surface_viewfactors/surface_names.h"
 
 static void write_csv(const rad_scene *scene, const double *sky, const double *bound, FILE *f)
 {
     fputs("index,surface,sky_view_factor,error_bound\n", f);
     uint32_t number = 0;
     for (uint32_t I = 0; I < scene->surface_count; I++) {
-        if (!listed(scene, I))
+        if (!vf_surface_listed(scene, I))
             continue;
         fprintf(f, "%u,", ++number);
-        write_name(f, scene->surfaces[I].name);
+        vf_write_csv_name(f, scene->surfaces[I].name);
         fprintf(f, ",%.9g,%.3g\n", sky[I], bound[I]);
     }
 }
@@ -49,7 +30,7 @@ static void write_matrix_market(const rad_scene *scene, const double *sky, const
 {
     uint32_t count = 0;
     for (uint32_t I = 0; I < scene->surface_count; I++)
-        count += listed(scene, I);
+        count += vf_surface_listed(scene, I);
     fputs("%%MatrixMarket matrix array real general\n", f);
     fputs("% sky view factors from radiosity viewfactors: row K is surface K of the view-factor "
           "matrix\n",
@@ -57,11 +38,11 @@ static void write_matrix_market(const rad_scene *scene, const double *sky, const
     fputs("% sky K ERROR_BOUND NAME\n", f);
     uint32_t number = 0;
     for (uint32_t I = 0; I < scene->surface_count; I++)
-        if (listed(scene, I))
+        if (vf_surface_listed(scene, I))
             fprintf(f, "%% sky %u %.3g %s\n", ++number, bound[I], scene->surfaces[I].name);
     fprintf(f, "%u 1\n", count);
     for (uint32_t I = 0; I < scene->surface_count; I++)
-        if (listed(scene, I))
+        if (vf_surface_listed(scene, I))
             fprintf(f, "%.17g\n", sky[I]);
 }
 

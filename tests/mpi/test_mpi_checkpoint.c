@@ -12,16 +12,6 @@
 
 #include "mpi_run.h"
 
-static bool same_bytes(const char *a_path, const char *b_path)
-{
-    size_t a_size, b_size;
-    uint8_t *a = test_read_bytes(a_path, &a_size), *b = test_read_bytes(b_path, &b_size);
-    bool same = a && b && a_size == b_size && a_size > 0 && memcmp(a, b, a_size) == 0;
-    free(a);
-    free(b);
-    return same;
-}
-
 /* The K of "FILE holds K of N rows" in the last run's stderr; -1 when missing. */
 static long rows_held(const char *file)
 {
@@ -61,7 +51,7 @@ int main(void)
         snprintf(arguments, sizeof(arguments), "viewfactors city.obj -o %s --threads 1 --resume %s",
                  name, checkpoint);
         CHECK(test_run_mpi(ranks, arguments, 0, NULL) == 0);
-        CHECK(same_bytes(test_path("serial.mtx"), test_path(name)));
+        CHECK(test_same_bytes(test_path("serial.mtx"), test_path(name)));
     }
 
     /* a 3-rank checkpoint, continued by 2 ranks (stopped again further on), then serially */
@@ -78,7 +68,7 @@ int main(void)
     CHECK(first > 0 && second > first && second < 384);
     CHECK(!test_file_exists(test_path("mixed.mtx")));
     CHECK(test_run_tool("viewfactors city.obj -o mixed.mtx --threads 2 --resume mixed.bin") == 0);
-    CHECK(same_bytes(test_path("serial.mtx"), test_path("mixed.mtx")));
+    CHECK(test_same_bytes(test_path("serial.mtx"), test_path("mixed.mtx")));
 
     /* a real SIGTERM once the first checkpoint exists (a 64th of the rows done; the rest
      * takes about a second): to the serial tool, which stops with status 130, and to
@@ -101,7 +91,7 @@ int main(void)
         CHECK(!test_file_exists(test_path("term.mtx")));
         CHECK(test_run_tool("viewfactors city.obj -o term.mtx --threads 2 --resume term.bin") ==
               0);
-        CHECK(same_bytes(test_path("serial.mtx"), test_path("term.mtx")));
+        CHECK(test_same_bytes(test_path("serial.mtx"), test_path("term.mtx")));
         remove(test_path("term.mtx"));
         remove(test_path("term.bin"));
     }

@@ -8,16 +8,6 @@
 
 #include "mpi_run.h"
 
-static bool same_bytes(const char *a_path, const char *b_path)
-{
-    size_t a_size, b_size;
-    uint8_t *a = test_read_bytes(a_path, &a_size), *b = test_read_bytes(b_path, &b_size);
-    bool same = a && b && a_size == b_size && a_size > 0 && memcmp(a, b, a_size) == 0;
-    free(a);
-    free(b);
-    return same;
-}
-
 int main(void)
 {
     const char *options = "--size 70x45 --spp 8";
@@ -32,8 +22,8 @@ int main(void)
         snprintf(arguments, sizeof(arguments),
                  "pathtrace -o %s --standard-error %s --threads 1 %s", image, error, options);
         CHECK(test_run_mpi(ranks, arguments, 0, NULL) == 0);
-        CHECK(same_bytes(test_path("serial.pfm"), test_path(image)));
-        CHECK(same_bytes(test_path("serial-se.pfm"), test_path(error)));
+        CHECK(test_same_bytes(test_path("serial.pfm"), test_path(image)));
+        CHECK(test_same_bytes(test_path("serial-se.pfm"), test_path(error)));
         const char *err = test_read_text(test_path("stderr.txt"));
         long long tiles = 0;
         for (int r = 0; r < ranks && ranks > 1; r++) {

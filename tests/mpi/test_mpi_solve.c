@@ -14,16 +14,6 @@
 
 #define PATCHES "--patch-size 60"
 
-static bool same_bytes(const char *a_path, const char *b_path)
-{
-    size_t a_size, b_size;
-    uint8_t *a = test_read_bytes(a_path, &a_size), *b = test_read_bytes(b_path, &b_size);
-    bool same = a && b && a_size == b_size && a_size > 0 && memcmp(a, b, a_size) == 0;
-    free(a);
-    free(b);
-    return same;
-}
-
 /* The integer after "KEY": in a --stats file; -1 when missing. */
 static long long stats_integer_of(const char *text, const char *key)
 {
@@ -69,7 +59,7 @@ int main(void)
         snprintf(arguments, sizeof(arguments),
                  "solve -o %s " PATCHES " --threads 1 --stats ranks.json", name);
         CHECK(test_run_mpi(ranks, arguments, 0, NULL) == 0);
-        CHECK(same_bytes(test_path("serial.ply"), test_path(name)));
+        CHECK(test_same_bytes(test_path("serial.ply"), test_path(name)));
         if (ranks > 1) {
             CHECK(rows_of_ranks(ranks) == patches);
             CHECK(stats_integer_of(test_read_text(test_path("ranks.json")), "ranks") == ranks);
@@ -78,16 +68,16 @@ int main(void)
         snprintf(arguments, sizeof(arguments), "render -o %s " PATCHES " --size 96x96 --threads 1",
                  name);
         CHECK(test_run_mpi(ranks, arguments, 0, NULL) == 0);
-        CHECK(same_bytes(test_path("serial.png"), test_path(name)));
+        CHECK(test_same_bytes(test_path("serial.png"), test_path(name)));
         if (ranks > 1)
             CHECK(rows_of_ranks(ranks) == patches);
     }
     CHECK(test_run_mpi(3, "solve -o gs.ply " PATCHES " --solver gauss-seidel --threads 1", 0,
                        NULL) == 0);
-    CHECK(same_bytes(test_path("serial-gs.ply"), test_path("gs.ply")));
+    CHECK(test_same_bytes(test_path("serial-gs.ply"), test_path("gs.ply")));
     CHECK(test_run_mpi(3, "solve -o h.ply " PATCHES " --solver hierarchical --threads 1", 0,
                        NULL) == 0);
-    CHECK(same_bytes(test_path("serial-h.ply"), test_path("h.ply")));
+    CHECK(test_same_bytes(test_path("serial-h.ply"), test_path("h.ply")));
     CHECK(strstr(test_read_text(test_path("stderr.txt")), "not shared over MPI ranks") != NULL);
     return test_finish("test_mpi_solve");
 }

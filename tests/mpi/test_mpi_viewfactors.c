@@ -18,16 +18,6 @@ static long long stats_integer_of(const char *text, const char *key)
     return at ? strtoll(at + strlen(quoted), NULL, 10) : -1;
 }
 
-static bool same_bytes(const char *a_path, const char *b_path)
-{
-    size_t a_size, b_size;
-    uint8_t *a = test_read_bytes(a_path, &a_size), *b = test_read_bytes(b_path, &b_size);
-    bool same = a && b && a_size == b_size && a_size > 0 && memcmp(a, b, a_size) == 0;
-    free(a);
-    free(b);
-    return same;
-}
-
 int main(void)
 {
     test_write_city(300, "city.obj");
@@ -48,7 +38,7 @@ int main(void)
         snprintf(name, sizeof(name), "ranks%d.mtx", ranks);
         snprintf(arguments, sizeof(arguments), "viewfactors city.obj -o %s --threads 1", name);
         CHECK(test_run_mpi(ranks, arguments, 0, NULL) == 0);
-        CHECK(same_bytes(test_path("serial.mtx"), test_path(name)));
+        CHECK(test_same_bytes(test_path("serial.mtx"), test_path(name)));
         const char *err = test_read_text(test_path("stderr.txt"));
         long long rows = 0;
         for (int r = 0; r < ranks && ranks > 1; r++) {
