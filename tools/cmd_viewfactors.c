@@ -9,6 +9,7 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "cli.h"
 #include "cli_ranks.h"
@@ -113,9 +114,12 @@ static void on_stop_signal(int signal_number)
 
 /* The progress of a checkpointed run: "checkpoint" reports are counted, not drawn. For
  * tests, RADIOSITY_STOP_AFTER_CHECKPOINTS=K acts as SIGTERM once K checkpoints are
- * written, so that a run can be interrupted at a known point without timing. */
+ * written, so that a run can be interrupted at a known point without timing, and
+ * RADIOSITY_WAIT_AFTER_CHECKPOINTS=K waits there (up to a minute) for a real SIGINT or
+ * SIGTERM, so that a test's signal always arrives mid-run. */
 typedef struct checkpoint_progress {
     long stop_after; /* 0: never */
+    long wait_after; /* 0: never */
     long written;
     rad_progress_fn next; /* gets every other report (the progress line, --plot) */
     void *next_user;
@@ -128,8 +132,12 @@ static void progress_with_checkpoints(void *user, const char *phase, double frac
         c->next(c->next_user, phase, fraction);
         return;
     }
-    if (c->stop_after > 0 && ++c->written >= c->stop_after)
+    c->written++;
+    if (c->stop_after > 0 && c->written >= c->stop_after)
         stop_requested = 1;
+    if (c->wait_after > 0 && c->written == c->wait_after)
+        for (int k = 0; k < 6000 && !stop_requested; k++)
+            nanosleep(&(struct timespec){0, 10000000}, NULL);
 }
 
 /* --repair-rows' default limits (relative change of a factor, share of exchange). */
@@ -320,10 +328,13 @@ int command_viewfactors(int argc, char **argv)
             return EXIT_USAGE;
         }
     }
-    checkpoint_progress checkpoints = {0, 0, NULL, NULL};
+    checkpoint_progress checkpoints = {0, 0, 0, NULL, NULL};
     const char *stop_after = getenv("RADIOSITY_STOP_AFTER_CHECKPOINTS");
     if (stop_after)
         checkpoints.stop_after = strtol(stop_after, NULL, 10);
+    const char *wait_after = getenv("RADIOSITY_WAIT_AFTER_CHECKPOINTS");
+    if (wait_after)
+        checkpoints.wait_after = strtol(wait_after, NULL, 10);
     const char *output = shared.output, *stats_path = shared.stats_path;
     rad_viewfactor_write_options write = {RAD_VIEWFACTOR_CSV, false, false};
     if (output)

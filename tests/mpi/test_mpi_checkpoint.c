@@ -70,14 +70,15 @@ int main(void)
     CHECK(test_run_tool("viewfactors city.obj -o mixed.mtx --threads 2 --resume mixed.bin") == 0);
     CHECK(test_same_bytes(test_path("serial.mtx"), test_path("mixed.mtx")));
 
-    /* a real SIGTERM once the first checkpoint exists (a 64th of the rows done; the rest
-     * takes about a second): to the serial tool, which stops with status 130, and to
-     * mpirun, which passes it to its 3 ranks (mpirun itself then ends non-zero); either
-     * checkpoint resumes to the serial matrix */
+    /* a real SIGTERM once the first checkpoint exists (a 64th of the rows done; the run
+     * waits there for it: RADIOSITY_WAIT_AFTER_CHECKPOINTS): to the serial tool, which
+     * stops with status 130, and to mpirun, which passes it to its 3 ranks (mpirun
+     * itself then ends non-zero); either checkpoint resumes to the serial matrix */
     for (int ranks = 0; ranks <= 3; ranks += 3) {
         char command[8000];
         snprintf(command, sizeof(command),
-                 "cd '%s' && sh -c \"%s%s%s '%s' viewfactors city.obj -o term.mtx --threads %d "
+                 "cd '%s' && RADIOSITY_WAIT_AFTER_CHECKPOINTS=1 sh -c \"%s%s%s '%s' viewfactors "
+                 "city.obj -o term.mtx --threads %d "
                  "--checkpoint term.bin --checkpoint-interval 0 & pid=\\$!; "
                  "while [ ! -e term.bin ]; do sleep 0.01; done; kill -TERM \\$pid; "
                  "wait \\$pid\" >'%s' 2>'%s' </dev/null",
