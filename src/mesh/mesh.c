@@ -604,8 +604,9 @@ rad_status rad_mesh_build_with(const rad_scene *scene, const rad_mesh_options *o
     if (result.patch_count > MESH_MAX_PATCHES) {
         free(first_patch);
         status = rad_fail(error, RAD_ERR_INVALID,
-                          "the shadow refinement made %zu patches (limit %u): use a larger "
-                          "--patch-size or fewer --shadow-levels",
+                          "the shadow and proximity refinements made %zu patches (limit "
+                          "%u): use a larger --patch-size or fewer --shadow-levels or "
+                          "--proximity-levels",
                           result.patch_count, MESH_MAX_PATCHES);
         goto done;
     }
