@@ -10,30 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "closed_forms.h"
 #include "testlib.h"
-
-static const double pi = 3.14159265358979323846;
-
-static double parallel_rectangles(double a, double b, double c)
-{
-    double X = a / c, Y = b / c;
-    return 2 / (pi * X * Y) *
-           (log(sqrt((1 + X * X) * (1 + Y * Y) / (1 + X * X + Y * Y))) +
-            X * sqrt(1 + Y * Y) * atan(X / sqrt(1 + Y * Y)) +
-            Y * sqrt(1 + X * X) * atan(Y / sqrt(1 + X * X)) - X * atan(X) - Y * atan(Y));
-}
-
-/* surface 1 is w x l, surface 2 is h x l, common edge l */
-static double perpendicular_rectangles(double w, double h, double l)
-{
-    double W = w / l, H = h / l, W2 = W * W, H2 = H * H;
-    double a = (1 + W2) * (1 + H2) / (1 + W2 + H2);
-    double b = pow(W2 * (1 + W2 + H2) / ((1 + W2) * (W2 + H2)), W2);
-    double c = pow(H2 * (1 + W2 + H2) / ((1 + H2) * (W2 + H2)), H2);
-    return 1 / (pi * W) *
-           (W * atan(1 / W) + H * atan(1 / H) - sqrt(H2 + W2) * atan(1 / sqrt(H2 + W2)) +
-            0.25 * log(a * b * c));
-}
 
 /* Appends a quad "o NAME" with corners p0..p3 (counter-clockwise seen from the front). */
 static void add_quad(char *obj, size_t size, int *vertices, const char *name, const double p[4][3])
