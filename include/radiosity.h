@@ -1321,6 +1321,17 @@ rad_status rad_convergence_plot_write(const rad_convergence *history, const char
                                       const rad_convergence_plot_options *options,
                                       rad_error *error);
 
+/* Several runs on the same axes (`radiosity plot`): the relative residual of each of the
+ * `runs` histories as its own <path class="residual" data-run="K"> in its own colour,
+ * named in the legend by names[K] (e.g. the solver), with no criterion curves and no
+ * phase lines; otherwise as rad_convergence_plot_write (criterion_label and residual
+ * are ignored). RAD_ERR_INVALID when a history is empty or there is none. */
+rad_status rad_convergence_plot_compare(const rad_convergence *histories,
+                                        const char *const *names, size_t runs,
+                                        const char *path,
+                                        const rad_convergence_plot_options *options,
+                                        rad_error *error);
+
 /* A record of a solve's snapshots, streamed to its file as they come (memory: one
  * snapshot's text, about 16 n bytes), as JSON:
  *   {"format":"radiosity-record","version":1,"scene":S,"solver":V,"patches":n,

@@ -436,6 +436,63 @@ static void check_bad_options(void)
     CHECK(test_count_files("x.ply") == 0);
 }
 
+/* `radiosity plot`: two solvers' records on one plot, a curve each (data-run K), each
+ * ending at its record's last residual; bad input refused with one line, nothing
+ * written. */
+static void check_compare(bool xml)
+{
+    const char *solvers[2] = {"gather", "shoot"};
+    for (int k = 0; k < 2; k++) {
+        char command[256];
+        snprintf(command, sizeof(command),
+                 "solve --solver %s --patch-size 120 -o c-%s.ply --record c-%s.json --quiet",
+                 solvers[k], solvers[k], solvers[k]);
+        CHECK(test_run_tool(command) == 0);
+    }
+    CHECK(test_run_tool("plot c-gather.json c-shoot.json -o compare.svg --quiet") == 0);
+    if (xml) {
+        const char *svg = test_path("compare.svg");
+        char command[1024];
+        snprintf(command, sizeof(command), "xmllint --noout '%s'", svg);
+        CHECK(system(command) == 0);
+        axes a = read_axes(svg, "steps");
+        CHECK(a.ok);
+        for (int k = 0; k < 2 && a.ok; k++) {
+            char file[64], xpath[256];
+            snprintf(file, sizeof(file), "c-%s.json", solvers[k]);
+            cJSON *record = read_json(file);
+            const cJSON *snapshots = cJSON_GetObjectItemCaseSensitive(record, "snapshots");
+            int count = cJSON_GetArraySize(snapshots);
+            snprintf(xpath, sizeof(xpath),
+                     "//*[local-name()='g'][@id='steps']/*[local-name()='path'][@data-run='%d']/@d",
+                     k);
+            const char *d = xpath_string(svg, xpath);
+            double last_x = NAN, last_y = NAN;
+            int points = 0;
+            for (const char *c = d; *c; c++)
+                if ((*c == 'M' || *c == 'L') && sscanf(c + 1, "%lf,%lf", &last_x, &last_y) == 2)
+                    points++;
+            CHECK(points == count);
+            const cJSON *last = cJSON_GetArrayItem(snapshots, count - 1);
+            CHECK_NEAR(axis_y(&a, last_y), json_number(last, "residual"), 1e-3);
+            CHECK_NEAR(axis_x(&a, last_x), json_number(last, "step"), 1e-3);
+            cJSON_Delete(record);
+            snprintf(xpath, sizeof(xpath), "(//*[local-name()='text'][@class='legend'])[%d]",
+                     k + 1);
+            const char *name = xpath_string(svg, xpath);
+            size_t length = strlen(solvers[k]);
+            CHECK(strncmp(name, solvers[k], length) == 0 &&
+                  (name[length] == '\0' || name[length] == '\n'));
+        }
+    }
+    test_write_file("not-a-record.json", "{\"format\": \"something else\"}\n");
+    CHECK(test_run_tool("plot c-gather.json not-a-record.json -o refused.svg") == 1);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "not-a-record.json") != NULL);
+    CHECK(test_count_files("refused") == 0);
+    CHECK(test_run_tool("plot c-gather.json") == 2);       /* no -o */
+    CHECK(test_run_tool("plot c-gather.json -o c.png") == 2); /* not an SVG */
+}
+
 int main(void)
 {
     test_tmpdir();
@@ -449,5 +506,6 @@ int main(void)
     check_viewfactors(xml);
     check_threads();
     check_bad_options();
+    check_compare(xml);
     return test_finish("test_convergence_outputs");
 }

@@ -550,5 +550,6 @@ int command_compare(int argc, char **argv);
 int command_info(int argc, char **argv);
 int command_illuminance(int argc, char **argv);
 int command_view(int argc, char **argv);
+int command_plot(int argc, char **argv);
 
 #endif

@@ -24,6 +24,7 @@ static const char usage[] =
     "  info [SCENE]              what was read: surfaces, materials, emitters, camera\n"
     "  view [SCENE|LIT.glb]      an HTML page showing the lit mesh in a browser (a build\n"
     "                            with -DRAD_VIEWER=ON)\n"
+    "  plot RECORD.json...       the recorded solves' convergence on one plot (SVG)\n"
     "  help [COMMAND]            this text, or a command's\n"
     "\n"
     "'radiosity COMMAND --help' tells a command's options.\n";
@@ -39,6 +40,7 @@ static const command commands[] = {
     {"raytrace", command_raytrace}, {"pathtrace", command_pathtrace},
     {"compare", command_compare},   {"info", command_info},
     {"illuminance", command_illuminance}, {"view", command_view},
+    {"plot", command_plot},
 };
 
 static const command *find_command(const char *name)

@@ -1,7 +1,7 @@
 /*
  * convergence_plot.c - rad_convergence_plot_write: a convergence history as a standalone
  * SVG (log y with decade ticks, linear x, one panel against the steps and one against
- * time). It draws what it is given and computes nothing about the solve; the history
+ * time); rad_convergence_plot_compare: several runs' residuals on the same axes. It draws what it is given and computes nothing about the solve; the history
  * comes from convergence_history.c. The text is built in memory and written atomically.
  */
 #include <math.h>
@@ -186,30 +186,42 @@ static void put_curve(svg_text *t, const panel *p, const rad_convergence *h, siz
     }
 }
 
-rad_status rad_convergence_plot_write(const rad_convergence *history, const char *path,
-                                      const rad_convergence_plot_options *options,
-                                      rad_error *error)
+/* Colours of the compared runs' curves, in order (then again). */
+static const char *const run_colour[] = {"#1f5fbf", "#d9730d", "#2a9d3a", "#b8307a",
+                                         "#6b4fbf", "#7f7f1f"};
+#define RUN_COLOURS (sizeof(run_colour) / sizeof(run_colour[0]))
+
+/* One history with its residual and criterion (names NULL), or several runs' residuals,
+ * each named in the legend (names given). */
+static rad_status plot_write(const rad_convergence *histories, const char *const *names,
+                             size_t runs, const char *path,
+                             const rad_convergence_plot_options *options, rad_error *error)
 {
-    if (!history || history->count == 0)
+    for (size_t r = 0; r < runs; r++)
+        if (histories[r].count == 0)
+            return rad_fail(error, RAD_ERR_INVALID, "%s: no steps to plot", path);
+    if (runs == 0)
         return rad_fail(error, RAD_ERR_INVALID, "%s: no steps to plot", path);
     rad_convergence_plot_options none = {0};
     const rad_convergence_plot_options *o = options ? options : &none;
     const char *y_label = o->y_label ? o->y_label : "relative to the emitted power sum A |E| (1)";
+    bool residual = o->residual || names, criterion = o->criterion_label && !names;
 
     /* y range: the decades around every drawn positive value */
     double lo = INFINITY, hi = 0, steps = 0, seconds = 0;
-    for (size_t i = 0; i < history->count; i++) {
-        const rad_convergence_point *q = &history->points[i];
-        double v[2] = {o->residual ? q->residual : NAN, o->criterion_label ? q->criterion : NAN};
-        for (int k = 0; k < 2; k++)
-            if (v[k] > 0 && isfinite(v[k])) {
-                lo = fmin(lo, v[k]);
-                hi = fmax(hi, v[k]);
-            }
-        steps = fmax(steps, q->step);
-        if (isfinite(q->seconds))
-            seconds = fmax(seconds, q->seconds);
-    }
+    for (size_t r = 0; r < runs; r++)
+        for (size_t i = 0; i < histories[r].count; i++) {
+            const rad_convergence_point *q = &histories[r].points[i];
+            double v[2] = {residual ? q->residual : NAN, criterion ? q->criterion : NAN};
+            for (int k = 0; k < 2; k++)
+                if (v[k] > 0 && isfinite(v[k])) {
+                    lo = fmin(lo, v[k]);
+                    hi = fmax(hi, v[k]);
+                }
+            steps = fmax(steps, q->step);
+            if (isfinite(q->seconds))
+                seconds = fmax(seconds, q->seconds);
+        }
     int decade_lo = -1, decade_hi = 0; /* nothing positive: an empty frame */
     if (hi > 0) {
         /* a value a rounding error above a power of ten (an unshot fraction of 1) does not
@@ -245,13 +257,23 @@ rad_status rad_convergence_plot_write(const rad_convergence *history, const char
     put(&t, "</text>\n");
     /* legend */
     double lx = PLOT_LEFT;
-    if (o->residual) {
+    for (size_t r = 0; names && r < runs; r++) {
+        double ly = 50 + 16.0 * (double)(r / 3);
+        double at = lx + 215.0 * (double)(r % 3);
+        put(&t, "<line x1=\"%.0f\" y1=\"%.0f\" x2=\"%.0f\" y2=\"%.0f\" stroke=\"%s\" "
+                "stroke-width=\"2\"/><text class=\"legend\" x=\"%.0f\" y=\"%.0f\" "
+                "font-size=\"12\">", at, ly, at + 28, ly, run_colour[r % RUN_COLOURS], at + 34,
+            ly + 4);
+        put_escaped(&t, names[r]);
+        put(&t, "</text>\n");
+    }
+    if (residual && !names) {
         put(&t, "<line x1=\"%.0f\" y1=\"50\" x2=\"%.0f\" y2=\"50\" stroke=\"#1f5fbf\" "
                 "stroke-width=\"2\"/><text x=\"%.0f\" y=\"54\" font-size=\"12\">relative "
                 "residual</text>\n", lx, lx + 28, lx + 34);
         lx += 190;
     }
-    if (o->criterion_label) {
+    if (criterion) {
         put(&t, "<line x1=\"%.0f\" y1=\"50\" x2=\"%.0f\" y2=\"50\" stroke=\"#d9730d\" "
                 "stroke-width=\"2\" stroke-dasharray=\"6 3\"/><text x=\"%.0f\" y=\"54\" "
                 "font-size=\"12\">", lx, lx + 28, lx + 34);
@@ -262,14 +284,19 @@ rad_status rad_convergence_plot_write(const rad_convergence *history, const char
         const panel *p = &panels[k];
         bool by_time = strcmp(p->id, "time") == 0;
         put_axes(&t, p, y_label);
-        put_phases(&t, p, history, by_time);
-        if (o->criterion_label)
-            put_curve(&t, p, history, offsetof(rad_convergence_point, criterion), by_time,
+        if (!names)
+            put_phases(&t, p, &histories[0], by_time);
+        if (criterion)
+            put_curve(&t, p, &histories[0], offsetof(rad_convergence_point, criterion), by_time,
                       "criterion",
                       "stroke=\"#d9730d\" stroke-width=\"2\" stroke-dasharray=\"6 3\"");
-        if (o->residual)
-            put_curve(&t, p, history, offsetof(rad_convergence_point, residual), by_time,
-                      "residual", "stroke=\"#1f5fbf\" stroke-width=\"2\"");
+        for (size_t r = 0; residual && r < runs; r++) {
+            char style[96];
+            snprintf(style, sizeof(style), "stroke=\"%s\" stroke-width=\"2\" data-run=\"%zu\"",
+                     names ? run_colour[r % RUN_COLOURS] : "#1f5fbf", r);
+            put_curve(&t, p, &histories[r], offsetof(rad_convergence_point, residual), by_time,
+                      "residual", style);
+        }
         put(&t, "</g>\n");
     }
     put(&t, "</svg>\n");
@@ -280,4 +307,24 @@ rad_status rad_convergence_plot_write(const rad_convergence *history, const char
     rad_status status = rad_write_file_atomic(path, t.data, t.length, error);
     free(t.data);
     return status;
+}
+
+rad_status rad_convergence_plot_write(const rad_convergence *history, const char *path,
+                                      const rad_convergence_plot_options *options,
+                                      rad_error *error)
+{
+    if (!history)
+        return rad_fail(error, RAD_ERR_INVALID, "%s: no steps to plot", path);
+    return plot_write(history, NULL, 1, path, options, error);
+}
+
+rad_status rad_convergence_plot_compare(const rad_convergence *histories,
+                                        const char *const *names, size_t runs,
+                                        const char *path,
+                                        const rad_convergence_plot_options *options,
+                                        rad_error *error)
+{
+    if (!histories || !names)
+        return rad_fail(error, RAD_ERR_INVALID, "%s: no runs to compare", path);
+    return plot_write(histories, names, runs, path, options, error);
 }
