@@ -224,9 +224,10 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
     rad_solver solver = rad_solve_scene_choice(out->mesh, &options, NULL, 0);
     bool stoppable = solver == RAD_SOLVER_HIERARCHICAL;
     cli_convergence convergence;
-    status = cli_convergence_begin(&convergence, solve->plot_path, solve->record_path,
-                                   out->scene->source, solver, out->mesh->patch_count,
-                                   &options, error);
+    bool writer = rad_rank() == 0; /* under MPI, rank 0 alone writes files */
+    status = cli_convergence_begin(&convergence, writer ? solve->plot_path : NULL,
+                                   writer ? solve->record_path : NULL, out->scene->source,
+                                   solver, out->mesh->patch_count, &options, error);
     if (status != RAD_OK)
         goto done;
     void (*previous)(int) = SIG_DFL;
@@ -241,7 +242,7 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         signal(SIGINT, previous == SIG_ERR ? SIG_DFL : previous);
     cli_progress_end();
     status = cli_convergence_end(&convergence, status, error);
-    if (status != RAD_OK || !solve->save_solution_path)
+    if (status != RAD_OK || !solve->save_solution_path || !writer)
         goto done;
     double t_save = rad_clock_seconds();
     status = rad_solution_write(out->scene, out->mesh, out->B, solve->save_solution_path, error);
