@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/hash.h"
 #include "testlib.h"
 
 #define VIEW "--size 48x36 --spp 4"
@@ -319,8 +320,31 @@ int main(void)
         write_bytes("version.sol", bytes, size);
         expect_refusal("render --solution version.sol -o out.pfm " VIEW, "version.sol",
                        "version 3");
+        bytes[8] = 2;
+        /* a version 1 file (no mesh levels: 8 header bytes fewer, its own checksum) is
+         * read as the default shadow levels and no proximity refinement: the same image */
+        uint8_t *v1 = malloc(size - 8);
+        CHECK(v1 != NULL);
+        if (v1) {
+            memcpy(v1, bytes, 32);
+            memcpy(v1 + 32, bytes + 40, size - 40);
+            v1[8] = 1;
+            uint64_t checksum = hash_bytes(RAD_HASH_START, v1, size - 16);
+            for (int k = 0; k < 8; k++)
+                v1[size - 16 + k] = (uint8_t)(checksum >> (8 * k));
+            write_bytes("version1.sol", v1, size - 8);
+            run_ok("render --solution version1.sol -o version1.pfm " VIEW);
+            CHECK(same_files("saved.pfm", "version1.pfm"));
+            free(v1);
+        }
     }
     free(bytes);
+    /* the automatic patch size brings the proximity refinement (3 levels): the file says
+     * so, and --solution rebuilds that mesh; --proximity-levels 0 asks for another one */
+    run_ok("solve -o auto.ply --save-solution auto.sol --quiet");
+    run_ok("render --solution auto.sol -o auto.pfm " VIEW);
+    expect_refusal("render --solution auto.sol --proximity-levels 0 -o out.pfm " VIEW,
+                   "auto.sol", "another scene or meshing");
     test_write_file("text.sol", "this is not a solution\n");
     expect_refusal("render --solution text.sol -o out.pfm " VIEW, "text.sol",
                    "not a radiosity solution file");
