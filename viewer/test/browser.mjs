@@ -1,4 +1,4 @@
-// browser.mjs - what the views' browser test (views.test.mjs) needs from chromium: launch
+// browser.mjs - what the browser tests (viewer, playback, views) need from chromium: launch
 // Debian's chromium with software WebGL, open a page `radiosity view` wrote and wait for
 // its first frame (recording console errors and requests), take the canvas's screenshot,
 // and read the page's embedded blocks the way the test's own references do. A test helper.

@@ -13,12 +13,11 @@ import { execFileSync } from 'node:child_process';
 import { mkdirSync, readFileSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import puppeteer from 'puppeteer-core';
+import { launch, open } from './browser.mjs';
 import { decodePng } from './png.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const tool = resolve(process.env.RADIOSITY || join(here, '..', '..', 'build', 'radiosity'));
-const chromium = process.env.RAD_CHROMIUM || '/usr/bin/chromium';
 const tmp = resolve(process.env.RAD_TEST_TMP || join(here, '..', 'dist', 'test-tmp'));
 mkdirSync(tmp, { recursive: true });
 
@@ -50,12 +49,7 @@ const recordPath = join(tmp, 'playback.json');
 before(async () => {
   execFileSync(tool, ['view', '--solver', 'shoot', '--patch-size', '60', '--threads', '2',
     '-o', pagePath, '--record', recordPath, '--quiet']);
-  browser = await puppeteer.launch({
-    executablePath: chromium,
-    headless: true,
-    args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-      '--disable-gpu-sandbox', '--no-first-run'],
-  });
+  browser = await launch();
 });
 
 after(async () => {
@@ -97,17 +91,7 @@ test('playback steps through the recorded shooting solve', async () => {
   assert.equal(record.solver, 'shoot');
   assert.ok(snapshots.length >= 50 && snapshots.length <= 200, `${snapshots.length} snapshots`);
 
-  const page = await browser.newPage();
-  await page.setViewport({ width: 812, height: 512, deviceScaleFactor: 1 });
-  const problems = [], requests = [];
-  page.on('console', (m) => { if (m.type() === 'error' || m.type() === 'warn') problems.push(`${m.type()}: ${m.text()}`); });
-  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
-  page.on('request', (r) => requests.push(r.url()));
-  await page.goto(`file://${pagePath}`);
-  await page.waitForFunction(() => document.body.dataset.ready && Number(document.body.dataset.frames || 0) > 0,
-    { timeout: 60000 });
-  assert.equal(await page.evaluate(() => document.body.dataset.ready), 'true',
-    await page.evaluate(() => document.getElementById('error')?.textContent || ''));
+  const { page, problems, requests } = await open(browser, pagePath);
   assert.equal(await page.$eval('#playback-step', (e) => e.max), String(snapshots.length - 1));
 
   // every snapshot, in order: its numbers in the panel

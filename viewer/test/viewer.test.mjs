@@ -13,12 +13,11 @@ import { execFileSync, spawnSync } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import puppeteer from 'puppeteer-core';
+import { launch, open as openPage } from './browser.mjs';
 import { decodePng } from './png.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const tool = resolve(process.env.RADIOSITY || join(here, '..', '..', 'build', 'radiosity'));
-const chromium = process.env.RAD_CHROMIUM || '/usr/bin/chromium';
 const tmp = resolve(process.env.RAD_TEST_TMP || join(here, '..', 'dist', 'test-tmp'));
 mkdirSync(tmp, { recursive: true });
 
@@ -97,12 +96,7 @@ before(async () => {
   execFileSync(tool, ['view', '-o', cornellPage, '--quiet']);
   execFileSync(tool, ['solve', '-o', cornellGlb, '--quiet']);
   execFileSync(tool, ['view', cornellGlb, '-o', glbPage, '--quiet']);
-  browser = await puppeteer.launch({
-    executablePath: chromium,
-    headless: true,
-    args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-      '--disable-gpu-sandbox', '--no-first-run'],
-  });
+  browser = await launch();
 });
 
 after(async () => {
@@ -110,20 +104,7 @@ after(async () => {
 });
 
 // Opens a page and waits for its first frame; records console errors and every request.
-async function open(path) {
-  const page = await browser.newPage();
-  await page.setViewport({ width: 812, height: 512, deviceScaleFactor: 1 });
-  const problems = [], requests = [];
-  page.on('console', (m) => { if (m.type() === 'error' || m.type() === 'warn') problems.push(`${m.type()}: ${m.text()}`); });
-  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
-  page.on('request', (r) => requests.push(r.url()));
-  await page.goto(`file://${path}`);
-  await page.waitForFunction(() => document.body.dataset.ready && Number(document.body.dataset.frames || 0) > 0,
-    { timeout: 60000 });
-  assert.equal(await page.evaluate(() => document.body.dataset.ready), 'true',
-    await page.evaluate(() => document.getElementById('error')?.textContent || ''));
-  return { page, problems, requests };
-}
+const open = (path) => openPage(browser, path);
 
 async function canvasShot(page, file) {
   const canvas = await page.$('#view canvas');
