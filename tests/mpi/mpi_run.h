@@ -9,6 +9,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/wait.h>
 
 #include "testlib.h"
@@ -43,6 +44,23 @@ static inline const char *test_write_city(int surfaces, const char *name)
     if (system(command) != 0)
         test_fail(__FILE__, __LINE__, "cannot generate %s", path);
     return path;
+}
+
+/* The sum over ranks of the work each reports in `err` ("rank R of N: K rows", tiles ...),
+ * each rank's line present and its K positive. */
+static inline long long test_rank_work(const char *err, int ranks)
+{
+    long long total = 0;
+    for (int r = 0; r < ranks; r++) {
+        char key[64];
+        snprintf(key, sizeof(key), "rank %d of %d: ", r, ranks);
+        const char *line = strstr(err, key);
+        CHECK(line != NULL);
+        long long mine = line ? strtoll(line + strlen(key), NULL, 10) : 0;
+        CHECK(mine > 0);
+        total += mine;
+    }
+    return total;
 }
 
 #endif

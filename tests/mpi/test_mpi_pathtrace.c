@@ -25,16 +25,7 @@ int main(void)
         CHECK(test_same_bytes(test_path("serial.pfm"), test_path(image)));
         CHECK(test_same_bytes(test_path("serial-se.pfm"), test_path(error)));
         const char *err = test_read_text(test_path("stderr.txt"));
-        long long tiles = 0;
-        for (int r = 0; r < ranks && ranks > 1; r++) {
-            char key[64];
-            snprintf(key, sizeof(key), "rank %d of %d: ", r, ranks);
-            const char *line = strstr(err, key);
-            CHECK(line != NULL);
-            long long mine = line ? strtoll(line + strlen(key), NULL, 10) : 0;
-            CHECK(mine > 0);
-            tiles += mine;
-        }
+        long long tiles = ranks > 1 ? test_rank_work(err, ranks) : 0;
         CHECK(ranks == 1 || tiles == 15);
     }
     return test_finish("test_mpi_pathtrace");

@@ -26,18 +26,7 @@ static long long stats_integer_of(const char *text, const char *key)
 /* The sum over ranks of "rank R of N: K form-factor rows" in the last run's stderr. */
 static long long rows_of_ranks(int ranks)
 {
-    const char *err = test_read_text(test_path("stderr.txt"));
-    long long rows = 0;
-    for (int r = 0; r < ranks; r++) {
-        char key[64];
-        snprintf(key, sizeof(key), "rank %d of %d: ", r, ranks);
-        const char *line = strstr(err, key);
-        CHECK(line != NULL);
-        long long mine = line ? strtoll(line + strlen(key), NULL, 10) : 0;
-        CHECK(mine > 0);
-        rows += mine;
-    }
-    return rows;
+    return test_rank_work(test_read_text(test_path("stderr.txt")), ranks);
 }
 
 int main(void)

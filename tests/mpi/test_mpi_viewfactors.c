@@ -40,16 +40,7 @@ int main(void)
         CHECK(test_run_mpi(ranks, arguments, 0, NULL) == 0);
         CHECK(test_same_bytes(test_path("serial.mtx"), test_path(name)));
         const char *err = test_read_text(test_path("stderr.txt"));
-        long long rows = 0;
-        for (int r = 0; r < ranks && ranks > 1; r++) {
-            char key[64];
-            snprintf(key, sizeof(key), "rank %d of %d: ", r, ranks);
-            const char *line = strstr(err, key);
-            CHECK(line != NULL);
-            long long mine = line ? strtoll(line + strlen(key), NULL, 10) : 0;
-            CHECK(mine > 0);
-            rows += mine;
-        }
+        long long rows = ranks > 1 ? test_rank_work(err, ranks) : 0;
         if (ranks > 1) {
             CHECK(rows == surfaces);
             CHECK(strstr(err, "load imbalance") != NULL);
