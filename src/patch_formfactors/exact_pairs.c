@@ -96,29 +96,14 @@ static void screen_build(exact_pairs *pairs, uint32_t node, uint32_t first, uint
     screen_build(pairs, children + 1, first + left, count - left, depth + 1);
 }
 
-/* Most side planes of a pair's hull: through an edge of one patch and a corner of the
- * other. */
-#define MAX_SIDES OCCLUDER_HULL_MAX_SIDES
-
 /* What screening needs of a pair: the box of its corners and the two patches' planes
  * (segments that carry light run in front of both); the hull's side planes are found only
- * for a pair with a triangle that passes those. */
+ * for a pair with a triangle that passes those (batch_may_cut). */
 typedef struct screen_query {
     const vf_polygon *p, *q;
     double lo[3], hi[3];
     double epsilon;
-    bool have_sides;
-    unsigned side_count;
-    rad_vec3 side_normal[MAX_SIDES]; /* outward */
-    double side_offset[MAX_SIDES];
 } screen_query;
-
-/* The faces of the pair's hull besides the patches' own planes (occluder_hull_sides). */
-static void find_sides(screen_query *s)
-{
-    s->have_sides = true;
-    s->side_count = occluder_hull_sides(s->p, s->q, s->epsilon, s->side_normal, s->side_offset);
-}
 
 /* True when the box lies wholly behind (or on) the plane n . x = offset. */
 static bool box_behind(const double lo[3], const double hi[3], rad_vec3 n, double offset,
@@ -172,24 +157,31 @@ static bool may_stand_between(const screen_query *s, const screen_triangle *t)
     return below && above;
 }
 
-/* May a triangle that stands between the pair cut its hull? Not when a side plane of the
- * hull has it wholly outside. */
-static bool inside_sides(screen_query *s, const screen_triangle *t)
+/* May one of these triangles (each standing between the pair) cut its hull? Not one that
+ * a side plane of the hull has wholly outside. The planes come one edge at a time
+ * (occluder_hull_edge_sides), dropping the triangles each has outside: a clear pair
+ * usually stops long before the last edge. */
+static bool batch_may_cut(const screen_query *s, const screen_triangle *const *candidate,
+                          unsigned count)
 {
-    if (!s->have_sides)
-        find_sides(s);
-    for (unsigned k = 0; k < s->side_count; k++) {
-        rad_vec3 n = s->side_normal[k];
-        double o = s->side_offset[k];
-        if (v3_dot(n, t->corner[0]) - o >= -s->epsilon &&
-            v3_dot(n, t->corner[1]) - o >= -s->epsilon &&
-            v3_dot(n, t->corner[2]) - o >= -s->epsilon)
-            return false;
+    uint32_t alive = count == 32 ? UINT32_MAX : (UINT32_C(1) << count) - 1;
+    for (unsigned edge = 0; alive && edge < s->p->count + s->q->count; edge++) {
+        rad_vec3 normal[2];
+        double offset[2];
+        unsigned faces = occluder_hull_edge_sides(s->p, s->q, edge, s->epsilon, normal, offset);
+        for (unsigned f = 0; f < faces; f++)
+            for (unsigned k = 0; k < count; k++) {
+                const rad_vec3 *c = candidate[k]->corner;
+                if ((alive >> k & 1u) && v3_dot(normal[f], c[0]) - offset[f] >= -s->epsilon &&
+                    v3_dot(normal[f], c[1]) - offset[f] >= -s->epsilon &&
+                    v3_dot(normal[f], c[2]) - offset[f] >= -s->epsilon)
+                    alive &= ~(UINT32_C(1) << k);
+            }
     }
-    return true;
+    return alive != 0;
 }
 
-/* Triangles kept for the second look; more are looked at as they come. */
+/* Triangles gathered for one batch_may_cut. */
 #define SCREEN_CANDIDATES 32u /* bits of a uint32_t */
 
 /* False when no triangle can cut the hull of p and q (then the pair is clear). The
@@ -203,7 +195,6 @@ static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, cons
     s.p = p;
     s.q = q;
     s.epsilon = pairs->epsilon;
-    s.have_sides = false;
     for (int a = 0; a < 3; a++) {
         s.lo[a] = INFINITY;
         s.hi[a] = -INFINITY;
@@ -232,33 +223,19 @@ static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, cons
                     continue;
                 if (blocks_centroids(&s, tt))
                     return true;
-                if (candidate_count < SCREEN_CANDIDATES)
-                    candidate[candidate_count++] = tt;
-                else if (inside_sides(&s, tt))
-                    return true;
+                candidate[candidate_count++] = tt;
+                if (candidate_count == SCREEN_CANDIDATES) {
+                    if (batch_may_cut(&s, candidate, candidate_count))
+                        return true;
+                    candidate_count = 0;
+                }
             }
         } else {
             stack[top++] = node->first;
             stack[top++] = node->first + 1;
         }
     }
-    /* the hull's side planes one edge at a time, dropping the triangles each has wholly
-     * outside: a clear pair usually stops long before the last edge */
-    uint32_t alive = candidate_count == 32 ? UINT32_MAX : (UINT32_C(1) << candidate_count) - 1;
-    for (unsigned edge = 0; alive && edge < p->count + q->count; edge++) {
-        rad_vec3 normal[2];
-        double offset[2];
-        unsigned faces = occluder_hull_edge_sides(p, q, edge, s.epsilon, normal, offset);
-        for (unsigned f = 0; f < faces; f++)
-            for (unsigned k = 0; k < candidate_count; k++) {
-                const rad_vec3 *c = candidate[k]->corner;
-                if ((alive >> k & 1u) && v3_dot(normal[f], c[0]) - offset[f] >= -s.epsilon &&
-                    v3_dot(normal[f], c[1]) - offset[f] >= -s.epsilon &&
-                    v3_dot(normal[f], c[2]) - offset[f] >= -s.epsilon)
-                    alive &= ~(UINT32_C(1) << k);
-            }
-    }
-    return alive != 0;
+    return candidate_count > 0 && batch_may_cut(&s, candidate, candidate_count);
 }
 
 rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
