@@ -274,9 +274,8 @@ static void test_room_on_ground(void)
     surface_means(scene, surface, reference, reference_mean, pixels);
     /* measured 2026-12-02: the room's surfaces -14 % (floor) to -4 %; without the
      * proximity refinement (--proximity-levels 0: the automatic size of the whole scene)
-     * -29 % to -12 %. The
-     * ground seen through the window (+280 %: the emitter's light on coarse ground
-     * patches, interpolated) is held with the per-pixel direct light below */
+     * -29 % to -12 %. The ground seen through the window (+280 %: the emitter's light on
+     * coarse ground patches, interpolated) is held with the per-pixel direct light below */
     double worst = check_render(scene_path, scene, surface, reference_mean, "", "ground", 0.16);
     printf("default render: largest difference %.1f %% (the issue asks for 5 %%)\n",
            100 * worst);
@@ -284,6 +283,17 @@ static void test_room_on_ground(void)
     worst = check_render(scene_path, scene, surface, reference_mean, "--direct pixel", NULL,
                          0.16);
     printf("--direct pixel: largest difference %.1f %%\n", 100 * worst);
+    /* every solver honours the refinement and meets the same bound: Gauss-Seidel and
+     * shooting on the default's mesh (measured within 0.1 % of it), the hierarchical
+     * solver on its own finer default patches with the refinement asked for (it is off by
+     * default there): measured -6.1 % (floor) to -1.9 % */
+    static const char *const solvers[] = {"--solver gauss-seidel", "--solver shoot",
+                                          "--solver hierarchical --proximity-levels 3"};
+    for (size_t k = 0; k < sizeof(solvers) / sizeof(solvers[0]); k++) {
+        worst = check_render(scene_path, scene, surface, reference_mean, solvers[k], "ground",
+                             0.16);
+        printf("%s: largest difference %.1f %%\n", solvers[k], 100 * worst);
+    }
     free(surface);
     free(reference_mean);
     free(pixels);
