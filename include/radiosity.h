@@ -586,17 +586,18 @@ double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patch
 rad_status rad_mesh_build(const rad_scene *scene, double patch_size, rad_mesh **out,
                           rad_error *error);
 
-/* Shadow refinement. A patch carries one radiosity, so a sharp shadow edge across it is
- * smeared over it. Where the scene's point, spot, luminaire or sun lights cast a shadow
- * (or a cone's edge) across a cell, the mesh splits the cell in four (quads into four
- * quads, triangles into four similar triangles), and the children again, `shadow_levels`
- * times at most: the shadow edges of the sharp lights are met at the patch size /
- * 2^levels, in every solver (the hierarchical solver's leaves are these patches) and in
- * the lit mesh. A cell is split when, at 4 x 4 points of it (both sides for a two-sided
- * surface), the share of the sharp lights' irradiance that the shadow rays let through
- * differs by more than 1/4 between two points and that difference is more than 1/4 of
- * the light there; smooth fall-off never splits. Emitters' and the sky's shadows are soft
- * and do not split patches. The splits stop when they have added max_added_patches. */
+/* Shadow refinement. A patch carries one radiosity, so a shadow edge or a penumbra across
+ * it is smeared over it. Where the scene's point, spot, luminaire or sun lights cast a
+ * shadow (or a cone's edge) across a cell, or an emitting surface's penumbra crosses it,
+ * the mesh splits the cell in four (quads into four quads, triangles into four similar
+ * triangles), and the children again, `shadow_levels` times at most: shadow edges and
+ * penumbrae are met at the patch size / 2^levels, in every solver (the hierarchical
+ * solver's leaves are these patches) and in the lit mesh. A cell is split when, at 4 x 4
+ * points of it (both sides for a two-sided surface), the share of the irradiance that the
+ * shadow rays let through (the sharp lights', and 32 fixed points on the emitters, chosen
+ * by power) differs by more than 1/4 between two points and that difference is more than
+ * 1/4 of the light there; smooth fall-off never splits. The sky's shadows do not split
+ * patches. The splits stop when they have added max_added_patches. */
 #define RAD_SHADOW_LEVELS_DEFAULT 1
 #define RAD_SHADOW_LEVELS_MAX 6
 

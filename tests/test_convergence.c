@@ -194,7 +194,7 @@ static void check_hierarchical(void)
     rad_scene *scene = NULL;
     rad_mesh *mesh = NULL;
     CHECK(rad_scene_cornell_box(&scene, &error) == RAD_OK);
-    CHECK(rad_mesh_build(scene, 120, &mesh, &error) == RAD_OK);
+    CHECK(test_mesh_uniform(scene, 120, &mesh, &error) == RAD_OK);
     if (!mesh) {
         rad_scene_destroy(scene);
         return;

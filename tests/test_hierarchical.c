@@ -105,15 +105,15 @@ static const char *write_furnished_room(void)
 }
 
 /* The dense reference (every F_ij, Gauss-Seidel to 1e-7) and the hierarchical solution on
- * the same ~2000 patches: area-weighted mean per surface within 1 %, image RMSE within 2 %
- * of the mean. */
+ * the same 2000 to 3000 patches (the shadow refinement adds some): area-weighted mean per
+ * surface within 1 %, image RMSE within 2 % of the mean. */
 static void compare_with_dense(const char *label, const rad_scene *scene, const rad_mesh *mesh,
                                const rad_tracer *tracer, const rad_camera *camera,
                                rad_rgb *dense, rad_rgb *hier, rad_hierarchy_report *report)
 {
     rad_error error;
     printf("%s: %u patches\n", label, mesh->patch_count);
-    CHECK(mesh->patch_count > 1500 && mesh->patch_count < 2600);
+    CHECK(mesh->patch_count > 1500 && mesh->patch_count < 3000);
     rad_formfactor_options ff_options = {.seed = 1};
     rad_formfactors *ff = NULL;
     rad_formfactor_report ff_report;

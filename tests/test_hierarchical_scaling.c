@@ -127,7 +127,7 @@ int main(void)
     for (int level = 0; level < 3; level++) {
         int n = 2 << level;
         fail_on(rad_scene_load(write_room(n), NULL, &scene, &error), &error, "room");
-        fail_on(rad_mesh_build(scene, 100, &mesh, &error), &error, "room mesh");
+        fail_on(test_mesh_uniform(scene, 100, &mesh, &error), &error, "room mesh");
         fail_on(rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &tracer, &error),
                 &error, "tracer");
         B = calloc(mesh->patch_count, sizeof(rad_rgb));

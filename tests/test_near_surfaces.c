@@ -273,7 +273,7 @@ static void check_box_in_box(double gap)
     rad_scene *scene = load(write_box_in_box(gap));
     rad_mesh *mesh = NULL;
     rad_error error = {0};
-    CHECK(rad_mesh_build(scene, 0.125, &mesh, &error) == RAD_OK);
+    CHECK(test_mesh_uniform(scene, 0.125, &mesh, &error) == RAD_OK);
     uint32_t n = mesh->patch_count;
 
     /* rows of F: a closed scene, so every row sums to 1 */
@@ -334,7 +334,7 @@ static void check_floor_copy(const char *name, double copy_z, bool sees_light)
     rad_scene *scene = load(write_floor_with_copy(name, copy_z));
     rad_mesh *mesh = NULL;
     rad_error error = {0};
-    CHECK(rad_mesh_build(scene, 0.125, &mesh, &error) == RAD_OK);
+    CHECK(test_mesh_uniform(scene, 0.125, &mesh, &error) == RAD_OK);
     int floor = surface_index(scene, "floor");
     double expected = sees_light ? RHO * LE * parallel_unit_squares() : 0;
     rad_rgb *B = malloc(sizeof(rad_rgb) * mesh->patch_count);
@@ -378,7 +378,7 @@ static void check_interpenetrating(void)
     rad_scene *scene = load(path);
     rad_mesh *mesh = NULL;
     rad_error error = {0};
-    CHECK(rad_mesh_build(scene, 0.1, &mesh, &error) == RAD_OK);
+    CHECK(test_mesh_uniform(scene, 0.1, &mesh, &error) == RAD_OK);
     uint32_t n = mesh->patch_count;
     rad_formfactor_report ff_report;
     rad_formfactors *ff = formfactors_of(scene, mesh, &ff_report);

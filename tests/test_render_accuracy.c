@@ -57,16 +57,19 @@ static void test_cornell(void)
            "  direct light per pixel:  block rel RMSE %.4f, pixel rel RMSE %.4f\n",
            classic.block_relative_rmse, classic.pixel_relative_rmse,
            per_pixel.block_relative_rmse, per_pixel.pixel_relative_rmse);
-    /* measured 2026-12-02 (seed 0, 2 threads): 0.0371 / 0.0397 and 0.0196 / 0.0209; from
-     * seed to seed the per-pixel render's blocks move by about 0.5 % (its noise) */
-    CHECK(classic.block_relative_rmse < 0.045 && classic.pixel_relative_rmse < 0.05);
-    CHECK(per_pixel.block_relative_rmse < 0.026 && per_pixel.pixel_relative_rmse < 0.027);
-    CHECK(per_pixel.block_relative_rmse < 0.7 * classic.block_relative_rmse);
-    CHECK(per_pixel.pixel_relative_rmse < 0.7 * classic.pixel_relative_rmse);
+    /* measured 2026-12-02 (seed 0, 2 threads), with the emitters' penumbrae refined in the
+     * mesh (shadow_refine.c): 0.0255 / 0.0278 and 0.0096 / 0.0202 (before that refinement
+     * 0.0393 / 0.0407 and 0.0158 / 0.0220); from seed to seed the per-pixel render's blocks
+     * move by about 0.5 % (its noise). The pixel measure is bounded below by the
+     * reference's own noise, about 1.6 % a pixel. */
+    CHECK(classic.block_relative_rmse < 0.030 && classic.pixel_relative_rmse < 0.033);
+    CHECK(per_pixel.block_relative_rmse < 0.013 && per_pixel.pixel_relative_rmse < 0.023);
+    CHECK(per_pixel.block_relative_rmse < 0.5 * classic.block_relative_rmse);
+    CHECK(per_pixel.pixel_relative_rmse < classic.pixel_relative_rmse);
     /* the mean radiance agrees within the reference's noise and the mesh's bias */
     CHECK_NEAR(per_pixel.mean_a.g, per_pixel.mean_b.g, 0.01);
     /* the per-pixel direct light over every solver's solution: the same accuracy */
-    /* (the direct LU solve of 3010 patches is left out for time: it matches the others to
+    /* (the direct LU solve of 3742 patches is left out for time: it matches the others to
      * 0.000 % in test_lights_matrix and test_feature_matrix) */
     const rad_solver others[] = {RAD_SOLVER_GAUSS_SEIDEL, RAD_SOLVER_SHOOT,
                                  RAD_SOLVER_HIERARCHICAL};
@@ -76,7 +79,7 @@ static void test_cornell(void)
         CHECK(rad_image_compare(c, reference, NULL, &d, NULL, &error) == RAD_OK);
         printf("  direct light per pixel, %-12s block rel RMSE %.4f, pixel rel RMSE %.4f\n",
                rad_solver_name(others[k]), d.block_relative_rmse, d.pixel_relative_rmse);
-        CHECK(d.block_relative_rmse < 0.026 && d.pixel_relative_rmse < 0.027);
+        CHECK(d.block_relative_rmse < 0.014 && d.pixel_relative_rmse < 0.023);
         rad_image_destroy(c);
     }
     rad_image_destroy(a);

@@ -28,7 +28,7 @@
 #include <string.h>
 
 #include "core/vec3.h" /* RAD_PI */
-#include "render/emitters.h"
+#include "lights/emitters.h"
 #include "testlib.h"
 
 /* A grey PNG of width x 1 whose first `split` columns are sRGB `left`, the rest `right`. */

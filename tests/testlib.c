@@ -258,3 +258,10 @@ bool test_same_bytes(const char *a_path, const char *b_path)
     free(b);
     return same;
 }
+
+rad_status test_mesh_uniform(const rad_scene *scene, double patch_size, rad_mesh **mesh,
+                             rad_error *error)
+{
+    rad_mesh_options options = {.patch_size = patch_size, .shadow_levels = -1};
+    return rad_mesh_build_with(scene, &options, mesh, error);
+}

@@ -90,6 +90,12 @@ void test_write_furnace(const char *name);
 int test_count_files(const char *prefix);
 
 /* rad_solve_hierarchical with the scene's patch inputs (rad_patch_inputs_build). */
+/* The scene's uniform split at patch_size, with no shadow or proximity refinement: for
+ * tests whose subject is not the mesh and whose expectations (patch, vertex and row
+ * counts) are the uniform split's. */
+rad_status test_mesh_uniform(const rad_scene *scene, double patch_size, rad_mesh **mesh,
+                             rad_error *error);
+
 rad_status test_solve_hierarchical(const rad_scene *scene, const rad_mesh *mesh,
                                    const rad_tracer *occluders,
                                    const rad_hierarchy_options *options, rad_rgb *B,

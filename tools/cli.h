@@ -127,8 +127,8 @@ enum {
  * -o), the same for both: a solution file of one is a solution file of the other. */
 /* Printed after the command's usage by every command that meshes a scene. */
 #define CLI_MESH_HELP                                                                      \
-    "  --shadow-levels N    split a patch that a point, spot, luminaire or sun shadow\n"   \
-    "                       edge crosses into four, and its children again, N times\n"    \
+    "  --shadow-levels N    split a patch that a light's shadow edge or an emitter's\n"   \
+    "                       penumbra crosses into four, and its children again, N times\n" \
     "                       (default " CLI_STR(RAD_SHADOW_LEVELS_DEFAULT) ", at most "        \
     CLI_STR(RAD_SHADOW_LEVELS_MAX) ", 0 = none)\n"                                          \
     "  --proximity-levels N split a patch larger than 1/3 of the mean distance to the\n"   \

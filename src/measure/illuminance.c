@@ -21,7 +21,7 @@
 #include "lights/direct_light.h"
 #include "reconstruct/display_mesh.h"
 #include "render/emitter_light.h"
-#include "render/emitters.h"
+#include "lights/emitters.h"
 #include "trace/ray.h"
 
 #define GATHER_STREAM 0x6A7E2ull

@@ -1,9 +1,10 @@
 /*
- * shadow_refine.h - where the sharp light sources' shadows cross a patch, split it
- * (internal: mesh.c asks it about every cell it makes).
+ * shadow_refine.h - where the shadows of the light sources and of the emitting surfaces
+ * cross a patch, split it (internal: mesh.c asks it about every cell it makes).
  *
  * The point, spot, luminaire and sun lights (direct_light.h's "sharp" sources) make light
- * that jumps at shadow boundaries. A patch carries one radiosity value, so a shadow edge
+ * that jumps at shadow boundaries; an emitting surface (an area light) makes a penumbra
+ * that changes over a short distance where an object stands on or near a lit floor. A patch carries one radiosity value, so a shadow edge
  * crossing it is smeared over the patch, in the lit mesh and in every solver's first
  * bounce. The mesh therefore tests each cell it makes: at 4 x 4 points of the cell (and
  * of its back, for a two-sided surface) the sharp sources' irradiance with and without
@@ -15,8 +16,8 @@
  * hierarchical one (whose leaves are these patches) all see the shadow at the finer size.
  *
  * Deterministic: the sun's disk point at each test point comes from the cell's corners,
- * not from a thread or call order. Not done: the emitters' (area lights') shadows, and
- * the sky's; both are soft.
+ * and the emitters' points are fixed per scene, not from a thread or call order. Not
+ * done: the sky's shadows (soft, and from every direction).
  */
 #ifndef RAD_MESH_SHADOW_REFINE_H
 #define RAD_MESH_SHADOW_REFINE_H
@@ -29,9 +30,19 @@
 #include "radiosity.h"
 
 #define SHADOW_REFINE_SIDE 4u /* test points per side of a cell */
+#define EMITTER_PROBES 32u     /* points on the emitting triangles, all together */
+
+/* A point on an emitting triangle, standing for its share of the emitters' power. */
+typedef struct emitter_probe {
+    rad_vec3 point, normal;
+    double power;   /* luminance of L_e x the area it stands for */
+    bool two_sided;
+} emitter_probe;
 
 typedef struct shadow_refiner {
     light_set set;
+    emitter_probe probes[EMITTER_PROBES];
+    uint32_t probe_count; /* 0: the scene has no emitter */
     rad_tracer *tracer;   /* the scene's triangles; NULL: refinement off */
     uint32_t levels;      /* splits of a cell at most */
     size_t budget;        /* patches it may add */
@@ -46,7 +57,7 @@ typedef struct shadow_refiner {
 } shadow_refiner;
 
 /* Ready to test cells of `scene` (off, with nothing allocated, when levels is 0 or the
- * scene has no sharp light). `budget` bounds the patches the splits may add. */
+ * scene has neither a sharp light nor an emitting surface). `budget` bounds the patches the splits may add. */
 rad_status shadow_refiner_init(shadow_refiner *refiner, const rad_scene *scene,
                                uint32_t levels, size_t budget, rad_error *error);
 

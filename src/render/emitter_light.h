@@ -13,7 +13,7 @@
 #define RAD_RENDER_EMITTER_LIGHT_H
 
 #include "core/random.h"
-#include "render/emitters.h"
+#include "lights/emitters.h"
 #include "radiosity.h"
 
 /* `count` samples for the point x (unit normal n; segments leave from x + n * leave and

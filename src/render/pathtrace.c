@@ -25,7 +25,7 @@
  * added with weight 1 on the camera ray and with the power-heuristic MIS weight against
  * light sampling on BSDF-sampled rays; next-event estimation samples a point on the
  * emitters (power-proportional by their mean emission, the sample's radiance the texel
- * at its point, src/render/emitters.h) and weights it by the same heuristic; the bounce is cosine-weighted around the front normal (throughput *= Kd);
+ * at its point, src/lights/emitters.h) and weights it by the same heuristic; the bounce is cosine-weighted around the front normal (throughput *= Kd);
  * Russian roulette starts after RR_START_BOUNCES bounces.
  */
 #include <float.h>
@@ -45,7 +45,7 @@
 #include "parallel/partition.h"
 #include "parallel/ranks.h"
 #include "render/camera.h"
-#include "render/emitters.h"
+#include "lights/emitters.h"
 #include "render/progress.h"
 #include "scene/material_at.h"
 #include "trace/ray.h"

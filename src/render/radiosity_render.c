@@ -34,7 +34,7 @@
 #include "lights/direct_light.h"
 #include "render/camera.h"
 #include "render/emitter_light.h"
-#include "render/emitters.h"
+#include "lights/emitters.h"
 #include "render/progress.h"
 #include "reconstruct/display_mesh.h"
 #include "scene/patch_materials.h"

@@ -57,7 +57,7 @@
 #include "core/vec3.h"
 #include "lights/direct_light.h"
 #include "render/camera.h"
-#include "render/emitters.h"
+#include "lights/emitters.h"
 #include "render/progress.h"
 #include "scene/material_at.h"
 #include "trace/ray.h"

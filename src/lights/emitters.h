@@ -14,8 +14,8 @@
  * emitter (material_emits), and nothing is lost. Built once per scene; read-only
  * afterwards (thread safe).
  */
-#ifndef RAD_SCENE_EMITTERS_H
-#define RAD_SCENE_EMITTERS_H
+#ifndef RAD_LIGHTS_EMITTERS_H
+#define RAD_LIGHTS_EMITTERS_H
 
 #include "radiosity.h"
 

@@ -1,7 +1,7 @@
 /*
  * emitters.c - power-proportional sampling of emitting triangles, see emitters.h.
  */
-#include "render/emitters.h"
+#include "lights/emitters.h"
 
 #include <math.h>
 #include <stdlib.h>
