@@ -1540,7 +1540,7 @@ typedef struct rad_render_options {
      * computed at every pixel sample by `direct_samples` shadow rays to points of the
      * emitters (stratified over the pixel's samples; exact soft shadows), and the rest
      * (their light reflected more than once, the sky) taken from the solution with their
-     * patch means (16 x 8 samples per patch) taken out first. Off: the emitters' direct
+     * patch means (16 x 32 samples per patch) taken out first. Off: the emitters' direct
      * light is interpolated from the solution like the rest (the classic radiosity
      * image). direct_samples 0 = RAD_DEFAULT_DIRECT_SAMPLES. */
     bool emitter_direct;

@@ -12,7 +12,6 @@
  * here (see the measured figures below).
  */
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,118 +24,44 @@
 
 /* ---- the scene, as OBJ text ---------------------------------------------------------- */
 
-typedef struct text {
-    char *data;
-    size_t length, capacity;
-    int vertices;
-} text;
-
-static void add(text *t, const char *format, ...) __attribute__((format(printf, 2, 3)));
-
-static void add(text *t, const char *format, ...)
-{
-    va_list args;
-    va_start(args, format);
-    int n = vsnprintf(NULL, 0, format, args);
-    va_end(args);
-    if (t->length + (size_t)n + 1 > t->capacity) {
-        t->capacity = 2 * (t->length + (size_t)n + 1);
-        t->data = realloc(t->data, t->capacity);
-        if (!t->data)
-            abort();
-    }
-    va_start(args, format);
-    vsnprintf(t->data + t->length, (size_t)n + 1, format, args);
-    va_end(args);
-    t->length += (size_t)n;
-}
-
-static void object(text *t, const char *name, const char *material)
-{
-    add(t, "o %s\nusemtl %s\n", name, material);
-}
-
-/* The rectangle in the plane coordinate[axis] = at, from (lo0, lo1) to (hi0, hi1) in the
- * next two axes (cyclically), facing +axis (facing > 0) or -axis. */
-static void rectangle(text *t, int axis, double at, double lo0, double lo1, double hi0,
-                      double hi1, int facing)
-{
-    double corner[4][2] = {{lo0, lo1}, {hi0, lo1}, {hi0, hi1}, {lo0, hi1}};
-    for (int k = 0; k < 4; k++) {
-        const double *c = corner[facing > 0 ? k : 3 - k];
-        double p[3];
-        p[axis] = at;
-        p[(axis + 1) % 3] = c[0];
-        p[(axis + 2) % 3] = c[1];
-        add(t, "v %.6g %.6g %.6g\n", p[0], p[1], p[2]);
-    }
-    int v = t->vertices;
-    add(t, "f %d %d %d %d\n", v + 1, v + 2, v + 3, v + 4);
-    t->vertices += 4;
-}
-
-/* The same with a rectangular hole, as four rectangles. */
-static void rectangle_with_hole(text *t, int axis, double at, double lo0, double lo1,
-                                double hi0, double hi1, double hole_lo0, double hole_lo1,
-                                double hole_hi0, double hole_hi1, int facing)
-{
-    rectangle(t, axis, at, lo0, lo1, hole_lo0, hi1, facing);
-    rectangle(t, axis, at, hole_hi0, lo1, hi0, hi1, facing);
-    rectangle(t, axis, at, hole_lo0, lo1, hole_hi0, hole_lo1, facing);
-    rectangle(t, axis, at, hole_lo0, hole_hi1, hole_hi0, hi1, facing);
-}
-
-/* A box facing outwards, without its bottom (it stands on the floor) and, with
- * `no_back`, without its -z face (it stands against a wall). */
-static void box(text *t, double x0, double y0, double z0, double x1, double y1, double z1,
-                bool no_back)
-{
-    rectangle(t, 0, x0, y0, z0, y1, z1, -1);
-    rectangle(t, 0, x1, y0, z0, y1, z1, 1);
-    rectangle(t, 1, y1, z0, x0, z1, x1, 1);
-    if (!no_back)
-        rectangle(t, 2, z0, x0, y0, x1, y1, -1);
-    rectangle(t, 2, z1, x0, y0, x1, y1, 1);
-}
-
 /* Metres, y up. The room's inside is x 0..5, y 0.2..2.8, z 0..4, walls 0.2 m thick, a
  * window 2 m x 1.3 m in the z = 4 wall; the ground is 100 m x 100 m at y = 0; the emitter
  * (3 m x 2 m, radiance 40) stands 3.8 m outside the window, facing it. */
 static void write_scene(void)
 {
-    text t = {0};
-    add(&t, "mtllib room.mtl\n");
-    object(&t, "ground", "ground");
-    rectangle(&t, 1, 0, -47.5, -48, 52.5, 52, 1);
-    object(&t, "floor", "wood");
-    rectangle(&t, 1, 0.2, 0, 0, 4, 5, 1);
-    object(&t, "ceiling", "white");
-    rectangle(&t, 1, 2.8, 0, 0, 4, 5, -1);
-    object(&t, "wall_left", "plaster");
-    rectangle(&t, 0, 0, 0.2, 0, 2.8, 4, 1);
-    object(&t, "wall_right", "plaster");
-    rectangle(&t, 0, 5, 0.2, 0, 2.8, 4, -1);
-    object(&t, "wall_back", "plaster");
-    rectangle(&t, 2, 0, 0, 0.2, 5, 2.8, 1);
-    object(&t, "wall_window", "plaster");
-    rectangle_with_hole(&t, 2, 4, 0, 0.2, 5, 2.8, 1.5, 0.9, 3.5, 2.2, -1);
-    object(&t, "reveal", "plaster");
-    rectangle(&t, 0, 1.5, 0.9, 4, 2.2, 4.2, 1);
-    rectangle(&t, 0, 3.5, 0.9, 4, 2.2, 4.2, -1);
-    rectangle(&t, 1, 0.9, 4, 1.5, 4.2, 3.5, 1);
-    rectangle(&t, 1, 2.2, 4, 1.5, 4.2, 3.5, -1);
-    object(&t, "facade", "facade");
-    rectangle(&t, 0, -0.2, 0, -0.2, 3, 4.2, -1);
-    rectangle(&t, 0, 5.2, 0, -0.2, 3, 4.2, 1);
-    rectangle(&t, 2, -0.2, -0.2, 0, 5.2, 3, -1);
-    rectangle_with_hole(&t, 2, 4.2, -0.2, 0, 5.2, 3, 1.5, 0.9, 3.5, 2.2, 1);
-    rectangle(&t, 1, 3, -0.2, -0.2, 4.2, 5.2, 1);
-    object(&t, "table", "oak");
-    box(&t, 1.0, 0.2, 1.0, 2.6, 0.95, 1.9, false);
-    object(&t, "cupboard", "blue");
-    box(&t, 3.8, 0.2, 0.0, 5.0, 2.1, 0.6, true);
-    object(&t, "light", "light");
-    rectangle(&t, 2, 8, 1, 0.6, 4, 2.6, -1);
+    test_obj t = {0};
+    test_obj_add(&t, "mtllib room.mtl\n");
+    test_obj_object(&t, "ground", "ground");
+    test_obj_rectangle(&t, 1, 0, -47.5, -48, 52.5, 52, 1);
+    test_obj_object(&t, "floor", "wood");
+    test_obj_rectangle(&t, 1, 0.2, 0, 0, 4, 5, 1);
+    test_obj_object(&t, "ceiling", "white");
+    test_obj_rectangle(&t, 1, 2.8, 0, 0, 4, 5, -1);
+    test_obj_object(&t, "wall_left", "plaster");
+    test_obj_rectangle(&t, 0, 0, 0.2, 0, 2.8, 4, 1);
+    test_obj_object(&t, "wall_right", "plaster");
+    test_obj_rectangle(&t, 0, 5, 0.2, 0, 2.8, 4, -1);
+    test_obj_object(&t, "wall_back", "plaster");
+    test_obj_rectangle(&t, 2, 0, 0, 0.2, 5, 2.8, 1);
+    test_obj_object(&t, "wall_window", "plaster");
+    test_obj_rectangle_with_hole(&t, 2, 4, 0, 0.2, 5, 2.8, 1.5, 0.9, 3.5, 2.2, -1);
+    test_obj_object(&t, "reveal", "plaster");
+    test_obj_rectangle(&t, 0, 1.5, 0.9, 4, 2.2, 4.2, 1);
+    test_obj_rectangle(&t, 0, 3.5, 0.9, 4, 2.2, 4.2, -1);
+    test_obj_rectangle(&t, 1, 0.9, 4, 1.5, 4.2, 3.5, 1);
+    test_obj_rectangle(&t, 1, 2.2, 4, 1.5, 4.2, 3.5, -1);
+    test_obj_object(&t, "facade", "facade");
+    test_obj_rectangle(&t, 0, -0.2, 0, -0.2, 3, 4.2, -1);
+    test_obj_rectangle(&t, 0, 5.2, 0, -0.2, 3, 4.2, 1);
+    test_obj_rectangle(&t, 2, -0.2, -0.2, 0, 5.2, 3, -1);
+    test_obj_rectangle_with_hole(&t, 2, 4.2, -0.2, 0, 5.2, 3, 1.5, 0.9, 3.5, 2.2, 1);
+    test_obj_rectangle(&t, 1, 3, -0.2, -0.2, 4.2, 5.2, 1);
+    test_obj_object(&t, "table", "oak");
+    test_obj_box(&t, 1.0, 0.2, 1.0, 2.6, 0.95, 1.9, false);
+    test_obj_object(&t, "cupboard", "blue");
+    test_obj_box(&t, 3.8, 0.2, 0.0, 5.0, 2.1, 0.6, true);
+    test_obj_object(&t, "light", "light");
+    test_obj_rectangle(&t, 2, 8, 1, 0.6, 4, 2.6, -1);
     test_write_file("room.obj", t.data);
     free(t.data);
     test_write_file("room.mtl", "newmtl ground\nKd 0.3 0.3 0.3\n"

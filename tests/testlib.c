@@ -265,3 +265,64 @@ rad_status test_mesh_uniform(const rad_scene *scene, double patch_size, rad_mesh
     rad_mesh_options options = {.patch_size = patch_size, .shadow_levels = -1};
     return rad_mesh_build_with(scene, &options, mesh, error);
 }
+
+void test_obj_add(test_obj *t, const char *format, ...)
+{
+    va_list args;
+    va_start(args, format);
+    int n = vsnprintf(NULL, 0, format, args);
+    va_end(args);
+    if (t->length + (size_t)n + 1 > t->capacity) {
+        t->capacity = 2 * (t->length + (size_t)n + 1);
+        t->data = realloc(t->data, t->capacity);
+        if (!t->data)
+            abort();
+    }
+    va_start(args, format);
+    vsnprintf(t->data + t->length, (size_t)n + 1, format, args);
+    va_end(args);
+    t->length += (size_t)n;
+}
+
+void test_obj_object(test_obj *t, const char *name, const char *material)
+{
+    test_obj_add(t, "o %s\nusemtl %s\n", name, material);
+}
+
+void test_obj_rectangle(test_obj *t, int axis, double at, double lo0, double lo1, double hi0,
+                        double hi1, int facing)
+{
+    double corner[4][2] = {{lo0, lo1}, {hi0, lo1}, {hi0, hi1}, {lo0, hi1}};
+    for (int k = 0; k < 4; k++) {
+        const double *c = corner[facing > 0 ? k : 3 - k];
+        double p[3];
+        p[axis] = at;
+        p[(axis + 1) % 3] = c[0];
+        p[(axis + 2) % 3] = c[1];
+        test_obj_add(t, "v %.6g %.6g %.6g\n", p[0], p[1], p[2]);
+    }
+    int v = t->vertices;
+    test_obj_add(t, "f %d %d %d %d\n", v + 1, v + 2, v + 3, v + 4);
+    t->vertices += 4;
+}
+
+void test_obj_rectangle_with_hole(test_obj *t, int axis, double at, double lo0, double lo1,
+                                  double hi0, double hi1, double hole_lo0, double hole_lo1,
+                                  double hole_hi0, double hole_hi1, int facing)
+{
+    test_obj_rectangle(t, axis, at, lo0, lo1, hole_lo0, hi1, facing);
+    test_obj_rectangle(t, axis, at, hole_hi0, lo1, hi0, hi1, facing);
+    test_obj_rectangle(t, axis, at, hole_lo0, lo1, hole_hi0, hole_lo1, facing);
+    test_obj_rectangle(t, axis, at, hole_lo0, hole_hi1, hole_hi0, hi1, facing);
+}
+
+void test_obj_box(test_obj *t, double x0, double y0, double z0, double x1, double y1,
+                  double z1, bool no_back)
+{
+    test_obj_rectangle(t, 0, x0, y0, z0, y1, z1, -1);
+    test_obj_rectangle(t, 0, x1, y0, z0, y1, z1, 1);
+    test_obj_rectangle(t, 1, y1, z0, x0, z1, x1, 1);
+    if (!no_back)
+        test_obj_rectangle(t, 2, z0, x0, y0, x1, y1, -1);
+    test_obj_rectangle(t, 2, z1, x0, y0, x1, y1, 1);
+}

@@ -108,6 +108,30 @@ void test_write_png(const char *name, uint32_t width, uint32_t height, const uns
 /* The linear value of an 8-bit sRGB byte (IEC 61966-2-1), the reference for textures. */
 double test_srgb_to_linear(unsigned byte);
 
+/* A scene's OBJ text built in memory, for tests that write their own scenes: objects,
+ * rectangles (and rectangles with a hole) in axis-aligned planes. */
+typedef struct test_obj {
+    char *data;
+    size_t length, capacity;
+    int vertices;
+} test_obj;
+
+void test_obj_add(test_obj *t, const char *format, ...) __attribute__((format(printf, 2, 3)));
+/* "o NAME" and "usemtl MATERIAL" */
+void test_obj_object(test_obj *t, const char *name, const char *material);
+/* The rectangle in the plane coordinate[axis] = at, from (lo0, lo1) to (hi0, hi1) in the
+ * next two axes (cyclically), facing +axis (facing > 0) or -axis. */
+void test_obj_rectangle(test_obj *t, int axis, double at, double lo0, double lo1, double hi0,
+                        double hi1, int facing);
+/* The same with a rectangular hole, as four rectangles. */
+void test_obj_rectangle_with_hole(test_obj *t, int axis, double at, double lo0, double lo1,
+                                  double hi0, double hi1, double hole_lo0, double hole_lo1,
+                                  double hole_hi0, double hole_hi1, int facing);
+/* A box from (x0, y0, z0) to (x1, y1, z1) facing outwards, without its bottom (it stands
+ * on a floor at y0) and, with `no_back`, without its -z face (it stands against a wall). */
+void test_obj_box(test_obj *t, double x0, double y0, double z0, double x1, double y1,
+                  double z1, bool no_back);
+
 /* Per-surface means of an image's pixels: `surface[p]` classifies pixel p (row-major) as a
  * surface index in [0, TEST_MAX_SURFACES), or < 0 to leave it out. With `se` (an image of
  * per-pixel standard errors, the path tracer's) the standard error of each mean, the

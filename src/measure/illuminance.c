@@ -141,7 +141,7 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
             /* the emitters' direct light: light samples and cosine rays, MIS-weighted */
             double shift1 = rad_rng_uniform(&rng), shift2 = rad_rng_uniform(&rng);
             k = emitter_light_rays_mis(&emitters, scene, x, n, lights.leave, EMITTER_SAMPLES,
-                                       rad_rng_uniform(&rng), 0, shift1, shift2, &rng, b->rays,
+                                       rad_rng_uniform(&rng), 0, shift1, shift2, b->rays,
                                        b->value);
             rad_tracer_occluded(occluders, b->rays, k, b->blocked);
             for (uint32_t q = 0; q < k; q++)

@@ -20,14 +20,14 @@
 #include "trace/ray.h"
 
 #define PATCH_EMITTER_POINTS 4u  /* per side: 16 points per patch */
-#define PATCH_EMITTER_SAMPLES 8u /* per point: 128 light samples per patch */
+#define PATCH_EMITTER_SAMPLES 32u /* per point: 512 light samples per patch */
 #define PATCH_EMITTER_STREAM 0xE3177E2ull
 
 static double wrap(double u) { return u < 1 ? u : u - 1; }
 
 static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
                            rad_vec3 n, double leave, uint32_t count, double turn, uint32_t first,
-                           double shift1, double shift2, rad_rng *rng, bool mis, rad_ray *rays,
+                           double shift1, double shift2, bool mis, rad_ray *rays,
                            rad_rgb *irradiance)
 {
     if (set->count == 0)
@@ -36,7 +36,10 @@ static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_v
     uint32_t made = 0;
     for (uint32_t k = 0; k < count; k++) {
         uint32_t j = first + k;
-        double u0 = wrap((k + rad_rng_uniform(rng)) / count + turn);
+        /* the triangle and the point on it from one Halton point (bases 5, 2, 3): a
+         * triangle chosen apart from the point's dimensions would take every other
+         * Halton point, which covers only stripes of it */
+        double u0 = wrap(rad_radical_inverse(j, 5) + turn);
         emitter_sample light;
         emitters_sample(set, scene, u0, wrap(rad_radical_inverse(j, 2) + shift1),
                         wrap(rad_radical_inverse(j, 3) + shift2), &light);
@@ -62,22 +65,13 @@ static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_v
     return made;
 }
 
-uint32_t emitter_light_rays(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
-                            rad_vec3 n, double leave, uint32_t count, double turn,
-                            uint32_t first, double shift1, double shift2, rad_rng *rng,
-                            rad_ray *rays, rad_rgb *irradiance)
-{
-    return light_rays(set, scene, x, n, leave, count, turn, first, shift1, shift2, rng, false,
-                      rays, irradiance);
-}
-
 uint32_t emitter_light_rays_mis(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
                                 rad_vec3 n, double leave, uint32_t count, double turn,
-                                uint32_t first, double shift1, double shift2, rad_rng *rng,
-                                rad_ray *rays, rad_rgb *irradiance)
+                                uint32_t first, double shift1, double shift2, rad_ray *rays,
+                                rad_rgb *irradiance)
 {
-    return light_rays(set, scene, x, n, leave, count, turn, first, shift1, shift2, rng, true,
-                      rays, irradiance);
+    return light_rays(set, scene, x, n, leave, count, turn, first, shift1, shift2, true, rays,
+                      irradiance);
 }
 
 void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, rad_rng *rng,
@@ -152,7 +146,8 @@ rad_status emitter_patch_direct(const emitter_set *set, const rad_scene *scene,
             size_t base = (size_t)omp_get_thread_num() * total;
             const rad_patch *patch = &mesh->patches[p];
             rad_rng rng = rad_rng_seed(seed ^ PATCH_EMITTER_STREAM, (uint64_t)p, 0);
-            double shift1 = rad_rng_uniform(&rng), shift2 = rad_rng_uniform(&rng);
+            double turn = rad_rng_uniform(&rng), shift1 = rad_rng_uniform(&rng),
+                   shift2 = rad_rng_uniform(&rng);
             double off = 2 * patch->bulge + leave;
             uint32_t count = 0;
             for (uint32_t q = 0; q < points; q++) {
@@ -160,11 +155,11 @@ rad_status emitter_patch_direct(const emitter_set *set, const rad_scene *scene,
                 double t = ((q / PATCH_EMITTER_POINTS) + rad_rng_uniform(&rng)) / PATCH_EMITTER_POINTS;
                 rad_vec3 x = patch_point(mesh, patch, s, t);
                 /* every point samples the whole light and its hemisphere; consecutive Halton
-                 * points and turns spread over the points make the patch's samples cover the
-                 * light evenly */
+                 * points (one shift for the patch) make the patch's samples cover the light
+                 * evenly */
                 count += emitter_light_rays_mis(set, scene, x, patch->normal, off,
-                                                PATCH_EMITTER_SAMPLES, (q + 0.5) / points,
-                                                q * PATCH_EMITTER_SAMPLES, shift1, shift2, &rng,
+                                                PATCH_EMITTER_SAMPLES, turn,
+                                                q * PATCH_EMITTER_SAMPLES, shift1, shift2,
                                                 &rays[base + count], &values[base + count]);
                 emitter_cosine_rays(x, patch->normal, off, PATCH_EMITTER_SAMPLES, &rng,
                                     &cosine_rays[base + q * PATCH_EMITTER_SAMPLES],

@@ -18,18 +18,13 @@
 
 /* `count` samples for the point x (unit normal n; segments leave from x + n * leave and
  * stop `leave` off the light), each of the whole light, so the query alone is unbiased:
- * the triangle choice u0 stratified over the `count` samples and turned by `turn` in
- * [0,1), the point on the triangle the Halton points first, first + 1, ... shifted by
- * (shift1, shift2) (a caller taking several queries for one pixel gives them consecutive
- * `first` and different turns, so together they cover the light evenly). Returns how
- * many pairs could carry light (the light in front of the surface and the surface in
- * front of the light). */
-uint32_t emitter_light_rays(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
-                            rad_vec3 n, double leave, uint32_t count, double turn,
-                            uint32_t first, double shift1, double shift2, rad_rng *rng,
-                            rad_ray *rays, rad_rgb *irradiance);
-
-/* Multiple importance sampling with the cosine-weighted directions below (power
+ * sample j (first, first + 1, ...) is the Halton point j in bases 5, 2 and 3, shifted by
+ * (turn, shift1, shift2) modulo 1: the first coordinate chooses the triangle, the other
+ * two the point on it, so the samples of one query, and of consecutive queries (a caller
+ * taking several for one pixel gives them consecutive `first`), cover the light evenly in
+ * all three together. Returns how many pairs could carry light (the light in front of
+ * the surface and the surface in front of the light).
+ * Multiple importance sampling with the cosine-weighted directions below (power
  * heuristic, as many of each): with it, a light sample's irradiance is
  * L cos_x p_L / ((p_L^2 + p_B^2) count) instead of L cos_x / (p_L count), p_L its density
  * per solid angle under light sampling and p_B = cos_x / pi, so points next to an emitter
@@ -37,8 +32,8 @@ uint32_t emitter_light_rays(const emitter_set *set, const rad_scene *scene, rad_
  * far light is left to light sampling (a cosine ray that finds it weighs next to nothing). */
 uint32_t emitter_light_rays_mis(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
                                 rad_vec3 n, double leave, uint32_t count, double turn,
-                                uint32_t first, double shift1, double shift2, rad_rng *rng,
-                                rad_ray *rays, rad_rgb *irradiance);
+                                uint32_t first, double shift1, double shift2, rad_ray *rays,
+                                rad_rgb *irradiance);
 
 /* `count` cosine-weighted directions around n (stratified), rays from x + n * leave, for
  * closest-hit queries against the scene's triangles; cos_x[k] receives each one's cosine. */

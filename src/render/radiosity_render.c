@@ -277,11 +277,9 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
         rad_rng per_pixel = rad_rng_seed(sh->seed ^ EMITTER_STREAM, w->row, pixel);
         double turn = rad_rng_uniform(&per_pixel), shift1 = rad_rng_uniform(&per_pixel),
                shift2 = rad_rng_uniform(&per_pixel);
-        uint32_t total = sh->strata + sh->edge_strata;
-        turn += (double)index / (sh->emitter_samples * (double)total);
         count += emitter_light_rays_mis(sh->emitters, sh->scene, point, patch->normal, leave,
-                                        sh->emitter_samples, turn - floor(turn),
-                                        index * sh->emitter_samples, shift1, shift2, &rng,
+                                        sh->emitter_samples, turn,
+                                        index * sh->emitter_samples, shift1, shift2,
                                         &w->light_rays[w->light_count + count],
                                         &w->light_value[w->light_count + count]);
         uint32_t c = w->cosine_count;
