@@ -84,15 +84,20 @@ bool cli_ranks_solve_summary(const cli_solved *solved, double *imbalance, rad_er
 {
     const rad_scene_solve_report *r = &solved->report;
     bool dense = !solved->from_file && r->solver != RAD_SOLVER_HIERARCHICAL;
-    if (rad_rank_count() > 1 && rad_rank() == 0 && !dense && !solved->from_file)
-        cli_warn("the hierarchical solver is not shared over MPI ranks yet: each of the %d "
-                 "ranks solved the whole scene",
-                 rad_rank_count());
-    rad_rank_report mine = {dense ? r->formfactors.rank_rows : 0,
-                            dense ? r->formfactors.rank_seconds + r->seconds_solve
-                                  : r->seconds_solve,
-                            0, 0};
-    return cli_ranks_summary(&mine, "form-factor rows", imbalance, error);
+    if (solved->from_file || dense) {
+        rad_rank_report mine = {dense ? r->formfactors.rank_rows : 0,
+                                dense ? r->formfactors.rank_seconds + r->seconds_solve
+                                      : r->seconds_solve,
+                                0, 0};
+        return cli_ranks_summary(&mine, "form-factor rows", imbalance, error);
+    }
+    const rad_hierarchy_report *h = &r->hierarchy;
+    if (rad_rank_count() > 1 && rad_rank() == 0)
+        cli_summary("links: %llu in all; each rank holds its receivers' and the %llu received "
+                    "above the cut into subtrees",
+                    (unsigned long long)h->links, (unsigned long long)h->shared_links);
+    rad_rank_report mine = {h->rank_links, h->rank_seconds, 0, 0};
+    return cli_ranks_summary(&mine, "links held", imbalance, error);
 }
 
 int cli_ranks_end(int exit_code)
