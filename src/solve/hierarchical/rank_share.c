@@ -16,6 +16,7 @@
 
 void rank_share_free(rank_share *share)
 {
+    free(share->subtree_of);
     free(share->role);
     free(share->leaf_owner);
     free(share->counts);
@@ -61,52 +62,59 @@ int rank_share_build(const hier_tree *tree, int ranks, int rank, rank_share *sha
     uint32_t nodes = tree->node_count, leaves = tree->nodes[0].count;
     uint32_t target = RANK_SHARE_SUBTREES_PER_RANK * (uint32_t)ranks;
     uint32_t *roots = rad_alloc_array(target, sizeof(uint32_t));
-    uint32_t *owner = rad_alloc_array(target, sizeof(uint32_t));
-    uint32_t *node_owner = rad_alloc_array(nodes, sizeof(uint32_t));
-    double *cost = rad_alloc_array(target, sizeof(double));
+    share->subtree_of = rad_alloc_array(nodes, sizeof(uint32_t));
     share->role = rad_alloc_array(nodes, 1);
     share->leaf_owner = rad_alloc_array(leaves, sizeof(uint32_t));
     share->counts = rad_alloc_array((size_t)ranks, sizeof(uint64_t));
     share->cursor = rad_alloc_array((size_t)ranks, sizeof(uint64_t));
     share->all = rad_alloc_array(3 * (size_t)leaves, sizeof(double));
-    rad_error ignored = {0};
-    int ok = roots && owner && node_owner && cost && share->role && share->leaf_owner &&
-             share->counts && share->cursor && share->all;
+    int ok = roots && share->subtree_of && share->role && share->leaf_owner && share->counts &&
+             share->cursor && share->all;
     if (ok) {
         share->subtrees = cut_tree(tree, target, roots);
-        for (uint32_t k = 0; k < share->subtrees; k++)
-            cost[k] = tree->nodes[roots[k]].count;
-        ok = partition_by_cost(cost, share->subtrees, ranks, owner, &ignored) == RAD_OK;
-    }
-    if (ok) {
-        /* preorder: a cut root's owner passes down to its subtree; nodes above stay NONE */
+        /* preorder: a cut root's index passes down to its subtree; nodes above: NONE */
         uint32_t next = 0;
         for (uint32_t k = 0; k < nodes; k++) {
             uint32_t parent = tree->nodes[k].parent;
             if (next < share->subtrees && roots[next] == k)
-                node_owner[k] = owner[next++];
+                share->subtree_of[k] = next++;
             else
-                node_owner[k] = parent == HNODE_NONE ? HNODE_NONE : node_owner[parent];
-            share->role[k] = node_owner[k] == HNODE_NONE           ? RECEIVER_SHARED
-                             : node_owner[k] == (uint32_t)rank ? RECEIVER_OWN
-                                                                : RECEIVER_ELSEWHERE;
-            const hnode *n = &tree->nodes[k];
-            if (n->patch != HNODE_NONE)
-                share->leaf_owner[n->first] = node_owner[k];
+                share->subtree_of[k] =
+                    parent == HNODE_NONE ? HNODE_NONE : share->subtree_of[parent];
         }
-        for (uint32_t p = 0; p < leaves; p++)
-            share->counts[share->leaf_owner[p]] += 3;
-        share->mine = rad_alloc_array(share->counts[rank] ? share->counts[rank] : 1,
-                                      sizeof(double));
-        ok = share->mine != NULL;
     }
     free(roots);
-    free(owner);
-    free(node_owner);
-    free(cost);
     if (!ok)
         rank_share_free(share);
     return ok;
+}
+
+int rank_share_assign(rank_share *share, const hier_tree *tree, const double *cost)
+{
+    uint32_t *owner = rad_alloc_array(share->subtrees, sizeof(uint32_t));
+    rad_error ignored = {0};
+    if (!owner || partition_by_cost(cost, share->subtrees, share->ranks, owner, &ignored) !=
+                      RAD_OK) {
+        free(owner);
+        return 0;
+    }
+    uint32_t me = (uint32_t)share->rank;
+    memset(share->counts, 0, (size_t)share->ranks * sizeof(uint64_t));
+    for (uint32_t k = 0; k < tree->node_count; k++) {
+        uint32_t subtree = share->subtree_of[k];
+        share->role[k] = subtree == HNODE_NONE   ? RECEIVER_SHARED
+                         : owner[subtree] == me ? RECEIVER_OWN
+                                                : RECEIVER_ELSEWHERE;
+        const hnode *n = &tree->nodes[k];
+        if (n->patch != HNODE_NONE) { /* a leaf is never above the cut */
+            share->leaf_owner[n->first] = owner[subtree];
+            share->counts[owner[subtree]] += 3;
+        }
+    }
+    free(owner);
+    free(share->mine);
+    share->mine = rad_alloc_array(share->counts[me] ? share->counts[me] : 1, sizeof(double));
+    return share->mine != NULL;
 }
 
 void rank_share_exchange(rank_share *share, uint32_t leaves, rad_rgb *by_position)

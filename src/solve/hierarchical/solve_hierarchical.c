@@ -59,7 +59,9 @@ typedef struct hsolver {
     uint32_t changed_most;      /* the patch whose B changed the most in the last sweep */
     rad_rgb *observed;          /* per patch: the observer's copy of B, or NULL */
     rank_share share;           /* over MPI ranks: who holds which receivers' links */
-    bool shared;                /* more than one rank */
+    bool over_ranks;            /* more than one rank: the collective steps */
+    bool links_split;           /* over ranks (from the start): each rank holds its
+                                   receivers' links and the shared ones */
     rad_rgb *fresh;             /* over ranks: a sweep's new B by leaf-order position */
     bool stop_seen;             /* over ranks: every rank saw the stop */
 } hsolver;
@@ -132,7 +134,7 @@ static double sweep(hsolver *s)
         s->gathered[k] = sum;
     }
     double change = 0, most = -1;
-    if (s->shared) { /* this rank's leaves, then every rank's from their owners */
+    if (s->links_split) { /* this rank's leaves, then every rank's from their owners */
         for (uint32_t k = 0; k < t->node_count; k++) {
             const hnode *n = &t->nodes[k];
             s->down[k] = n->parent == HNODE_NONE ? s->gathered[k]
@@ -144,12 +146,12 @@ static double sweep(hsolver *s)
     }
     for (uint32_t k = 0; k < t->node_count; k++) {
         const hnode *n = &t->nodes[k];
-        if (!s->shared)
+        if (!s->links_split)
             s->down[k] = n->parent == HNODE_NONE ? s->gathered[k]
                                                  : rgb_add(s->down[n->parent], s->gathered[k]);
         if (n->patch != HNODE_NONE) {
             uint32_t p = n->patch;
-            rad_rgb b = s->shared ? s->fresh[n->first] : leaf_radiosity(s, k);
+            rad_rgb b = s->links_split ? s->fresh[n->first] : leaf_radiosity(s, k);
             double moved = n->area * (fabs(b.r - s->patch_B[p].r) + fabs(b.g - s->patch_B[p].g) +
                                       fabs(b.b - s->patch_B[p].b));
             change += moved;
@@ -250,30 +252,50 @@ static double sweep_observed(hsolver *s, hobserver *ob, const char *phase)
 static bool stopped(hsolver *s, const rad_hierarchy_options *o)
 {
     bool here = s->stop_seen || (o->stop && *o->stop);
-    if (s->shared && !s->stop_seen)
+    if (s->over_ranks && !s->stop_seen)
         here = ranks_failures(here) > 0;
-    s->stop_seen = s->stop_seen || (s->shared && here);
+    s->stop_seen = s->stop_seen || (s->over_ranks && here);
     return here;
+}
+
+/* Over ranks: assigns the receiver subtrees by their leaf counts (measured on two scenes,
+ * a better predictor of the links each will receive than the links the first passes put
+ * there). 0 when out of memory. */
+static int assign_by_leaves(hsolver *s)
+{
+    rank_share *share = &s->share;
+    double *cost = rad_alloc_array(share->subtrees, sizeof(double));
+    if (!cost)
+        return 0;
+    for (uint32_t k = 0; k < s->tree.node_count; k++)
+        if (s->tree.nodes[k].patch != HNODE_NONE)
+            cost[share->subtree_of[k]] += 1;
+    int ok = rank_share_assign(share, &s->tree, cost);
+    free(cost);
+    s->links_split = ok;
+    return ok;
 }
 
 /* Whether any rank holds a link (collective over ranks). */
 static bool links_anywhere(const hsolver *s)
 {
     uint64_t count = s->store.count;
-    if (s->shared)
+    if (s->over_ranks)
         ranks_sum(&count, 1);
     return count > 0;
 }
 
 /* Of this rank's links: those it alone counts in the whole (its own receivers', and on rank
- * 0 the shared ones), how many of those are partly visible, and the shared ones. */
+ * 0 those every rank holds), how many of those are partly visible, and those every rank
+ * holds (over ranks: those received above the cut). */
 static void count_links(const hsolver *s, uint64_t *counted, uint64_t *partial,
                         uint64_t *shared)
 {
     *counted = *partial = *shared = 0;
     for (size_t l = 0; l < s->store.count; l++) {
         const hlink *link = &s->store.links[l];
-        bool is_shared = s->shared && s->share.role[link->receiver] == RECEIVER_SHARED;
+        bool is_shared = s->over_ranks && (!s->links_split ||
+                                           s->share.role[link->receiver] == RECEIVER_SHARED);
         bool counts = !is_shared || s->share.rank == 0;
         *shared += is_shared;
         *counted += counts;
@@ -339,16 +361,16 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
         return RAD_OK;
     }
     /* over ranks every rank builds the same tree, then they agree before working together */
-    s.shared = ranks_count() > 1;
+    s.over_ranks = ranks_count() > 1;
     rad_status setup = RAD_OK;
     if (!hier_tree_build(mesh, &s.tree))
         setup = rad_fail(error, RAD_ERR_NOMEM, "out of memory building the element tree");
-    if (setup == RAD_OK && s.shared &&
+    if (setup == RAD_OK && s.over_ranks &&
         (!rank_share_build(&s.tree, ranks_count(), ranks_rank(), &s.share) ||
-         !(s.fresh = rad_alloc_array(n, sizeof(rad_rgb)))))
+         !assign_by_leaves(&s) || !(s.fresh = rad_alloc_array(n, sizeof(rad_rgb)))))
         setup = rad_fail(error, RAD_ERR_NOMEM, "out of memory sharing the hierarchy over %d "
                          "ranks", ranks_count());
-    if (s.shared)
+    if (s.over_ranks)
         setup = ranks_agree(setup, "the hierarchical solver", error);
     if (setup != RAD_OK) {
         hsolver_free(&s);
@@ -369,7 +391,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
                     !s.brightness || (ob.fn && !ob.before)
                 ? rad_fail(error, RAD_ERR_NOMEM, "out of memory for the hierarchy")
                 : RAD_OK;
-    if (s.shared)
+    if (s.over_ranks)
         setup = ranks_agree(setup, "the hierarchical solver", error);
     if (setup != RAD_OK) {
         hsolver_free(&s);
@@ -391,7 +413,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     s.store.max_bytes = budget;
     bool root_cluster = !s.tree.nodes[0].planar;
     if (root_cluster && s.emitted > 0 &&
-        !(s.shared && s.share.role[0] == RECEIVER_ELSEWHERE)) {
+        !(s.links_split && s.share.role[0] == RECEIVER_ELSEWHERE)) {
         if (2 * sizeof(hlink) > budget) {
             hsolver_free(&s);
             return rad_fail(error, RAD_ERR_NOMEM, "--max-memory: %llu bytes cannot hold a link",
@@ -418,7 +440,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
                          rays,
                          o.seed,
                          s.threads,
-                         s.shared ? s.share.role : NULL};
+                         s.links_split ? s.share.role : NULL};
 
     double sweep_change = s.emitted > 0 ? 1 : 0;
     uint64_t rays_shared = 0; /* over ranks: traced alike on every rank, counted once */
@@ -435,7 +457,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
                 hier_refine_pass(&rc, &s.store, &rr)
                     ? RAD_OK
                     : rad_fail(error, RAD_ERR_NOMEM, "out of memory refining the links");
-            if (s.shared)
+            if (s.over_ranks)
                 refined = ranks_agree(refined, "refining the links", error);
             if (refined != RAD_OK) {
                 hsolver_free(&s);
@@ -445,7 +467,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             rep.rays += rr.rays - rr.rays_shared;
             rays_shared += rr.rays_shared;
             split = rr.split;
-            if (s.shared) { /* whether any rank split, or stopped at its budget */
+            if (s.over_ranks) { /* whether any rank split, or stopped at its budget */
                 uint64_t any[2] = {split, rr.capped};
                 ranks_sum(any, 2);
                 split = (size_t)any[0];
@@ -453,6 +475,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             }
             if (rr.capped)
                 rep.memory_capped = true;
+
             rep.seconds_refine += now_seconds() - tr;
             if (o.progress)
                 o.progress(o.progress_user, "refine", refine_fraction(rep.passes, nodes));
@@ -499,10 +522,10 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
         final_gather_context fg = {mesh,       &s.tree,    occluders,  s.store.links,
                                    s.offsets,  s.node_B,   s.brightness, rays,
                                    o.seed + 2, s.threads,  o.progress, o.progress_user,
-                                   o.stop,     s.shared ? s.share.role : NULL};
+                                   o.stop,     s.links_split ? s.share.role : NULL};
         int gathered = s.correction && s.scale ? hier_final_gather(&fg, s.correction, &rep.rays)
                                                : 0;
-        if (s.shared) { /* out of memory anywhere fails all; a stop anywhere stops all */
+        if (s.over_ranks) { /* out of memory anywhere fails all; a stop anywhere stops all */
             if (ranks_failures(gathered == 0) > 0)
                 gathered = 0;
             else if (ranks_failures(gathered < 0) > 0)
@@ -550,7 +573,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     uint64_t counts[3] = {0, 0, rep.rays}; /* links, partial, rays: every one once */
     count_links(&s, &counts[0], &counts[1], &rep.shared_links);
     rep.rank_links = s.store.count;
-    if (s.shared)
+    if (s.over_ranks)
         ranks_sum(counts, 3);
     rep.links = counts[0];
     rep.links_partial = counts[1];
