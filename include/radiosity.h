@@ -1268,8 +1268,8 @@ typedef struct rad_hierarchy_report {
      * over all ranks. With one process rank_links = links and shared_links = 0. */
     uint64_t rank_links;     /* links this process held at the end */
     uint64_t shared_links;   /* links every rank holds (received by the nodes above the cut) */
-    double rank_seconds;     /* this process's solve time less its waiting in the exchanges of
-                                radiosity (for the load imbalance) */
+    double rank_seconds;     /* this process's solve time less its waiting for the other
+                                ranks (exchanges and agreements; for the load imbalance) */
 } rad_hierarchy_report;
 
 /* Solves the mesh's radiosity hierarchically with the patch inputs of rad_patch_inputs_build:

@@ -64,6 +64,8 @@ typedef struct hsolver {
                                    receivers' links and the shared ones */
     rad_rgb *fresh;             /* over ranks: a sweep's new B by leaf-order position */
     bool stop_seen;             /* over ranks: every rank saw the stop */
+    double seconds_waiting;     /* over ranks: in the collective steps here (the exchanges
+                                   of B are timed by rank_share) */
 } hsolver;
 
 /* A sweep whose change (relative to the emitted power) is not finite or above this has
@@ -252,8 +254,11 @@ static double sweep_observed(hsolver *s, hobserver *ob, const char *phase)
 static bool stopped(hsolver *s, const rad_hierarchy_options *o)
 {
     bool here = s->stop_seen || (o->stop && *o->stop);
-    if (s->over_ranks && !s->stop_seen)
+    if (s->over_ranks && !s->stop_seen) {
+        double t = now_seconds();
         here = ranks_failures(here) > 0;
+        s->seconds_waiting += now_seconds() - t;
+    }
     s->stop_seen = s->stop_seen || (s->over_ranks && here);
     return here;
 }
@@ -277,11 +282,13 @@ static int assign_by_leaves(hsolver *s)
 }
 
 /* Whether any rank holds a link (collective over ranks). */
-static bool links_anywhere(const hsolver *s)
+static bool links_anywhere(hsolver *s)
 {
     uint64_t count = s->store.count;
+    double t = now_seconds();
     if (s->over_ranks)
         ranks_sum(&count, 1);
+    s->seconds_waiting += now_seconds() - t;
     return count > 0;
 }
 
@@ -457,8 +464,10 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
                 hier_refine_pass(&rc, &s.store, &rr)
                     ? RAD_OK
                     : rad_fail(error, RAD_ERR_NOMEM, "out of memory refining the links");
+            double tw = now_seconds(); /* the ranks wait here for the slowest */
             if (s.over_ranks)
                 refined = ranks_agree(refined, "refining the links", error);
+            s.seconds_waiting += now_seconds() - tw;
             if (refined != RAD_OK) {
                 hsolver_free(&s);
                 return refined;
@@ -525,12 +534,14 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
                                    o.stop,     s.links_split ? s.share.role : NULL};
         int gathered = s.correction && s.scale ? hier_final_gather(&fg, s.correction, &rep.rays)
                                                : 0;
+        double tw = now_seconds(); /* the ranks wait here for the slowest */
         if (s.over_ranks) { /* out of memory anywhere fails all; a stop anywhere stops all */
             if (ranks_failures(gathered == 0) > 0)
                 gathered = 0;
             else if (ranks_failures(gathered < 0) > 0)
                 gathered = -1;
         }
+        s.seconds_waiting += now_seconds() - tw;
         if (gathered == 0) {
             hsolver_free(&s);
             return rad_fail(error, RAD_ERR_NOMEM, "out of memory in the final gather");
@@ -579,7 +590,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     rep.links_partial = counts[1];
     rep.rays = counts[2] + rays_shared;
     rep.link_bytes = s.store.peak_bytes;
-    rep.rank_seconds = now_seconds() - t0 - s.share.seconds_exchanging;
+    rep.rank_seconds = now_seconds() - t0 - s.share.seconds_exchanging - s.seconds_waiting;
     if (s.diverged || !isfinite(sweep_change) || !isfinite(rep.residual)) {
         /* never hand out a diverged answer as a solution */
         rep.patch = s.changed_most;
