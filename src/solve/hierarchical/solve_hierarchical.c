@@ -59,9 +59,8 @@ typedef struct hsolver {
     uint32_t changed_most;      /* the patch whose B changed the most in the last sweep */
     rad_rgb *observed;          /* per patch: the observer's copy of B, or NULL */
     rank_share share;           /* over MPI ranks: who holds which receivers' links */
-    bool over_ranks;            /* more than one rank: the collective steps */
-    bool links_split;           /* over ranks (from the start): each rank holds its
-                                   receivers' links and the shared ones */
+    bool over_ranks;            /* more than one rank: each holds its receivers' links and
+                                   the shared ones, and the steps here are collective */
     rad_rgb *fresh;             /* over ranks: a sweep's new B by leaf-order position */
     bool stop_seen;             /* over ranks: every rank saw the stop */
     double seconds_waiting;     /* over ranks: in the collective steps here (the exchanges
@@ -136,7 +135,7 @@ static double sweep(hsolver *s)
         s->gathered[k] = sum;
     }
     double change = 0, most = -1;
-    if (s->links_split) { /* this rank's leaves, then every rank's from their owners */
+    if (s->over_ranks) { /* this rank's leaves, then every rank's from their owners */
         for (uint32_t k = 0; k < t->node_count; k++) {
             const hnode *n = &t->nodes[k];
             s->down[k] = n->parent == HNODE_NONE ? s->gathered[k]
@@ -148,12 +147,12 @@ static double sweep(hsolver *s)
     }
     for (uint32_t k = 0; k < t->node_count; k++) {
         const hnode *n = &t->nodes[k];
-        if (!s->links_split)
+        if (!s->over_ranks)
             s->down[k] = n->parent == HNODE_NONE ? s->gathered[k]
                                                  : rgb_add(s->down[n->parent], s->gathered[k]);
         if (n->patch != HNODE_NONE) {
             uint32_t p = n->patch;
-            rad_rgb b = s->links_split ? s->fresh[n->first] : leaf_radiosity(s, k);
+            rad_rgb b = s->over_ranks ? s->fresh[n->first] : leaf_radiosity(s, k);
             double moved = n->area * (fabs(b.r - s->patch_B[p].r) + fabs(b.g - s->patch_B[p].g) +
                                       fabs(b.b - s->patch_B[p].b));
             change += moved;
@@ -277,7 +276,6 @@ static int assign_by_leaves(hsolver *s)
             cost[share->subtree_of[k]] += 1;
     int ok = rank_share_assign(share, &s->tree, cost);
     free(cost);
-    s->links_split = ok;
     return ok;
 }
 
@@ -301,8 +299,7 @@ static void count_links(const hsolver *s, uint64_t *counted, uint64_t *partial,
     *counted = *partial = *shared = 0;
     for (size_t l = 0; l < s->store.count; l++) {
         const hlink *link = &s->store.links[l];
-        bool is_shared = s->over_ranks && (!s->links_split ||
-                                           s->share.role[link->receiver] == RECEIVER_SHARED);
+        bool is_shared = s->over_ranks && s->share.role[link->receiver] == RECEIVER_SHARED;
         bool counts = !is_shared || s->share.rank == 0;
         *shared += is_shared;
         *counted += counts;
@@ -420,7 +417,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     s.store.max_bytes = budget;
     bool root_cluster = !s.tree.nodes[0].planar;
     if (root_cluster && s.emitted > 0 &&
-        !(s.links_split && s.share.role[0] == RECEIVER_ELSEWHERE)) {
+        !(s.over_ranks && s.share.role[0] == RECEIVER_ELSEWHERE)) {
         if (2 * sizeof(hlink) > budget) {
             hsolver_free(&s);
             return rad_fail(error, RAD_ERR_NOMEM, "--max-memory: %llu bytes cannot hold a link",
@@ -447,7 +444,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
                          rays,
                          o.seed,
                          s.threads,
-                         s.links_split ? s.share.role : NULL};
+                         s.over_ranks ? s.share.role : NULL};
 
     double sweep_change = s.emitted > 0 ? 1 : 0;
     uint64_t rays_shared = 0; /* over ranks: traced alike on every rank, counted once */
@@ -484,7 +481,6 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             }
             if (rr.capped)
                 rep.memory_capped = true;
-
             rep.seconds_refine += now_seconds() - tr;
             if (o.progress)
                 o.progress(o.progress_user, "refine", refine_fraction(rep.passes, nodes));
@@ -531,7 +527,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
         final_gather_context fg = {mesh,       &s.tree,    occluders,  s.store.links,
                                    s.offsets,  s.node_B,   s.brightness, rays,
                                    o.seed + 2, s.threads,  o.progress, o.progress_user,
-                                   o.stop,     s.links_split ? s.share.role : NULL};
+                                   o.stop,     s.over_ranks ? s.share.role : NULL};
         int gathered = s.correction && s.scale ? hier_final_gather(&fg, s.correction, &rep.rays)
                                                : 0;
         double tw = now_seconds(); /* the ranks wait here for the slowest */
