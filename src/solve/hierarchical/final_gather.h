@@ -29,10 +29,10 @@ typedef struct final_gather_context {
                                      NULL: every leaf */
 } final_gather_context;
 
-/* correction[k] for every leaf node k (of this rank's, over MPI ranks): the irradiance per unit area its ancestors' links
- * give at its own resolution minus what they hand down (their transfer x B). Adds the
- * segments traced to *rays. Returns 1, or 0 when memory ran out, or -1 when stopped (the
- * corrections are then incomplete and must not be used). */
+/* correction[k] for every leaf node k (over MPI ranks, this rank's own): the irradiance
+ * per unit area its ancestors' links give at its own resolution minus what they hand down
+ * (their transfer x B). Adds the segments traced to *rays. Returns 1, or 0 when memory ran
+ * out, or -1 when stopped (the corrections are then incomplete and must not be used). */
 int hier_final_gather(const final_gather_context *context, rad_rgb *correction,
                       uint64_t *rays);
 
