@@ -1244,7 +1244,8 @@ typedef struct rad_hierarchy_report {
     uint64_t links;          /* links at the end */
     uint64_t links_partial;  /* of which partly visible */
     uint64_t rays;           /* visibility segments traced */
-    uint64_t link_bytes;     /* the most the link store held, bytes */
+    uint64_t link_bytes;     /* the most the link store held, bytes (this process's store:
+                                over MPI ranks, this rank's share) */
     uint32_t passes;         /* refinement passes (each splits links one level) */
     uint32_t iterations;     /* Jacobi sweeps with push-pull */
     double change;           /* relative change of the last sweep: sum A |B_new - B|_1 /
@@ -1262,6 +1263,14 @@ typedef struct rad_hierarchy_report {
     int threads;
     uint32_t patch;          /* after a diverging solve (RAD_ERR_INVALID): the patch whose
                                 radiosity changed the most, else UINT32_MAX */
+    /* Over MPI ranks (rad_rank_count() > 1) the tree is cut into receiver subtrees shared
+     * by leaf count, and a rank holds the links received in its subtrees and the
+     * shared_links; links, links_partial and rays above count every link and segment once,
+     * over all ranks. With one process rank_links = links and shared_links = 0. */
+    uint64_t rank_links;     /* links this process held at the end */
+    uint64_t shared_links;   /* links every rank holds (received by the nodes above the cut) */
+    double rank_seconds;     /* this process's solve time less its waiting for the other
+                                ranks (exchanges and agreements; for the load imbalance) */
 } rad_hierarchy_report;
 
 /* Solves the mesh's radiosity hierarchically with the patch inputs of rad_patch_inputs_build:

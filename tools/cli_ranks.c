@@ -80,19 +80,50 @@ void cli_ranks_solve_quiet(cli_solve *solve)
     solve->save_solution_path = NULL;
 }
 
+/* Collective: rank 0 prints every rank's peak link-store bytes on one line. */
+static bool link_store_summary(uint64_t bytes, rad_error *error)
+{
+    int count = rad_rank_count();
+    rad_rank_report *all = rad_alloc_array((size_t)count, sizeof(*all));
+    bool ok = all != NULL;
+    if (!cli_ranks_ok(ok ? RAD_OK : RAD_ERR_NOMEM, error) || !ok) {
+        free(all);
+        return false;
+    }
+    rad_rank_report mine = {bytes, 0, 0, 0};
+    ok = rad_ranks_gather_reports(&mine, all, error) == RAD_OK;
+    if (ok && rad_rank() == 0) {
+        char line[4096];
+        size_t at = 0;
+        for (int r = 0; r < count && at < sizeof(line); r++)
+            at += (size_t)snprintf(line + at, sizeof(line) - at, "%s%.1f", r ? ", " : "",
+                                   (double)all[r].work / 1e6);
+        cli_summary("link store per rank (peak, MB, rank 0 first): %s", line);
+    }
+    free(all);
+    return ok;
+}
+
 bool cli_ranks_solve_summary(const cli_solved *solved, double *imbalance, rad_error *error)
 {
     const rad_scene_solve_report *r = &solved->report;
     bool dense = !solved->from_file && r->solver != RAD_SOLVER_HIERARCHICAL;
-    if (rad_rank_count() > 1 && rad_rank() == 0 && !dense && !solved->from_file)
-        cli_warn("the hierarchical solver is not shared over MPI ranks yet: each of the %d "
-                 "ranks solved the whole scene",
-                 rad_rank_count());
-    rad_rank_report mine = {dense ? r->formfactors.rank_rows : 0,
-                            dense ? r->formfactors.rank_seconds + r->seconds_solve
-                                  : r->seconds_solve,
-                            0, 0};
-    return cli_ranks_summary(&mine, "form-factor rows", imbalance, error);
+    if (solved->from_file || dense) {
+        rad_rank_report mine = {dense ? r->formfactors.rank_rows : 0,
+                                dense ? r->formfactors.rank_seconds + r->seconds_solve
+                                      : r->seconds_solve,
+                                0, 0};
+        return cli_ranks_summary(&mine, "form-factor rows", imbalance, error);
+    }
+    const rad_hierarchy_report *h = &r->hierarchy;
+    if (rad_rank_count() > 1 && rad_rank() == 0)
+        cli_summary("links: %llu in all; each rank holds its receivers' and the %llu received "
+                    "above the cut into subtrees",
+                    (unsigned long long)h->links, (unsigned long long)h->shared_links);
+    rad_rank_report mine = {h->rank_links, h->rank_seconds, 0, 0};
+    if (!cli_ranks_summary(&mine, "links held", imbalance, error))
+        return false;
+    return rad_rank_count() == 1 || link_store_summary(h->link_bytes, error);
 }
 
 int cli_ranks_end(int exit_code)

@@ -38,8 +38,8 @@ void cli_ranks_solve_quiet(cli_solve *solve);
 
 /* Collective, after cli_solve_scene: the per-rank summary of the solve (cli_ranks_summary
  * with the dense form-factor rows each rank computed, and its time on them plus the
- * solve's); rank 0 warns when the solver was not shared over the ranks (hierarchical:
- * every rank solved the whole scene; a solution file read: nothing was solved). */
+ * solve's; hierarchical: the links each rank held at the end and its solve time less its
+ * waiting, and on rank 0 a line with the links in all and those every rank holds). */
 bool cli_ranks_solve_summary(const cli_solved *solved, double *imbalance, rad_error *error);
 
 /* Leaves the job; returns exit_code. */

@@ -288,3 +288,43 @@ rad_status ranks_share_status(rad_status status, rad_error *error)
     }
     return (rad_status)shared;
 }
+
+#ifdef RAD_MPI
+
+void ranks_share_parts(const double *mine, double *all, const uint64_t *counts)
+{
+    if (rank_total == 1) {
+        memcpy(all, mine, counts[0] * sizeof(double));
+        return;
+    }
+    int *sizes = rad_alloc_array((size_t)rank_total, sizeof(int));
+    int *starts = rad_alloc_array((size_t)rank_total, sizeof(int));
+    uint64_t at = 0;
+    bool fits = sizes && starts;
+    for (int r = 0; fits && r < rank_total; r++) {
+        fits = counts[r] <= (uint64_t)INT32_MAX && at <= (uint64_t)INT32_MAX;
+        sizes[r] = fits ? (int)counts[r] : 0;
+        starts[r] = fits ? (int)at : 0;
+        at += counts[r];
+    }
+    if (!fits) { /* the same on every rank: none can go on without the others' values */
+        free(sizes);
+        free(starts);
+        rad_ranks_abort(EXIT_FAILURE);
+        return;
+    }
+    MPI_Allgatherv(mine, sizes[rank_index], MPI_DOUBLE, all, sizes, starts, MPI_DOUBLE,
+                   MPI_COMM_WORLD);
+    bytes_communicated += at * sizeof(double);
+    free(sizes);
+    free(starts);
+}
+
+#else
+
+void ranks_share_parts(const double *mine, double *all, const uint64_t *counts)
+{
+    memcpy(all, mine, counts[0] * sizeof(double));
+}
+
+#endif

@@ -53,4 +53,10 @@ void ranks_broadcast(void *data, uint64_t size);
 rad_status ranks_gather(const void *data, uint64_t size, void **gathered, uint64_t *sizes,
                         rad_error *error);
 
+/* Collective: every rank's counts[rank] doubles at `mine`, concatenated in rank order, in
+ * all[] (room for the sum of counts[]) on every rank; counts[] is the same on every rank.
+ * For blocks of unequal, scattered items (the hierarchical solver's leaves). Ends the job
+ * (rad_ranks_abort) when a rank's count exceeds what one MPI call carries (2^31 - 1). */
+void ranks_share_parts(const double *mine, double *all, const uint64_t *counts);
+
 #endif

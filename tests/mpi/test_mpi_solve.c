@@ -3,8 +3,8 @@
  * the same bytes as the serial run, on the built-in Cornell box (its two boxes obstruct:
  * the form factors cast rays) with the default dense solver (gather, Jacobi: the sweeps
  * are shared over the ranks); Gauss-Seidel (solved whole on every rank from the shared
- * matrix) and the hierarchical solver (every rank solves the whole scene, with a warning,
- * for now) too under 3 ranks. The per-rank
+ * matrix) and the hierarchical solver (its links shared by receiver; see
+ * test_mpi_hierarchical) too under 3 ranks. The per-rank
  * summary accounts for every form-factor row once. The ranks run one thread each, the
  * serial run two: the results depend on neither.
  */
@@ -67,6 +67,7 @@ int main(void)
     CHECK(test_run_mpi(3, "solve -o h.ply " PATCHES " --solver hierarchical --threads 1", 0,
                        NULL) == 0);
     CHECK(test_same_bytes(test_path("serial-h.ply"), test_path("h.ply")));
-    CHECK(strstr(test_read_text(test_path("stderr.txt")), "not shared over MPI ranks") != NULL);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "rank 2 of 3: ") != NULL &&
+          strstr(test_read_text(test_path("stderr.txt")), " links held, ") != NULL);
     return test_finish("test_mpi_solve");
 }

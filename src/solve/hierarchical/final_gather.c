@@ -13,7 +13,8 @@
  * minus what the ancestors' links handed down. The solver keeps it fixed and sweeps again
  * (the correction moves with B only to second order). Parallel over leaves; every random
  * number comes from (seed, leaf, source), so the result does not depend on the thread
- * count.
+ * count. Over MPI ranks each rank corrects its own leaves only (their ancestors' links
+ * are all held there).
  */
 #include <omp.h>
 #include <stdlib.h>
@@ -156,7 +157,8 @@ int hier_final_gather(const final_gather_context *c, rad_rgb *correction, uint64
                 c->progress(c->progress_user, "final gather", (double)k / (double)nodes);
             if (c->stop && *c->stop)
                 stopped = 1;
-            if (t->nodes[k].patch == HNODE_NONE || failed || stopped)
+            if (t->nodes[k].patch == HNODE_NONE || failed || stopped ||
+                (c->receiver_role && c->receiver_role[k] != RECEIVER_OWN))
                 continue;
             if (!gather_leaf(c, (uint32_t)k, &b, &correction[k], &cast))
                 failed = 1;

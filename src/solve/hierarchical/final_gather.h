@@ -25,12 +25,14 @@ typedef struct final_gather_context {
     rad_progress_fn progress; /* "final gather", from the calling thread; may be NULL */
     void *progress_user;
     const volatile int *stop; /* when it becomes non-zero, the gather gives up; may be NULL */
+    const uint8_t *receiver_role; /* over MPI ranks: only the leaves RECEIVER_OWN gather;
+                                     NULL: every leaf */
 } final_gather_context;
 
-/* correction[k] for every leaf node k: the irradiance per unit area its ancestors' links
- * give at its own resolution minus what they hand down (their transfer x B). Adds the
- * segments traced to *rays. Returns 1, or 0 when memory ran out, or -1 when stopped (the
- * corrections are then incomplete and must not be used). */
+/* correction[k] for every leaf node k (over MPI ranks, this rank's own): the irradiance
+ * per unit area its ancestors' links give at its own resolution minus what they hand down
+ * (their transfer x B). Adds the segments traced to *rays. Returns 1, or 0 when memory ran
+ * out, or -1 when stopped (the corrections are then incomplete and must not be used). */
 int hier_final_gather(const final_gather_context *context, rad_rgb *correction,
                       uint64_t *rays);
 

@@ -140,6 +140,11 @@ typedef struct link_store {
     uint64_t peak_bytes; /* the most both buffers held */
 } link_store;
 
+/* Over MPI ranks (rank_share.h), a node's role as a receiver on this rank: its links are
+ * held here only (OWN), on every rank (SHARED: the few nodes above the cut), or on another
+ * rank only (ELSEWHERE). */
+enum { RECEIVER_ELSEWHERE = 0, RECEIVER_OWN = 1, RECEIVER_SHARED = 2 };
+
 typedef struct refine_context {
     const rad_mesh *mesh;
     const hier_tree *tree;
@@ -151,12 +156,16 @@ typedef struct refine_context {
     unsigned visibility_rays;      /* segments for a link the first 4 found partial */
     uint64_t seed;
     int threads;
+    const uint8_t *receiver_role;  /* per node, over MPI ranks: children received ELSEWHERE
+                                      are dropped unestimated; NULL: every receiver here */
 } refine_context;
 
 typedef struct refine_result {
     size_t split;  /* links replaced by their children */
     bool capped;   /* some links wanted to split but the budget said no */
     uint64_t rays;
+    uint64_t rays_shared; /* of which for links received by a SHARED node (every rank
+                             traces those) */
 } refine_result;
 
 /* One refinement pass: every link whose BFA bound exceeds epsilon (a quarter of it for

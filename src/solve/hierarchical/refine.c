@@ -7,7 +7,10 @@
  * the budget, the links with the largest bounds split first and the rest stay (the run is
  * then "capped"). Phase 2 (parallel over fixed chunks of links): children are estimated and
  * their visibility traced, written at positions fixed by the chunk's place, then chunks are
- * compacted in order. Nothing depends on the thread count.
+ * compacted in order. Nothing depends on the thread count. Over MPI ranks a child whose
+ * receiver another rank owns is dropped before it costs anything (that rank makes it from
+ * its own copy of the parent, the same way), so each rank's links are the serial run's
+ * with its receivers, in the same order.
  */
 #include <math.h>
 #include <omp.h>
@@ -96,7 +99,7 @@ typedef struct thread_buffers {
 /* Children of one chunk of parent links, written to out; returns how many are live. */
 static size_t refine_chunk(const refine_context *c, const hlink *links, const uint8_t *action,
                            size_t begin, size_t end, hlink *out, thread_buffers *tb,
-                           uint64_t *rays_cast)
+                           uint64_t *rays_cast, uint64_t *rays_shared)
 {
     const hnode *nodes = c->tree->nodes;
     size_t slot = 0;
@@ -136,6 +139,11 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
             child->visible = (uint16_t)LINK_VISIBLE;
             child->flags = 0;
             child->bound = 0;
+            if (c->receiver_role && c->receiver_role[child->receiver] == RECEIVER_ELSEWHERE) {
+                child->receiver = HNODE_NONE; /* another rank's: it refines it itself */
+                slot++;
+                continue;
+            }
             if (child->receiver == child->source) {
                 if (nodes[child->receiver].planar) /* a plane sends nothing to itself */
                     child->receiver = HNODE_NONE;
@@ -160,6 +168,8 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
                           &tb->rays[ray_count], &tb->kernel[ray_count], c->leaf_brightness,
                           &tb->weight[ray_count], &tb->blocked[ray_count]);
             ray_count += FIRST_RAYS;
+            if (c->receiver_role && c->receiver_role[child->receiver] == RECEIVER_SHARED)
+                *rays_shared += FIRST_RAYS;
             pending_count++;
             slot++;
         }
@@ -192,6 +202,8 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
             hier_occluded(c->occluders, tb->more_rays, extra, tb->more_blocked,
                           tb->more_occluded);
             *rays_cast += extra;
+            if (c->receiver_role && c->receiver_role[child->receiver] == RECEIVER_SHARED)
+                *rays_shared += extra;
             for (unsigned r = 0; r < extra; r++) {
                 bool open = !tb->more_occluded[r];
                 double kernel = tb->more_kernel[r], weighted = kernel * tb->more_weight[r];
@@ -334,12 +346,13 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
             sum += children_of(action[l]);
         chunk_start[k + 1] = chunk_start[k] + sum;
     }
-    uint64_t rays = 0;
+    uint64_t rays = 0, rays_shared = 0;
     int failed = 0;
     unsigned extra_rays = c->visibility_rays > MAX_RAYS ? MAX_RAYS : c->visibility_rays;
     links = store->links;
     hlink *out = store->spare;
-#pragma omp parallel num_threads(c->threads) reduction(+ : rays) reduction(| : failed)
+#pragma omp parallel num_threads(c->threads) reduction(+ : rays, rays_shared) \
+    reduction(| : failed)
     {
         thread_buffers tb;
         size_t most = 4 * (size_t)CHUNK_LINKS;
@@ -367,7 +380,7 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
                 continue;
             size_t end = (k + 1) * CHUNK_LINKS < n ? (k + 1) * CHUNK_LINKS : n;
             chunk_live[k] = refine_chunk(&local, links, action, k * CHUNK_LINKS, end,
-                                         out + chunk_start[k], &tb, &rays);
+                                         out + chunk_start[k], &tb, &rays, &rays_shared);
         }
         free(tb.rays);
         free(tb.occluded);
@@ -399,6 +412,7 @@ int hier_refine_pass(const refine_context *c, link_store *store, refine_result *
     store->count = live;
     result->split = split;
     result->rays = rays;
+    result->rays_shared = rays_shared;
     free(action);
     free(bound);
     free(chunk_start);

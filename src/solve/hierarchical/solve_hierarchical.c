@@ -8,6 +8,13 @@
  * the area-weighted mean of its children's (one backward loop). The outer loop refines the
  * links one level with the newest B and sweeps twice, until nothing splits; then it sweeps
  * to the tolerance and checks refinement once more with the converged B.
+ *
+ * Over MPI ranks (rank_share.h) every rank builds the same tree; the links are shared by
+ * receiver subtree, each held by its owner only (those of the few nodes above the cut by
+ * every rank), and each rank refines, gathers and final-gathers its own receivers. After a
+ * sweep the leaves' new B go to every rank, which then measures the change and pulls over
+ * the whole tree exactly as one process does: each rank's links and sums are the serial
+ * run's, so the solution is bitwise the serial one for any rank count.
  */
 #include <math.h>
 #include <omp.h>
@@ -23,6 +30,8 @@
 #include "core/vec3.h"
 #include "solve/hierarchical/final_gather.h"
 #include "solve/hierarchical/hierarchy.h"
+#include "solve/hierarchical/rank_share.h"
+#include "parallel/ranks.h"
 
 #define DEFAULT_THRESHOLD RAD_DEFAULT_REFINE_THRESHOLD
 #define DEFAULT_TOLERANCE RAD_DEFAULT_TOLERANCE
@@ -49,6 +58,13 @@ typedef struct hsolver {
     bool diverged;              /* a sweep changed B by more than HIER_DIVERGED_CHANGE */
     uint32_t changed_most;      /* the patch whose B changed the most in the last sweep */
     rad_rgb *observed;          /* per patch: the observer's copy of B, or NULL */
+    rank_share share;           /* over MPI ranks: who holds which receivers' links */
+    bool over_ranks;            /* more than one rank: each holds its receivers' links and
+                                   the shared ones, and the steps here are collective */
+    rad_rgb *fresh;             /* over ranks: a sweep's new B by leaf-order position */
+    bool stop_seen;             /* over ranks: every rank saw the stop */
+    double seconds_waiting;     /* over ranks: in the collective steps here (the exchanges
+                                   of B are timed by rank_share) */
 } hsolver;
 
 /* A sweep whose change (relative to the emitted power) is not finite or above this has
@@ -95,7 +111,17 @@ static void sort_by_receiver(hsolver *s)
     st->spare = swap;
 }
 
-/* One Jacobi sweep with push-pull; returns the relative change. */
+/* Leaf node k's new B from what comes down to it (and the final gather's correction). */
+static rad_rgb leaf_radiosity(const hsolver *s, uint32_t k)
+{
+    uint32_t p = s->tree.nodes[k].patch;
+    rad_rgb h = s->down[k];
+    if (s->correction) /* irradiance is never negative, however corrected */
+        h = rgb_max0(rgb_add(rgb_mul(h, s->scale[k]), s->correction[k]));
+    return rgb_add(s->emission[p], rgb_mul(s->albedo[p], h));
+}
+
+/* One Jacobi sweep with push-pull; returns the relative change. Collective over ranks. */
 static double sweep(hsolver *s)
 {
     const hier_tree *t = &s->tree;
@@ -109,16 +135,24 @@ static double sweep(hsolver *s)
         s->gathered[k] = sum;
     }
     double change = 0, most = -1;
+    if (s->over_ranks) { /* this rank's leaves, then every rank's from their owners */
+        for (uint32_t k = 0; k < t->node_count; k++) {
+            const hnode *n = &t->nodes[k];
+            s->down[k] = n->parent == HNODE_NONE ? s->gathered[k]
+                                                 : rgb_add(s->down[n->parent], s->gathered[k]);
+            if (n->patch != HNODE_NONE && s->share.role[k] == RECEIVER_OWN)
+                s->fresh[n->first] = leaf_radiosity(s, k);
+        }
+        rank_share_exchange(&s->share, s->mesh->patch_count, s->fresh);
+    }
     for (uint32_t k = 0; k < t->node_count; k++) {
         const hnode *n = &t->nodes[k];
-        s->down[k] = n->parent == HNODE_NONE ? s->gathered[k]
-                                             : rgb_add(s->down[n->parent], s->gathered[k]);
+        if (!s->over_ranks)
+            s->down[k] = n->parent == HNODE_NONE ? s->gathered[k]
+                                                 : rgb_add(s->down[n->parent], s->gathered[k]);
         if (n->patch != HNODE_NONE) {
             uint32_t p = n->patch;
-            rad_rgb h = s->down[k];
-            if (s->correction) /* irradiance is never negative, however corrected */
-                h = rgb_max0(rgb_add(rgb_mul(h, s->scale[k]), s->correction[k]));
-            rad_rgb b = rgb_add(s->emission[p], rgb_mul(s->albedo[p], h));
+            rad_rgb b = s->over_ranks ? s->fresh[n->first] : leaf_radiosity(s, k);
             double moved = n->area * (fabs(b.r - s->patch_B[p].r) + fabs(b.g - s->patch_B[p].g) +
                                       fabs(b.b - s->patch_B[p].b));
             change += moved;
@@ -171,6 +205,8 @@ static void hsolver_free(hsolver *s)
     free(s->store.links);
     free(s->store.spare);
     free(s->observed);
+    free(s->fresh);
+    rank_share_free(&s->share);
 }
 
 /* The observer (rad_solve_step): B_k is handed over after sweep k + 1, whose change is
@@ -212,7 +248,64 @@ static double sweep_observed(hsolver *s, hobserver *ob, const char *phase)
     return change;
 }
 
-static bool stopped(const rad_hierarchy_options *o) { return o->stop && *o->stop; }
+/* Whether the solve is to stop; over ranks collective, true on every rank once any saw the
+ * stop (and from then on without asking again). */
+static bool stopped(hsolver *s, const rad_hierarchy_options *o)
+{
+    bool here = s->stop_seen || (o->stop && *o->stop);
+    if (s->over_ranks && !s->stop_seen) {
+        double t = now_seconds();
+        here = ranks_failures(here) > 0;
+        s->seconds_waiting += now_seconds() - t;
+    }
+    s->stop_seen = s->stop_seen || (s->over_ranks && here);
+    return here;
+}
+
+/* Over ranks: assigns the receiver subtrees by their leaf counts (measured on two scenes,
+ * a better predictor of the links each will receive than the links the first passes put
+ * there). 0 when out of memory. */
+static int assign_by_leaves(hsolver *s)
+{
+    rank_share *share = &s->share;
+    double *cost = rad_alloc_array(share->subtrees, sizeof(double));
+    if (!cost)
+        return 0;
+    for (uint32_t k = 0; k < s->tree.node_count; k++)
+        if (s->tree.nodes[k].patch != HNODE_NONE)
+            cost[share->subtree_of[k]] += 1;
+    int ok = rank_share_assign(share, &s->tree, cost);
+    free(cost);
+    return ok;
+}
+
+/* Whether any rank holds a link (collective over ranks). */
+static bool links_anywhere(hsolver *s)
+{
+    uint64_t count = s->store.count;
+    double t = now_seconds();
+    if (s->over_ranks)
+        ranks_sum(&count, 1);
+    s->seconds_waiting += now_seconds() - t;
+    return count > 0;
+}
+
+/* Of this rank's links: those it alone counts in the whole (its own receivers', and on rank
+ * 0 those every rank holds), how many of those are partly visible, and those every rank
+ * holds (over ranks: those received above the cut). */
+static void count_links(const hsolver *s, uint64_t *counted, uint64_t *partial,
+                        uint64_t *shared)
+{
+    *counted = *partial = *shared = 0;
+    for (size_t l = 0; l < s->store.count; l++) {
+        const hlink *link = &s->store.links[l];
+        bool is_shared = s->over_ranks && s->share.role[link->receiver] == RECEIVER_SHARED;
+        bool counts = !is_shared || s->share.rank == 0;
+        *shared += is_shared;
+        *counted += counts;
+        *partial += counts && link->visible < LINK_VISIBLE;
+    }
+}
 
 /* Progress of refinement after `passes` passes: about 4 passes per level of the tree
  * (measured: 87 at 1M leaves' 21 levels), linear up to 90 % of that; past it the fraction
@@ -271,8 +364,22 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             *report = rep;
         return RAD_OK;
     }
+    /* over ranks every rank builds the same tree, then they agree before working together */
+    s.over_ranks = ranks_count() > 1;
+    rad_status setup = RAD_OK;
     if (!hier_tree_build(mesh, &s.tree))
-        return rad_fail(error, RAD_ERR_NOMEM, "out of memory building the element tree");
+        setup = rad_fail(error, RAD_ERR_NOMEM, "out of memory building the element tree");
+    if (setup == RAD_OK && s.over_ranks &&
+        (!rank_share_build(&s.tree, ranks_count(), ranks_rank(), &s.share) ||
+         !assign_by_leaves(&s) || !(s.fresh = rad_alloc_array(n, sizeof(rad_rgb)))))
+        setup = rad_fail(error, RAD_ERR_NOMEM, "out of memory sharing the hierarchy over %d "
+                         "ranks", ranks_count());
+    if (s.over_ranks)
+        setup = ranks_agree(setup, "the hierarchical solver", error);
+    if (setup != RAD_OK) {
+        hsolver_free(&s);
+        return setup;
+    }
     uint32_t nodes = s.tree.node_count;
     s.emission = inputs->source; /* E + rho H: the light sources' first bounce */
     s.albedo = inputs->albedo;
@@ -284,10 +391,15 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     s.offsets = rad_alloc_array((size_t)nodes + 1, sizeof(size_t));
     if (ob.fn)
         ob.before = s.observed = rad_alloc_array(n, sizeof(rad_rgb));
-    if (!s.patch_B || !s.node_B || !s.gathered || !s.down ||
-        !s.offsets || !s.brightness || (ob.fn && !ob.before)) {
+    setup = !s.patch_B || !s.node_B || !s.gathered || !s.down || !s.offsets ||
+                    !s.brightness || (ob.fn && !ob.before)
+                ? rad_fail(error, RAD_ERR_NOMEM, "out of memory for the hierarchy")
+                : RAD_OK;
+    if (s.over_ranks)
+        setup = ranks_agree(setup, "the hierarchical solver", error);
+    if (setup != RAD_OK) {
         hsolver_free(&s);
-        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the hierarchy");
+        return setup;
     }
     double brightest_total = 0;
     for (uint32_t p = 0; p < n; p++) {
@@ -304,7 +416,8 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
 
     s.store.max_bytes = budget;
     bool root_cluster = !s.tree.nodes[0].planar;
-    if (root_cluster && s.emitted > 0) {
+    if (root_cluster && s.emitted > 0 &&
+        !(s.over_ranks && s.share.role[0] == RECEIVER_ELSEWHERE)) {
         if (2 * sizeof(hlink) > budget) {
             hsolver_free(&s);
             return rad_fail(error, RAD_ERR_NOMEM, "--max-memory: %llu bytes cannot hold a link",
@@ -330,25 +443,42 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
                          true,
                          rays,
                          o.seed,
-                         s.threads};
+                         s.threads,
+                         s.over_ranks ? s.share.role : NULL};
 
     double sweep_change = s.emitted > 0 ? 1 : 0;
-    bool refining = s.store.count > 0, converged = false;
+    uint64_t rays_shared = 0; /* over ranks: traced alike on every rank, counted once */
+    bool refining = links_anywhere(&s), converged = false;
     uint32_t quiet_passes = 0;
-    while (!stopped(&o) && rep.iterations < max_sweeps && !s.diverged) {
+    while (!stopped(&s, &o) && rep.iterations < max_sweeps && !s.diverged) {
         size_t split = 0;
         if (refining && !rep.memory_capped && rep.passes < MAX_PASSES) {
             double tr = now_seconds();
             refine_result rr;
             update_brightness(&s);
             rc.full_check = quiet_passes > 0 || rep.passes % FULL_CHECK_EVERY == 0;
-            if (!hier_refine_pass(&rc, &s.store, &rr)) {
+            rad_status refined =
+                hier_refine_pass(&rc, &s.store, &rr)
+                    ? RAD_OK
+                    : rad_fail(error, RAD_ERR_NOMEM, "out of memory refining the links");
+            double tw = now_seconds(); /* the ranks wait here for the slowest */
+            if (s.over_ranks)
+                refined = ranks_agree(refined, "refining the links", error);
+            s.seconds_waiting += now_seconds() - tw;
+            if (refined != RAD_OK) {
                 hsolver_free(&s);
-                return rad_fail(error, RAD_ERR_NOMEM, "out of memory refining the links");
+                return refined;
             }
             rep.passes++;
-            rep.rays += rr.rays;
+            rep.rays += rr.rays - rr.rays_shared;
+            rays_shared += rr.rays_shared;
             split = rr.split;
+            if (s.over_ranks) { /* whether any rank split, or stopped at its budget */
+                uint64_t any[2] = {split, rr.capped};
+                ranks_sum(any, 2);
+                split = (size_t)any[0];
+                rr.capped = any[1] > 0;
+            }
             if (rr.capped)
                 rep.memory_capped = true;
             rep.seconds_refine += now_seconds() - tr;
@@ -369,7 +499,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
         }
         /* nothing split: sweep to the tolerance, then look once more */
         double first = sweep_change;
-        while (sweep_change > tolerance && rep.iterations < max_sweeps && !stopped(&o) &&
+        while (sweep_change > tolerance && rep.iterations < max_sweeps && !stopped(&s, &o) &&
                !s.diverged) {
             sweep_change = sweep_observed(&s, &ob, "gather");
             rep.iterations++;
@@ -385,11 +515,11 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             break;
         }
         quiet_passes++;
-        refining = s.store.count > 0;
+        refining = links_anywhere(&s);
     }
     if (o.progress)
         o.progress(o.progress_user, "gather", 1);
-    if (!stopped(&o) && s.store.count > 0 && !s.diverged) {
+    if (!stopped(&s, &o) && links_anywhere(&s) && !s.diverged) {
         double tf = now_seconds();
         s.correction = rad_alloc_array(nodes, sizeof(rad_rgb));
         s.scale = rad_alloc_array(nodes, sizeof(rad_rgb));
@@ -397,9 +527,17 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
         final_gather_context fg = {mesh,       &s.tree,    occluders,  s.store.links,
                                    s.offsets,  s.node_B,   s.brightness, rays,
                                    o.seed + 2, s.threads,  o.progress, o.progress_user,
-                                   o.stop};
+                                   o.stop,     s.over_ranks ? s.share.role : NULL};
         int gathered = s.correction && s.scale ? hier_final_gather(&fg, s.correction, &rep.rays)
                                                : 0;
+        double tw = now_seconds(); /* the ranks wait here for the slowest */
+        if (s.over_ranks) { /* out of memory anywhere fails all; a stop anywhere stops all */
+            if (ranks_failures(gathered == 0) > 0)
+                gathered = 0;
+            else if (ranks_failures(gathered < 0) > 0)
+                gathered = -1;
+        }
+        s.seconds_waiting += now_seconds() - tw;
         if (gathered == 0) {
             hsolver_free(&s);
             return rad_fail(error, RAD_ERR_NOMEM, "out of memory in the final gather");
@@ -417,7 +555,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             as_scale(s.down[k].b, &s.correction[k].b, &s.scale[k].b);
         }
         double change = s.correction ? 1 : 0;
-        while (change > tolerance && rep.iterations < max_sweeps && !stopped(&o) &&
+        while (change > tolerance && rep.iterations < max_sweeps && !stopped(&s, &o) &&
                !s.diverged) {
             sweep_change = change = sweep_observed(&s, &ob, "final gather");
             rep.iterations++;
@@ -427,7 +565,7 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             o.progress(o.progress_user, "final gather", 1);
         rep.seconds_final = now_seconds() - tf;
     }
-    rep.interrupted = stopped(&o);
+    rep.interrupted = stopped(&s, &o);
     rep.converged = converged && !rep.interrupted;
     rep.change = sweep_change;
     /* the sweep_change of the B handed out: one more sweep, measured and not applied */
@@ -439,10 +577,16 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
         ob.pending.final = true;
         ob.fn(ob.user, &ob.pending);
     }
-    rep.links = s.store.count;
-    for (size_t l = 0; l < s.store.count; l++)
-        rep.links_partial += s.store.links[l].visible < LINK_VISIBLE;
+    uint64_t counts[3] = {0, 0, rep.rays}; /* links, partial, rays: every one once */
+    count_links(&s, &counts[0], &counts[1], &rep.shared_links);
+    rep.rank_links = s.store.count;
+    if (s.over_ranks)
+        ranks_sum(counts, 3);
+    rep.links = counts[0];
+    rep.links_partial = counts[1];
+    rep.rays = counts[2] + rays_shared;
     rep.link_bytes = s.store.peak_bytes;
+    rep.rank_seconds = now_seconds() - t0 - s.share.seconds_exchanging - s.seconds_waiting;
     if (s.diverged || !isfinite(sweep_change) || !isfinite(rep.residual)) {
         /* never hand out a diverged answer as a solution */
         rep.patch = s.changed_most;
