@@ -193,15 +193,16 @@ void pair_sample_visibility(const vf_polygon *p, const vf_polygon *q,
             spread += (estimate[r] - mean) * (estimate[r] - mean);
         double standard_error = sqrt(spread / (PAIR_REPLICATES - 1) / PAIR_REPLICATES);
         out->fraction = fmin(fmax(mean, 0), 1);
-        /* all segments agreeing says nothing about features smaller than a cell: the
-         * bound is then one cell's share */
-        out->bound = all_same ? 1.0 / (double)n : PAIR_STUDENT_T * standard_error;
+        out->unseen = all_same && w->occluded[0];
+        /* all segments agreeing has no spread: what they could all have missed (a slot
+         * narrower than a cell, an occluder between them) is bounded binomially */
+        out->bound = all_same ? PAIR_UNSEEN_BOUND / (double)n : PAIR_STUDENT_T * standard_error;
         uint32_t next = PAIR_REPLICATES * (2 * k) * (2 * k);
-        bool settled = all_same ? k >= 2 : out->bound <= accuracy;
-        if (settled)
+        /* agreeing segments take two rounds at least: one says little */
+        if (out->bound <= accuracy && (k >= 2 || !all_same))
             return;
         if (out->rays + next > max_rays || next > w->capacity || 2 * k > MAX_STRATA) {
-            out->capped = !all_same;
+            out->capped = true;
             return;
         }
     }

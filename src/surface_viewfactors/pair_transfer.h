@@ -10,12 +10,16 @@
  * fraction, estimated from
  * replicated stratified segments between the polygons, weighted by the kernel
  * cos cos / r^2; rounds of 4x more segments until the estimate's error bound meets the
- * target or the ray budget is spent. The result never exceeds the unobstructed value.
+ * target or the ray budget is spent. The bound is the replicates' spread (Student t), or,
+ * when every segment of a round agreed, the binomial bound PAIR_UNSEEN_BOUND / n on what
+ * they could all have missed, so a pair whose segments were all blocked still carries the
+ * error it may have. The result never exceeds the unobstructed value.
  */
 #ifndef RAD_VIEWFACTOR_PAIR_TRANSFER_H
 #define RAD_VIEWFACTOR_PAIR_TRANSFER_H
 
 #include "radiosity.h"
+#include "surface_viewfactors/pair_hidden.h"
 #include "surface_viewfactors/shadow_clip.h"
 #include "surface_viewfactors/vf_geometry.h"
 
@@ -24,6 +28,11 @@
 
 /* Two-sided 95 % Student t for PAIR_REPLICATES - 1 = 7 degrees of freedom. */
 #define PAIR_STUDENT_T 2.365
+
+/* -ln(0.05): when all n segments of a round agree (all blocked, or all free), the other
+ * outcome's share is below PAIR_UNSEEN_BOUND / n with 95 % confidence (binomial: a share f
+ * passes n stratified segments unseen with probability at most (1 - f)^n <= exp(-n f)). */
+#define PAIR_UNSEEN_BOUND 2.995732
 
 /* The unobstructed transfer, to relative tolerance `accuracy` (and *bound receives the
  * estimated absolute error). plane_epsilon as in vf_geometry. */
@@ -43,7 +52,7 @@ bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
 #define PAIR_EXACT_MAX_OCCLUDERS 4u
 
 typedef struct pair_workspace {
-    shadow_occluder occluders[PAIR_EXACT_MAX_OCCLUDERS];
+    shadow_occluder occluders[PAIR_HIDDEN_MAX_OCCLUDERS]; /* room for the hidden proof */
     rad_ray *rays;
     uint8_t *occluded;
     double *weight;
@@ -58,6 +67,7 @@ typedef struct pair_visibility {
     double bound;    /* its error bound (about 95 %), absolute, as a fraction */
     uint32_t rays;
     bool capped;     /* the ray budget ran out before the bound met the target */
+    bool unseen;     /* every segment of the last round was blocked */
 } pair_visibility;
 
 /* Samples visibility between p and q through `occluders` until bound <= accuracy or

@@ -4,7 +4,8 @@
  * Each occluding triangle is cut to the slab between the point and the receiving polygon's
  * plane and projected from the point onto that plane; its shadow is subtracted from the
  * visible part of the receiver, kept as a list of convex pieces. The factor is Lambert's
- * contour formula summed over the pieces that remain: exact, with no sampling.
+ * contour formula summed over the pieces that remain: exact, with no sampling. The same
+ * subtraction tells whether triangles lying in one plane cover a convex window of it.
  */
 #ifndef RAD_VIEWFACTOR_SHADOW_CLIP_H
 #define RAD_VIEWFACTOR_SHADOW_CLIP_H
@@ -25,5 +26,12 @@ typedef struct shadow_occluder {
 double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
                              const shadow_occluder *occluders, uint32_t occluder_count,
                              double plane_epsilon);
+
+/* True when the triangles, lying in the plane of the convex `window` (counter-clockwise
+ * about the unit `normal`, 3 to 15 corners), cover all of it: nothing of the window is
+ * left but slivers of at most 1e-12 of its area. False when something is left, or when
+ * it breaks into more than SHADOW_MAX_PIECES pieces. */
+bool shadow_window_covered(const rad_vec3 *window, unsigned window_count, rad_vec3 normal,
+                           const shadow_occluder *triangles, uint32_t triangle_count);
 
 #endif

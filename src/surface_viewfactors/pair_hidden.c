@@ -1,0 +1,130 @@
+/*
+ * pair_hidden.c - the exact "wholly hidden" test, see pair_hidden.h.
+ */
+#include "surface_viewfactors/pair_hidden.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/vec3.h"
+
+#define MAX_CROSSINGS (VF_MAX_VERTICES * VF_MAX_VERTICES)
+
+/* Corners of the window as shadow_window_covered takes them at most. */
+#define MAX_WINDOW 15u
+
+/* +1 when every corner is in front of the plane beyond epsilon, -1 when every corner is
+ * behind it, 0 otherwise. */
+static int side_of(const vf_polygon *polygon, rad_vec3 n, double offset, double epsilon)
+{
+    bool front = true, back = true;
+    for (unsigned k = 0; k < polygon->count; k++) {
+        double d = v3_dot(n, polygon->vertex[k]) - offset;
+        front = front && d > epsilon;
+        back = back && d < -epsilon;
+    }
+    return front ? 1 : back ? -1 : 0;
+}
+
+static bool on_plane(const shadow_occluder *o, rad_vec3 n, double offset, double epsilon)
+{
+    for (int c = 0; c < 3; c++)
+        if (fabs(v3_dot(n, o->corner[c]) - offset) > epsilon)
+            return false;
+    return true;
+}
+
+typedef struct planar_point {
+    double u, v;
+    unsigned index;
+} planar_point;
+
+static int by_u_then_v(const void *a, const void *b)
+{
+    const planar_point *x = a, *y = b;
+    if (x->u != y->u)
+        return x->u < y->u ? -1 : 1;
+    return (x->v > y->v) - (x->v < y->v);
+}
+
+static double turn(const planar_point *o, const planar_point *a, const planar_point *b)
+{
+    return (a->u - o->u) * (b->v - o->v) - (a->v - o->v) * (b->u - o->u);
+}
+
+/* The convex hull of points lying in the plane of unit normal n, counter-clockwise about
+ * n, collinear points dropped (monotone chain). Returns its corner count, 0 when it has
+ * more than MAX_WINDOW or is degenerate. */
+static unsigned window_hull(const rad_vec3 *points, unsigned count, rad_vec3 n,
+                            rad_vec3 window[MAX_WINDOW])
+{
+    rad_vec3 helper = fabs(n.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
+    rad_vec3 u = v3_normalize(v3_cross(helper, n)), v = v3_cross(n, u);
+    planar_point sorted[MAX_CROSSINGS], hull[2 * MAX_CROSSINGS];
+    for (unsigned k = 0; k < count; k++)
+        sorted[k] = (planar_point){v3_dot(points[k], u), v3_dot(points[k], v), k};
+    qsort(sorted, count, sizeof(*sorted), by_u_then_v);
+    unsigned h = 0;
+    for (unsigned k = 0; k < count; k++) {
+        while (h >= 2 && turn(&hull[h - 2], &hull[h - 1], &sorted[k]) <= 0)
+            h--;
+        hull[h++] = sorted[k];
+    }
+    for (unsigned k = count - 1, lower = h + 1; k-- > 0;) {
+        while (h >= lower && turn(&hull[h - 2], &hull[h - 1], &sorted[k]) <= 0)
+            h--;
+        hull[h++] = sorted[k];
+    }
+    h--; /* the last point is the first again */
+    if (h < 3 || h > MAX_WINDOW)
+        return 0;
+    for (unsigned k = 0; k < h; k++)
+        window[k] = points[hull[k].index];
+    return h;
+}
+
+bool pair_proven_hidden(const vf_polygon *p, const vf_polygon *q,
+                        const shadow_occluder *occluders, uint32_t occluder_count,
+                        double plane_epsilon)
+{
+    if (occluder_count > PAIR_HIDDEN_MAX_OCCLUDERS)
+        occluder_count = PAIR_HIDDEN_MAX_OCCLUDERS;
+    bool tried[PAIR_HIDDEN_MAX_OCCLUDERS] = {false};
+    shadow_occluder in_plane[PAIR_HIDDEN_MAX_OCCLUDERS];
+    for (uint32_t i = 0; i < occluder_count; i++) {
+        if (tried[i])
+            continue;
+        tried[i] = true;
+        const rad_vec3 *c = occluders[i].corner;
+        rad_vec3 n = v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0]));
+        double length = v3_length(n);
+        if (!(length > 0))
+            continue;
+        n = v3_scale(n, 1 / length);
+        double offset = v3_dot(n, c[0]);
+        int side_p = side_of(p, n, offset, plane_epsilon),
+            side_q = side_of(q, n, offset, plane_epsilon);
+        if (side_p == 0 || side_q == 0 || side_p == side_q)
+            continue;
+        uint32_t count = 0;
+        for (uint32_t j = i; j < occluder_count; j++)
+            if (on_plane(&occluders[j], n, offset, plane_epsilon)) {
+                in_plane[count++] = occluders[j];
+                tried[j] = true;
+            }
+        /* where the segments between corners cross the plane: their hull is the window */
+        rad_vec3 crossings[MAX_CROSSINGS], window[MAX_WINDOW];
+        unsigned crossing_count = 0;
+        for (unsigned a = 0; a < p->count; a++)
+            for (unsigned b = 0; b < q->count; b++) {
+                rad_vec3 x = p->vertex[a], y = q->vertex[b];
+                double hx = v3_dot(n, x) - offset, hy = v3_dot(n, y) - offset;
+                crossings[crossing_count++] = v3_lerp(x, y, hx / (hx - hy));
+            }
+        unsigned window_count = window_hull(crossings, crossing_count, n, window);
+        if (window_count &&
+            shadow_window_covered(window, window_count, n, in_plane, count))
+            return true;
+    }
+    return false;
+}
