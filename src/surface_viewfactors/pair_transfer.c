@@ -21,10 +21,11 @@
  * point costs more: what is left at this depth is reported in the error bound. */
 #define OBSTRUCTED_MAX_DEPTH 8
 
-/* Exact shadow clipping may spend this many (point, occluder) clippings on one pair, about
- * a millisecond; a pair that needs more is sampled instead, so the run time stays
- * predictable. */
-#define EXACT_WORK_BUDGET 4096u
+/* Exact shadow clipping may spend this many (point, occluder) clippings on one pair, some
+ * 50 ms at most; a pair that needs more is sampled instead, so the run time stays
+ * predictable. A slot 1/50 as wide as two unit plates, behind 4 triangles, needs more
+ * than 65536 (the kinks where its image leaves the receiver refine to the deepest level). */
+#define EXACT_WORK_BUDGET 262144u
 
 /* Largest k of a round's k x k stratified segments per replicate. */
 #define MAX_STRATA 32u
