@@ -83,14 +83,48 @@ static unsigned window_hull(const rad_vec3 *points, unsigned count, rad_vec3 n,
     return h;
 }
 
-bool pair_proven_hidden(const vf_polygon *p, const vf_polygon *q,
-                        const shadow_occluder *occluders, uint32_t occluder_count,
-                        double plane_epsilon)
+/* Most uncovered pieces of a window looked into. */
+#define MAX_PIECES_FOLLOWED 8u
+
+static bool proven_hidden(const occluder_tree *tree, const vf_polygon *p, const vf_polygon *q,
+                          const shadow_occluder *occluders, uint32_t occluder_count,
+                          double plane_epsilon, unsigned depth);
+
+/* The convex piece r of a plane as a polygon facing `toward` (a point off the plane), for
+ * the occluder tree: its own triangles are none (source matches no triangle). */
+static bool piece_polygon(const shadow_piece *r, rad_vec3 normal, rad_vec3 toward,
+                          vf_polygon *out)
+{
+    if (r->count > VF_MAX_VERTICES)
+        return false;
+    out->count = r->count;
+    for (unsigned k = 0; k < r->count; k++)
+        out->vertex[k] = r->vertex[k];
+    bool flip = v3_dot(normal, v3_sub(toward, r->vertex[0])) < 0;
+    out->normal = flip ? v3_scale(normal, -1) : normal;
+    out->source = UINT32_MAX - 1;
+    return true;
+}
+
+/* Every segment from `a` to the piece (or from the piece to `a`) is blocked. */
+static bool piece_hidden_from(const occluder_tree *tree, const vf_polygon *a,
+                              const vf_polygon *piece, double plane_epsilon, unsigned depth)
+{
+    shadow_occluder found[PAIR_HIDDEN_MAX_OCCLUDERS];
+    uint32_t count =
+        occluder_tree_collect(tree, a, piece, plane_epsilon, found, PAIR_HIDDEN_MAX_OCCLUDERS);
+    return count > 0 && proven_hidden(tree, a, piece, found, count, plane_epsilon, depth);
+}
+
+static bool proven_hidden(const occluder_tree *tree, const vf_polygon *p, const vf_polygon *q,
+                          const shadow_occluder *occluders, uint32_t occluder_count,
+                          double plane_epsilon, unsigned depth)
 {
     if (occluder_count > PAIR_HIDDEN_MAX_OCCLUDERS)
         occluder_count = PAIR_HIDDEN_MAX_OCCLUDERS;
     bool tried[PAIR_HIDDEN_MAX_OCCLUDERS] = {false};
     shadow_occluder in_plane[PAIR_HIDDEN_MAX_OCCLUDERS];
+    shadow_piece left[SHADOW_MAX_PIECES];
     for (uint32_t i = 0; i < occluder_count; i++) {
         if (tried[i])
             continue;
@@ -122,9 +156,31 @@ bool pair_proven_hidden(const vf_polygon *p, const vf_polygon *q,
                 crossings[crossing_count++] = v3_lerp(x, y, hx / (hx - hy));
             }
         unsigned window_count = window_hull(crossings, crossing_count, n, window);
-        if (window_count &&
-            shadow_window_covered(window, window_count, n, in_plane, count))
+        if (!window_count)
+            continue;
+        int pieces = shadow_window_remainder(window, window_count, n, in_plane, count, left);
+        if (pieces == 0)
+            return true;
+        if (pieces < 0 || depth == 0 || (unsigned)pieces > MAX_PIECES_FOLLOWED)
+            continue;
+        bool all = true;
+        for (int k = 0; k < pieces && all; k++) {
+            vf_polygon to_p, to_q;
+            all = piece_polygon(&left[k], n, p->vertex[0], &to_p) &&
+                  piece_polygon(&left[k], n, q->vertex[0], &to_q) &&
+                  (piece_hidden_from(tree, p, &to_p, plane_epsilon, depth - 1) ||
+                   piece_hidden_from(tree, &to_q, q, plane_epsilon, depth - 1));
+        }
+        if (all)
             return true;
     }
     return false;
+}
+
+bool pair_proven_hidden(const occluder_tree *tree, const vf_polygon *p, const vf_polygon *q,
+                        const shadow_occluder *occluders, uint32_t occluder_count,
+                        double plane_epsilon)
+{
+    return proven_hidden(tree, p, q, occluders, occluder_count, plane_epsilon,
+                         PAIR_HIDDEN_DEPTH);
 }

@@ -9,12 +9,12 @@
 #include "core/vec3.h"
 #include "geometry/contour.h"
 
-#define PIECE_MAX_VERTICES (CONTOUR_MAX_VERTICES - 1)
+#define PIECE_MAX_VERTICES SHADOW_PIECE_MAX_VERTICES
 
-typedef struct piece {
-    rad_vec3 vertex[PIECE_MAX_VERTICES];
-    unsigned count;
-} piece;
+_Static_assert(SHADOW_PIECE_MAX_VERTICES <= CONTOUR_MAX_VERTICES - 1,
+               "a piece is a polygon the contour integral takes");
+
+typedef shadow_piece piece;
 
 /* Keeps the part of `in` where dot(normal, v) - offset >= 0 (into `out`); false when
  * the result would have more than PIECE_MAX_VERTICES corners. */
@@ -168,13 +168,14 @@ double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
     return factor;
 }
 
-bool shadow_window_covered(const rad_vec3 *window, unsigned window_count, rad_vec3 normal,
-                           const shadow_occluder *triangles, uint32_t triangle_count)
+int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_vec3 normal,
+                            const shadow_occluder *triangles, uint32_t triangle_count,
+                            shadow_piece *left)
 {
     if (window_count < 3 || window_count > PIECE_MAX_VERTICES)
-        return false;
-    piece buffers[2][SHADOW_MAX_PIECES];
-    piece *pieces = buffers[0], *next = buffers[1];
+        return -1;
+    piece buffer[SHADOW_MAX_PIECES];
+    piece *pieces = left, *next = buffer;
     unsigned count = 1;
     pieces[0].count = window_count;
     memcpy(pieces[0].vertex, window, window_count * sizeof(rad_vec3));
@@ -191,11 +192,13 @@ bool shadow_window_covered(const rad_vec3 *window, unsigned window_count, rad_ve
         }
         int made = subtract_shadow(pieces, count, &triangle, normal, tiny, next);
         if (made < 0)
-            return false;
+            return -1;
         piece *swap = pieces;
         pieces = next;
         next = swap;
         count = (unsigned)made;
     }
-    return count == 0;
+    if (pieces != left)
+        memcpy(left, pieces, count * sizeof(piece));
+    return (int)count;
 }

@@ -27,11 +27,21 @@ double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
                              const shadow_occluder *occluders, uint32_t occluder_count,
                              double plane_epsilon);
 
-/* True when the triangles, lying in the plane of the convex `window` (counter-clockwise
- * about the unit `normal`, 3 to 15 corners), cover all of it: nothing of the window is
- * left but slivers of at most 1e-12 of its area. False when something is left, or when
+/* A convex piece of a plane, counter-clockwise about its normal. */
+#define SHADOW_PIECE_MAX_VERTICES 15
+
+typedef struct shadow_piece {
+    rad_vec3 vertex[SHADOW_PIECE_MAX_VERTICES];
+    unsigned count;
+} shadow_piece;
+
+/* What the triangles, lying in the plane of the convex `window` (counter-clockwise about
+ * the unit `normal`, 3 to SHADOW_PIECE_MAX_VERTICES corners), leave of it: its convex
+ * pieces go to `left` (room for SHADOW_MAX_PIECES), slivers of at most 1e-12 of the
+ * window's area dropped. Returns how many (0: the triangles cover the window), or -1 when
  * it breaks into more than SHADOW_MAX_PIECES pieces. */
-bool shadow_window_covered(const rad_vec3 *window, unsigned window_count, rad_vec3 normal,
-                           const shadow_occluder *triangles, uint32_t triangle_count);
+int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_vec3 normal,
+                            const shadow_occluder *triangles, uint32_t triangle_count,
+                            shadow_piece *left);
 
 #endif

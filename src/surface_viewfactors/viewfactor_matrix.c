@@ -166,7 +166,7 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
     uint32_t occluders =
         occluder_tree_collect(e->tree, p, q, eps, w->occluders,
                               seen ? PAIR_EXACT_MAX_OCCLUDERS : PAIR_HIDDEN_MAX_OCCLUDERS);
-    if (!seen && occluders > 0 && pair_proven_hidden(p, q, w->occluders, occluders, eps)) {
+    if (!seen && occluders > 0 && pair_proven_hidden(e->tree, p, q, w->occluders, occluders, eps)) {
         counts->hidden_pairs++;
         return 0;
     }
