@@ -9,8 +9,8 @@
 
 #define MAX_CROSSINGS (VF_MAX_VERTICES * VF_MAX_VERTICES)
 
-/* Corners of the window as shadow_window_covered takes them at most. */
-#define MAX_WINDOW 15u
+/* Corners of the window as shadow_window_remainder takes them at most. */
+#define MAX_WINDOW SHADOW_PIECE_MAX_VERTICES
 
 /* +1 when every corner is in front of the plane beyond epsilon, -1 when every corner is
  * behind it, 0 otherwise. */
@@ -38,9 +38,8 @@ typedef struct planar_point {
     unsigned index;
 } planar_point;
 
-static int by_u_then_v(const void *a, const void *b)
+static int by_u_then_v(const planar_point *x, const planar_point *y)
 {
-    const planar_point *x = a, *y = b;
     if (x->u != y->u)
         return x->u < y->u ? -1 : 1;
     return (x->v > y->v) - (x->v < y->v);
@@ -102,7 +101,7 @@ static bool piece_polygon(const shadow_piece *r, rad_vec3 normal, rad_vec3 towar
 {
     if (r->count > VF_MAX_VERTICES)
         return false;
-    out->count = r->count;
+    *out = (vf_polygon){.count = r->count};
     for (unsigned k = 0; k < r->count; k++)
         out->vertex[k] = r->vertex[k];
     bool flip = v3_dot(normal, v3_sub(toward, r->vertex[0])) < 0;

@@ -4,8 +4,9 @@
  * A plane with polygon p strictly on one side and q strictly on the other is crossed by
  * every segment between them, inside the window where it cuts their convex hull (the
  * convex hull of the points where the segments between their corners cross it). When the
- * scene triangles lying in that plane cover the whole window, every segment is blocked and
- * the pair is hidden, with no error. When they leave a few convex pieces of the window
+ * scene triangles lying in that plane cover the whole window (up to slivers of 1e-12 of
+ * its area: rounding where their edges meet), every segment is blocked and the pair is
+ * hidden, with no error. When they leave a few convex pieces of the window
  * uncovered, a segment through a piece r is still blocked when the pair (p, r) or the pair
  * (r, q) is proven hidden the same way, one level down (a street between two buildings
  * whose walls fill the rest, closed off further along). The planes tried are those of
