@@ -6,35 +6,66 @@
  * convex hull of the points where the segments between their corners cross it). When the
  * scene triangles lying in that plane cover the whole window (up to slivers of 1e-12 of
  * its area: rounding where their edges meet), every segment is blocked and the pair is
- * hidden, with no error. When they leave a few convex pieces of the window
- * uncovered, a segment through a piece r is still blocked when the pair (p, r) or the pair
- * (r, q) is proven hidden the same way, one level down (a street between two buildings
- * whose walls fill the rest, closed off further along). The planes tried are those of
- * the occluders that shaft culling found (occluder_tree.h). It is a proof, not an
- * estimate: false means "not proven", never "visible"; the caller then integrates or
- * samples the pair.
+ * hidden, with no error.
+ *
+ * The planes tried are those of the triangles a few probe segments between p and q hit
+ * first (closest to p): the blockers themselves, found by the tracer, not a shaft's whole
+ * contents. When no plane covers its window, the polygon that widens the window most is
+ * halved and each half is proven hidden the same way (a street seen past two buildings is
+ * closed off by one wall for each half), PAIR_HIDDEN_MAX_DEPTH levels and
+ * PAIR_HIDDEN_MAX_PROOFS sub-pairs at most. A probe segment that gets through ends the
+ * attempt. It is a proof, not an estimate: false means "not proven", never "visible"; the
+ * caller then integrates or samples the pair. The probes only choose planes: which rays
+ * they are changes what is proven, never whether a proof is right.
  */
 #ifndef RAD_VIEWFACTOR_PAIR_HIDDEN_H
 #define RAD_VIEWFACTOR_PAIR_HIDDEN_H
 
 #include "radiosity.h"
-#include "surface_viewfactors/occluder_tree.h"
-#include "surface_viewfactors/shadow_clip.h"
+#include "surface_viewfactors/coplanar_polygons.h"
 #include "surface_viewfactors/vf_geometry.h"
 
-/* Most occluders a proof looks at (the first found by occluder_tree_collect). */
-#define PAIR_HIDDEN_MAX_OCCLUDERS 64u
+/* Levels of pieces or halves, and sub-pairs looked at, at most per attempt; levels with
+ * the remembered planes. */
+#define PAIR_HIDDEN_MAX_DEPTH 3u
+#define PAIR_HIDDEN_MAX_PROOFS 8u
+#define PAIR_HIDDEN_REMEMBERED_DEPTH 1u
 
-/* Levels of uncovered pieces looked into at most. */
-#define PAIR_HIDDEN_DEPTH 1u
+/* Probe segments per (sub-)pair and way: 2 points of each polygon, every pairing. */
+#define PAIR_HIDDEN_PROBES 4u
 
-/* True when some occluder's plane separates p and q (beyond plane_epsilon) and the
- * occluders lying in it (within plane_epsilon) cover the window, or leave pieces that are
- * proven hidden from p or from q through `tree`, PAIR_HIDDEN_DEPTH levels at most: no
- * segment between p and q is free. Looks at the first PAIR_HIDDEN_MAX_OCCLUDERS
- * occluders at most. */
-bool pair_proven_hidden(const occluder_tree *tree, const vf_polygon *p, const vf_polygon *q,
-                        const shadow_occluder *occluders, uint32_t occluder_count,
-                        double plane_epsilon);
+typedef struct pair_hidden_context {
+    const coplanar_polygons *planes;  /* what blocks, grouped by plane */
+    const rad_tracer *tracer;         /* the same triangles */
+    double plane_epsilon;             /* as in vf_geometry */
+} pair_hidden_context;
+
+/* What the attempts did: probe segments cast, sub-pairs looked at, pairs proven with the
+ * planes remembered from the polygon's last proof. */
+typedef struct pair_hidden_work {
+    uint64_t rays, proofs, remembered;
+} pair_hidden_work;
+
+/* Distinct planes a probe keeps at most. */
+#define PAIR_HIDDEN_MAX_PLANES 32u
+
+typedef struct pair_hidden_planes {
+    uint32_t group[PAIR_HIDDEN_MAX_PLANES]; /* coplanar_polygons groups */
+    unsigned count;
+} pair_hidden_planes;
+
+/* The planes of the last proof for polygon p: tried first, with no probe, for p's next
+ * pair (the walls that hide one building from p often hide its neighbours too). Owned by
+ * one thread; zero-initialise. Which pairs came before changes how much work a proof
+ * takes, never what it proves right. */
+typedef struct pair_hidden_memory {
+    const vf_polygon *p;
+    pair_hidden_planes planes;
+} pair_hidden_memory;
+
+/* True when every segment between p and q is proven blocked (see above). `memory` may be
+ * NULL. */
+bool pair_proven_hidden(const pair_hidden_context *context, pair_hidden_memory *memory,
+                        const vf_polygon *p, const vf_polygon *q, pair_hidden_work *work);
 
 #endif

@@ -19,7 +19,6 @@
 #define RAD_VIEWFACTOR_PAIR_TRANSFER_H
 
 #include "radiosity.h"
-#include "surface_viewfactors/pair_hidden.h"
 #include "surface_viewfactors/shadow_clip.h"
 #include "surface_viewfactors/vf_geometry.h"
 
@@ -52,7 +51,7 @@ bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
 #define PAIR_EXACT_MAX_OCCLUDERS 4u
 
 typedef struct pair_workspace {
-    shadow_occluder occluders[PAIR_HIDDEN_MAX_OCCLUDERS]; /* room for the hidden proof */
+    shadow_occluder occluders[PAIR_EXACT_MAX_OCCLUDERS];
     rad_ray *rays;
     uint8_t *occluded;
     double *weight;

@@ -169,7 +169,7 @@ double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
 }
 
 int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_vec3 normal,
-                            const shadow_occluder *triangles, uint32_t triangle_count,
+                            const shadow_polygon *polygons, uint32_t polygon_count,
                             shadow_piece *left)
 {
     if (window_count < 3 || window_count > PIECE_MAX_VERTICES)
@@ -180,17 +180,17 @@ int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_v
     pieces[0].count = window_count;
     memcpy(pieces[0].vertex, window, window_count * sizeof(rad_vec3));
     double tiny = 1e-12 * fabs(piece_area(&pieces[0], normal));
-    for (uint32_t t = 0; t < triangle_count && count > 0; t++) {
-        piece triangle = {{triangles[t].corner[0], triangles[t].corner[1],
-                           triangles[t].corner[2]}, 3};
-        double area = piece_area(&triangle, normal);
+    for (uint32_t t = 0; t < polygon_count && count > 0; t++) {
+        const shadow_polygon *polygon = &polygons[t];
+        piece shape = {.count = polygon->count};
+        memcpy(shape.vertex, polygon->vertex, polygon->count * sizeof(rad_vec3));
+        double area = piece_area(&shape, normal);
         if (area == 0)
             continue;
-        if (area < 0) {
-            triangle.vertex[1] = triangles[t].corner[2];
-            triangle.vertex[2] = triangles[t].corner[1];
-        }
-        int made = subtract_shadow(pieces, count, &triangle, normal, tiny, next);
+        if (area < 0)
+            for (unsigned k = 0; k < polygon->count; k++)
+                shape.vertex[k] = polygon->vertex[polygon->count - 1 - k];
+        int made = subtract_shadow(pieces, count, &shape, normal, tiny, next);
         if (made < 0)
             return -1;
         piece *swap = pieces;

@@ -5,7 +5,7 @@
  * plane and projected from the point onto that plane; its shadow is subtracted from the
  * visible part of the receiver, kept as a list of convex pieces. The factor is Lambert's
  * contour formula summed over the pieces that remain: exact, with no sampling. The same
- * subtraction tells whether triangles lying in one plane cover a convex window of it.
+ * subtraction tells whether polygons lying in one plane cover a convex window of it.
  */
 #ifndef RAD_VIEWFACTOR_SHADOW_CLIP_H
 #define RAD_VIEWFACTOR_SHADOW_CLIP_H
@@ -35,13 +35,19 @@ typedef struct shadow_piece {
     unsigned count;
 } shadow_piece;
 
-/* What the triangles, lying in the plane of the convex `window` (counter-clockwise about
- * the unit `normal`, 3 to SHADOW_PIECE_MAX_VERTICES corners), leave of it: its convex
- * pieces go to `left` (room for SHADOW_MAX_PIECES), slivers of at most 1e-12 of the
- * window's area dropped. Returns how many (0: the triangles cover the window), or -1 when
- * it breaks into more than SHADOW_MAX_PIECES pieces. */
+/* A convex polygon of the scene, as many corners as a view-factor polygon at most. */
+typedef struct shadow_polygon {
+    rad_vec3 vertex[VF_MAX_VERTICES];
+    unsigned count;
+} shadow_polygon;
+
+/* What the convex polygons, lying in the plane of the convex `window` (counter-clockwise
+ * about the unit `normal`, 3 to SHADOW_PIECE_MAX_VERTICES corners; the polygons either
+ * way round), leave of it: its convex pieces go to `left` (room for SHADOW_MAX_PIECES),
+ * slivers of at most 1e-12 of the window's area dropped. Returns how many (0: the polygons
+ * cover the window), or -1 when it breaks into more than SHADOW_MAX_PIECES pieces. */
 int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_vec3 normal,
-                            const shadow_occluder *triangles, uint32_t triangle_count,
+                            const shadow_polygon *polygons, uint32_t polygon_count,
                             shadow_piece *left);
 
 #endif

@@ -40,6 +40,7 @@
 #include "parallel/partition.h"
 #include "parallel/ranks.h"
 #include "surface_viewfactors/checkpoint.h"
+#include "surface_viewfactors/coplanar_polygons.h"
 #include "surface_viewfactors/matrix_entry.h"
 #include "surface_viewfactors/occluder_tree.h"
 #include "surface_viewfactors/pair_hidden.h"
@@ -87,6 +88,7 @@ typedef struct engine {
     const vf_geometry *geometry;
     const occluder_tree *tree;
     const rad_tracer *occluders;
+    pair_hidden_context hidden; /* the tracer and the scene's planes, for hidden proofs */
     double accuracy;
     uint32_t max_rays;
     uint64_t seed;
@@ -146,7 +148,7 @@ static uint64_t matrix_bound_bytes(const vf_geometry *g, uint64_t *pairs)
  * only when pair_proven_hidden proves it; every other pair is integrated, exactly or with
  * sampled visibility, and carries its bound (even a sampled 0). */
 static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_workspace *w,
-                           pair_counts *counts, double *bound)
+                           pair_hidden_memory *memory, pair_counts *counts, double *bound)
 {
     const vf_polygon *p = &e->geometry->polygons[pi], *q = &e->geometry->polygons[qi];
     double eps = e->geometry->plane_epsilon;
@@ -162,14 +164,17 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
      * hidden; when it sees nothing, the occluders in between are asked for a proof */
     pair_sample_visibility(p, q, e->occluders, INFINITY, e->max_rays, stream, w, &visibility);
     counts->rays += visibility.rays;
-    bool seen = visibility.fraction > 0;
-    uint32_t occluders =
-        occluder_tree_collect(e->tree, p, q, eps, w->occluders,
-                              seen ? PAIR_EXACT_MAX_OCCLUDERS : PAIR_HIDDEN_MAX_OCCLUDERS);
-    if (!seen && occluders > 0 && pair_proven_hidden(e->tree, p, q, w->occluders, occluders, eps)) {
-        counts->hidden_pairs++;
-        return 0;
+    if (visibility.fraction == 0) {
+        pair_hidden_work work = {0, 0, 0};
+        bool hidden = pair_proven_hidden(&e->hidden, memory, p, q, &work);
+        counts->rays += work.rays;
+        if (hidden) {
+            counts->hidden_pairs++;
+            return 0;
+        }
     }
+    uint32_t occluders = occluder_tree_collect(e->tree, p, q, eps, w->occluders,
+                                               PAIR_EXACT_MAX_OCCLUDERS);
     if (occluders == 0) {
         counts->unobstructed_pairs++;
         unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
@@ -227,6 +232,8 @@ static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_work
     const vf_surface *a = &g->surfaces[I];
     if (a->polygon_count == 0)
         return true;
+    /* the row's own: its result cannot depend on which thread ran which row before */
+    pair_hidden_memory memory = {0};
     for (uint32_t J = I; J < g->surface_count; J++) {
         const vf_surface *b = &g->surfaces[J];
         if (b->polygon_count == 0 || (J == I && a->planar))
@@ -242,7 +249,7 @@ static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_work
             uint32_t q_first = J == I ? pi + 1 : b->first_polygon;
             for (uint32_t qi = q_first; qi < b->first_polygon + b->polygon_count; qi++) {
                 double bound;
-                double G = polygon_pair(e, pi, qi, w, counts, &bound);
+                double G = polygon_pair(e, pi, qi, w, &memory, counts, &bound);
                 transfer += G;
                 /* sampled parts are independent: their bounds add in quadrature */
                 variance += bound * bound;
@@ -553,6 +560,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     vf_geometry geometry;
     occluder_tree *tree = NULL;
     rad_tracer *occluders = NULL;
+    coplanar_polygons planes = {0};
     pending_row *rows = NULL;
     rad_status status = vf_geometry_build(scene, &geometry, error);
     if (status == RAD_OK && rad_memory_budget()) {
@@ -567,6 +575,8 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
+    if (status == RAD_OK)
+        status = coplanar_polygons_build(scene, &geometry, &planes, error);
     uint32_t n = scene->surface_count;
     uint8_t *state = NULL;
     uint32_t *mine = NULL;
@@ -599,12 +609,14 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         free(mine);
         rad_tracer_destroy(occluders);
         occluder_tree_destroy(tree);
+        coplanar_polygons_free(&planes);
         vf_geometry_free(&geometry);
         return status;
     }
     e.geometry = &geometry;
     e.tree = tree;
     e.occluders = occluders;
+    e.hidden = (pair_hidden_context){&planes, occluders, geometry.plane_epsilon};
 
     /* over several ranks: who computes which row (owner NULL: this process, all), decided
      * by rank 0 alone so that no rank can disagree; resumed rows are rank 0's already */
@@ -633,6 +645,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
             free(mine);
             rad_tracer_destroy(occluders);
             occluder_tree_destroy(tree);
+            coplanar_polygons_free(&planes);
             vf_geometry_free(&geometry);
             return rad_fail(error, RAD_ERR_NOMEM, "out of memory sharing %u rows over %d ranks",
                             n, ranks_count());
@@ -726,6 +739,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     double rank_seconds = now_seconds() - rows_start;
     rad_tracer_destroy(occluders);
     occluder_tree_destroy(tree);
+    coplanar_polygons_free(&planes);
     rad_viewfactor_matrix *matrix = NULL;
     if (cp.status != RAD_OK) {
         status = cp.status;
