@@ -830,9 +830,11 @@ typedef struct rad_viewfactor_report {
     /* every facing polygon pair is one of: unobstructed_pairs, hidden_pairs, exact_pairs,
      * sampled_pairs */
     uint64_t unobstructed_pairs; /* nothing in between (shaft culling): analytic value */
-    uint64_t hidden_pairs;       /* proven wholly hidden, exactly: occluder triangles in
-                                    one plane that separates the pair cover every segment
-                                    between them; F = 0 with no error */
+    uint64_t hidden_pairs;       /* proven wholly hidden, exactly: the scene's shapes in a
+                                    plane that separates the pair cover every segment
+                                    between them (or, piece by piece or half by half, in
+                                    a few planes); F = 0 with no error. Only pairs whose
+                                    first 40 segments were all blocked are tried */
     uint64_t obstructed_pairs;   /* pairs with something in between, not proven hidden:
                                     exact_pairs + sampled_pairs */
     uint64_t exact_pairs;        /* of those, up to 4 triangles in between: their shadows

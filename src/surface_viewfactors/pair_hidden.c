@@ -195,6 +195,7 @@ static bool probe(const pair_hidden_context *c, const vf_polygon *p, const vf_po
     rad_tracer_intersect(c->tracer, rays, n, hits);
     work->rays += n;
     *count = 0;
+    unsigned times[PROBE_GROUPS];
     for (unsigned k = 0; k < n; k++)
         if (hits[k].triangle == RAD_NO_HIT)
             return false;
@@ -206,9 +207,14 @@ static bool probe(const pair_hidden_context *c, const vf_polygon *p, const vf_po
             uint32_t g = c->planes->group_of[hits[k].triangle];
             bool known = g == UINT32_MAX;
             for (unsigned m = 0; m < *count && !known; m++)
-                known = groups[m] == g;
-            if (!known && *count < PROBE_GROUPS)
+                if (groups[m] == g) {
+                    known = true;
+                    times[m]++;
+                }
+            if (!known && *count < PROBE_GROUPS) {
+                times[*count] = 1;
                 groups[(*count)++] = g;
+            }
         }
         if (round + 1 == PROBE_HITS)
             break;
@@ -222,6 +228,16 @@ static bool probe(const pair_hidden_context *c, const vf_polygon *p, const vf_po
         work->rays += again;
         n = again;
     }
+    /* the planes crossed most often first (stable: ties keep the order found) */
+    for (unsigned k = 1; k < *count; k++)
+        for (unsigned m = k; m > 0 && times[m] > times[m - 1]; m--) {
+            unsigned t = times[m];
+            times[m] = times[m - 1];
+            times[m - 1] = t;
+            uint32_t g = groups[m];
+            groups[m] = groups[m - 1];
+            groups[m - 1] = g;
+        }
     return true;
 }
 
@@ -288,6 +304,9 @@ static bool piece_polygon(const shadow_piece *r, rad_vec3 n, rad_vec3 toward, vf
     return out->area > 0;
 }
 
+/* Separating planes whose coverage is worked out per sub-pair at most. */
+#define PLANES_TRIED 6u
+
 /* Planes whose uncovered pieces are looked into, and most pieces per plane. */
 #define PLANES_FOLLOWED 2u
 #define MAX_PIECES_FOLLOWED 4u
@@ -320,12 +339,15 @@ static bool hidden(const pair_hidden_context *c, const pair_hidden_planes *plane
     candidate best[PLANES_FOLLOWED];
     unsigned best_count = 0;
     double p_distance = 0, q_distance = 0;
-    for (unsigned k = 0; k < group_count; k++) {
+    /* the planes crossed most often first, PLANES_TRIED that separate p and q at most */
+    unsigned tried = 0;
+    for (unsigned k = 0; k < group_count && tried < PLANES_TRIED; k++) {
         const coplanar_group *group = &c->planes->groups[groups[k]];
         int side_p = side_of(p, group->normal, group->offset, c->plane_epsilon),
             side_q = side_of(q, group->normal, group->offset, c->plane_epsilon);
         if (side_p == 0 || side_q == 0 || side_p == side_q)
             continue;
+        tried++;
         int pieces = plane_remainder(c, groups[k], p, q, left);
         if (pieces == 0)
             return true;

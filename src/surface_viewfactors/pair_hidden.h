@@ -4,19 +4,21 @@
  * A plane with polygon p strictly on one side and q strictly on the other is crossed by
  * every segment between them, inside the window where it cuts their convex hull (the
  * convex hull of the points where the segments between their corners cross it). When the
- * scene triangles lying in that plane cover the whole window (up to slivers of 1e-12 of
- * its area: rounding where their edges meet), every segment is blocked and the pair is
- * hidden, with no error.
+ * scene's shapes lying in that plane (coplanar_polygons.h) cover the whole window (up to
+ * slivers of 1e-12 of its area: rounding where their edges meet), every segment is blocked
+ * and the pair is hidden, with no error.
  *
- * The planes tried are those of the triangles a few probe segments between p and q hit
- * first (closest to p): the blockers themselves, found by the tracer, not a shaft's whole
- * contents. When no plane covers its window, the polygon that widens the window most is
- * halved and each half is proven hidden the same way (a street seen past two buildings is
- * closed off by one wall for each half), PAIR_HIDDEN_MAX_DEPTH levels and
+ * The planes tried are those of the triangles that 8 probe segments between p and q cross
+ * (2 points of each, both ways, the first 3 triangles along each): the blockers, found by
+ * the tracer, not a shaft's whole contents; the most often crossed first. When no plane
+ * covers its window, the uncovered pieces of the two planes that leave least are proven
+ * hidden from q or from p (the same test on the pair (piece, q) or (p, piece)); failing
+ * that, the polygon that widens the window more is halved and both halves are proven.
+ * Each sub-pair probes for its own planes; PAIR_HIDDEN_MAX_DEPTH levels and
  * PAIR_HIDDEN_MAX_PROOFS sub-pairs at most. A probe segment that gets through ends the
  * attempt. It is a proof, not an estimate: false means "not proven", never "visible"; the
- * caller then integrates or samples the pair. The probes only choose planes: which rays
- * they are changes what is proven, never whether a proof is right.
+ * caller then integrates or samples the pair. Probes and memory only choose which planes
+ * are tried: they change what is proven, never whether a proof is right.
  */
 #ifndef RAD_VIEWFACTOR_PAIR_HIDDEN_H
 #define RAD_VIEWFACTOR_PAIR_HIDDEN_H
