@@ -21,11 +21,10 @@
  * point costs more: what is left at this depth is reported in the error bound. */
 #define OBSTRUCTED_MAX_DEPTH 8
 
-/* Exact shadow clipping may spend this many (point, occluder) clippings on one pair, some
- * 50 ms at most; a pair that needs more is sampled instead, so the run time stays
- * predictable. A slot 1/50 as wide as two unit plates, behind 4 triangles, needs more
- * than 65536 (the kinks where its image leaves the receiver refine to the deepest level). */
-#define EXACT_WORK_BUDGET 262144u
+/* Exact shadow clipping may spend this many (point, occluder) clippings on one pair, about
+ * a millisecond, by default (pair_obstructed_exact); a pair that needs more is sampled
+ * instead, so the run time stays predictable. */
+#define EXACT_WORK_BUDGET 4096u
 
 /* Largest k of a round's k x k stratified segments per replicate. */
 #define MAX_STRATA 32u
@@ -81,15 +80,24 @@ double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accura
     return integrate_outer(&c, outer, accuracy, bound);
 }
 
+bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
+                                  const shadow_occluder *occluders, uint32_t occluder_count,
+                                  double accuracy, double plane_epsilon, uint64_t work_budget,
+                                  double *value, double *bound)
+{
+    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
+    outer_context c = {outer->normal,       inner, plane_epsilon, occluders, occluder_count,
+                       OBSTRUCTED_MAX_DEPTH, work_budget, false};
+    *value = integrate_outer(&c, outer, accuracy, bound);
+    return !c.failed;
+}
+
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            const shadow_occluder *occluders, uint32_t occluder_count,
                            double accuracy, double plane_epsilon, double *value, double *bound)
 {
-    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
-    outer_context c = {outer->normal,       inner, plane_epsilon, occluders, occluder_count,
-                       OBSTRUCTED_MAX_DEPTH, EXACT_WORK_BUDGET, false};
-    *value = integrate_outer(&c, outer, accuracy, bound);
-    return !c.failed;
+    return pair_obstructed_exact_within(p, q, occluders, occluder_count, accuracy,
+                                        plane_epsilon, EXACT_WORK_BUDGET, value, bound);
 }
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)

@@ -40,10 +40,22 @@ double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accura
 
 /* The obstructed transfer by exact shadow clipping at every quadrature point
  * (shadow_clip.h), to relative tolerance `accuracy`; false when the visible part broke into
- * too many pieces (sample instead). */
+ * too many pieces or more than about a millisecond of clipping was needed (sample
+ * instead). */
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            const shadow_occluder *occluders, uint32_t occluder_count,
                            double accuracy, double plane_epsilon, double *value, double *bound);
+
+/* The same with at most `work_budget` (point, occluder) clippings. */
+bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
+                                  const shadow_occluder *occluders, uint32_t occluder_count,
+                                  double accuracy, double plane_epsilon, uint64_t work_budget,
+                                  double *value, double *bound);
+
+/* The clippings the surface view factors allow one pair: some 50 ms at most. A slot 1/50 as
+ * wide as two unit plates, behind 4 triangles, needs more than 65536 (the kinks where its
+ * image leaves the receiver refine to the deepest level). */
+#define PAIR_EXACT_WORK_BUDGET 262144u
 
 /* Scratch space for the sampled visibility of one thread. */
 /* Pairs with at most this many triangles in between get exact shadow clipping; pairs with

@@ -184,8 +184,8 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
     counts->obstructed_pairs++;
     if (occluders <= PAIR_EXACT_MAX_OCCLUDERS) {
         double visible, error;
-        if (pair_obstructed_exact(p, q, w->occluders, occluders, 0.25 * e->accuracy, eps,
-                                  &visible, &error)) {
+        if (pair_obstructed_exact_within(p, q, w->occluders, occluders, 0.25 * e->accuracy,
+                                         eps, PAIR_EXACT_WORK_BUDGET, &visible, &error)) {
             counts->exact_pairs++;
             unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
             *bound = error;
