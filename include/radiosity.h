@@ -781,7 +781,8 @@ void rad_formfactors_check(const rad_formfactors *formfactors, const rad_mesh *m
 
 /* A surface-to-surface view-factor matrix in compressed sparse rows. Rows and columns are
  * the scene's surfaces (n = scene->surface_count); obstruction surfaces have empty rows
- * and columns. Only non-zero factors are stored, columns ascending within a row. */
+ * and columns. Only non-zero factors are stored, columns ascending within a row, and the
+ * sampled factors that came out 0 but carry an error bound (value 0, error_bound > 0). */
 typedef struct rad_viewfactor_matrix {
     uint32_t n;
     double *area;          /* n: A_I (twice the triangles' area for a two-sided surface) */
@@ -789,8 +790,9 @@ typedef struct rad_viewfactor_matrix {
     uint32_t *column;      /* row_start[n] column indices J */
     double *value;         /* F_IJ */
     double *error_bound;   /* estimated absolute error of each F_IJ (about two standard
-                              errors of its sampled obstruction; the accuracy asked
-                              for where unobstructed) */
+                              errors of its sampled obstruction, or, when every segment
+                              agreed, the 95 % binomial bound on what they could have
+                              missed; the quadrature error where integrated exactly) */
 } rad_viewfactor_matrix;
 
 typedef struct rad_viewfactor_options {
@@ -826,14 +828,26 @@ typedef struct rad_viewfactor_options {
 typedef struct rad_viewfactor_report {
     uint64_t surface_pairs;      /* surface pairs considered */
     uint64_t polygon_pairs;      /* triangle pairs that face each other */
-    uint64_t hidden_pairs;       /* of those, pairs whose first segments (40, stratified)
-                                    were all blocked: taken as wholly hidden, F = 0 */
-    uint64_t obstructed_pairs;   /* of the others, pairs with something in between */
-    uint64_t sampled_pairs;      /* of those, pairs with too many occluders for exact
-                                    shadow clipping: visibility sampled */
+    /* every facing polygon pair is one of: unobstructed_pairs, hidden_pairs, exact_pairs,
+     * sampled_pairs */
+    uint64_t unobstructed_pairs; /* nothing in between (shaft culling): analytic value */
+    uint64_t hidden_pairs;       /* proven wholly hidden, exactly: the scene's shapes in a
+                                    plane that separates the pair cover every segment
+                                    between them (or, piece by piece or half by half, in
+                                    a few planes); F = 0 with no error. Only pairs whose
+                                    first 40 segments were all blocked are tried */
+    uint64_t obstructed_pairs;   /* pairs with something in between, not proven hidden:
+                                    exact_pairs + sampled_pairs */
+    uint64_t exact_pairs;        /* of those, up to 4 triangles in between: their shadows
+                                    clipped exactly */
+    uint64_t sampled_pairs;      /* of those, more occluders (or too many shadow pieces):
+                                    visibility sampled */
+    uint64_t unseen_pairs;       /* sampled pairs whose last round of segments was all
+                                    blocked: F = 0, stored with the bound of what the
+                                    segments could have missed */
     uint64_t capped_pairs;       /* sampled pairs that reached max_rays first */
     uint64_t rays;               /* visibility rays cast */
-    uint64_t nonzeros;           /* stored factors */
+    uint64_t nonzeros;           /* stored factors other than 0 */
     double largest_error_bound;  /* largest error_bound (absolute, in units of F) */
     double seconds;
     int threads;

@@ -517,9 +517,12 @@ int command_viewfactors(int argc, char **argv)
     stats_integer(&stats, "surfaces", S);
     stats_integer(&stats, "surface_pairs", report.surface_pairs);
     stats_integer(&stats, "polygon_pairs", report.polygon_pairs);
+    stats_integer(&stats, "unobstructed_pairs", report.unobstructed_pairs);
     stats_integer(&stats, "hidden_pairs", report.hidden_pairs);
     stats_integer(&stats, "obstructed_pairs", report.obstructed_pairs);
+    stats_integer(&stats, "exact_pairs", report.exact_pairs);
     stats_integer(&stats, "sampled_pairs", report.sampled_pairs);
+    stats_integer(&stats, "unseen_pairs", report.unseen_pairs);
     stats_integer(&stats, "capped_pairs", report.capped_pairs);
     stats_integer(&stats, "rays_cast", report.rays);
     stats_integer(&stats, "nonzeros", report.nonzeros);
@@ -559,13 +562,16 @@ int command_viewfactors(int argc, char **argv)
         stats_number(&stats, "load_imbalance", imbalance);
     }
     exit_code = cli_finish(&stats, stats_path,
-                           "%zu surfaces, %llu polygon pairs (%llu hidden, %llu obstructed, "
-                           "%llu of them sampled), %llu rays, %llu non-zero factors, %.2f s: "
+                           "%zu surfaces, %llu polygon pairs (%llu unobstructed exact, %llu "
+                           "obstructed exact, %llu sampled of which %llu saw nothing, %llu "
+                           "proven hidden), %llu rays, %llu non-zero factors, %.2f s: "
                            "wrote %s",
                            S, (unsigned long long)report.polygon_pairs,
-                           (unsigned long long)report.hidden_pairs,
-                           (unsigned long long)report.obstructed_pairs,
+                           (unsigned long long)report.unobstructed_pairs,
+                           (unsigned long long)report.exact_pairs,
                            (unsigned long long)report.sampled_pairs,
+                           (unsigned long long)report.unseen_pairs,
+                           (unsigned long long)report.hidden_pairs,
                            (unsigned long long)report.rays, (unsigned long long)report.nonzeros,
                            seconds, output ? output : "standard output");
     goto done;

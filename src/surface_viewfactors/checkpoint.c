@@ -4,8 +4,8 @@
  * Layout, little-endian: the magic "\x89RADVFC\n", format version (u32), surface count
  * (u32), scene fingerprint (u64), accuracy (f64), ray cap (u32), seed (u64), rows in the
  * file (u32); then per row, in increasing row order, the row I (u32), its entry count (u32)
- * and per entry the column J >= I (u32, increasing), the transfer G_IJ (f64, > 0) and its
- * error bound (f64, >= 0); last the FNV-1a checksum of every byte before it (u64). The
+ * and per entry the column J >= I (u32, increasing), the transfer G_IJ (f64, >= 0) and its
+ * error bound (f64, >= 0; > 0 when the transfer is 0: a sampled pair that saw nothing); last the FNV-1a checksum of every byte before it (u64). The
  * whole file is checked before any row is used. Written atomically (core/atomic_file.h),
  * so a run killed while writing leaves the previous checkpoint whole.
  */
@@ -172,8 +172,8 @@ static rad_status parse_checkpoint(const char *path, const uint8_t *bytes, size_
         for (uint32_t k = 0; k < entries; k++, p += ENTRY_BYTES) {
             row_entry e = {bytes_get_u32(p), bytes_get_f64(p + 4), bytes_get_f64(p + 12)};
             if (e.column >= n || (int64_t)e.column <= column_before ||
-                !(e.transfer > 0 && isfinite(e.transfer)) ||
-                !(e.bound >= 0 && isfinite(e.bound)))
+                !(e.transfer >= 0 && isfinite(e.transfer)) ||
+                !(e.bound >= 0 && isfinite(e.bound)) || !(e.transfer > 0 || e.bound > 0))
                 return rad_fail(error, RAD_ERR_PARSE,
                                 "%s: row %u: entry %u is out of range or not a finite number",
                                 path, I, k);

@@ -22,8 +22,8 @@
 #define OBSTRUCTED_MAX_DEPTH 8
 
 /* Exact shadow clipping may spend this many (point, occluder) clippings on one pair, about
- * a millisecond; a pair that needs more is sampled instead, so the run time stays
- * predictable. */
+ * a millisecond, by default (pair_obstructed_exact); a pair that needs more is sampled
+ * instead, so the run time stays predictable. */
 #define EXACT_WORK_BUDGET 4096u
 
 /* Largest k of a round's k x k stratified segments per replicate. */
@@ -80,15 +80,24 @@ double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accura
     return integrate_outer(&c, outer, accuracy, bound);
 }
 
+bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
+                                  const shadow_occluder *occluders, uint32_t occluder_count,
+                                  double accuracy, double plane_epsilon, uint64_t work_budget,
+                                  double *value, double *bound)
+{
+    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
+    outer_context c = {outer->normal,       inner, plane_epsilon, occluders, occluder_count,
+                       OBSTRUCTED_MAX_DEPTH, work_budget, false};
+    *value = integrate_outer(&c, outer, accuracy, bound);
+    return !c.failed;
+}
+
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            const shadow_occluder *occluders, uint32_t occluder_count,
                            double accuracy, double plane_epsilon, double *value, double *bound)
 {
-    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
-    outer_context c = {outer->normal,       inner, plane_epsilon, occluders, occluder_count,
-                       OBSTRUCTED_MAX_DEPTH, EXACT_WORK_BUDGET, false};
-    *value = integrate_outer(&c, outer, accuracy, bound);
-    return !c.failed;
+    return pair_obstructed_exact_within(p, q, occluders, occluder_count, accuracy,
+                                        plane_epsilon, EXACT_WORK_BUDGET, value, bound);
 }
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)
@@ -193,15 +202,16 @@ void pair_sample_visibility(const vf_polygon *p, const vf_polygon *q,
             spread += (estimate[r] - mean) * (estimate[r] - mean);
         double standard_error = sqrt(spread / (PAIR_REPLICATES - 1) / PAIR_REPLICATES);
         out->fraction = fmin(fmax(mean, 0), 1);
-        /* all segments agreeing says nothing about features smaller than a cell: the
-         * bound is then one cell's share */
-        out->bound = all_same ? 1.0 / (double)n : PAIR_STUDENT_T * standard_error;
+        out->unseen = all_same && w->occluded[0];
+        /* all segments agreeing has no spread: what they could all have missed (a slot
+         * narrower than a cell, an occluder between them) is bounded binomially */
+        out->bound = all_same ? PAIR_UNSEEN_BOUND / (double)n : PAIR_STUDENT_T * standard_error;
         uint32_t next = PAIR_REPLICATES * (2 * k) * (2 * k);
-        bool settled = all_same ? k >= 2 : out->bound <= accuracy;
-        if (settled)
+        /* agreeing segments take two rounds at least: one says little */
+        if (out->bound <= accuracy && (k >= 2 || !all_same))
             return;
         if (out->rays + next > max_rays || next > w->capacity || 2 * k > MAX_STRATA) {
-            out->capped = !all_same;
+            out->capped = true;
             return;
         }
     }

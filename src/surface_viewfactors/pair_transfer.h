@@ -10,7 +10,10 @@
  * fraction, estimated from
  * replicated stratified segments between the polygons, weighted by the kernel
  * cos cos / r^2; rounds of 4x more segments until the estimate's error bound meets the
- * target or the ray budget is spent. The result never exceeds the unobstructed value.
+ * target or the ray budget is spent. The bound is the replicates' spread (Student t), or,
+ * when every segment of a round agreed, the binomial bound PAIR_UNSEEN_BOUND / n on what
+ * they could all have missed, so a pair whose segments were all blocked still carries the
+ * error it may have. The result never exceeds the unobstructed value.
  */
 #ifndef RAD_VIEWFACTOR_PAIR_TRANSFER_H
 #define RAD_VIEWFACTOR_PAIR_TRANSFER_H
@@ -25,6 +28,11 @@
 /* Two-sided 95 % Student t for PAIR_REPLICATES - 1 = 7 degrees of freedom. */
 #define PAIR_STUDENT_T 2.365
 
+/* -ln(0.05): when all n segments of a round agree (all blocked, or all free), the other
+ * outcome's share is below PAIR_UNSEEN_BOUND / n with 95 % confidence (binomial: a share f
+ * passes n stratified segments unseen with probability at most (1 - f)^n <= exp(-n f)). */
+#define PAIR_UNSEEN_BOUND 2.995732
+
 /* The unobstructed transfer, to relative tolerance `accuracy` (and *bound receives the
  * estimated absolute error). plane_epsilon as in vf_geometry. */
 double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accuracy,
@@ -32,10 +40,22 @@ double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accura
 
 /* The obstructed transfer by exact shadow clipping at every quadrature point
  * (shadow_clip.h), to relative tolerance `accuracy`; false when the visible part broke into
- * too many pieces (sample instead). */
+ * too many pieces or more than about a millisecond of clipping was needed (sample
+ * instead). */
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            const shadow_occluder *occluders, uint32_t occluder_count,
                            double accuracy, double plane_epsilon, double *value, double *bound);
+
+/* The same with at most `work_budget` (point, occluder) clippings. */
+bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
+                                  const shadow_occluder *occluders, uint32_t occluder_count,
+                                  double accuracy, double plane_epsilon, uint64_t work_budget,
+                                  double *value, double *bound);
+
+/* The clippings the surface view factors allow one pair: some 50 ms at most. A slot 1/50 as
+ * wide as two unit plates, behind 4 triangles, needs more than 65536 (the kinks where its
+ * image leaves the receiver refine to the deepest level). */
+#define PAIR_EXACT_WORK_BUDGET 262144u
 
 /* Scratch space for the sampled visibility of one thread. */
 /* Pairs with at most this many triangles in between get exact shadow clipping; pairs with
@@ -58,6 +78,7 @@ typedef struct pair_visibility {
     double bound;    /* its error bound (about 95 %), absolute, as a fraction */
     uint32_t rays;
     bool capped;     /* the ray budget ran out before the bound met the target */
+    bool unseen;     /* every segment of the last round was blocked */
 } pair_visibility;
 
 /* Samples visibility between p and q through `occluders` until bound <= accuracy or

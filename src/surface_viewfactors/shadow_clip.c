@@ -9,12 +9,12 @@
 #include "core/vec3.h"
 #include "geometry/contour.h"
 
-#define PIECE_MAX_VERTICES (CONTOUR_MAX_VERTICES - 1)
+#define PIECE_MAX_VERTICES SHADOW_PIECE_MAX_VERTICES
 
-typedef struct piece {
-    rad_vec3 vertex[PIECE_MAX_VERTICES];
-    unsigned count;
-} piece;
+_Static_assert(SHADOW_PIECE_MAX_VERTICES <= CONTOUR_MAX_VERTICES - 1,
+               "a piece is a polygon the contour integral takes");
+
+typedef shadow_piece piece;
 
 /* Keeps the part of `in` where dot(normal, v) - offset >= 0 (into `out`); false when
  * the result would have more than PIECE_MAX_VERTICES corners. */
@@ -100,6 +100,40 @@ static bool separated(const piece *a, const piece *b, rad_vec3 N)
     return false;
 }
 
+/* Subtracts the convex `shadow` (counter-clockwise about N) from the `count` pieces, into
+ * `next`: the parts of each piece outside each shadow edge in turn, pieces of area at most
+ * `tiny` dropped. Returns how many, or -1 past SHADOW_MAX_PIECES. */
+static int subtract_shadow(const piece *pieces, unsigned count, const piece *shadow, rad_vec3 N,
+                           double tiny, piece *next)
+{
+    int made = 0;
+    for (unsigned k = 0; k < count; k++) {
+        if (separated(&pieces[k], shadow, N)) {
+            if (made == SHADOW_MAX_PIECES)
+                return -1;
+            next[made++] = pieces[k];
+            continue;
+        }
+        piece remaining = pieces[k];
+        for (unsigned e = 0; e < shadow->count && remaining.count >= 3; e++) {
+            rad_vec3 p0 = shadow->vertex[e], p1 = shadow->vertex[(e + 1) % shadow->count];
+            rad_vec3 inward = v3_cross(N, v3_sub(p1, p0));
+            double edge_offset = v3_dot(inward, p0);
+            piece outside, inside;
+            if (!clip_half_space(&remaining, v3_scale(inward, -1), -edge_offset, &outside) ||
+                !clip_half_space(&remaining, inward, edge_offset, &inside))
+                return -1;
+            if (outside.count >= 3 && piece_area(&outside, N) > tiny) {
+                if (made == SHADOW_MAX_PIECES)
+                    return -1;
+                next[made++] = outside;
+            }
+            remaining = inside;
+        }
+    }
+    return made;
+}
+
 double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
                              const shadow_occluder *occluders, uint32_t occluder_count,
                              double plane_epsilon)
@@ -119,40 +153,52 @@ double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
         piece shadow;
         if (!project_shadow(x, H, N, offset, &occluders[o], plane_epsilon, &shadow))
             continue;
-        unsigned made = 0;
-        for (unsigned k = 0; k < count; k++) {
-            if (separated(&pieces[k], &shadow, N)) {
-                if (made == SHADOW_MAX_PIECES)
-                    return -1;
-                next[made++] = pieces[k];
-                continue;
-            }
-            /* the piece minus the shadow: the parts outside each shadow edge in turn */
-            piece remaining = pieces[k];
-            for (unsigned e = 0; e < shadow.count && remaining.count >= 3; e++) {
-                rad_vec3 p0 = shadow.vertex[e], p1 = shadow.vertex[(e + 1) % shadow.count];
-                rad_vec3 inward = v3_cross(N, v3_sub(p1, p0));
-                double edge_offset = v3_dot(inward, p0);
-                piece outside, inside;
-                if (!clip_half_space(&remaining, v3_scale(inward, -1), -edge_offset, &outside) ||
-                    !clip_half_space(&remaining, inward, edge_offset, &inside))
-                    return -1;
-                if (outside.count >= 3 && piece_area(&outside, N) > tiny) {
-                    if (made == SHADOW_MAX_PIECES)
-                        return -1;
-                    next[made++] = outside;
-                }
-                remaining = inside;
-            }
-        }
+        int made = subtract_shadow(pieces, count, &shadow, N, tiny, next);
+        if (made < 0)
+            return -1;
         piece *swap = pieces;
         pieces = next;
         next = swap;
-        count = made;
+        count = (unsigned)made;
     }
     double factor = 0;
     for (unsigned k = 0; k < count; k++)
         factor += contour_point_to_polygon(x, n, pieces[k].vertex, pieces[k].count, N,
                                            plane_epsilon);
     return factor;
+}
+
+int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_vec3 normal,
+                            const shadow_polygon *polygons, uint32_t polygon_count,
+                            shadow_piece *left)
+{
+    if (window_count < 3 || window_count > PIECE_MAX_VERTICES)
+        return -1;
+    piece buffer[SHADOW_MAX_PIECES];
+    piece *pieces = left, *next = buffer;
+    unsigned count = 1;
+    pieces[0].count = window_count;
+    memcpy(pieces[0].vertex, window, window_count * sizeof(rad_vec3));
+    double tiny = 1e-12 * fabs(piece_area(&pieces[0], normal));
+    for (uint32_t t = 0; t < polygon_count && count > 0; t++) {
+        const shadow_polygon *polygon = &polygons[t];
+        piece shape = {.count = polygon->count};
+        memcpy(shape.vertex, polygon->vertex, polygon->count * sizeof(rad_vec3));
+        double area = piece_area(&shape, normal);
+        if (area == 0)
+            continue;
+        if (area < 0)
+            for (unsigned k = 0; k < polygon->count; k++)
+                shape.vertex[k] = polygon->vertex[polygon->count - 1 - k];
+        int made = subtract_shadow(pieces, count, &shape, normal, tiny, next);
+        if (made < 0)
+            return -1;
+        piece *swap = pieces;
+        pieces = next;
+        next = swap;
+        count = (unsigned)made;
+    }
+    if (pieces != left)
+        memcpy(left, pieces, count * sizeof(piece));
+    return (int)count;
 }

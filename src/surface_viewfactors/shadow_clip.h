@@ -4,7 +4,8 @@
  * Each occluding triangle is cut to the slab between the point and the receiving polygon's
  * plane and projected from the point onto that plane; its shadow is subtracted from the
  * visible part of the receiver, kept as a list of convex pieces. The factor is Lambert's
- * contour formula summed over the pieces that remain: exact, with no sampling.
+ * contour formula summed over the pieces that remain: exact, with no sampling. The same
+ * subtraction tells whether polygons lying in one plane cover a convex window of it.
  */
 #ifndef RAD_VIEWFACTOR_SHADOW_CLIP_H
 #define RAD_VIEWFACTOR_SHADOW_CLIP_H
@@ -25,5 +26,28 @@ typedef struct shadow_occluder {
 double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
                              const shadow_occluder *occluders, uint32_t occluder_count,
                              double plane_epsilon);
+
+/* A convex piece of a plane, counter-clockwise about its normal. */
+#define SHADOW_PIECE_MAX_VERTICES 15
+
+typedef struct shadow_piece {
+    rad_vec3 vertex[SHADOW_PIECE_MAX_VERTICES];
+    unsigned count;
+} shadow_piece;
+
+/* A convex polygon of the scene, as many corners as a view-factor polygon at most. */
+typedef struct shadow_polygon {
+    rad_vec3 vertex[VF_MAX_VERTICES];
+    unsigned count;
+} shadow_polygon;
+
+/* What the convex polygons, lying in the plane of the convex `window` (counter-clockwise
+ * about the unit `normal`, 3 to SHADOW_PIECE_MAX_VERTICES corners; the polygons either
+ * way round), leave of it: its convex pieces go to `left` (room for SHADOW_MAX_PIECES),
+ * slivers of at most 1e-12 of the window's area dropped. Returns how many (0: the polygons
+ * cover the window), or -1 when it breaks into more than SHADOW_MAX_PIECES pieces. */
+int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_vec3 normal,
+                            const shadow_polygon *polygons, uint32_t polygon_count,
+                            shadow_piece *left);
 
 #endif

@@ -4,9 +4,11 @@
  * Surface pairs (I, J), J >= I, are visited once, in parallel over rows I. A pair is
  * skipped at once when either surface is planar and the other lies wholly behind (or on)
  * its plane. Otherwise every facing polygon pair (p of I, q of J) adds its transfer
- * G_pq = A_p F_pq (pair_transfer.c): the analytic value when the occluder tree proves
- * nothing can stand between them; with a few triangles in between, the same integral of
- * the exactly clipped visible part; with many, that value times a sampled visible fraction.
+ * G_pq = A_p F_pq (pair_transfer.c): 0 when pair_hidden.c proves every segment between
+ * them blocked; the analytic value when the occluder tree proves nothing can stand between
+ * them; with a few triangles in between, the same integral of the exactly clipped visible
+ * part; with many, that value times a sampled visible fraction, with its bound even when
+ * no segment got through.
  * G_IJ = sum G_pq is symmetric, so F_IJ = G_IJ / A_I and F_JI = G_IJ / A_J hold
  * reciprocity exactly. A curved surface sees itself: F_II = 2 sum_{p<q} G_pq / A_I.
  *
@@ -38,16 +40,18 @@
 #include "parallel/partition.h"
 #include "parallel/ranks.h"
 #include "surface_viewfactors/checkpoint.h"
+#include "surface_viewfactors/coplanar_polygons.h"
 #include "surface_viewfactors/matrix_entry.h"
 #include "surface_viewfactors/occluder_tree.h"
+#include "surface_viewfactors/pair_hidden.h"
 #include "surface_viewfactors/pair_transfer.h"
 #include "surface_viewfactors/pending_row.h"
 #include "surface_viewfactors/vf_geometry.h"
 
 
 typedef struct pair_counts {
-    uint64_t surface_pairs, polygon_pairs, hidden_pairs, obstructed_pairs, sampled_pairs,
-        capped_pairs, rays;
+    uint64_t surface_pairs, polygon_pairs, unobstructed_pairs, hidden_pairs, obstructed_pairs,
+        exact_pairs, sampled_pairs, unseen_pairs, capped_pairs, rays;
 } pair_counts;
 
 /* Progress by polygon pairs, the unit of work (a row's cost is its polygons times the
@@ -84,6 +88,7 @@ typedef struct engine {
     const vf_geometry *geometry;
     const occluder_tree *tree;
     const rad_tracer *occluders;
+    pair_hidden_context hidden; /* the tracer and the scene's planes, for hidden proofs */
     double accuracy;
     uint32_t max_rays;
     uint64_t seed;
@@ -139,9 +144,11 @@ static uint64_t matrix_bound_bytes(const vf_geometry *g, uint64_t *pairs)
            2 * ((uint64_t)g->surface_count + 1) * sizeof(uint64_t);
 }
 
-/* G_pq and its error bound; 0 when they do not face each other. */
+/* G_pq and its error bound; 0 when they do not face each other. A pair is taken as hidden
+ * only when pair_proven_hidden proves it; every other pair is integrated, exactly or with
+ * sampled visibility, and carries its bound (even a sampled 0). */
 static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_workspace *w,
-                           pair_counts *counts, double *bound)
+                           pair_hidden_memory *memory, pair_counts *counts, double *bound)
 {
     const vf_polygon *p = &e->geometry->polygons[pi], *q = &e->geometry->polygons[qi];
     double eps = e->geometry->plane_epsilon;
@@ -154,16 +161,22 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
     uint64_t stream = rad_mix64(e->seed ^ rad_mix64(((uint64_t)pi << 32) | qi));
     pair_visibility visibility;
     /* a first look with a few dozen segments: most pairs of a large scene are wholly
-     * hidden, and need no more work than that */
+     * hidden; when it sees nothing, the occluders in between are asked for a proof */
     pair_sample_visibility(p, q, e->occluders, INFINITY, e->max_rays, stream, w, &visibility);
     counts->rays += visibility.rays;
     if (visibility.fraction == 0) {
-        counts->hidden_pairs++;
-        return 0;
+        pair_hidden_work work = {0, 0, 0};
+        bool hidden = pair_proven_hidden(&e->hidden, memory, p, q, &work);
+        counts->rays += work.rays;
+        if (hidden) {
+            counts->hidden_pairs++;
+            return 0;
+        }
     }
     uint32_t occluders = occluder_tree_collect(e->tree, p, q, eps, w->occluders,
                                                PAIR_EXACT_MAX_OCCLUDERS);
     if (occluders == 0) {
+        counts->unobstructed_pairs++;
         unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
         *bound = quadrature_error;
         return fmax(unobstructed, 0);
@@ -171,8 +184,9 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
     counts->obstructed_pairs++;
     if (occluders <= PAIR_EXACT_MAX_OCCLUDERS) {
         double visible, error;
-        if (pair_obstructed_exact(p, q, w->occluders, occluders, 0.25 * e->accuracy, eps,
-                                  &visible, &error)) {
+        if (pair_obstructed_exact_within(p, q, w->occluders, occluders, 0.25 * e->accuracy,
+                                         eps, PAIR_EXACT_WORK_BUDGET, &visible, &error)) {
+            counts->exact_pairs++;
             unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
             *bound = error;
             return fmax(fmin(visible, unobstructed), 0);
@@ -191,6 +205,7 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
                            &visibility);
     counts->rays += visibility.rays;
     counts->capped_pairs += visibility.capped;
+    counts->unseen_pairs += visibility.unseen;
     *bound = quadrature_error + visibility.bound * unobstructed;
     return unobstructed * visibility.fraction;
 }
@@ -217,6 +232,8 @@ static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_work
     const vf_surface *a = &g->surfaces[I];
     if (a->polygon_count == 0)
         return true;
+    /* the row's own: its result cannot depend on which thread ran which row before */
+    pair_hidden_memory memory = {0};
     for (uint32_t J = I; J < g->surface_count; J++) {
         const vf_surface *b = &g->surfaces[J];
         if (b->polygon_count == 0 || (J == I && a->planar))
@@ -232,7 +249,7 @@ static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_work
             uint32_t q_first = J == I ? pi + 1 : b->first_polygon;
             for (uint32_t qi = q_first; qi < b->first_polygon + b->polygon_count; qi++) {
                 double bound;
-                double G = polygon_pair(e, pi, qi, w, counts, &bound);
+                double G = polygon_pair(e, pi, qi, w, &memory, counts, &bound);
                 transfer += G;
                 /* sampled parts are independent: their bounds add in quadrature */
                 variance += bound * bound;
@@ -241,7 +258,8 @@ static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_work
         }
         if (J == I)
             transfer *= 2, variance *= 4;
-        if (transfer > 0 && !row_push(out, J, transfer, sqrt(variance)))
+        /* a sampled 0 is kept with its bound: what the segments could have missed */
+        if ((transfer > 0 || variance > 0) && !row_push(out, J, transfer, sqrt(variance)))
             return false;
     }
     return true;
@@ -542,6 +560,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     vf_geometry geometry;
     occluder_tree *tree = NULL;
     rad_tracer *occluders = NULL;
+    coplanar_polygons planes = {0};
     pending_row *rows = NULL;
     rad_status status = vf_geometry_build(scene, &geometry, error);
     if (status == RAD_OK && rad_memory_budget()) {
@@ -556,6 +575,8 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
+    if (status == RAD_OK)
+        status = coplanar_polygons_build(scene, &geometry, &planes, error);
     uint32_t n = scene->surface_count;
     uint8_t *state = NULL;
     uint32_t *mine = NULL;
@@ -588,12 +609,14 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         free(mine);
         rad_tracer_destroy(occluders);
         occluder_tree_destroy(tree);
+        coplanar_polygons_free(&planes);
         vf_geometry_free(&geometry);
         return status;
     }
     e.geometry = &geometry;
     e.tree = tree;
     e.occluders = occluders;
+    e.hidden = (pair_hidden_context){&planes, occluders, geometry.plane_epsilon};
 
     /* over several ranks: who computes which row (owner NULL: this process, all), decided
      * by rank 0 alone so that no rank can disagree; resumed rows are rank 0's already */
@@ -622,6 +645,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
             free(mine);
             rad_tracer_destroy(occluders);
             occluder_tree_destroy(tree);
+            coplanar_polygons_free(&planes);
             vf_geometry_free(&geometry);
             return rad_fail(error, RAD_ERR_NOMEM, "out of memory sharing %u rows over %d ranks",
                             n, ranks_count());
@@ -702,9 +726,12 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         {
             totals.surface_pairs += counts.surface_pairs;
             totals.polygon_pairs += counts.polygon_pairs;
+            totals.unobstructed_pairs += counts.unobstructed_pairs;
             totals.hidden_pairs += counts.hidden_pairs;
             totals.obstructed_pairs += counts.obstructed_pairs;
+            totals.exact_pairs += counts.exact_pairs;
             totals.sampled_pairs += counts.sampled_pairs;
+            totals.unseen_pairs += counts.unseen_pairs;
             totals.capped_pairs += counts.capped_pairs;
             totals.rays += counts.rays;
         }
@@ -712,6 +739,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     double rank_seconds = now_seconds() - rows_start;
     rad_tracer_destroy(occluders);
     occluder_tree_destroy(tree);
+    coplanar_polygons_free(&planes);
     rad_viewfactor_matrix *matrix = NULL;
     if (cp.status != RAD_OK) {
         status = cp.status;
@@ -725,11 +753,14 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
                                                   : "another rank ran out of memory")
                      : cp.interrupted ? RAD_OK
                                       : gather_rows(rows, state, n, error);
-        uint64_t sums[7] = {totals.surface_pairs, totals.polygon_pairs, totals.hidden_pairs,
-                            totals.obstructed_pairs, totals.sampled_pairs,
-                            totals.capped_pairs, totals.rays};
-        ranks_sum(sums, 7);
-        totals = (pair_counts){sums[0], sums[1], sums[2], sums[3], sums[4], sums[5], sums[6]};
+        uint64_t sums[10] = {totals.surface_pairs,      totals.polygon_pairs,
+                             totals.unobstructed_pairs, totals.hidden_pairs,
+                             totals.obstructed_pairs,   totals.exact_pairs,
+                             totals.sampled_pairs,      totals.unseen_pairs,
+                             totals.capped_pairs,       totals.rays};
+        ranks_sum(sums, 10);
+        totals = (pair_counts){sums[0], sums[1], sums[2], sums[3], sums[4],
+                               sums[5], sums[6], sums[7], sums[8], sums[9]};
         free(owner);
         if (status == RAD_OK && rank == 0 && !cp.interrupted)
             matrix = assemble(&geometry, rows, n);
@@ -755,15 +786,19 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         memset(report, 0, sizeof(*report));
         report->surface_pairs = totals.surface_pairs;
         report->polygon_pairs = totals.polygon_pairs;
+        report->unobstructed_pairs = totals.unobstructed_pairs;
         report->hidden_pairs = totals.hidden_pairs;
         report->obstructed_pairs = totals.obstructed_pairs;
+        report->exact_pairs = totals.exact_pairs;
         report->sampled_pairs = totals.sampled_pairs;
+        report->unseen_pairs = totals.unseen_pairs;
         report->capped_pairs = totals.capped_pairs;
         report->rays = totals.rays;
-        for (uint64_t k = 0; matrix && k < matrix->row_start[n]; k++)
+        for (uint64_t k = 0; matrix && k < matrix->row_start[n]; k++) {
+            report->nonzeros += matrix->value[k] != 0;
             report->largest_error_bound =
                 fmax(report->largest_error_bound, matrix->error_bound[k]);
-        report->nonzeros = matrix ? matrix->row_start[n] : 0;
+        }
         report->seconds = now_seconds() - start;
         report->threads = threads;
         report->rank_rows = rank_rows;
