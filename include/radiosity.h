@@ -1589,7 +1589,10 @@ void rad_reconstruct_vertices(const rad_mesh *mesh, const rad_rgb *B,
  * options->scene above); back faces of one-sided patches and misses are black (a hit on
  * the back of a patch with a twin shows the twin there); mirror reflections are added
  * when options->materials is given (above). Fills `image` (its size decides the
- * resolution). */
+ * resolution). After rad_ranks_begin joined a job of several MPI ranks this is
+ * collective: every rank calls it with the same arguments and renders every N-th row,
+ * and every rank's image is then whole, bitwise a serial run's. A failure on any rank
+ * fails it on every rank. */
 rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
                       const rad_render_options *options, rad_image *image,
                       rad_error *error);

@@ -190,10 +190,6 @@ int command_render(int argc, char **argv)
         exit_code = cli_ranks_failed(&error);
         goto done;
     }
-    if (rad_rank() != 0) { /* rank 0 renders and writes */
-        exit_code = EXIT_OK;
-        goto done;
-    }
     t_solved = rad_clock_seconds();
     rad_camera camera = cli_view_camera(&s.view, solved.scene);
     if (s.specular)
@@ -203,10 +199,24 @@ int command_render(int argc, char **argv)
     cli_memory_release(); /* the image reserved up front is made now */
     status = rad_image_create(s.view.width, s.view.height, &image, &error);
     cli_progress_mark();
+    /* every rank renders its share of the rows (rad_render is collective), so every rank
+     * must have its image first; rank 0 writes */
+    if (rad_rank_count() > 1 && !cli_ranks_ok(status, &error)) {
+        exit_code = cli_ranks_failed(&error);
+        goto done;
+    }
     if (status == RAD_OK)
         status = rad_render(solved.mesh, solved.B, &camera, &s.render, image, &error);
+    if (rad_rank_count() > 1 && !cli_ranks_ok(status, &error)) {
+        exit_code = cli_ranks_failed(&error);
+        goto done;
+    }
     if (status != RAD_OK)
         goto fail;
+    if (rad_rank() != 0) {
+        exit_code = EXIT_OK;
+        goto done;
+    }
     t_render = rad_clock_seconds();
     if (rad_scene_has_emitter(solved.scene) || solved.scene->light_count > 0) {
         /* lit surfaces, a black image: the camera sees only backs (surfaces are one-sided),

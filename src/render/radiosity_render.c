@@ -35,6 +35,7 @@
 #include "render/camera.h"
 #include "render/emitter_light.h"
 #include "lights/emitters.h"
+#include "parallel/ranks.h"
 #include "render/progress.h"
 #include "reconstruct/display_mesh.h"
 #include "scene/patch_materials.h"
@@ -537,6 +538,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     rad_rgb *emitter_direct = NULL;
     uint8_t *hidden = NULL, *near = NULL;
     rad_rgb *reflected = NULL;
+    bool agreed = false; /* every rank has passed ranks_agree (collective over MPI ranks) */
     status = display_mesh_build(mesh, true, &display, error);
     if (status != RAD_OK)
         goto done;
@@ -709,10 +711,22 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                      near,      reflected,
                      B,         gather_rays};
 
-    render_progress progress =
-        render_progress_start(options->progress, options->progress_user, "render", H);
+    /* over several MPI ranks the rows are dealt out in turn (every pixel's random numbers
+     * are its own, so each row comes out as in a serial run), then summed: every pixel is
+     * non-zero on its row's rank alone, so the sum is that rank's value, exactly */
+    status = ranks_agree(RAD_OK, "render", error);
+    agreed = true;
+    if (status != RAD_OK)
+        goto done;
+    const uint32_t rank = (uint32_t)ranks_rank(), ranks = (uint32_t)ranks_count();
+    render_progress progress = render_progress_start(options->progress, options->progress_user,
+                                                     "render", (H - rank + ranks - 1) / ranks);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
     for (uint32_t y = 0; y < H; y++) {
+        if (y % ranks != rank) {
+            memset(&image->rgb[(size_t)y * W * 3], 0, (size_t)W * 3 * sizeof(float));
+            continue;
+        }
         int thread = omp_get_thread_num();
         row_work *w = &work[thread];
         w->row = y;
@@ -803,10 +817,14 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         render_progress_step(&progress);
     }
     render_progress_finish(&progress);
+    if (ranks > 1)
+        ranks_sum_floats(image->rgb, (uint64_t)W * H * 3);
     goto done;
 nomem:
     status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for rendering");
 done:
+    if (!agreed) /* failed before the ranks agreed: the others learn it there */
+        status = ranks_agree(status, "render", error);
     if (work)
         for (int th = 0; th < threads; th++) {
             free(work[th].rays);

@@ -4,7 +4,8 @@
  * the form factors cast rays) with the default dense solver (gather, Jacobi: the sweeps
  * are shared over the ranks); Gauss-Seidel (solved whole on every rank from the shared
  * matrix) and the hierarchical solver (its links shared by receiver; see
- * test_mpi_hierarchical) too under 3 ranks. The per-rank
+ * test_mpi_hierarchical) too under 3 ranks, and the per-pixel direct light's image (its
+ * rows dealt out over the ranks) under 3 ranks bit for bit. The per-rank
  * summary accounts for every form-factor row once. The ranks run one thread each, the
  * serial run two: the results depend on neither.
  */
@@ -61,6 +62,13 @@ int main(void)
         if (ranks > 1)
             CHECK(rows_of_ranks(ranks) == patches);
     }
+    /* the image's rows dealt out over the ranks: the per-pixel direct light (each pixel's
+     * own random numbers) as linear floats, bit for bit */
+    CHECK(test_run_tool("render -o serial-pixel.pfm " PATCHES
+                        " --size 96x96 --direct pixel --threads 2") == 0);
+    CHECK(test_run_mpi(3, "render -o pixel.pfm " PATCHES " --size 96x96 --direct pixel --threads 1",
+                       0, NULL) == 0);
+    CHECK(test_same_bytes(test_path("serial-pixel.pfm"), test_path("pixel.pfm")));
     CHECK(test_run_mpi(3, "solve -o gs.ply " PATCHES " --solver gauss-seidel --threads 1", 0,
                        NULL) == 0);
     CHECK(test_same_bytes(test_path("serial-gs.ply"), test_path("gs.ply")));
