@@ -11,29 +11,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "closed_forms.h"
 #include "testlib.h"
 
-static const double pi = 3.14159265358979323846;
-
-static double parallel_squares(void)
-{
-    double X = 1, Y = 1;
-    return 2 / (pi * X * Y) *
-           (log(sqrt((1 + X * X) * (1 + Y * Y) / (1 + X * X + Y * Y))) +
-            X * sqrt(1 + Y * Y) * atan(X / sqrt(1 + Y * Y)) +
-            Y * sqrt(1 + X * X) * atan(Y / sqrt(1 + X * X)) - X * atan(X) - Y * atan(Y));
-}
-
-static double perpendicular_squares(void)
-{
-    double W = 1, H = 1, W2 = 1, H2 = 1;
-    double a = (1 + W2) * (1 + H2) / (1 + W2 + H2);
-    double b = pow(W2 * (1 + W2 + H2) / ((1 + W2) * (W2 + H2)), W2);
-    double c = pow(H2 * (1 + W2 + H2) / ((1 + H2) * (W2 + H2)), H2);
-    return 1 / (pi * W) *
-           (W * atan(1 / W) + H * atan(1 / H) - sqrt(H2 + W2) * atan(1 / sqrt(H2 + W2)) +
-            0.25 * log(a * b * c));
-}
+/* the unit squares' closed forms (Howell's catalogue, tests/closed_forms.h) */
+static double parallel_squares(void) { return parallel_rectangles(1, 1, 1); }
+static double perpendicular_squares(void) { return perpendicular_rectangles(1, 1, 1); }
 
 /* A dense row-major matrix as CSR (zeros not stored). */
 static rad_viewfactor_matrix *from_dense(uint32_t n, const double *F, const double *area)
