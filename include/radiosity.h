@@ -1525,13 +1525,20 @@ rad_status rad_image_false_colour(const rad_image *values,
 /* ------------------------------------------------------------------------------------ */
 /* Rendering                                                                             */
 
+/* Where a render takes the emitters' direct light from (rad_render_options.direct_light). */
+typedef enum rad_direct_light {
+    RAD_DIRECT_VERTEX = 0,
+    RAD_DIRECT_PIXEL,
+    RAD_DIRECT_SOLUTION,
+} rad_direct_light;
+
 /* The image's size is the rad_image's (rad_render fills the image it is given). */
 typedef struct rad_render_options {
     uint32_t samples_per_pixel; /* rounded to a square, stratified, box filter; 0 = 16 */
     uint32_t edge_samples;      /* more samples (rounded to a square) for a pixel whose first
                                    ones disagree by over 10 % in luminance, or that differs
                                    so from a row neighbour: silhouettes and the light's rim;
-                                   0 = 64 (256 with emitter_direct) */
+                                   0 = 64 (256 with RAD_DIRECT_PIXEL) */
     /* The two-pass method: with `materials` (the scene's) given, a surface whose specular
      * reflectance Ks > 0 adds Ks times the radiance seen along the mirror direction, traced
      * through the radiosity-lit scene, up to max_depth reflections (0 = 5). NULL = the
@@ -1559,16 +1566,27 @@ typedef struct rad_render_options {
      * sharp light sources added per pixel as for radiance; a black patch shows its direct
      * light alone; misses and mirrors show nothing. Needs `scene`. */
     bool irradiance;
-    /* With `emitter_direct` (and `scene`), the direct light of emissive surfaces is
-     * computed at every pixel sample by `direct_samples` shadow rays to points of the
-     * emitters (stratified over the pixel's samples; exact soft shadows), and the rest
-     * (their light reflected more than once, the sky) taken from the solution with their
-     * patch means (16 x 32 samples per patch) taken out first. Off: the emitters' direct
-     * light is interpolated from the solution like the rest (the classic radiosity
-     * image). direct_samples 0 = RAD_DEFAULT_DIRECT_SAMPLES. */
-    bool emitter_direct;
+    /* How the emitters' direct light (emissive surfaces; with `scene`) reaches the image:
+     * RAD_DIRECT_VERTEX (the default): computed at every mesh vertex (1024 light samples
+     *   and 512 cosine rays, MIS, at a point a tenth of the way into the vertex's patches)
+     *   together with a final gather there (1024 cosine rays meeting the solution's
+     *   reflected light (B - E) / pi, or the sky), and interpolated: the vertex shows
+     *   E / pi + rho / pi (H_emitters + H_gathered); soft shadows, contact shadows and the
+     *   light next to creases follow the light, not patch means, and the image has no
+     *   pixel noise;
+     * RAD_DIRECT_PIXEL: computed at every pixel sample by `direct_samples` shadow rays to
+     *   points of the emitters (stratified over the pixel's samples; exact soft shadows, a
+     *   little noise), the rest (light reflected more than once, the sky) from the
+     *   solution with the direct light's patch means (16 x 32 samples per patch) taken
+     *   out first;
+     * RAD_DIRECT_SOLUTION: interpolated from the solution like the rest (the classic
+     *   radiosity image).
+     * A scene without emissive surfaces gets the classic image in every mode (point, spot,
+     * luminaire and sun light is computed at each pixel in all of them).
+     * direct_samples 0 = RAD_DEFAULT_DIRECT_SAMPLES (RAD_DIRECT_PIXEL only). */
+    rad_direct_light direct_light;
     uint32_t direct_samples;
-    /* With emitter_direct: at a patch with another surface within 1.5 patch widths (a
+    /* With RAD_DIRECT_PIXEL: at a patch with another surface within 1.5 patch widths (a
      * crease, a contact, a corner), the light reflected more than once is gathered at each
      * pixel sample by `gather_rays` cosine-weighted rays meeting the solution (B - E
      * interpolated; the sky where they leave) instead of being interpolated; 0 =

@@ -178,16 +178,18 @@ static void test_contact(void)
     CHECK(p.exact[p.count - 1] < 0.05 * p.open || p.exact[0] < 0.05 * p.open);
     char command[1024];
     /* measured 2026-12-02, the largest difference as a share of the open floor's value
-     * (the issue asks for 2 %): the default render (gather) 8.3 %, Gauss-Seidel and
-     * shooting the same, all at the umbra's end (x = -1.17 m), where interpolation from
-     * the partly lit patches carries light 10 cm into the umbra; the hierarchical solver
-     * (30,000 patches) 3.3 %; the per-pixel direct light 5.7 % at 16 samples a pixel and
-     * 2.5 % at 256 (its noise: without bias; before the emitter samples were one Halton
-     * point in all three dimensions it was 20 % at any sample count) */
+     * (the issue asks for 2 %): the default render (gather; the emitter's light computed at
+     * the vertices and interpolated) 6.5 %, Gauss-Seidel and shooting the same, all at the
+     * umbra's end (x = -1.17 m), where the light falls to zero inside a patch and the
+     * interpolation between its vertices carries some 4 cm into the umbra (8.3 % with the
+     * patch values interpolated instead); the hierarchical solver (30,000 patches) 1.0 %
+     * (3.3 % with patch values); the per-pixel direct light 5.7 % at 16 samples a pixel
+     * and 2.5 % at 256 (its noise: without bias; before the emitter samples were one
+     * Halton point in all three dimensions it was 20 % at any sample count) */
     static const char *const runs[] = {"", "--solver gauss-seidel", "--solver shoot",
                                        "--solver hierarchical", "--direct pixel",
                                        "--direct pixel --spp 256"};
-    static const double bounds[] = {0.09, 0.09, 0.09, 0.04, 0.07, 0.03};
+    static const double bounds[] = {0.075, 0.075, 0.075, 0.02, 0.07, 0.03};
     for (size_t r = 0; r < sizeof(runs) / sizeof(runs[0]); r++) {
         snprintf(command, sizeof(command), "render %s -o %s %s %s", test_path("contact.obj"),
                  test_path("image.pfm"), CONTACT_CAMERA, runs[r]);

@@ -31,7 +31,7 @@ static const char usage[] =
     "  --max-depth N        mirror reflections followed with --specular (default 5)\n"
     "  --quantity illuminance  pixels: illuminance (lux) at the surface seen, not radiance\n"
     "  --false-colour       PNG in false colour with a legend; --scale LOW,HIGH, --log\n"
-    "  --direct pixel       emitters' direct light at each pixel (shadow rays), not patches\n"
+    "  --direct MODE        emitters' direct light: vertex (default), pixel or solution\n"
     CLI_TWO_SIDED_HELP
     CLI_SOLVE_HELP;
 
@@ -110,11 +110,15 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
     s->render.irradiance =
         quantity && (strcmp(quantity, "illuminance") == 0 || strcmp(quantity, "irradiance") == 0);
     const char *direct = args.value[OPT_DIRECT];
-    if (direct && strcmp(direct, "pixel") != 0 && strcmp(direct, "solution") != 0) {
-        cli_error("--direct: '%s' is not pixel or solution", direct);
+    if (direct && strcmp(direct, "vertex") != 0 && strcmp(direct, "pixel") != 0 &&
+        strcmp(direct, "solution") != 0) {
+        cli_error("--direct: '%s' is not vertex, pixel or solution", direct);
         return false;
     }
-    s->render.emitter_direct = direct && strcmp(direct, "pixel") == 0;
+    s->render.direct_light = !direct                          ? RAD_DIRECT_VERTEX
+                             : strcmp(direct, "pixel") == 0    ? RAD_DIRECT_PIXEL
+                             : strcmp(direct, "solution") == 0 ? RAD_DIRECT_SOLUTION
+                                                               : RAD_DIRECT_VERTEX;
     s->false_colour = args.value[OPT_FALSE_COLOUR] != NULL;
     s->colours.logarithmic = args.value[OPT_LOG] != NULL;
     if (args.value[OPT_SCALE]) {

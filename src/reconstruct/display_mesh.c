@@ -777,19 +777,23 @@ bool display_mesh_radiance_weighted(const rad_mesh *mesh, const display_mesh *di
         vertex_radiance[v].b *= scale;
     }
     free(weight);
-    if (!display)
-        return true;
+    if (display)
+        display_mesh_constrain(mesh, display, vertex_radiance);
+    return true;
+}
+
+void display_mesh_constrain(const rad_mesh *mesh, const display_mesh *display,
+                            rad_rgb *vertex_values)
+{
     for (uint32_t i = 0; i < display->tvertex_count; i++) {
         const display_tvertex *tv = &display->tvertices[i];
-        vertex_radiance[tv->vertex] =
-            rgb_lerp(vertex_radiance[tv->from], vertex_radiance[tv->to], tv->t);
+        vertex_values[tv->vertex] = rgb_lerp(vertex_values[tv->from], vertex_values[tv->to], tv->t);
     }
     for (uint32_t k = 0; k < display->extra_count; k++) {
         const display_extra *x = &display->extras[k];
-        vertex_radiance[mesh->vertex_count + k] =
-            rgb_lerp(vertex_radiance[x->from], vertex_radiance[x->to], x->t);
+        vertex_values[mesh->vertex_count + k] =
+            rgb_lerp(vertex_values[x->from], vertex_values[x->to], x->t);
     }
-    return true;
 }
 
 uint32_t display_mesh_front_triangles(const rad_mesh *mesh, const display_mesh *display)

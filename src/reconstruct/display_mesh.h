@@ -67,6 +67,11 @@ bool display_mesh_radiance_weighted(const rad_mesh *mesh, const display_mesh *di
                                     const rad_rgb *B, const uint8_t *hidden,
                                     rad_rgb *vertex_radiance);
 
+/* Makes values given at the mesh's vertices (the first mesh->vertex_count) displayable:
+ * each T-vertex takes the interpolation between its anchors, and each added vertex the
+ * interpolation along its edge (display_mesh_radiance_weighted ends with this). */
+void display_mesh_constrain(const rad_mesh *mesh, const display_mesh *display,
+                            rad_rgb *vertex_values);
 /* Marks in hidden[p] (mesh->patch_count values) the patches no one can see: every ray of
  * a few over the patch's hemisphere meets the back of a surface of `tracer` (the scene, or
  * the patches); rays leave the centre `leave` off the patch (hidden_patches.c). With

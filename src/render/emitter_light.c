@@ -25,24 +25,55 @@
 
 static double wrap(double u) { return u < 1 ? u : u - 1; }
 
+/* The emitting triangle emitters_sample picks for u0: the first k with cdf[k] > u0. */
+static uint32_t emitter_index(const emitter_set *set, double u0)
+{
+    uint32_t lo = 0, hi = set->count - 1;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (set->cdf[mid] > u0)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    return lo;
+}
+
 static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
                            rad_vec3 n, double leave, uint32_t count, double turn, uint32_t first,
-                           double shift1, double shift2, bool mis, rad_ray *rays,
-                           rad_rgb *irradiance)
+                           double shift1, double shift2, bool by_triangle,
+                           double cosine_per_light, rad_ray *rays, rad_rgb *irradiance)
 {
     if (set->count == 0)
         return 0;
     rad_vec3 origin = v3_add(x, v3_scale(n, leave));
     uint32_t made = 0;
+    uint32_t current = UINT32_MAX, local = 0; /* by_triangle: the triangle, its k-th point */
     for (uint32_t k = 0; k < count; k++) {
         uint32_t j = first + k;
-        /* the triangle and the point on it from one Halton point (bases 5, 2, 3): a
-         * triangle chosen apart from the point's dimensions would take every other
-         * Halton point, which covers only stripes of it */
-        double u0 = wrap(rad_radical_inverse(j, 5) + turn);
+        double u0, u1, u2;
+        if (by_triangle) {
+            /* evenly spaced choices (k + turn) / count, so each triangle gets its share of
+             * consecutive samples, and its own Halton points (bases 2, 3) on it */
+            u0 = (k + turn) / count;
+            uint32_t t = emitter_index(set, u0);
+            if (t != current) {
+                current = t;
+                local = 0;
+            }
+            u1 = wrap(rad_radical_inverse(local, 2) + shift1);
+            u2 = wrap(rad_radical_inverse(local, 3) + shift2);
+            local++;
+        } else {
+            /* the triangle and the point on it from one Halton point (bases 5, 2, 3): a
+             * triangle chosen apart from the point's dimensions would take every other
+             * Halton point, which covers only stripes of it */
+            u0 = wrap(rad_radical_inverse(j, 5) + turn);
+            u1 = wrap(rad_radical_inverse(j, 2) + shift1);
+            u2 = wrap(rad_radical_inverse(j, 3) + shift2);
+        }
         emitter_sample light;
-        emitters_sample(set, scene, u0, wrap(rad_radical_inverse(j, 2) + shift1),
-                        wrap(rad_radical_inverse(j, 3) + shift2), &light);
+        emitters_sample(set, scene, u0, u1, u2, &light);
         rad_vec3 d = v3_sub(light.point, x);
         double r2 = v3_dot(d, d);
         if (!(r2 > 0) || !(light.pdf_area > 0))
@@ -52,8 +83,9 @@ static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_v
         if (!(cos_x > 0) || !(cos_e > 0))
             continue;
         double p_light = light.pdf_area * r2 / cos_e; /* per solid angle */
-        double p_cosine = mis ? cos_x / RAD_PI : 0;
-        /* L cos_x / p_light times the power heuristic's p_light^2 / (p_light^2 + p_cosine^2) */
+        double p_cosine = cosine_per_light * cos_x / RAD_PI;
+        /* L cos_x / p_light times the power heuristic's p_light^2 / (p_light^2 + p_cosine^2),
+         * each density times its strategy's sample count */
         rad_rgb value = rgb_scale(light.radiance, cos_x * p_light /
                                                       ((p_light * p_light + p_cosine * p_cosine) * count));
         if (rgb_is_zero(value))
@@ -70,8 +102,18 @@ uint32_t emitter_light_rays_mis(const emitter_set *set, const rad_scene *scene, 
                                 uint32_t first, double shift1, double shift2, rad_ray *rays,
                                 rad_rgb *irradiance)
 {
-    return light_rays(set, scene, x, n, leave, count, turn, first, shift1, shift2, true, rays,
-                      irradiance);
+    return light_rays(set, scene, x, n, leave, count, turn, first, shift1, shift2, false, 1,
+                      rays, irradiance);
+}
+
+uint32_t emitter_light_rays_by_triangle(const emitter_set *set, const rad_scene *scene,
+                                        rad_vec3 x, rad_vec3 n, double leave, uint32_t count,
+                                        double turn, double shift1, double shift2,
+                                        double cosine_per_light, rad_ray *rays,
+                                        rad_rgb *irradiance)
+{
+    return light_rays(set, scene, x, n, leave, count, turn, 0, shift1, shift2, true,
+                      cosine_per_light, rays, irradiance);
 }
 
 void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, rad_rng *rng,
@@ -96,6 +138,13 @@ void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, r
 rad_rgb emitter_cosine_value(const emitter_set *set, const rad_scene *scene, const rad_ray *ray,
                              const rad_hit *hit, double cos_x, uint32_t count)
 {
+    return emitter_cosine_value_weighted(set, scene, ray, hit, cos_x, count, 1);
+}
+
+rad_rgb emitter_cosine_value_weighted(const emitter_set *set, const rad_scene *scene,
+                                      const rad_ray *ray, const rad_hit *hit, double cos_x,
+                                      uint32_t count, double light_per_cosine)
+{
     rad_rgb none = {0, 0, 0};
     if (hit->triangle == RAD_NO_HIT || !(cos_x > 0))
         return none;
@@ -114,8 +163,10 @@ rad_rgb emitter_cosine_value(const emitter_set *set, const rad_scene *scene, con
     double cos_e = fabs(v3_dot(normal, d)) / length, distance = (double)hit->t * length;
     if (!(cos_e > 0))
         return none;
-    double p_light = pdf_area * distance * distance / cos_e, p_cosine = cos_x / RAD_PI;
-    /* pi L times the power heuristic's p_cosine^2 / (p_cosine^2 + p_light^2) */
+    double p_light = light_per_cosine * pdf_area * distance * distance / cos_e,
+           p_cosine = cos_x / RAD_PI;
+    /* pi L times the power heuristic's p_cosine^2 / (p_cosine^2 + p_light^2), each density
+     * times its strategy's sample count */
     return rgb_scale(emitted, RAD_PI * p_cosine * p_cosine /
                                   ((p_cosine * p_cosine + p_light * p_light) * count));
 }

@@ -35,6 +35,21 @@ uint32_t emitter_light_rays_mis(const emitter_set *set, const rad_scene *scene, 
                                 uint32_t first, double shift1, double shift2, rad_ray *rays,
                                 rad_rgb *irradiance);
 
+/* The same for one point that takes all `count` samples at once (a mesh vertex): the
+ * triangle choices are evenly spaced, (k + turn) / count, so each emitting triangle gets
+ * a run of consecutive samples in proportion to its power, and the points on it are the
+ * Halton points (bases 2 and 3, shifted by shift1, shift2) of their place in that run: a
+ * low-discrepancy set on every triangle. MIS against cosine_per_light x count cosine rays
+ * (emitter_cosine_value_weighted with 1 / cosine_per_light): fewer cosine rays than light
+ * samples weigh the cosine half down where light sampling does well (its hit-or-miss
+ * noise: 0.7 % on a 1 x 1 lamp with as many of each, 512) and keep it where light
+ * sampling spikes (next to an emitter). */
+uint32_t emitter_light_rays_by_triangle(const emitter_set *set, const rad_scene *scene,
+                                        rad_vec3 x, rad_vec3 n, double leave, uint32_t count,
+                                        double turn, double shift1, double shift2,
+                                        double cosine_per_light, rad_ray *rays,
+                                        rad_rgb *irradiance);
+
 /* `count` cosine-weighted directions around n (stratified), rays from x + n * leave, for
  * closest-hit queries against the scene's triangles; cos_x[k] receives each one's cosine. */
 void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, rad_rng *rng,
@@ -44,6 +59,12 @@ void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, r
  * else), MIS-weighted against light sampling: pi L_e p_B^2 / ((p_B^2 + p_L^2) count). */
 rad_rgb emitter_cosine_value(const emitter_set *set, const rad_scene *scene, const rad_ray *ray,
                              const rad_hit *hit, double cos_x, uint32_t count);
+
+/* The same when light sampling takes light_per_cosine times as many samples as the
+ * `count` cosine rays (power heuristic with each density times its sample count). */
+rad_rgb emitter_cosine_value_weighted(const emitter_set *set, const rad_scene *scene,
+                                      const rad_ray *ray, const rad_hit *hit, double cos_x,
+                                      uint32_t count, double light_per_cosine);
 
 /* Per patch, the mean over the patch of the emitters' direct irradiance (shadows
  * included): PATCH_EMITTER_POINTS^2 points, PATCH_EMITTER_SAMPLES samples each, traced

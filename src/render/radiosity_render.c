@@ -34,9 +34,11 @@
 #include "lights/direct_light.h"
 #include "render/camera.h"
 #include "render/emitter_light.h"
+#include "render/gather.h"
 #include "lights/emitters.h"
 #include "parallel/ranks.h"
 #include "render/progress.h"
+#include "render/vertex_light.h"
 #include "reconstruct/display_mesh.h"
 #include "scene/patch_materials.h"
 #include "trace/ray.h"
@@ -117,10 +119,7 @@ typedef struct shading {
     const uint8_t *near;            /* per patch: next to a crease or contact, where the
                                        light reflected more than once is gathered at the
                                        pixel (NULL: interpolated everywhere) */
-    const rad_rgb *reflected;       /* per display vertex: (B - E) / pi, what a gather ray
-                                       sees (emission left out: the direct light is the
-                                       pixel's own) */
-    const rad_rgb *B;
+    const gather_view *view;        /* what a gather ray meets (NULL: no gather) */
     uint32_t gather_rays;           /* per pixel sample */
 } shading;
 
@@ -201,29 +200,9 @@ static uint32_t twin_triangle(const shading *sh, uint32_t twin, rad_vec3 point, 
 static void flush_lights(const shading *sh, row_work *w)
 {
     if (w->gather_count) {
-        rad_tracer_intersect(sh->tracer, w->gather_rays, w->gather_count, w->gather_hits);
+        rad_tracer_intersect(sh->view->tracer, w->gather_rays, w->gather_count, w->gather_hits);
         for (uint32_t k = 0; k < w->gather_count; k++) {
-            const rad_hit *hit = &w->gather_hits[k];
-            rad_rgb L = {0, 0, 0};
-            if (hit->triangle == RAD_NO_HIT) {
-                if (sh->lights && sh->lights->has_sky) {
-                    const rad_ray *ray = &w->gather_rays[k];
-                    L = light_set_sky_radiance(sh->lights, v3(ray->direction[0], ray->direction[1],
-                                                              ray->direction[2]));
-                }
-            } else if (hit->front) {
-                const uint32_t *v = sh->triangles[hit->triangle];
-                double u = hit->u, vv = hit->v;
-                L = rgb_add(rgb_scale(sh->reflected[v[0]], 1 - u - vv),
-                            rgb_add(rgb_scale(sh->reflected[v[1]], u),
-                                    rgb_scale(sh->reflected[v[2]], vv)));
-            } else {
-                uint32_t twin = sh->mesh->patches[sh->patch_of[hit->triangle]].twin;
-                if (twin)
-                    L = rgb_scale(rgb_max0(rgb_add(sh->B[twin - 1],
-                                                   rgb_scale(sh->inputs->exitance[twin - 1], -1))),
-                                  1 / RAD_PI);
-            }
+            rad_rgb L = gather_seen(sh->view, &w->gather_rays[k], &w->gather_hits[k]);
             rgb_add_to(&w->sum[w->gather_sample[k]], rgb_mul(L, w->gather_factor[k]));
         }
         w->gather_count = 0;
@@ -435,7 +414,7 @@ static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work 
  * (B - E) / rho - H_sharp (0 where rho is 0), elsewhere the exitance B - rho H_sharp. All
  * NULL when there is no scene or neither textures nor light sources. */
 static rad_status inputs_begin(const rad_render_options *options, const rad_mesh *mesh,
-                               const rad_rgb *B, const rad_rgb *emitter_direct,
+                               const rad_rgb *B, const rad_rgb *emitter_direct, bool need,
                                patch_material_lookup **lookup,
                                const rad_patch_inputs **inputs, rad_patch_inputs **built,
                                rad_rgb **shaded, rad_error *error)
@@ -453,13 +432,14 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
         return rad_fail(error, RAD_ERR_INVALID,
                         "render: an irradiance image needs the scene (options.scene)");
     if (!scene || (scene->texture_count == 0 && scene->light_count == 0 && !options->irradiance &&
-                   !emitter_direct))
+                   !emitter_direct && !need))
         return RAD_OK;
     rad_status status = RAD_OK;
     if (scene->texture_count > 0)
         status = patch_material_lookup_create(scene, lookup, error);
     if (status != RAD_OK ||
-        (!*lookup && scene->light_count == 0 && !options->irradiance && !emitter_direct))
+        (!*lookup && scene->light_count == 0 && !options->irradiance && !emitter_direct &&
+         !need))
         return status;
     if (!options->inputs) {
         status = rad_patch_inputs_build(scene, mesh, built, error);
@@ -496,6 +476,61 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
             out[c] = rho[c] > 0 ? fmax((b[c] - e[c]) / rho[c] - h[c], 0) : 0;
     }
     return RAD_OK;
+}
+
+/* The vertices' radiance from the light there (vertex_light.h): the emission plus the
+ * albedo the hits multiply by (rho / pi; 1 / pi where the vertices hold irradiance:
+ * textures, or an irradiance image) times the emitters' direct and the gathered
+ * irradiance, replacing the values interpolated from the patches; then made displayable
+ * (T-vertices, added vertices). The sharp sources' light is the hits' own, as before. */
+static rad_status vertex_radiance(const rad_render_options *options, const rad_mesh *mesh,
+                                  const display_mesh *display, const emitter_set *emitters,
+                                  const rad_tracer *scene_tracer, const gather_view *view,
+                                  const rad_patch_inputs *inputs,
+                                  const patch_material_lookup *lookup, const uint8_t *hidden,
+                                  double leave, int threads, rad_rgb *radiance,
+                                  rad_error *error)
+{
+    uint32_t n = mesh->patch_count ? mesh->patch_count : 1;
+    size_t vertices = display->vertex_count ? display->vertex_count : 1;
+    rad_rgb *factor = rad_alloc_array(n, sizeof(*factor));
+    rad_rgb *emission = rad_alloc_array(n, sizeof(*emission));
+    rad_rgb *vertex_factor = rad_alloc_array(vertices, sizeof(*vertex_factor));
+    rad_rgb *vertex_emission = rad_alloc_array(vertices, sizeof(*vertex_emission));
+    rad_rgb *direct = rad_alloc_array(vertices, sizeof(*direct));
+    rad_rgb *gathered = rad_alloc_array(vertices, sizeof(*gathered));
+    rad_status status = RAD_OK;
+    if (!factor || !emission || !vertex_factor || !vertex_emission || !direct || !gathered) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for rendering");
+        goto done;
+    }
+    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        bool holds_irradiance =
+            options->irradiance || patch_material_textured(lookup, mesh->patches[p].material);
+        factor[p] = holds_irradiance ? (rad_rgb){1, 1, 1} : inputs->albedo[p];
+        emission[p] = holds_irradiance ? (rad_rgb){0, 0, 0} : inputs->exitance[p];
+    }
+    if (!display_mesh_radiance_weighted(mesh, NULL, factor, hidden, vertex_factor) ||
+        !display_mesh_radiance_weighted(mesh, NULL, emission, hidden, vertex_emission)) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for rendering");
+        goto done;
+    }
+    status = vertex_light(emitters, options->scene, mesh, scene_tracer, view, hidden, leave,
+                          options->seed, threads, direct, gathered, error);
+    if (status != RAD_OK)
+        goto done;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++)
+        radiance[v] = rgb_add(vertex_emission[v],
+                              rgb_mul(vertex_factor[v], rgb_add(direct[v], gathered[v])));
+    display_mesh_constrain(mesh, display, radiance);
+done:
+    free(factor);
+    free(emission);
+    free(vertex_factor);
+    free(vertex_emission);
+    free(direct);
+    free(gathered);
+    return status;
 }
 
 rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
@@ -562,26 +597,31 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     if (gather_rays > MAX_GATHER_RAYS)
         gather_rays = MAX_GATHER_RAYS;
 
-    /* the emitters' direct light at every pixel sample, and its patch means to take out of
-     * the solution first */
-    if (options->scene && options->emitter_direct && rad_scene_has_emitter(options->scene)) {
+    /* the emitters' direct light at every pixel sample or at every vertex, and its patch
+     * means to take out of the solution first */
+    rad_direct_light direct_light = options->scene && rad_scene_has_emitter(options->scene)
+                                        ? options->direct_light
+                                        : RAD_DIRECT_SOLUTION;
+    if (direct_light == RAD_DIRECT_PIXEL || direct_light == RAD_DIRECT_VERTEX) {
         status = emitters_build(options->scene, &emitters, error);
         if (status == RAD_OK)
             status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, options->scene,
                                                  &scene_tracer, error);
         if (status != RAD_OK)
             goto done;
-        emitter_direct = rad_alloc_array(mesh->patch_count, sizeof(*emitter_direct));
-        if (!emitter_direct)
-            goto nomem;
-        status = emitter_patch_direct(&emitters, options->scene, mesh, scene_tracer,
-                                      leave, options->seed, threads,
-                                      emitter_direct, error);
-        if (status != RAD_OK)
-            goto done;
-        emitters_ptr = &emitters;
+        if (direct_light == RAD_DIRECT_PIXEL) {
+            emitter_direct = rad_alloc_array(mesh->patch_count, sizeof(*emitter_direct));
+            if (!emitter_direct)
+                goto nomem;
+            status = emitter_patch_direct(&emitters, options->scene, mesh, scene_tracer,
+                                          leave, options->seed, threads, emitter_direct, error);
+            if (status != RAD_OK)
+                goto done;
+            emitters_ptr = &emitters;
+        }
     }
-    status = inputs_begin(options, mesh, B, emitter_direct, &lookup, &inputs, &built_inputs,
+    status = inputs_begin(options, mesh, B, emitter_direct, direct_light == RAD_DIRECT_VERTEX,
+                          &lookup, &inputs, &built_inputs,
                           &shaded, error);
     if (status != RAD_OK)
         goto done;
@@ -611,7 +651,12 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     hidden = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1, sizeof(*hidden));
     if (!hidden)
         goto nomem;
-    if (emitters_ptr) {
+    gather_view view = {mesh,   (const uint32_t(*)[3])display.triangles,
+                        display.patch_of, NULL,
+                        B,      inputs ? inputs->exitance : NULL,
+                        lights_ptr, tracer};
+    if (direct_light != RAD_DIRECT_SOLUTION) {
+        /* what gather rays meet: the reflected light (B - E) / pi at the vertices */
         near = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1, sizeof(*near));
         reflected = rad_alloc_array(display.vertex_count, sizeof(*reflected));
         rad_rgb *outgoing = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1,
@@ -624,19 +669,26 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         free(outgoing);
         if (!made)
             goto nomem;
+        view.reflected = reflected;
     } else
         display_hidden_patches(mesh, tracer, leave, hidden, NULL, 0);
     if (!display_mesh_radiance_weighted(mesh, &display, shaded ? shaded : B, hidden, radiance))
         goto nomem;
+    if (direct_light == RAD_DIRECT_VERTEX) {
+        status = vertex_radiance(options, mesh, &display, &emitters, scene_tracer, &view,
+                                 inputs, lookup, hidden, leave, threads, radiance, error);
+        if (status != RAD_OK)
+            goto done;
+    }
 
     float t_near = (float)(RAD_CAMERA_NEAR * diagonal);
 
     size_t per_row = (size_t)W * k * k;
-    /* with the direct light per pixel the image is accurate enough for the light's rim to
-     * show: its pixels get four times the samples */
-    uint32_t edge_samples = options->edge_samples ? options->edge_samples
-                            : emitters_ptr        ? 4 * RAD_DEFAULT_EDGE_SAMPLES
-                                                  : RAD_DEFAULT_EDGE_SAMPLES;
+    /* with the direct light per pixel or at the vertices the image is accurate enough for
+     * the light's rim to show: its pixels get four times the samples */
+    uint32_t edge_samples = options->edge_samples            ? options->edge_samples
+                            : direct_light != RAD_DIRECT_SOLUTION ? 4 * RAD_DEFAULT_EDGE_SAMPLES
+                                                                  : RAD_DEFAULT_EDGE_SAMPLES;
     unsigned edge_k = (unsigned)lround(sqrt((double)edge_samples));
     edge_k = edge_k < 1 ? 1 : edge_k > MAX_STRATA ? MAX_STRATA : edge_k;
     size_t per_row_edges = (size_t)W * edge_k * edge_k;
@@ -708,8 +760,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                      emitters_ptr, options->scene,
                      emitter_samples, per_row,
                      edge_k * edge_k, scene_tracer,
-                     near,      reflected,
-                     B,         gather_rays};
+                     direct_light == RAD_DIRECT_PIXEL ? near : NULL, &view,
+                     gather_rays};
 
     /* over several MPI ranks the rows are dealt out in turn (every pixel's random numbers
      * are its own, so each row comes out as in a serial run), then summed: every pixel is

@@ -1,0 +1,30 @@
+/*
+ * gather.h - what a final-gather ray meets of a radiosity solution (internal): the light
+ * the surfaces reflect, (B - E) / pi interpolated at the hit from the display vertices
+ * (emission left out: the gathering point takes the emitters' direct light its own way),
+ * the twin's value on the back of a two-sided patch, and the sky where the ray leaves the
+ * scene. Used by the per-pixel gather next to creases (radiosity_render.c) and by the
+ * gather at the mesh's vertices (vertex_light.c). It does not trace: the caller traces its
+ * rays in batches against `tracer`.
+ */
+#ifndef RAD_RENDER_GATHER_H
+#define RAD_RENDER_GATHER_H
+
+#include "lights/direct_light.h"
+#include "radiosity.h"
+
+typedef struct gather_view {
+    const rad_mesh *mesh;
+    const uint32_t (*triangles)[3]; /* the display triangles, into display vertices */
+    const uint32_t *patch_of;       /* display triangle -> patch */
+    const rad_rgb *reflected;       /* per display vertex: (B - E) / pi */
+    const rad_rgb *B;               /* per patch */
+    const rad_rgb *exitance;        /* per patch: E, as the solve used it */
+    const light_set *lights;        /* NULL: no sky */
+    const rad_tracer *tracer;       /* the display's front triangles */
+} gather_view;
+
+/* The radiance the ray meets (0 on the back of a one-sided patch). */
+rad_rgb gather_seen(const gather_view *view, const rad_ray *ray, const rad_hit *hit);
+
+#endif

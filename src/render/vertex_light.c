@@ -1,0 +1,140 @@
+/*
+ * vertex_light.c - the light arriving at each mesh vertex (vertex_light.h).
+ */
+#include "render/vertex_light.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/random.h"
+#include "core/rgb.h"
+#include "core/vec3.h"
+#include "render/emitter_light.h"
+#include "trace/ray.h"
+
+#define VERTEX_EMITTER_SAMPLES 1024u /* light samples per vertex */
+#define VERTEX_COSINE_RAYS 512u     /* their MIS partners: cosine rays toward the emitters */
+/* final-gather rays per vertex */
+#define VERTEX_GATHER_RAYS 1024u    /* final-gather rays per vertex */
+#define VERTEX_STREAM 0xE3177E3ull
+/* A vertex's point: this share of the way to its patches' mean centre. On a crease or a
+ * contact the light changes fastest next to the vertex (a contact shadow's foot), so its
+ * exact limit there, interpolated linearly over the patch, would pull the patch's values
+ * down; a point a tenth of the way in stands for the vertex's neighbourhood. Measured on
+ * the Cornell box at 128 x 128 against the path tracer (block / pixel relative RMSE):
+ * 1e-3 1.57 % / 1.95 %, 0.1 1.17 % / 1.72 %, 0.25 1.20 % / 1.70 %, 0.5 1.60 % / 1.83 %. */
+#define VERTEX_INWARD 0.1 /* a vertex's point: this share of the way to its patches' centre */
+
+/* Each vertex's side (its visible patches' normal: a region is planar), the way into those
+ * patches, how far their cells may lie behind the input triangles, and their area (0: a
+ * vertex of hidden patches alone). */
+typedef struct vertex_frame {
+    rad_vec3 normal, inward;
+    double bulge, weight;
+} vertex_frame;
+
+static void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *frame)
+{
+    for (uint32_t v = 0; v < mesh->vertex_count; v++)
+        frame[v] = (vertex_frame){v3(0, 0, 0), v3(0, 0, 0), 0, 0};
+    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        const rad_patch *patch = &mesh->patches[p];
+        if (hidden && hidden[p])
+            continue; /* seen by no one: its vertices' values come from the others */
+        for (uint32_t k = 0; k < patch->vertex_count; k++) {
+            vertex_frame *f = &frame[patch->vertex[k]];
+            f->normal = v3_add(f->normal, v3_scale(patch->normal, patch->area));
+            f->inward = v3_add(f->inward, v3_scale(v3_sub(patch->centroid,
+                                                          mesh->vertices[patch->vertex[k]]),
+                                                   patch->area));
+            f->bulge = fmax(f->bulge, patch->bulge);
+            f->weight += patch->area;
+        }
+    }
+}
+
+rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const rad_mesh *mesh,
+                        const rad_tracer *occluders, const gather_view *view,
+                        const uint8_t *hidden, double leave, uint64_t seed, int threads,
+                        rad_rgb *direct, rad_rgb *gathered, rad_error *error)
+{
+    uint32_t n = mesh->vertex_count;
+    for (uint32_t v = 0; v < n; v++)
+        direct[v] = gathered[v] = (rad_rgb){0, 0, 0};
+    if (n == 0)
+        return RAD_OK;
+    const uint32_t samples = VERTEX_EMITTER_SAMPLES, gather = VERTEX_GATHER_RAYS;
+    const uint32_t cosines_per_vertex =
+        VERTEX_COSINE_RAYS > gather ? VERTEX_COSINE_RAYS : gather;
+    vertex_frame *frame = rad_alloc_array(n, sizeof(*frame));
+    rad_ray *rays = rad_alloc_array((size_t)threads * samples, sizeof(*rays));
+    rad_rgb *values = rad_alloc_array((size_t)threads * samples, sizeof(*values));
+    uint8_t *blocked = rad_alloc_array((size_t)threads * samples, sizeof(*blocked));
+    rad_ray *cosine_rays = rad_alloc_array((size_t)threads * cosines_per_vertex,
+                                           sizeof(*cosine_rays));
+    rad_hit *hits = rad_alloc_array((size_t)threads * cosines_per_vertex, sizeof(*hits));
+    double *cosines = rad_alloc_array((size_t)threads * cosines_per_vertex, sizeof(*cosines));
+    bool ok = frame && rays && values && blocked && cosine_rays && hits && cosines;
+    if (ok) {
+        vertex_frames(mesh, hidden, frame);
+#pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
+        for (int64_t v = 0; v < (int64_t)n; v++) {
+            const vertex_frame *f = &frame[v];
+            if (!(f->weight > 0))
+                continue;
+            int thread = omp_get_thread_num();
+            rad_ray *light = &rays[(size_t)thread * samples];
+            rad_rgb *value = &values[(size_t)thread * samples];
+            uint8_t *shadowed = &blocked[(size_t)thread * samples];
+            rad_ray *cosine = &cosine_rays[(size_t)thread * cosines_per_vertex];
+            rad_hit *hit = &hits[(size_t)thread * cosines_per_vertex];
+            double *cos_x = &cosines[(size_t)thread * cosines_per_vertex];
+            rad_rng rng = rad_rng_seed(seed ^ VERTEX_STREAM, (uint64_t)v, 0);
+            double turn = rad_rng_uniform(&rng), shift1 = rad_rng_uniform(&rng),
+                   shift2 = rad_rng_uniform(&rng);
+            rad_vec3 nv = v3_normalize(f->normal);
+            /* inside the vertex's patches (toward their mean centre): at a contact or a
+             * crease the point is on the open side, as the patches are */
+            rad_vec3 x = v3_add(mesh->vertices[v], v3_scale(f->inward, VERTEX_INWARD / f->weight));
+            double off = 2 * f->bulge + leave;
+            rad_rgb sum = {0, 0, 0};
+            if (set->count > 0) {
+                const double share = (double)VERTEX_COSINE_RAYS / samples;
+                uint32_t count = emitter_light_rays_by_triangle(
+                    set, scene, x, nv, off, samples, turn, shift1, shift2, share, light, value);
+                emitter_cosine_rays(x, nv, off, VERTEX_COSINE_RAYS, &rng, cosine, cos_x);
+                rad_tracer_occluded(occluders, light, count, shadowed);
+                rad_tracer_intersect(occluders, cosine, VERTEX_COSINE_RAYS, hit);
+                for (uint32_t k = 0; k < count; k++)
+                    if (!shadowed[k])
+                        rgb_add_to(&sum, value[k]);
+                for (uint32_t k = 0; k < VERTEX_COSINE_RAYS; k++)
+                    rgb_add_to(&sum, emitter_cosine_value_weighted(set, scene, &cosine[k], &hit[k],
+                                                                   cos_x[k], VERTEX_COSINE_RAYS,
+                                                                   1 / share));
+            }
+            direct[v] = sum;
+
+            /* the gather: E = pi / N x the sum of the radiance met by N cosine rays */
+            emitter_cosine_rays(x, nv, off, gather, &rng, cosine, cos_x);
+            rad_tracer_intersect(view->tracer, cosine, gather, hit);
+            rad_rgb seen = {0, 0, 0};
+            for (uint32_t k = 0; k < gather; k++)
+                rgb_add_to(&seen, gather_seen(view, &cosine[k], &hit[k]));
+            gathered[v] = rgb_scale(seen, RAD_PI / gather);
+        }
+    }
+    free(frame);
+    free(rays);
+    free(values);
+    free(blocked);
+    free(cosine_rays);
+    free(hits);
+    free(cosines);
+    if (!ok)
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light at the vertices");
+    return RAD_OK;
+}
