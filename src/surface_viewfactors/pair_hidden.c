@@ -140,22 +140,12 @@ static int plane_remainder(const pair_hidden_context *c, uint32_t g, const vf_po
     shadow_polygon in_plane[MAX_IN_PLANE];
     uint32_t count = 0;
     for (uint32_t k = begin; k < end && count < MAX_IN_PLANE; k++) {
-        const shadow_polygon *shape = &c->planes->shape[k];
-        bool outside = false, flat = true;
-        for (int a = 0; a < 3 && !outside; a++) {
-            double slo = INFINITY, shi = -INFINITY;
-            for (unsigned m = 0; m < shape->count; m++) {
-                rad_vec3 v = shape->vertex[m];
-                double x = a == 0 ? v.x : a == 1 ? v.y : v.z;
-                slo = fmin(slo, x);
-                shi = fmax(shi, x);
-            }
-            outside = shi < lo[a] || slo > hi[a];
-        }
-        for (unsigned m = 0; m < shape->count && flat && !outside; m++)
-            flat = fabs(v3_dot(n, shape->vertex[m]) - offset) <= eps;
-        if (!outside && flat)
-            in_plane[count++] = *shape;
+        const coplanar_box *box = &c->planes->box[k];
+        bool outside = false;
+        for (int a = 0; a < 3 && !outside; a++)
+            outside = box->hi[a] < lo[a] || box->lo[a] > hi[a];
+        if (!outside && box->flat)
+            in_plane[count++] = c->planes->shape[k];
     }
     if (count == 0)
         return -1;
