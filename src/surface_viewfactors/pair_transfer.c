@@ -106,6 +106,10 @@ bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)
     workspace->rays = rad_alloc_array(max_rays, sizeof(rad_ray));
     workspace->occluded = rad_alloc_array(max_rays, 1);
     workspace->weight = rad_alloc_array(max_rays, sizeof(double));
+    workspace->last_p = workspace->last_q = NULL;
+    workspace->last_occluders = NULL;
+    workspace->last_stream = 0;
+    workspace->last_rounds = 0;
     return workspace->rays && workspace->occluded && workspace->weight;
 }
 
@@ -172,47 +176,101 @@ static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
     return n;
 }
 
-void pair_sample_visibility(const vf_polygon *p, const vf_polygon *q,
-                            const rad_tracer *occluders, double accuracy, uint32_t max_rays,
-                            uint64_t stream, pair_workspace *w, pair_visibility *out)
+/* Round `round` (k x k strata a side) cast and weighed. */
+static pair_round cast_round(const vf_polygon *p, const vf_polygon *q,
+                             const rad_tracer *occluders, unsigned k, unsigned round,
+                             uint64_t stream, pair_workspace *w)
 {
+    uint32_t n = fill_round(p, q, k, stream, round, w);
+    rad_tracer_occluded(occluders, w->rays, n, w->occluded);
+    double estimate[PAIR_REPLICATES], mean = 0;
+    unsigned cells = k * k;
+    bool all_same = true;
+    for (unsigned r = 0; r < PAIR_REPLICATES; r++) {
+        double seen = 0, total = 0;
+        for (unsigned m = r * cells; m < (r + 1) * cells; m++) {
+            total += w->weight[m];
+            seen += w->occluded[m] ? 0 : w->weight[m];
+            all_same = all_same && w->occluded[m] == w->occluded[0];
+        }
+        estimate[r] = total > 0 ? seen / total : (w->occluded[r * cells] ? 0 : 1);
+        mean += estimate[r];
+    }
+    mean /= PAIR_REPLICATES;
+    double spread = 0;
+    for (unsigned r = 0; r < PAIR_REPLICATES; r++)
+        spread += (estimate[r] - mean) * (estimate[r] - mean);
+    double standard_error = sqrt(spread / (PAIR_REPLICATES - 1) / PAIR_REPLICATES);
+    pair_round result;
+    result.fraction = fmin(fmax(mean, 0), 1);
+    result.all_same = all_same;
+    result.unseen = all_same && w->occluded[0];
+    /* all segments agreeing has no spread: what they could all have missed (a slot
+     * narrower than a cell, an occluder between them) is bounded binomially */
+    result.bound = all_same ? PAIR_UNSEEN_BOUND / (double)n : PAIR_STUDENT_T * standard_error;
+    result.rays = n;
+    return result;
+}
+
+/* Rounds of 4x more segments from the first; the first `known` rounds are the
+ * workspace's record of the last call (same pair and stream), the others are cast and
+ * recorded. */
+static void sample_rounds(const vf_polygon *p, const vf_polygon *q, const rad_tracer *occluders,
+                          double accuracy, uint32_t max_rays, uint64_t stream, unsigned known,
+                          pair_workspace *w, pair_visibility *out)
+{
+    w->last_p = p;
+    w->last_q = q;
+    w->last_occluders = occluders;
+    w->last_stream = stream;
     out->rays = 0;
     out->capped = false;
+    /* the rays the rounds would have cast: the budget counts them, cast now or before */
+    uint32_t spent = 0;
     unsigned round = 0;
     for (unsigned k = 1;; k *= 2, round++) {
-        uint32_t n = fill_round(p, q, k, stream, round, w);
-        rad_tracer_occluded(occluders, w->rays, n, w->occluded);
-        out->rays += n;
-        double estimate[PAIR_REPLICATES], mean = 0;
-        unsigned cells = k * k;
-        bool all_same = true;
-        for (unsigned r = 0; r < PAIR_REPLICATES; r++) {
-            double seen = 0, total = 0;
-            for (unsigned m = r * cells; m < (r + 1) * cells; m++) {
-                total += w->weight[m];
-                seen += w->occluded[m] ? 0 : w->weight[m];
-                all_same = all_same && w->occluded[m] == w->occluded[0];
+        pair_round result;
+        if (round < known) {
+            result = w->last_round[round];
+        } else {
+            result = cast_round(p, q, occluders, k, round, stream, w);
+            out->rays += result.rays;
+            if (round < PAIR_MAX_ROUNDS) {
+                w->last_round[round] = result;
+                w->last_rounds = round + 1;
             }
-            estimate[r] = total > 0 ? seen / total : (w->occluded[r * cells] ? 0 : 1);
-            mean += estimate[r];
         }
-        mean /= PAIR_REPLICATES;
-        double spread = 0;
-        for (unsigned r = 0; r < PAIR_REPLICATES; r++)
-            spread += (estimate[r] - mean) * (estimate[r] - mean);
-        double standard_error = sqrt(spread / (PAIR_REPLICATES - 1) / PAIR_REPLICATES);
-        out->fraction = fmin(fmax(mean, 0), 1);
-        out->unseen = all_same && w->occluded[0];
-        /* all segments agreeing has no spread: what they could all have missed (a slot
-         * narrower than a cell, an occluder between them) is bounded binomially */
-        out->bound = all_same ? PAIR_UNSEEN_BOUND / (double)n : PAIR_STUDENT_T * standard_error;
+        spent += result.rays;
+        out->fraction = result.fraction;
+        out->unseen = result.unseen;
+        out->bound = result.bound;
         uint32_t next = PAIR_REPLICATES * (2 * k) * (2 * k);
         /* agreeing segments take two rounds at least: one says little */
-        if (out->bound <= accuracy && (k >= 2 || !all_same))
+        if (out->bound <= accuracy && (k >= 2 || !result.all_same))
             return;
-        if (out->rays + next > max_rays || next > w->capacity || 2 * k > MAX_STRATA) {
+        if (spent + next > max_rays || next > w->capacity || 2 * k > MAX_STRATA) {
             out->capped = true;
             return;
         }
     }
+}
+
+void pair_sample_visibility(const vf_polygon *p, const vf_polygon *q,
+                            const rad_tracer *occluders, double accuracy, uint32_t max_rays,
+                            uint64_t stream, pair_workspace *w, pair_visibility *out)
+{
+    w->last_rounds = 0;
+    sample_rounds(p, q, occluders, accuracy, max_rays, stream, 0, w, out);
+}
+
+void pair_sample_visibility_resume(const vf_polygon *p, const vf_polygon *q,
+                                   const rad_tracer *occluders, double accuracy,
+                                   uint32_t max_rays, uint64_t stream, pair_workspace *w,
+                                   pair_visibility *out)
+{
+    bool same = w->last_p == p && w->last_q == q && w->last_occluders == occluders &&
+                w->last_stream == stream;
+    if (!same)
+        w->last_rounds = 0;
+    sample_rounds(p, q, occluders, accuracy, max_rays, stream, w->last_rounds, w, out);
 }

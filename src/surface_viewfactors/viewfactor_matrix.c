@@ -201,8 +201,9 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
      * within accuracy (the F0 of a row sum to at most 1) while small factors take few
      * rays. */
     double f0 = fmin(unobstructed / fmin(p->area, q->area), 1);
-    pair_sample_visibility(p, q, e->occluders, e->accuracy / sqrt(f0), e->max_rays, stream, w,
-                           &visibility);
+    /* the first look's rounds are taken as they came out, not cast again */
+    pair_sample_visibility_resume(p, q, e->occluders, e->accuracy / sqrt(f0), e->max_rays,
+                                  stream, w, &visibility);
     counts->rays += visibility.rays;
     counts->capped_pairs += visibility.capped;
     counts->unseen_pairs += visibility.unseen;
