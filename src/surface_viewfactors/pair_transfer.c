@@ -34,6 +34,7 @@ typedef struct outer_context {
     const vf_polygon *inner;
     double plane_epsilon;
     const shadow_occluder *occluders; /* what may stand in between (none: unobstructed) */
+    const shadow_polygon *joined;     /* or the same joined into polygons */
     uint32_t occluder_count;
     int max_depth;
     uint64_t work_left;      /* occluder clippings this pair may still spend */
@@ -50,8 +51,11 @@ static inline double point_factor(outer_context *c, rad_vec3 x)
         return 0;
     }
     c->work_left -= c->occluder_count;
-    double factor = shadow_visible_factor(x, c->normal, c->inner, c->occluders,
-                                          c->occluder_count, c->plane_epsilon);
+    double factor = c->joined ? shadow_visible_factor_polygons(x, c->normal, c->inner, c->joined,
+                                                               c->occluder_count,
+                                                               c->plane_epsilon)
+                              : shadow_visible_factor(x, c->normal, c->inner, c->occluders,
+                                                      c->occluder_count, c->plane_epsilon);
     if (factor < 0) {
         c->failed = true;
         return 0;
@@ -76,8 +80,22 @@ double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accura
                          double plane_epsilon, double *bound)
 {
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
-    outer_context c = {outer->normal, inner, plane_epsilon, NULL, 0, MAX_DEPTH, 0, false};
+    outer_context c = {outer->normal, inner, plane_epsilon, NULL, NULL, 0, MAX_DEPTH, 0, false};
     return integrate_outer(&c, outer, accuracy, bound);
+}
+
+/* The obstructed transfer behind the triangles, or behind `joined` (count of them) when not
+ * NULL. */
+static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
+                             const shadow_occluder *occluders, const shadow_polygon *joined,
+                             uint32_t count, double accuracy, double plane_epsilon,
+                             uint64_t work_budget, double *value, double *bound)
+{
+    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
+    outer_context c = {outer->normal,       inner, plane_epsilon, occluders, joined, count,
+                       OBSTRUCTED_MAX_DEPTH, work_budget, false};
+    *value = integrate_outer(&c, outer, accuracy, bound);
+    return !c.failed;
 }
 
 bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
@@ -85,19 +103,21 @@ bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
                                   double accuracy, double plane_epsilon, uint64_t work_budget,
                                   double *value, double *bound)
 {
-    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
-    outer_context c = {outer->normal,       inner, plane_epsilon, occluders, occluder_count,
-                       OBSTRUCTED_MAX_DEPTH, work_budget, false};
-    *value = integrate_outer(&c, outer, accuracy, bound);
-    return !c.failed;
+    shadow_polygon joined[PAIR_EXACT_MAX_OCCLUDERS];
+    if (occluder_count > PAIR_EXACT_MAX_OCCLUDERS)
+        return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, plane_epsilon,
+                                work_budget, value, bound);
+    uint32_t count = shadow_join_occluders(occluders, occluder_count, joined);
+    return obstructed_exact(p, q, NULL, joined, count, accuracy, plane_epsilon, work_budget,
+                            value, bound);
 }
 
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            const shadow_occluder *occluders, uint32_t occluder_count,
                            double accuracy, double plane_epsilon, double *value, double *bound)
 {
-    return pair_obstructed_exact_within(p, q, occluders, occluder_count, accuracy,
-                                        plane_epsilon, EXACT_WORK_BUDGET, value, bound);
+    return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, plane_epsilon,
+                            EXACT_WORK_BUDGET, value, bound);
 }
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)

@@ -46,7 +46,10 @@ bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            const shadow_occluder *occluders, uint32_t occluder_count,
                            double accuracy, double plane_epsilon, double *value, double *bound);
 
-/* The same with at most `work_budget` (point, occluder) clippings. */
+/* The same with at most `work_budget` (point, occluder) clippings, and the occluders
+ * (at most PAIR_EXACT_MAX_OCCLUDERS of them) first joined where they share an edge in one
+ * plane (shadow_join_occluders: a wall's triangles cast one shadow, not one each; the same
+ * visible part, in fewer pieces). */
 bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
                                   const shadow_occluder *occluders, uint32_t occluder_count,
                                   double accuracy, double plane_epsilon, uint64_t work_budget,
