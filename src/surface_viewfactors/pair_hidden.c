@@ -393,9 +393,19 @@ typedef struct candidate {
 /* cover: NULL, or where the group and shape go when one shape of a plane alone covers the
  * window of p and q themselves (the caller's pair, not a piece or half); left untouched
  * otherwise. */
+static void note_used(pair_hidden_planes *used, uint32_t g)
+{
+    for (unsigned k = 0; k < used->count; k++)
+        if (used->group[k] == g)
+            return;
+    if (used->count < PAIR_HIDDEN_MAX_PLANES)
+        used->group[used->count++] = g;
+}
+
 static bool hidden(const pair_hidden_context *c, const pair_hidden_planes *planes, bool probe_all,
                    const vf_polygon *p, const vf_polygon *q, unsigned depth,
-                   unsigned *proofs_left, pair_hidden_work *work, uint32_t cover[2])
+                   unsigned *proofs_left, pair_hidden_work *work, uint32_t cover[2],
+                   pair_hidden_planes *used)
 {
     if (*proofs_left == 0)
         return false;
@@ -425,6 +435,7 @@ static bool hidden(const pair_hidden_context *c, const pair_hidden_planes *plane
         uint32_t shape = UINT32_MAX;
         int pieces = plane_remainder(c, groups[k], p, q, left, cover ? &shape : NULL);
         if (pieces == 0) {
+            note_used(used, groups[k]);
             if (cover && shape != UINT32_MAX) {
                 cover[0] = groups[k];
                 cover[1] = shape;
@@ -464,9 +475,13 @@ static bool hidden(const pair_hidden_context *c, const pair_hidden_planes *plane
             vf_polygon to_p, to_q;
             all = piece_polygon(&best[b].piece[k], group->normal, p->centroid, &to_p) &&
                   piece_polygon(&best[b].piece[k], group->normal, q->centroid, &to_q) &&
-                  (hidden(c, planes, probe_all, &to_q, q, depth - 1, proofs_left, work, NULL) ||
-                   hidden(c, planes, probe_all, p, &to_p, depth - 1, proofs_left, work, NULL));
+                  (hidden(c, planes, probe_all, &to_q, q, depth - 1, proofs_left, work, NULL,
+                          used) ||
+                   hidden(c, planes, probe_all, p, &to_p, depth - 1, proofs_left, work, NULL,
+                          used));
         }
+        if (all)
+            note_used(used, best[b].group);
         if (all)
             return true;
     }
@@ -480,7 +495,7 @@ static bool hidden(const pair_hidden_context *c, const pair_hidden_planes *plane
         return false;
     for (int k = 0; k < 2; k++)
         if (!hidden(c, planes, probe_all, split_p ? &half[k] : p, split_p ? q : &half[k],
-                    depth - 1, proofs_left, work, NULL))
+                    depth - 1, proofs_left, work, NULL, used))
             return false;
     return true;
 }
@@ -533,10 +548,13 @@ bool pair_proven_hidden(const pair_hidden_context *context, pair_hidden_memory *
         return true;
     unsigned proofs_left = PAIR_HIDDEN_MAX_PROOFS;
     uint32_t cover[2] = {UINT32_MAX, UINT32_MAX};
-    /* the remembered planes first, with no probe, one level of pieces or halves at most */
-    if (memory && memory->p == p && memory->planes.count > 0) {
+    pair_hidden_planes used = {.count = 0};
+    bool remembered = memory && memory->p == p;
+    /* the planes the last proof used first, with no probe, one level of pieces or halves at
+     * most */
+    if (remembered && memory->planes.count > 0) {
         if (hidden(context, &memory->planes, false, p, q, PAIR_HIDDEN_REMEMBERED_DEPTH,
-                   &proofs_left, work, cover)) {
+                   &proofs_left, work, cover, &used)) {
             work->remembered++;
             if (cover[1] != UINT32_MAX)
                 remember_shape(memory, p, cover[0], cover[1]);
@@ -548,13 +566,28 @@ bool pair_proven_hidden(const pair_hidden_context *context, pair_hidden_memory *
     pair_hidden_planes planes;
     if (!probe(context, p, q, planes.group, &planes.count, work))
         return false;
+    used.count = 0;
     bool proven = hidden(context, &planes, true, p, q, PAIR_HIDDEN_MAX_DEPTH, &proofs_left, work,
-                         cover);
+                         cover, &used);
     if (proven && memory) {
         memory->p = p;
-        memory->planes = planes;
+        memory->planes = used;
+        memory->probed = planes;
         if (cover[1] != UINT32_MAX)
             remember_shape(memory, p, cover[0], cover[1]);
+        return true;
+    }
+    /* last, every plane the last proof's probes found, as above */
+    if (!proven && remembered && memory->probed.count > 0) {
+        proofs_left = PAIR_HIDDEN_MAX_PROOFS;
+        cover[1] = UINT32_MAX;
+        if (hidden(context, &memory->probed, false, p, q, PAIR_HIDDEN_REMEMBERED_DEPTH,
+                   &proofs_left, work, cover, &used)) {
+            work->remembered++;
+            if (cover[1] != UINT32_MAX)
+                remember_shape(memory, p, cover[0], cover[1]);
+            return true;
+        }
     }
     return proven;
 }
