@@ -162,12 +162,19 @@ static rad_vec3 polygon_point(const vf_polygon *polygon, double s, double t)
                        r * (1 - t), r * t);
 }
 
-/* One round: PAIR_REPLICATES independent stratified sets of k x k segments. */
+/* One round: PAIR_REPLICATES independent stratified sets of k x k segments (k a power of
+ * 2). */
 static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
                            uint64_t stream, unsigned round, pair_workspace *w)
 {
     uint32_t n = 0;
     unsigned cells = k * k;
+    /* k is a power of 2: times its reciprocal is division by it, bit for bit, and the
+     * cell's column and row are a mask and a shift */
+    double cell = 1.0 / k;
+    unsigned shift = 0, mask = k - 1;
+    while ((1u << shift) < k)
+        shift++;
     for (unsigned r = 0; r < PAIR_REPLICATES; r++) {
         rad_rng rng = rad_rng_seed(stream, round, r);
         /* the cells of q are visited in a shuffled order, paired with p's in order */
@@ -181,10 +188,10 @@ static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
             order[swap] = keep;
         }
         for (unsigned m = 0; m < cells; m++) {
-            double s0 = ((m % k) + rad_rng_uniform(&rng)) / k;
-            double t0 = ((m / k) + rad_rng_uniform(&rng)) / k;
-            double s1 = ((order[m] % k) + rad_rng_uniform(&rng)) / k;
-            double t1 = ((order[m] / k) + rad_rng_uniform(&rng)) / k;
+            double s0 = ((m & mask) + rad_rng_uniform(&rng)) * cell;
+            double t0 = ((m >> shift) + rad_rng_uniform(&rng)) * cell;
+            double s1 = ((order[m] & mask) + rad_rng_uniform(&rng)) * cell;
+            double t1 = ((order[m] >> shift) + rad_rng_uniform(&rng)) * cell;
             rad_vec3 x = polygon_point(p, s0, t0), y = polygon_point(q, s1, t1);
             rad_vec3 d = v3_sub(y, x);
             double r2 = v3_dot(d, d);
