@@ -390,9 +390,7 @@ typedef struct candidate {
 } candidate;
 
 
-/* cover: NULL, or where the group and shape go when one shape of a plane alone covers the
- * window of p and q themselves (the caller's pair, not a piece or half); left untouched
- * otherwise. */
+/* Group g among the planes a proof used (once). */
 static void note_used(pair_hidden_planes *used, uint32_t g)
 {
     for (unsigned k = 0; k < used->count; k++)
@@ -402,6 +400,9 @@ static void note_used(pair_hidden_planes *used, uint32_t g)
         used->group[used->count++] = g;
 }
 
+/* cover: NULL, or where the group and shape go when one shape of a plane alone covers the
+ * window of p and q themselves (the caller's pair, not a piece or half); left untouched
+ * otherwise. used: receives the planes that settled the proof or a part of it. */
 static bool hidden(const pair_hidden_context *c, const pair_hidden_planes *planes, bool probe_all,
                    const vf_polygon *p, const vf_polygon *q, unsigned depth,
                    unsigned *proofs_left, pair_hidden_work *work, uint32_t cover[2],
@@ -480,10 +481,10 @@ static bool hidden(const pair_hidden_context *c, const pair_hidden_planes *plane
                    hidden(c, planes, probe_all, p, &to_p, depth - 1, proofs_left, work, NULL,
                           used));
         }
-        if (all)
+        if (all) {
             note_used(used, best[b].group);
-        if (all)
             return true;
+        }
     }
     /* halve the polygon that widens the window more: p's size counts in proportion to
      * the plane's distance from q, and the other way round */
