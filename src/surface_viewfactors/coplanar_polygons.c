@@ -86,10 +86,11 @@ rad_status coplanar_polygons_build(const rad_scene *scene, const vf_geometry *ge
     out->group_of = rad_alloc_array(n ? n : 1, sizeof(*out->group_of));
     out->shape = rad_alloc_array(most, sizeof(*out->shape));
     out->low = rad_alloc_array(most, sizeof(*out->low));
+    out->box = rad_alloc_array(most, sizeof(*out->box));
     out->groups = rad_alloc_array(most, sizeof(*out->groups));
     rad_status status = RAD_OK;
     if (!shapes || !keyed || !sorted || !shape_of_source || !group_of_shape || !out->group_of ||
-        !out->shape || !out->low || !out->groups) {
+        !out->shape || !out->low || !out->box || !out->groups) {
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the planes of %u triangles",
                           n);
         goto done;
@@ -162,8 +163,23 @@ rad_status coplanar_polygons_build(const rad_scene *scene, const vf_geometry *ge
         }
         qsort(&sorted[first], k - first, sizeof(*sorted), by_low);
         for (uint32_t m = first; m < k; m++) {
-            out->shape[m] = shapes[sorted[m].shape];
+            const shadow_polygon *s = &shapes[sorted[m].shape];
+            coplanar_box *box = &out->box[m];
+            out->shape[m] = *s;
             out->low[m] = sorted[m].low;
+            box->flat = true;
+            for (unsigned a = 0; a < 3; a++) {
+                box->lo[a] = INFINITY;
+                box->hi[a] = -INFINITY;
+            }
+            for (unsigned c = 0; c < s->count; c++) {
+                for (unsigned a = 0; a < 3; a++) {
+                    box->lo[a] = fmin(box->lo[a], coordinate(s->vertex[c], a));
+                    box->hi[a] = fmax(box->hi[a], coordinate(s->vertex[c], a));
+                }
+                box->flat = box->flat && fabs(v3_dot(g->normal, s->vertex[c]) - g->offset) <=
+                                             geometry->plane_epsilon;
+            }
         }
         out->group_count++;
     }
@@ -192,6 +208,7 @@ void coplanar_polygons_free(coplanar_polygons *planes)
     free(planes->group_of);
     free(planes->shape);
     free(planes->low);
+    free(planes->box);
     memset(planes, 0, sizeof(*planes));
 }
 

@@ -26,6 +26,13 @@ typedef struct coplanar_group {
     double widest;         /* largest extent of one shape along that axis */
 } coplanar_group;
 
+/* A shape's bounding box, and whether every corner lies within plane_epsilon of its
+ * group's plane (a shape whose normal differs from the group's by up to 1e-9 may not). */
+typedef struct coplanar_box {
+    double lo[3], hi[3];
+    bool flat;
+} coplanar_box;
+
 typedef struct coplanar_polygons {
     coplanar_group *groups;
     uint32_t group_count;
@@ -33,6 +40,7 @@ typedef struct coplanar_polygons {
                               UINT32_MAX (degenerate) */
     shadow_polygon *shape; /* the shapes, by group */
     double *low;           /* per shape: its smallest value along its group's axis */
+    coplanar_box *box;     /* per shape */
 } coplanar_polygons;
 
 rad_status coplanar_polygons_build(const rad_scene *scene, const vf_geometry *geometry,

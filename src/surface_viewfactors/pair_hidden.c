@@ -115,10 +115,57 @@ static unsigned plane_window(const vf_polygon *p, const vf_polygon *q, rad_vec3 
  * axis): fewer only proves less. */
 #define MAX_IN_PLANE 256u
 
+/* Slack of the inside test, as a share of the window's extent: rounding where the crossing
+ * points are worked out (shadow_window_remainder drops slivers of 1e-12 of the window's
+ * area alike). */
+#define INSIDE_SLACK 1e-12
+
+/* True when every one of the `count` points (lying in the plane of unit normal n) is inside
+ * the convex shape (either way round) or within `slack` of it. */
+static bool shape_contains(const shadow_polygon *shape, rad_vec3 n, const rad_vec3 *points,
+                           unsigned count, double slack)
+{
+    rad_vec3 sum = {0, 0, 0};
+    for (unsigned m = 0; m < shape->count; m++)
+        sum = v3_add(sum, v3_cross(shape->vertex[m], shape->vertex[(m + 1) % shape->count]));
+    double orientation = v3_dot(sum, n);
+    if (orientation == 0)
+        return false;
+    for (unsigned m = 0; m < shape->count; m++) {
+        rad_vec3 a = shape->vertex[m], b = shape->vertex[(m + 1) % shape->count];
+        rad_vec3 edge = v3_sub(b, a);
+        /* n x edge points inwards when the shape runs counter-clockwise about n */
+        rad_vec3 inward = v3_cross(n, edge);
+        if (orientation < 0)
+            inward = v3_scale(inward, -1);
+        double least = -slack * v3_length(edge);
+        for (unsigned k = 0; k < count; k++)
+            if (v3_dot(inward, v3_sub(points[k], a)) < least)
+                return false;
+    }
+    return true;
+}
+
+/* The largest extent along x, y or z of the points. */
+static double points_extent(const rad_vec3 *points, unsigned count)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (unsigned k = 0; k < count; k++) {
+        double x[3] = {points[k].x, points[k].y, points[k].z};
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], x[a]);
+            hi[a] = fmax(hi[a], x[a]);
+        }
+    }
+    return fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+}
+
 /* What the shapes of group g leave of the window of p and q in its plane (n, offset):
- * the pieces (into `left`), their count, or -1 (no window, or too many pieces). */
+ * the pieces (into `left`), their count, or -1 (no window, or too many pieces). When they
+ * leave nothing and `cover` is not NULL, *cover receives a shape that alone covers the
+ * window, or UINT32_MAX. */
 static int plane_remainder(const pair_hidden_context *c, uint32_t g, const vf_polygon *p,
-                           const vf_polygon *q, shadow_piece *left)
+                           const vf_polygon *q, shadow_piece *left, uint32_t *cover)
 {
     const coplanar_group *group = &c->planes->groups[g];
     rad_vec3 n = group->normal;
@@ -138,28 +185,52 @@ static int plane_remainder(const pair_hidden_context *c, uint32_t g, const vf_po
     uint32_t begin, end;
     coplanar_polygons_range(c->planes, g, lo[group->axis], hi[group->axis], &begin, &end);
     shadow_polygon in_plane[MAX_IN_PLANE];
+    uint32_t shape_index[MAX_IN_PLANE];
     uint32_t count = 0;
     for (uint32_t k = begin; k < end && count < MAX_IN_PLANE; k++) {
-        const shadow_polygon *shape = &c->planes->shape[k];
-        bool outside = false, flat = true;
-        for (int a = 0; a < 3 && !outside; a++) {
-            double slo = INFINITY, shi = -INFINITY;
-            for (unsigned m = 0; m < shape->count; m++) {
-                rad_vec3 v = shape->vertex[m];
-                double x = a == 0 ? v.x : a == 1 ? v.y : v.z;
-                slo = fmin(slo, x);
-                shi = fmax(shi, x);
-            }
-            outside = shi < lo[a] || slo > hi[a];
+        const coplanar_box *box = &c->planes->box[k];
+        bool outside = false;
+        for (int a = 0; a < 3 && !outside; a++)
+            outside = box->hi[a] < lo[a] || box->lo[a] > hi[a];
+        if (!outside && box->flat) {
+            shape_index[count] = k;
+            in_plane[count++] = c->planes->shape[k];
         }
-        for (unsigned m = 0; m < shape->count && flat && !outside; m++)
-            flat = fabs(v3_dot(n, shape->vertex[m]) - offset) <= eps;
-        if (!outside && flat)
-            in_plane[count++] = *shape;
     }
     if (count == 0)
         return -1;
-    return shadow_window_remainder(window, window_count, n, in_plane, count, left);
+    int pieces = shadow_window_remainder(window, window_count, n, in_plane, count, left);
+    if (pieces == 0 && cover) {
+        *cover = UINT32_MAX;
+        double slack = INSIDE_SLACK * points_extent(window, window_count);
+        for (uint32_t k = 0; k < count && *cover == UINT32_MAX; k++)
+            if (shape_contains(&in_plane[k], n, window, window_count, slack))
+                *cover = shape_index[k];
+    }
+    return pieces;
+}
+
+/* True when shape k of group g alone hides q from p: they lie strictly on either side of
+ * its plane and every segment between their corners crosses it inside the shape. */
+static bool shape_hides(const pair_hidden_context *c, uint32_t g, uint32_t k,
+                        const vf_polygon *p, const vf_polygon *q)
+{
+    const coplanar_group *group = &c->planes->groups[g];
+    rad_vec3 n = group->normal;
+    double offset = group->offset;
+    int side_q = side_of(q, n, offset, c->plane_epsilon);
+    if (side_q == 0 || side_of(p, n, offset, c->plane_epsilon) != -side_q)
+        return false;
+    rad_vec3 crossings[MAX_CROSSINGS];
+    unsigned count = 0;
+    for (unsigned a = 0; a < p->count; a++)
+        for (unsigned b = 0; b < q->count; b++) {
+            rad_vec3 x = p->vertex[a], y = q->vertex[b];
+            double hx = v3_dot(n, x) - offset, hy = v3_dot(n, y) - offset;
+            crossings[count++] = v3_lerp(x, y, hx / (hx - hy));
+        }
+    double slack = INSIDE_SLACK * points_extent(crossings, count);
+    return shape_contains(&c->planes->shape[k], n, crossings, count, slack);
 }
 
 /* A probe point of the polygon: 0.8 of the way from its centroid to corner 0, or to the
@@ -319,9 +390,23 @@ typedef struct candidate {
 } candidate;
 
 
+/* Group g among the planes a proof used (once). */
+static void note_used(pair_hidden_planes *used, uint32_t g)
+{
+    for (unsigned k = 0; k < used->count; k++)
+        if (used->group[k] == g)
+            return;
+    if (used->count < PAIR_HIDDEN_MAX_PLANES)
+        used->group[used->count++] = g;
+}
+
+/* cover: NULL, or where the group and shape go when one shape of a plane alone covers the
+ * window of p and q themselves (the caller's pair, not a piece or half); left untouched
+ * otherwise. used: receives the planes that settled the proof or a part of it. */
 static bool hidden(const pair_hidden_context *c, const pair_hidden_planes *planes, bool probe_all,
                    const vf_polygon *p, const vf_polygon *q, unsigned depth,
-                   unsigned *proofs_left, pair_hidden_work *work)
+                   unsigned *proofs_left, pair_hidden_work *work, uint32_t cover[2],
+                   pair_hidden_planes *used)
 {
     if (*proofs_left == 0)
         return false;
@@ -348,9 +433,16 @@ static bool hidden(const pair_hidden_context *c, const pair_hidden_planes *plane
         if (side_p == 0 || side_q == 0 || side_p == side_q)
             continue;
         tried++;
-        int pieces = plane_remainder(c, groups[k], p, q, left);
-        if (pieces == 0)
+        uint32_t shape = UINT32_MAX;
+        int pieces = plane_remainder(c, groups[k], p, q, left, cover ? &shape : NULL);
+        if (pieces == 0) {
+            note_used(used, groups[k]);
+            if (cover && shape != UINT32_MAX) {
+                cover[0] = groups[k];
+                cover[1] = shape;
+            }
             return true;
+        }
         if (pieces < 0)
             continue;
         double uncovered = pieces_area(left, pieces, group->normal);
@@ -384,11 +476,15 @@ static bool hidden(const pair_hidden_context *c, const pair_hidden_planes *plane
             vf_polygon to_p, to_q;
             all = piece_polygon(&best[b].piece[k], group->normal, p->centroid, &to_p) &&
                   piece_polygon(&best[b].piece[k], group->normal, q->centroid, &to_q) &&
-                  (hidden(c, planes, probe_all, &to_q, q, depth - 1, proofs_left, work) ||
-                   hidden(c, planes, probe_all, p, &to_p, depth - 1, proofs_left, work));
+                  (hidden(c, planes, probe_all, &to_q, q, depth - 1, proofs_left, work, NULL,
+                          used) ||
+                   hidden(c, planes, probe_all, p, &to_p, depth - 1, proofs_left, work, NULL,
+                          used));
         }
-        if (all)
+        if (all) {
+            note_used(used, best[b].group);
             return true;
+        }
     }
     /* halve the polygon that widens the window more: p's size counts in proportion to
      * the plane's distance from q, and the other way round */
@@ -399,21 +495,70 @@ static bool hidden(const pair_hidden_context *c, const pair_hidden_planes *plane
     if (!halve(split_p ? p : q, half))
         return false;
     for (int k = 0; k < 2; k++)
-        if (!hidden(c, planes, probe_all, split_p ? &half[k] : p, split_p ? q : &half[k], depth - 1, proofs_left,
-                    work))
+        if (!hidden(c, planes, probe_all, split_p ? &half[k] : p, split_p ? q : &half[k],
+                    depth - 1, proofs_left, work, NULL, used))
             return false;
     return true;
+}
+
+/* Shape k of group g to the front of p's remembered shapes (added when new, the least
+ * recently useful dropped when full). */
+static void remember_shape(pair_hidden_memory *memory, const vf_polygon *p, uint32_t g,
+                           uint32_t k)
+{
+    if (memory->shapes_of != p) {
+        memory->shapes_of = p;
+        memory->shape_count = 0;
+    }
+    unsigned at = 0;
+    while (at < memory->shape_count && memory->shape[at] != k)
+        at++;
+    if (at == memory->shape_count) {
+        if (memory->shape_count < PAIR_HIDDEN_SHAPES)
+            memory->shape_count++;
+        at = memory->shape_count - 1;
+    }
+    for (; at > 0; at--) {
+        memory->shape[at] = memory->shape[at - 1];
+        memory->shape_group[at] = memory->shape_group[at - 1];
+    }
+    memory->shape[0] = k;
+    memory->shape_group[0] = g;
+}
+
+bool pair_hidden_by_remembered_shape(const pair_hidden_context *context,
+                                     pair_hidden_memory *memory, const vf_polygon *p,
+                                     const vf_polygon *q)
+{
+    if (!memory || memory->shapes_of != p)
+        return false;
+    for (unsigned k = 0; k < memory->shape_count; k++)
+        if (shape_hides(context, memory->shape_group[k], memory->shape[k], p, q)) {
+            if (k > 0)
+                remember_shape(memory, p, memory->shape_group[k], memory->shape[k]);
+            memory->shape_proofs++;
+            return true;
+        }
+    return false;
 }
 
 bool pair_proven_hidden(const pair_hidden_context *context, pair_hidden_memory *memory,
                         const vf_polygon *p, const vf_polygon *q, pair_hidden_work *work)
 {
+    if (pair_hidden_by_remembered_shape(context, memory, p, q))
+        return true;
     unsigned proofs_left = PAIR_HIDDEN_MAX_PROOFS;
-    /* the remembered planes first, with no probe, one level of pieces or halves at most */
-    if (memory && memory->p == p && memory->planes.count > 0) {
+    uint32_t cover[2] = {UINT32_MAX, UINT32_MAX};
+    pair_hidden_planes used = {.count = 0};
+    bool remembered = memory && memory->p == p;
+    /* the planes the last proof used first, with no probe, one level of pieces or halves at
+     * most */
+    if (remembered && memory->planes.count > 0) {
         if (hidden(context, &memory->planes, false, p, q, PAIR_HIDDEN_REMEMBERED_DEPTH,
-                   &proofs_left, work)) {
+                   &proofs_left, work, cover, &used)) {
             work->remembered++;
+            if (cover[1] != UINT32_MAX)
+                remember_shape(memory, p, cover[0], cover[1]);
             return true;
         }
         proofs_left = PAIR_HIDDEN_MAX_PROOFS;
@@ -422,10 +567,28 @@ bool pair_proven_hidden(const pair_hidden_context *context, pair_hidden_memory *
     pair_hidden_planes planes;
     if (!probe(context, p, q, planes.group, &planes.count, work))
         return false;
-    bool proven = hidden(context, &planes, true, p, q, PAIR_HIDDEN_MAX_DEPTH, &proofs_left, work);
+    used.count = 0;
+    bool proven = hidden(context, &planes, true, p, q, PAIR_HIDDEN_MAX_DEPTH, &proofs_left, work,
+                         cover, &used);
     if (proven && memory) {
         memory->p = p;
-        memory->planes = planes;
+        memory->planes = used;
+        memory->probed = planes;
+        if (cover[1] != UINT32_MAX)
+            remember_shape(memory, p, cover[0], cover[1]);
+        return true;
+    }
+    /* last, every plane the last proof's probes found, as above */
+    if (!proven && remembered && memory->probed.count > 0) {
+        proofs_left = PAIR_HIDDEN_MAX_PROOFS;
+        cover[1] = UINT32_MAX;
+        if (hidden(context, &memory->probed, false, p, q, PAIR_HIDDEN_REMEMBERED_DEPTH,
+                   &proofs_left, work, cover, &used)) {
+            work->remembered++;
+            if (cover[1] != UINT32_MAX)
+                remember_shape(memory, p, cover[0], cover[1]);
+            return true;
+        }
     }
     return proven;
 }

@@ -56,18 +56,40 @@ typedef struct pair_hidden_planes {
     unsigned count;
 } pair_hidden_planes;
 
-/* The planes of the last proof for polygon p: tried first, with no probe, for p's next
- * pair (the walls that hide one building from p often hide its neighbours too). Owned by
- * one thread; zero-initialise. Which pairs came before changes how much work a proof
- * takes, never what it proves right. */
+/* Shapes remembered per polygon (pair_hidden_memory). */
+#define PAIR_HIDDEN_SHAPES 8u
+
+/* What hid polygon p's earlier pairs, tried for its next: the last PAIR_HIDDEN_SHAPES
+ * single shapes that alone covered a whole window, most recently useful first (tried
+ * first), and the planes the last probed proof used (the top plane and those that settled
+ * its pieces or halves; tried next, with no probe: the walls that hide one building from
+ * p often hide its neighbours too). Every plane that proof's probes found is tried last,
+ * when the pair's own probes found no proof. One shape hides q from p when p and q lie
+ * strictly on either side of its plane and every segment between their corners crosses
+ * it inside the shape (then, by convexity, every segment between p and q does): a few
+ * dozen dot products, no ray. Owned by one thread; zero-initialise. Which pairs came
+ * before changes how much work a proof takes, never what it proves right. */
 typedef struct pair_hidden_memory {
     const vf_polygon *p;
-    pair_hidden_planes planes;
+    pair_hidden_planes planes;              /* the planes the last proof used */
+    pair_hidden_planes probed;              /* every plane its probes found */
+    const vf_polygon *shapes_of;            /* the polygon the shapes hid pairs from */
+    uint32_t shape[PAIR_HIDDEN_SHAPES];     /* coplanar_polygons shapes */
+    uint32_t shape_group[PAIR_HIDDEN_SHAPES];
+    unsigned shape_count;
+    uint64_t shape_proofs;                  /* pairs proven by a remembered shape */
 } pair_hidden_memory;
 
-/* True when every segment between p and q is proven blocked (see above). `memory` may be
- * NULL. */
+/* True when every segment between p and q is proven blocked (see above): by a remembered
+ * shape, the planes the last proof used, the pair's own probes, or every plane the last
+ * proof's probes found, in that order. `memory` may be NULL. */
 bool pair_proven_hidden(const pair_hidden_context *context, pair_hidden_memory *memory,
                         const vf_polygon *p, const vf_polygon *q, pair_hidden_work *work);
+
+/* Only the first of those tests: true when one shape remembered for p hides q from it (the
+ * same exact test, no ray cast). For a caller that tries it before anything else. */
+bool pair_hidden_by_remembered_shape(const pair_hidden_context *context,
+                                     pair_hidden_memory *memory, const vf_polygon *p,
+                                     const vf_polygon *q);
 
 #endif

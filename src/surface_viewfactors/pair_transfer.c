@@ -34,6 +34,7 @@ typedef struct outer_context {
     const vf_polygon *inner;
     double plane_epsilon;
     const shadow_occluder *occluders; /* what may stand in between (none: unobstructed) */
+    const shadow_polygon *joined;     /* or the same joined into polygons */
     uint32_t occluder_count;
     int max_depth;
     uint64_t work_left;      /* occluder clippings this pair may still spend */
@@ -50,8 +51,11 @@ static inline double point_factor(outer_context *c, rad_vec3 x)
         return 0;
     }
     c->work_left -= c->occluder_count;
-    double factor = shadow_visible_factor(x, c->normal, c->inner, c->occluders,
-                                          c->occluder_count, c->plane_epsilon);
+    double factor = c->joined ? shadow_visible_factor_polygons(x, c->normal, c->inner, c->joined,
+                                                               c->occluder_count,
+                                                               c->plane_epsilon)
+                              : shadow_visible_factor(x, c->normal, c->inner, c->occluders,
+                                                      c->occluder_count, c->plane_epsilon);
     if (factor < 0) {
         c->failed = true;
         return 0;
@@ -76,8 +80,22 @@ double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accura
                          double plane_epsilon, double *bound)
 {
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
-    outer_context c = {outer->normal, inner, plane_epsilon, NULL, 0, MAX_DEPTH, 0, false};
+    outer_context c = {outer->normal, inner, plane_epsilon, NULL, NULL, 0, MAX_DEPTH, 0, false};
     return integrate_outer(&c, outer, accuracy, bound);
+}
+
+/* The obstructed transfer behind the triangles, or behind `joined` (count of them) when not
+ * NULL. */
+static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
+                             const shadow_occluder *occluders, const shadow_polygon *joined,
+                             uint32_t count, double accuracy, double plane_epsilon,
+                             uint64_t work_budget, double *value, double *bound)
+{
+    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
+    outer_context c = {outer->normal,       inner, plane_epsilon, occluders, joined, count,
+                       OBSTRUCTED_MAX_DEPTH, work_budget, false};
+    *value = integrate_outer(&c, outer, accuracy, bound);
+    return !c.failed;
 }
 
 bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
@@ -85,19 +103,21 @@ bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
                                   double accuracy, double plane_epsilon, uint64_t work_budget,
                                   double *value, double *bound)
 {
-    const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
-    outer_context c = {outer->normal,       inner, plane_epsilon, occluders, occluder_count,
-                       OBSTRUCTED_MAX_DEPTH, work_budget, false};
-    *value = integrate_outer(&c, outer, accuracy, bound);
-    return !c.failed;
+    shadow_polygon joined[PAIR_EXACT_MAX_OCCLUDERS];
+    if (occluder_count > PAIR_EXACT_MAX_OCCLUDERS)
+        return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, plane_epsilon,
+                                work_budget, value, bound);
+    uint32_t count = shadow_join_occluders(occluders, occluder_count, joined);
+    return obstructed_exact(p, q, NULL, joined, count, accuracy, plane_epsilon, work_budget,
+                            value, bound);
 }
 
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            const shadow_occluder *occluders, uint32_t occluder_count,
                            double accuracy, double plane_epsilon, double *value, double *bound)
 {
-    return pair_obstructed_exact_within(p, q, occluders, occluder_count, accuracy,
-                                        plane_epsilon, EXACT_WORK_BUDGET, value, bound);
+    return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, plane_epsilon,
+                            EXACT_WORK_BUDGET, value, bound);
 }
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)
@@ -106,6 +126,10 @@ bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)
     workspace->rays = rad_alloc_array(max_rays, sizeof(rad_ray));
     workspace->occluded = rad_alloc_array(max_rays, 1);
     workspace->weight = rad_alloc_array(max_rays, sizeof(double));
+    workspace->last_p = workspace->last_q = NULL;
+    workspace->last_occluders = NULL;
+    workspace->last_stream = 0;
+    workspace->last_rounds = 0;
     return workspace->rays && workspace->occluded && workspace->weight;
 }
 
@@ -138,12 +162,19 @@ static rad_vec3 polygon_point(const vf_polygon *polygon, double s, double t)
                        r * (1 - t), r * t);
 }
 
-/* One round: PAIR_REPLICATES independent stratified sets of k x k segments. */
+/* One round: PAIR_REPLICATES independent stratified sets of k x k segments (k a power of
+ * 2). */
 static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
                            uint64_t stream, unsigned round, pair_workspace *w)
 {
     uint32_t n = 0;
     unsigned cells = k * k;
+    /* k is a power of 2: times its reciprocal is division by it, bit for bit, and the
+     * cell's column and row are a mask and a shift */
+    double cell = 1.0 / k;
+    unsigned shift = 0, mask = k - 1;
+    while ((1u << shift) < k)
+        shift++;
     for (unsigned r = 0; r < PAIR_REPLICATES; r++) {
         rad_rng rng = rad_rng_seed(stream, round, r);
         /* the cells of q are visited in a shuffled order, paired with p's in order */
@@ -157,10 +188,10 @@ static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
             order[swap] = keep;
         }
         for (unsigned m = 0; m < cells; m++) {
-            double s0 = ((m % k) + rad_rng_uniform(&rng)) / k;
-            double t0 = ((m / k) + rad_rng_uniform(&rng)) / k;
-            double s1 = ((order[m] % k) + rad_rng_uniform(&rng)) / k;
-            double t1 = ((order[m] / k) + rad_rng_uniform(&rng)) / k;
+            double s0 = ((m & mask) + rad_rng_uniform(&rng)) * cell;
+            double t0 = ((m >> shift) + rad_rng_uniform(&rng)) * cell;
+            double s1 = ((order[m] & mask) + rad_rng_uniform(&rng)) * cell;
+            double t1 = ((order[m] >> shift) + rad_rng_uniform(&rng)) * cell;
             rad_vec3 x = polygon_point(p, s0, t0), y = polygon_point(q, s1, t1);
             rad_vec3 d = v3_sub(y, x);
             double r2 = v3_dot(d, d);
@@ -172,47 +203,101 @@ static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
     return n;
 }
 
-void pair_sample_visibility(const vf_polygon *p, const vf_polygon *q,
-                            const rad_tracer *occluders, double accuracy, uint32_t max_rays,
-                            uint64_t stream, pair_workspace *w, pair_visibility *out)
+/* Round `round` (k x k strata a side) cast and weighed. */
+static pair_round cast_round(const vf_polygon *p, const vf_polygon *q,
+                             const rad_tracer *occluders, unsigned k, unsigned round,
+                             uint64_t stream, pair_workspace *w)
 {
+    uint32_t n = fill_round(p, q, k, stream, round, w);
+    rad_tracer_occluded(occluders, w->rays, n, w->occluded);
+    double estimate[PAIR_REPLICATES], mean = 0;
+    unsigned cells = k * k;
+    bool all_same = true;
+    for (unsigned r = 0; r < PAIR_REPLICATES; r++) {
+        double seen = 0, total = 0;
+        for (unsigned m = r * cells; m < (r + 1) * cells; m++) {
+            total += w->weight[m];
+            seen += w->occluded[m] ? 0 : w->weight[m];
+            all_same = all_same && w->occluded[m] == w->occluded[0];
+        }
+        estimate[r] = total > 0 ? seen / total : (w->occluded[r * cells] ? 0 : 1);
+        mean += estimate[r];
+    }
+    mean /= PAIR_REPLICATES;
+    double spread = 0;
+    for (unsigned r = 0; r < PAIR_REPLICATES; r++)
+        spread += (estimate[r] - mean) * (estimate[r] - mean);
+    double standard_error = sqrt(spread / (PAIR_REPLICATES - 1) / PAIR_REPLICATES);
+    pair_round result;
+    result.fraction = fmin(fmax(mean, 0), 1);
+    result.all_same = all_same;
+    result.unseen = all_same && w->occluded[0];
+    /* all segments agreeing has no spread: what they could all have missed (a slot
+     * narrower than a cell, an occluder between them) is bounded binomially */
+    result.bound = all_same ? PAIR_UNSEEN_BOUND / (double)n : PAIR_STUDENT_T * standard_error;
+    result.rays = n;
+    return result;
+}
+
+/* Rounds of 4x more segments from the first; the first `known` rounds are the
+ * workspace's record of the last call (same pair and stream), the others are cast and
+ * recorded. */
+static void sample_rounds(const vf_polygon *p, const vf_polygon *q, const rad_tracer *occluders,
+                          double accuracy, uint32_t max_rays, uint64_t stream, unsigned known,
+                          pair_workspace *w, pair_visibility *out)
+{
+    w->last_p = p;
+    w->last_q = q;
+    w->last_occluders = occluders;
+    w->last_stream = stream;
     out->rays = 0;
     out->capped = false;
+    /* the rays the rounds would have cast: the budget counts them, cast now or before */
+    uint32_t spent = 0;
     unsigned round = 0;
     for (unsigned k = 1;; k *= 2, round++) {
-        uint32_t n = fill_round(p, q, k, stream, round, w);
-        rad_tracer_occluded(occluders, w->rays, n, w->occluded);
-        out->rays += n;
-        double estimate[PAIR_REPLICATES], mean = 0;
-        unsigned cells = k * k;
-        bool all_same = true;
-        for (unsigned r = 0; r < PAIR_REPLICATES; r++) {
-            double seen = 0, total = 0;
-            for (unsigned m = r * cells; m < (r + 1) * cells; m++) {
-                total += w->weight[m];
-                seen += w->occluded[m] ? 0 : w->weight[m];
-                all_same = all_same && w->occluded[m] == w->occluded[0];
+        pair_round result;
+        if (round < known) {
+            result = w->last_round[round];
+        } else {
+            result = cast_round(p, q, occluders, k, round, stream, w);
+            out->rays += result.rays;
+            if (round < PAIR_MAX_ROUNDS) {
+                w->last_round[round] = result;
+                w->last_rounds = round + 1;
             }
-            estimate[r] = total > 0 ? seen / total : (w->occluded[r * cells] ? 0 : 1);
-            mean += estimate[r];
         }
-        mean /= PAIR_REPLICATES;
-        double spread = 0;
-        for (unsigned r = 0; r < PAIR_REPLICATES; r++)
-            spread += (estimate[r] - mean) * (estimate[r] - mean);
-        double standard_error = sqrt(spread / (PAIR_REPLICATES - 1) / PAIR_REPLICATES);
-        out->fraction = fmin(fmax(mean, 0), 1);
-        out->unseen = all_same && w->occluded[0];
-        /* all segments agreeing has no spread: what they could all have missed (a slot
-         * narrower than a cell, an occluder between them) is bounded binomially */
-        out->bound = all_same ? PAIR_UNSEEN_BOUND / (double)n : PAIR_STUDENT_T * standard_error;
+        spent += result.rays;
+        out->fraction = result.fraction;
+        out->unseen = result.unseen;
+        out->bound = result.bound;
         uint32_t next = PAIR_REPLICATES * (2 * k) * (2 * k);
         /* agreeing segments take two rounds at least: one says little */
-        if (out->bound <= accuracy && (k >= 2 || !all_same))
+        if (out->bound <= accuracy && (k >= 2 || !result.all_same))
             return;
-        if (out->rays + next > max_rays || next > w->capacity || 2 * k > MAX_STRATA) {
+        if (spent + next > max_rays || next > w->capacity || 2 * k > MAX_STRATA) {
             out->capped = true;
             return;
         }
     }
+}
+
+void pair_sample_visibility(const vf_polygon *p, const vf_polygon *q,
+                            const rad_tracer *occluders, double accuracy, uint32_t max_rays,
+                            uint64_t stream, pair_workspace *w, pair_visibility *out)
+{
+    w->last_rounds = 0;
+    sample_rounds(p, q, occluders, accuracy, max_rays, stream, 0, w, out);
+}
+
+void pair_sample_visibility_resume(const vf_polygon *p, const vf_polygon *q,
+                                   const rad_tracer *occluders, double accuracy,
+                                   uint32_t max_rays, uint64_t stream, pair_workspace *w,
+                                   pair_visibility *out)
+{
+    bool same = w->last_p == p && w->last_q == q && w->last_occluders == occluders &&
+                w->last_stream == stream;
+    if (!same)
+        w->last_rounds = 0;
+    sample_rounds(p, q, occluders, accuracy, max_rays, stream, w->last_rounds, w, out);
 }

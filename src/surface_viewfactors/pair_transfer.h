@@ -46,7 +46,10 @@ bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            const shadow_occluder *occluders, uint32_t occluder_count,
                            double accuracy, double plane_epsilon, double *value, double *bound);
 
-/* The same with at most `work_budget` (point, occluder) clippings. */
+/* The same with at most `work_budget` (point, occluder) clippings, and the occluders
+ * (at most PAIR_EXACT_MAX_OCCLUDERS of them) first joined where they share an edge in one
+ * plane (shadow_join_occluders: a wall's triangles cast one shadow, not one each; the same
+ * visible part, in fewer pieces). */
 bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
                                   const shadow_occluder *occluders, uint32_t occluder_count,
                                   double accuracy, double plane_epsilon, uint64_t work_budget,
@@ -62,12 +65,29 @@ bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
  * more are sampled. */
 #define PAIR_EXACT_MAX_OCCLUDERS 4u
 
+/* Rounds of pair_sample_visibility at most (k = 1, 2, 4, ... 32 strata a side). */
+#define PAIR_MAX_ROUNDS 6u
+
+/* What one round found: the visible fraction, its bound, whether every segment agreed,
+ * whether they were all blocked, and its segments. */
+typedef struct pair_round {
+    double fraction, bound;
+    bool all_same, unseen;
+    uint32_t rays;
+} pair_round;
+
 typedef struct pair_workspace {
     shadow_occluder occluders[PAIR_EXACT_MAX_OCCLUDERS];
     rad_ray *rays;
     uint8_t *occluded;
     double *weight;
     uint32_t capacity; /* rays */
+    /* the rounds of the last pair_sample_visibility, for pair_sample_visibility_resume */
+    const vf_polygon *last_p, *last_q;
+    const rad_tracer *last_occluders;
+    uint64_t last_stream;
+    unsigned last_rounds;
+    pair_round last_round[PAIR_MAX_ROUNDS];
 } pair_workspace;
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays);
@@ -87,5 +107,15 @@ void pair_sample_visibility(const vf_polygon *p, const vf_polygon *q,
                             const rad_tracer *occluders, double accuracy, uint32_t max_rays,
                             uint64_t stream, pair_workspace *workspace,
                             pair_visibility *out);
+
+/* The same as pair_sample_visibility with these arguments, when the last call on this
+ * workspace was for the same p, q, occluders and stream (another target or budget): its
+ * rounds are taken as they came out rather than cast again (their segments and outcomes
+ * would be the same), so the result is the same bit for bit, and out->rays counts only
+ * the segments cast now. Any other last call: a fresh pair_sample_visibility. */
+void pair_sample_visibility_resume(const vf_polygon *p, const vf_polygon *q,
+                                   const rad_tracer *occluders, double accuracy,
+                                   uint32_t max_rays, uint64_t stream, pair_workspace *workspace,
+                                   pair_visibility *out);
 
 #endif

@@ -43,22 +43,31 @@ static double piece_area(const piece *p, rad_vec3 normal)
     return 0.5 * v3_dot(sum, normal);
 }
 
-/* The shadow of one occluder on the receiver's plane (normal N . v = offset), seen from x
- * at height H above it; false when it casts none. Counter-clockwise about N. */
+/* The shadow of one convex occluder (`corners`, `count` of them, flat) on the receiver's
+ * plane (normal N . v = offset), seen from x at height H above it; false when it casts
+ * none. Counter-clockwise about N. */
 static bool project_shadow(rad_vec3 x, double H, rad_vec3 N, double offset,
-                           const shadow_occluder *o, double epsilon, piece *shadow)
+                           const rad_vec3 *corners, unsigned count, double epsilon,
+                           piece *shadow)
 {
-    piece triangle = {{o->corner[0], o->corner[1], o->corner[2]}, 3}, low, slab;
+    piece occluder, low, slab;
+    occluder.count = count;
     double top = H * (1 - 1e-9);
-    double h0 = v3_dot(N, o->corner[0]) - offset, h1 = v3_dot(N, o->corner[1]) - offset,
-           h2 = v3_dot(N, o->corner[2]) - offset;
-    if ((h0 <= epsilon && h1 <= epsilon && h2 <= epsilon) || (h0 >= top && h1 >= top && h2 >= top))
+    bool behind = true, above = true, between = true;
+    for (unsigned k = 0; k < count; k++) {
+        occluder.vertex[k] = corners[k];
+        double h = v3_dot(N, corners[k]) - offset;
+        behind = behind && h <= epsilon;
+        above = above && h >= top;
+        between = between && h > epsilon && h < top;
+    }
+    if (behind || above)
         return false; /* wholly behind the receiver's plane, or not below the point */
-    if (h0 > epsilon && h1 > epsilon && h2 > epsilon && h0 < top && h1 < top && h2 < top) {
-        slab = triangle; /* the common case: wholly in between */
+    if (between) {
+        slab = occluder; /* the common case: wholly in between */
     } else {
         /* between the plane and the point: epsilon < h < H (1 - 1e-9) */
-        if (!clip_half_space(&triangle, N, offset + epsilon, &low) || low.count < 3)
+        if (!clip_half_space(&occluder, N, offset + epsilon, &low) || low.count < 3)
             return false;
         if (!clip_half_space(&low, v3_scale(N, -1), -(offset + top), &slab) || slab.count < 3)
             return false;
@@ -134,9 +143,16 @@ static int subtract_shadow(const piece *pieces, unsigned count, const piece *sha
     return made;
 }
 
-double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
-                             const shadow_occluder *occluders, uint32_t occluder_count,
-                             double plane_epsilon)
+/* The factor from x past occluders given as corner lists: occluder o has count(o) corners
+ * at corners(o). */
+typedef struct occluder_list {
+    const shadow_occluder *triangles; /* either triangles */
+    const shadow_polygon *polygons;   /* or convex polygons */
+    uint32_t count;
+} occluder_list;
+
+static double visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
+                             const occluder_list *occluders, double plane_epsilon)
 {
     rad_vec3 N = receiver->normal;
     double offset = v3_dot(N, receiver->vertex[0]);
@@ -149,9 +165,12 @@ double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
     unsigned count = 1;
     pieces[0].count = receiver->count;
     memcpy(pieces[0].vertex, receiver->vertex, receiver->count * sizeof(rad_vec3));
-    for (uint32_t o = 0; o < occluder_count && count > 0; o++) {
+    for (uint32_t o = 0; o < occluders->count && count > 0; o++) {
         piece shadow;
-        if (!project_shadow(x, H, N, offset, &occluders[o], plane_epsilon, &shadow))
+        const rad_vec3 *corners = occluders->triangles ? occluders->triangles[o].corner
+                                                       : occluders->polygons[o].vertex;
+        unsigned corner_count = occluders->triangles ? 3 : occluders->polygons[o].count;
+        if (!project_shadow(x, H, N, offset, corners, corner_count, plane_epsilon, &shadow))
             continue;
         int made = subtract_shadow(pieces, count, &shadow, N, tiny, next);
         if (made < 0)
@@ -166,6 +185,106 @@ double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
         factor += contour_point_to_polygon(x, n, pieces[k].vertex, pieces[k].count, N,
                                            plane_epsilon);
     return factor;
+}
+
+double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
+                             const shadow_occluder *occluders, uint32_t occluder_count,
+                             double plane_epsilon)
+{
+    occluder_list list = {occluders, NULL, occluder_count};
+    return visible_factor(x, n, receiver, &list, plane_epsilon);
+}
+
+double shadow_visible_factor_polygons(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
+                                      const shadow_polygon *occluders, uint32_t occluder_count,
+                                      double plane_epsilon)
+{
+    occluder_list list = {NULL, occluders, occluder_count};
+    return visible_factor(x, n, receiver, &list, plane_epsilon);
+}
+
+/* Sine of the turn below which a corner of a joined occluder counts as straight (dropped)
+ * and above which, turning the wrong way, as reflex (no join). */
+#define JOIN_STRAIGHT 1e-12
+
+/* Joins b into a across an edge they share (the same corners, bit for bit, run opposite
+ * ways) when they lie in one plane and the union is convex with at most VF_MAX_VERTICES
+ * corners; false, a unchanged, otherwise. */
+static bool join_occluders(shadow_polygon *a, const shadow_polygon *b)
+{
+    rad_vec3 na = {0, 0, 0}, nb = {0, 0, 0};
+    for (unsigned k = 0; k < a->count; k++)
+        na = v3_add(na, v3_cross(a->vertex[k], a->vertex[(k + 1) % a->count]));
+    for (unsigned k = 0; k < b->count; k++)
+        nb = v3_add(nb, v3_cross(b->vertex[k], b->vertex[(k + 1) % b->count]));
+    double la = v3_length(na), lb = v3_length(nb);
+    if (!(la > 0) || !(lb > 0))
+        return false;
+    rad_vec3 normal = v3_scale(na, 1 / la);
+    if (v3_dot(normal, v3_scale(nb, 1 / lb)) < 1 - JOIN_STRAIGHT)
+        return false;
+    for (unsigned i = 0; i < a->count; i++) {
+        rad_vec3 u = a->vertex[i], v = a->vertex[(i + 1) % a->count];
+        for (unsigned j = 0; j < b->count; j++) {
+            rad_vec3 bj = b->vertex[j], bn = b->vertex[(j + 1) % b->count];
+            if (!(bj.x == v.x && bj.y == v.y && bj.z == v.z && bn.x == u.x && bn.y == u.y &&
+                  bn.z == u.z))
+                continue;
+            rad_vec3 joined[2 * VF_MAX_VERTICES];
+            unsigned n = 0;
+            for (unsigned k = 0; k <= i; k++)
+                joined[n++] = a->vertex[k];
+            for (unsigned k = 2; k < b->count; k++) /* b from after u round to before v */
+                joined[n++] = b->vertex[(j + k) % b->count];
+            for (unsigned k = i + 1; k < a->count; k++)
+                joined[n++] = a->vertex[k];
+            /* b's corners off a's plane: not one flat polygon */
+            double size = 0;
+            for (unsigned k = 0; k < n; k++)
+                size = fmax(size, v3_length(v3_sub(joined[k], joined[0])));
+            for (unsigned k = 0; k < n; k++)
+                if (fabs(v3_dot(normal, v3_sub(joined[k], joined[0]))) > JOIN_STRAIGHT * size)
+                    return false;
+            rad_vec3 kept[2 * VF_MAX_VERTICES];
+            unsigned m = 0;
+            for (unsigned k = 0; k < n; k++) {
+                rad_vec3 in = v3_sub(joined[k], joined[(k + n - 1) % n]);
+                rad_vec3 out = v3_sub(joined[(k + 1) % n], joined[k]);
+                double turn = v3_dot(normal, v3_cross(in, out));
+                double scale = v3_length(in) * v3_length(out);
+                if (turn < -JOIN_STRAIGHT * scale)
+                    return false; /* reflex */
+                if (turn > JOIN_STRAIGHT * scale)
+                    kept[m++] = joined[k];
+            }
+            if (m < 3 || m > VF_MAX_VERTICES)
+                return false;
+            memcpy(a->vertex, kept, m * sizeof(rad_vec3));
+            a->count = m;
+            return true;
+        }
+    }
+    return false;
+}
+
+uint32_t shadow_join_occluders(const shadow_occluder *triangles, uint32_t count,
+                               shadow_polygon *out)
+{
+    for (uint32_t k = 0; k < count; k++) {
+        out[k].count = 3;
+        memcpy(out[k].vertex, triangles[k].corner, 3 * sizeof(rad_vec3));
+    }
+    bool joined = true;
+    while (joined) {
+        joined = false;
+        for (uint32_t a = 0; a < count && !joined; a++)
+            for (uint32_t b = a + 1; b < count && !joined; b++)
+                if (join_occluders(&out[a], &out[b])) {
+                    out[b] = out[--count];
+                    joined = true;
+                }
+    }
+    return count;
 }
 
 int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_vec3 normal,

@@ -27,6 +27,27 @@ double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
                              const shadow_occluder *occluders, uint32_t occluder_count,
                              double plane_epsilon);
 
+/* A convex polygon of the scene, as many corners as a view-factor polygon at most. */
+typedef struct shadow_polygon {
+    rad_vec3 vertex[VF_MAX_VERTICES];
+    unsigned count;
+} shadow_polygon;
+
+/* The same behind flat convex occluders (either way round): the factor is the same as
+ * behind the triangles they join (shadow_join_occluders), each shadow subtracted once
+ * rather than by parts. */
+double shadow_visible_factor_polygons(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
+                                      const shadow_polygon *occluders, uint32_t occluder_count,
+                                      double plane_epsilon);
+
+/* The occluding triangles joined where they can be, into `out` (room for `count`): two
+ * join when they share an edge (the same corners, bit for bit), lie in one plane and their
+ * union is convex with at most VF_MAX_VERTICES corners (straight corners dropped, to 1e-12
+ * of a turn), until no two do. They cover the same points. Returns how many are left (a
+ * wall given as 4 triangles: 1). */
+uint32_t shadow_join_occluders(const shadow_occluder *triangles, uint32_t count,
+                               shadow_polygon *out);
+
 /* A convex piece of a plane, counter-clockwise about its normal. */
 #define SHADOW_PIECE_MAX_VERTICES 15
 
@@ -35,11 +56,6 @@ typedef struct shadow_piece {
     unsigned count;
 } shadow_piece;
 
-/* A convex polygon of the scene, as many corners as a view-factor polygon at most. */
-typedef struct shadow_polygon {
-    rad_vec3 vertex[VF_MAX_VERTICES];
-    unsigned count;
-} shadow_polygon;
 
 /* What the convex polygons, lying in the plane of the convex `window` (counter-clockwise
  * about the unit `normal`, 3 to SHADOW_PIECE_MAX_VERTICES corners; the polygons either

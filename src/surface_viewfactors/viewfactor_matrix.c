@@ -160,6 +160,12 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
     double quadrature_error, unobstructed;
     uint64_t stream = rad_mix64(e->seed ^ rad_mix64(((uint64_t)pi << 32) | qi));
     pair_visibility visibility;
+    /* a shape that alone hid one of p's earlier pairs often hides this one: an exact test
+     * of a few dozen dot products, tried before any ray */
+    if (pair_hidden_by_remembered_shape(&e->hidden, memory, p, q)) {
+        counts->hidden_pairs++;
+        return 0;
+    }
     /* a first look with a few dozen segments: most pairs of a large scene are wholly
      * hidden; when it sees nothing, the occluders in between are asked for a proof */
     pair_sample_visibility(p, q, e->occluders, INFINITY, e->max_rays, stream, w, &visibility);
@@ -201,8 +207,9 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
      * within accuracy (the F0 of a row sum to at most 1) while small factors take few
      * rays. */
     double f0 = fmin(unobstructed / fmin(p->area, q->area), 1);
-    pair_sample_visibility(p, q, e->occluders, e->accuracy / sqrt(f0), e->max_rays, stream, w,
-                           &visibility);
+    /* the first look's rounds are taken as they came out, not cast again */
+    pair_sample_visibility_resume(p, q, e->occluders, e->accuracy / sqrt(f0), e->max_rays,
+                                  stream, w, &visibility);
     counts->rays += visibility.rays;
     counts->capped_pairs += visibility.capped;
     counts->unseen_pairs += visibility.unseen;
