@@ -323,6 +323,10 @@ void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *st
         return;
     }
     stats_string(stats, "solver", rad_solver_name(r->solver));
+    if (solve->checkpoint_path) {
+        stats_integer(stats, "checkpoints_written", r->checkpoints);
+        stats_bool(stats, "resumed", r->resumed);
+    }
     stats_bool(stats, "solver_chosen", r->solver_chosen);
     stats_string(stats, "solver_reason", r->reason);
     stats_integer(stats, "iterations", r->iterations);

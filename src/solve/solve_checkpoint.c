@@ -222,21 +222,34 @@ static rad_status match_job(const char *path, const solve_checkpoint_job *file,
         return rad_fail(error, RAD_ERR_INVALID,
                         "%s: a checkpoint of the %s solver; this run's is %s", path,
                         solver_word(file->solver), solver_word(run->solver));
-    if (file->quadrature != run->quadrature || file->visibility_rays != run->visibility_rays ||
-        file->max_iterations != run->max_iterations || file->seed != run->seed ||
-        file->tolerance != run->tolerance || file->refine_threshold != run->refine_threshold ||
-        file->link_budget != run->link_budget)
+    /* the options that differ, each with this run's value */
+    char differ[512] = "";
+    size_t used = 0;
+#define DIFFER(test, format, ...)                                                           \
+    if ((test) && used < sizeof(differ))                                                   \
+    used += (size_t)snprintf(differ + used, sizeof(differ) - used, "%s" format,            \
+                             used ? ", " : "", __VA_ARGS__)
+    DIFFER(file->quadrature != run->quadrature, "--quadrature %u (this run: %u)",
+           file->quadrature, run->quadrature);
+    DIFFER(file->visibility_rays != run->visibility_rays, "--visibility-rays %u (this run: %u)",
+           file->visibility_rays, run->visibility_rays);
+    DIFFER(file->max_iterations != run->max_iterations, "--max-iterations %u (this run: %u)",
+           file->max_iterations, run->max_iterations);
+    DIFFER(file->seed != run->seed, "--seed %llu (this run: %llu)",
+           (unsigned long long)file->seed, (unsigned long long)run->seed);
+    DIFFER(file->tolerance != run->tolerance, "--tolerance %.17g (this run: %.17g)",
+           file->tolerance, run->tolerance);
+    DIFFER(file->refine_threshold != run->refine_threshold,
+           "--refine-threshold %.17g (this run: %.17g)", file->refine_threshold,
+           run->refine_threshold);
+    DIFFER(file->link_budget != run->link_budget,
+           "a link budget of %llu bytes (this run: %llu; --max-memory, --threads)",
+           (unsigned long long)file->link_budget, (unsigned long long)run->link_budget);
+#undef DIFFER
+    if (used)
         return rad_fail(error, RAD_ERR_INVALID,
-                        "%s: a checkpoint made with other options (--quadrature %u, "
-                        "--visibility-rays %u, --max-iterations %u, --seed %llu, --tolerance "
-                        "%.17g, --refine-threshold %.17g, link budget %llu bytes; this run: %u, "
-                        "%u, %u, %llu, %.17g, %.17g, %llu)",
-                        path, file->quadrature, file->visibility_rays, file->max_iterations,
-                        (unsigned long long)file->seed, file->tolerance, file->refine_threshold,
-                        (unsigned long long)file->link_budget, run->quadrature,
-                        run->visibility_rays, run->max_iterations,
-                        (unsigned long long)run->seed, run->tolerance, run->refine_threshold,
-                        (unsigned long long)run->link_budget);
+                        "%s: a checkpoint made with other options: %s (0: the default)", path,
+                        differ);
     return RAD_OK;
 }
 
