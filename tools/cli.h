@@ -198,8 +198,8 @@ enum {
     "  --checkpoint FILE    write the solve's state to FILE (atomically) every\n"          \
     "                       --checkpoint-interval seconds: dense solvers the form-factor\n" \
     "                       rows done, then the iterate; hierarchical the links and B;\n"  \
-    "                       SIGINT or SIGTERM then write one and end the run (status\n"    \
-    "                       130, no output file)\n"                                        \
+    "                       SIGINT or SIGTERM (Ctrl-C) then stop any solver at its next\n" \
+    "                       step, write one and end the run (status 130, no output file)\n" \
     "  --checkpoint-interval S  seconds between checkpoints (default "                     \
     CLI_STR(CLI_CHECKPOINT_INTERVAL) "; 0: at every\n"                                    \
     "                       step: a round of rows, a sweep, n/16 shots)\n"                 \
