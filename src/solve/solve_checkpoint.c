@@ -275,6 +275,13 @@ static rad_status read_here(solve_checkpoint *cp, rad_error *error)
     else {
         solve_checkpoint_job job = get_job(p);
         status = match_job(cp->resume_path, &job, &cp->job, error);
+        bool hierarchical = job.solver == RAD_SOLVER_HIERARCHICAL;
+        if (status == RAD_OK && (hierarchical != (kind == SOLVE_CHECKPOINT_HIERARCHY) ||
+                                 (job.solver == RAD_SOLVER_DIRECT &&
+                                  kind == SOLVE_CHECKPOINT_ITERATE)))
+            status = rad_fail(error, RAD_ERR_PARSE,
+                              "%s: a state of kind %u, which the %s solver does not write",
+                              cp->resume_path, kind, solver_word(job.solver));
     }
     if (status == RAD_OK) {
         cp->resumed_size = body - JOB_BYTES;
