@@ -386,13 +386,17 @@ rad_status solve_checkpoint_write(solve_checkpoint *cp, uint32_t kind, const byt
 void iterate_body_begin(const solve_checkpoint *cp, const rad_system *system,
                         const iterate_state *state, byte_sink *body)
 {
-    const iterate_trim *trim = &cp->trim;
+    const rad_formfactor_report *r = &cp->formfactors;
     body->off = ranks_rank() != 0;
     sink_u32(body, system->n);
     sink_floats(body, system->F, (size_t)system->n * system->n);
-    sink_u32(body, trim->rows_trimmed);
-    sink_u32(body, trim->largest_row);
-    sink_f64(body, trim->largest_row_sum);
+    const uint64_t counts[6] = {r->pairs,       r->pairs_facing, r->pairs_refined,
+                                r->pairs_clear, r->pairs_exact,  r->rays};
+    for (int k = 0; k < 6; k++)
+        sink_u64(body, counts[k]);
+    sink_u32(body, r->rows_trimmed);
+    sink_u32(body, r->largest_row);
+    sink_f64(body, r->largest_row_sum);
     sink_u32(body, state->iterations);
     sink_f64(body, state->criterion);
     sink_f64(body, state->smallest);
@@ -400,12 +404,13 @@ void iterate_body_begin(const solve_checkpoint *cp, const rad_system *system,
 }
 
 bool iterate_body_read(const solve_checkpoint *cp, uint32_t n, uint32_t vectors, float *F,
-                       iterate_trim *trim, iterate_state *state, byte_source *source,
-                       rad_error *error)
+                       rad_formfactor_report *formfactors, iterate_state *state,
+                       byte_source *source, rad_error *error)
 {
     const char *path = cp->resume_path;
     uint64_t matrix = (uint64_t)n * n;
-    size_t expected = 4 + 4 * matrix + 4 + 4 + 8 + 4 + 8 + 8 + 4 + (size_t)vectors * 24 * n;
+    size_t expected = 4 + 4 * matrix + 6 * 8 + 4 + 4 + 8 + 4 + 8 + 8 + 4 +
+                      (size_t)vectors * 24 * n;
     if (source_left(source) != expected || source_u32(source) != n) {
         rad_fail(error, RAD_ERR_PARSE,
                  "%s: %zu bytes of solver state, not the %zu of %u patches and %u vectors",
@@ -423,12 +428,19 @@ bool iterate_body_read(const solve_checkpoint *cp, uint32_t n, uint32_t vectors,
     } else {
         source->p += 4 * matrix;
     }
-    iterate_trim t;
-    t.rows_trimmed = source_u32(source);
-    t.largest_row = source_u32(source);
-    t.largest_row_sum = source_f64(source);
-    if (trim)
-        *trim = t;
+    rad_formfactor_report r = {0};
+    r.pairs = source_u64(source);
+    r.pairs_facing = source_u64(source);
+    r.pairs_refined = source_u64(source);
+    r.pairs_clear = source_u64(source);
+    r.pairs_exact = source_u64(source);
+    r.rays = source_u64(source);
+    r.rows_trimmed = source_u32(source);
+    r.largest_row = source_u32(source);
+    r.largest_row_sum = source_f64(source);
+    r.rank_rows = n;
+    if (formfactors)
+        *formfactors = r;
     state->iterations = source_u32(source);
     state->criterion = source_f64(source);
     state->smallest = source_f64(source);

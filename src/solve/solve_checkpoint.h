@@ -71,11 +71,6 @@ void source_rgbs(byte_source *source, rad_rgb *v, size_t count);
 /* Bytes left to read. */
 size_t source_left(const byte_source *source);
 
-/* The trim's report (formfactors.c) as the ITERATE kind keeps it. */
-typedef struct iterate_trim {
-    uint32_t rows_trimmed, largest_row;
-    double largest_row_sum;
-} iterate_trim;
 
 /* A run's checkpointing: where and when to write, and the checkpoint it resumed from. */
 typedef struct solve_checkpoint {
@@ -86,7 +81,8 @@ typedef struct solve_checkpoint {
     rad_progress_fn progress;   /* rank 0: told "checkpoint" after each write */
     void *progress_user;
     uint32_t written;           /* checkpoints written by this run */
-    iterate_trim trim;          /* dense: the matrix's trim, for ITERATE checkpoints */
+    rad_formfactor_report formfactors; /* dense: the matrix's report (its counts and trim),
+                                          kept in ITERATE checkpoints */
     bool interrupted;           /* stopped on request, the checkpoint written */
     /* resuming: the body (after the header) of the checkpoint read, on every rank */
     const char *resume_path;
@@ -132,7 +128,7 @@ rad_status solve_hierarchical_checkpointed(const rad_mesh *mesh,
                                            solve_checkpoint *cp, rad_rgb *B,
                                            rad_hierarchy_report *report, rad_error *error);
 
-/* The ITERATE kind: the whole matrix (trimmed), what its trim reported, the solver's
+/* The ITERATE kind: the whole matrix (trimmed), its report's counts and trim, the solver's
  * scalars, then the solver's vectors (n rad_rgb each: Jacobi and Gauss-Seidel B, shooting
  * B and the unshot dB). */
 typedef struct iterate_state {
@@ -141,7 +137,7 @@ typedef struct iterate_state {
     uint32_t last_shooter;      /* shooting; UINT32_MAX otherwise */
 } iterate_state;
 
-/* Starts an ITERATE body on rank 0 (elsewhere the sink stays off): F, the trim, state. */
+/* Starts an ITERATE body on rank 0 (elsewhere the sink stays off): F, its report, state. */
 void iterate_body_begin(const solve_checkpoint *cp, const rad_system *system,
                         const iterate_state *state, byte_sink *body);
 /* Collective, between a dense solver's steps: writes an ITERATE checkpoint of the body
@@ -153,12 +149,13 @@ bool iterate_step(solve_checkpoint *cp, const rad_system *system, const iterate_
 /* Puts three channel arrays as n rad_rgb. */
 void sink_channels(byte_sink *sink, const double *x0, const double *x1, const double *x2,
                    uint32_t n);
-/* The ITERATE checkpoint being resumed: reads F (n x n) and the trim into the given places
- * (either may be NULL: skipped), the state into *state, and leaves *source at the
+/* The ITERATE checkpoint being resumed: reads F (n x n) and the matrix's report (counts and
+ * trim) into the given places (either may be NULL: skipped), the state into *state, and leaves *source at the
  * vectors. False (error set, naming the file) when the body does not hold `vectors`
  * vectors of finite values >= 0 (shooting's dB included) after F in [0, 1]. */
 bool iterate_body_read(const solve_checkpoint *cp, uint32_t n, uint32_t vectors, float *F,
-                       iterate_trim *trim, iterate_state *state, byte_source *source,
+                       rad_formfactor_report *formfactors, iterate_state *state,
+                       byte_source *source,
                        rad_error *error);
 /* Reads three channel arrays from n rad_rgb. */
 void source_channels(byte_source *source, double *x0, double *x1, double *x2, uint32_t n);

@@ -162,7 +162,7 @@ static rad_status resumed_matrix(solve_checkpoint *cp, uint32_t n, rad_solver so
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the %u x %u matrix of %s", n,
                         n, cp->resume_path);
     }
-    if (!iterate_body_read(cp, n, solver == RAD_SOLVER_SHOOT ? 2 : 1, F, &cp->trim, &state,
+    if (!iterate_body_read(cp, n, solver == RAD_SOLVER_SHOOT ? 2 : 1, F, report, &state,
                            &source, error)) {
         free(m);
         free(F);
@@ -171,11 +171,7 @@ static rad_status resumed_matrix(solve_checkpoint *cp, uint32_t n, rad_solver so
     m->n = n;
     m->F = F;
     *ff = m;
-    report->rows_trimmed = cp->trim.rows_trimmed;
-    report->largest_row = cp->trim.largest_row;
-    report->largest_row_sum = cp->trim.largest_row_sum;
-    report->pairs = (uint64_t)n * (n - 1) / 2;
-    report->rank_rows = n;
+    cp->formfactors = *report;
     return RAD_OK;
 }
 
@@ -213,8 +209,7 @@ static rad_status solve_dense(const rad_scene *scene, const rad_mesh *mesh, cons
         return RAD_OK;
     }
     if (cp)
-        cp->trim = (iterate_trim){r->formfactors.rows_trimmed, r->formfactors.largest_row,
-                                  r->formfactors.largest_row_sum};
+        cp->formfactors = r->formfactors;
     rad_formfactors_check(ff, mesh, &r->check);
     double t1 = seconds_now();
     r->seconds_form_factors = t1 - t0;
