@@ -212,10 +212,20 @@ static rad_status rows_body(row_checkpoints *c, uint32_t rounds, byte_sink *body
     return status;
 }
 
-/* After round r: writes a checkpoint when one is due; true to stop the rows. Collective. */
-static bool after_round(void *user, uint32_t round)
+/* After round r: writes a checkpoint when one is due; true to stop the rows. Collective:
+ * over ranks, a rank that failed before its rows (`failed`, out of memory: it calls this
+ * once) stops every rank here. */
+static bool after_round(void *user, uint32_t round, bool failed)
 {
     row_checkpoints *c = user;
+    if (ranks_count() > 1 && ranks_failures(failed) > 0) {
+        if (!failed)
+            c->status =
+                rad_fail(&c->error, RAD_ERR_INVALID, "form factors: another rank failed");
+        return true;
+    }
+    if (failed)
+        return true;
     if (round + 1 >= CHECKPOINT_ROUNDS)
         return false; /* the rows are done: the solver's first step checkpoints next */
     bool stop;

@@ -579,7 +579,7 @@ static rad_status run(const rad_mesh *mesh, const rad_tracer *occluders,
                                           total ? (double)done / total : 1);
                 }
             }
-            if (r->after_round && r->after_round(r->user, round)) {
+            if (r->after_round && r->after_round(r->user, round, false)) {
                 r->stopped_after = round + 1;
                 break;
             }
@@ -625,6 +625,8 @@ static rad_status run(const rad_mesh *mesh, const rad_tracer *occluders,
 nomem:
     status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for form factors of %u patches", n);
 done:
+    if (status != RAD_OK && plan.rounds && plan.rounds->after_round)
+        plan.rounds->after_round(plan.rounds->user, 0, true); /* failed before the rows */
     if (work)
         for (int t = 0; t < threads; t++) {
             batch *b[2] = {&work[t].first, &work[t].refine};

@@ -150,9 +150,9 @@ bool iterate_step(solve_checkpoint *cp, const rad_system *system, const iterate_
 void sink_channels(byte_sink *sink, const double *x0, const double *x1, const double *x2,
                    uint32_t n);
 /* The ITERATE checkpoint being resumed: reads F (n x n) and the matrix's report (counts and
- * trim) into the given places (either may be NULL: skipped), the state into *state, and leaves *source at the
- * vectors. False (error set, naming the file) when the body does not hold `vectors`
- * vectors of finite values >= 0 (shooting's dB included) after F in [0, 1]. */
+ * trim) into the given places (either may be NULL: skipped), the state into *state, and
+ * leaves *source at the vectors. False (error set, naming the file) when the body does not
+ * hold `vectors` vectors of finite values >= 0 (shooting's dB included) after F in [0, 1]. */
 bool iterate_body_read(const solve_checkpoint *cp, uint32_t n, uint32_t vectors, float *F,
                        rad_formfactor_report *formfactors, iterate_state *state,
                        byte_source *source,
