@@ -1418,7 +1418,9 @@ typedef struct rad_scene_solve_options {
                                   with 2 MB a thread; the links a quarter less */
     uint64_t seed;
     int threads;               /* 0 = all cores */
-    const volatile int *stop;  /* hierarchical: stops at the next sweep (report.interrupted) */
+    const volatile int *stop;  /* hierarchical: stops at the next sweep (report.interrupted);
+                                  with `checkpoint`, every solver: writes one at its next
+                                  step and stops there */
     const rad_patch_inputs *inputs; /* the patch inputs when the caller has built them
                                   (rad_patch_inputs_build of this scene and mesh), to use
                                   them again in rad_render; NULL: built here */
@@ -1429,6 +1431,22 @@ typedef struct rad_scene_solve_options {
     rad_solve_observer_fn observer; /* every solver's steps (rad_solve_step); NULL: none */
     void *observer_user;
     uint32_t observe_every;    /* shooting: shots between two calls; 0 = n / 16 */
+    /* Checkpoints of a long solve (restart files; the CLI's --checkpoint, --resume). Each
+     * holds the state at a point where the solver goes on as if never stopped: the dense
+     * solvers' form-factor rows done (the rows go in 64 rounds per rank, a checkpoint
+     * possible between two), then the whole matrix and the iterate between sweeps (shooting:
+     * every n / 16 shots); the hierarchical solver's links, B and loop state between sweeps,
+     * and always one before its final gather (a stop during it goes back there). A resumed
+     * run gives B bitwise the same as an uninterrupted one, for any thread count (and rank
+     * count). Written atomically; refused on resuming, naming the file, when made for
+     * another scene, mesh, solver, --quadrature, --visibility-rays, --max-iterations,
+     * --seed, --tolerance, --refine-threshold or link budget (RAD_ERR_INVALID). */
+    const char *checkpoint;     /* NULL: none. Written when checkpoint_interval seconds have
+                                   passed since the last (checked at the solver's steps
+                                   only), and at `stop` */
+    double checkpoint_interval; /* seconds; 0: at every step */
+    const char *resume;         /* NULL: none. A checkpoint to go on from (it may be the
+                                   `checkpoint` file itself) */
 } rad_scene_solve_options;
 
 typedef struct rad_scene_solve_report {
@@ -1440,7 +1458,11 @@ typedef struct rad_scene_solve_report {
     double residual;           /* relative residual of the B returned, every solver (see
                                   rad_solve_report, rad_hierarchy_report) */
     bool converged;
-    bool interrupted;          /* options.stop was raised: B is the solution so far */
+    bool interrupted;          /* options.stop was raised: B is the solution so far; with
+                                  options.checkpoint, the checkpoint holds the state and B
+                                  is only each patch's own exitance */
+    bool resumed;              /* options.resume was read and the solve went on from it */
+    uint32_t checkpoints;      /* checkpoints written */
     rad_formfactor_report formfactors; /* dense solvers */
     rad_formfactor_check check;        /* dense solvers */
     rad_solve_report solve;            /* dense solvers */

@@ -462,6 +462,8 @@ bool cli_begin(const char *command, const char *usage, int argc, char **argv,
             fputs("\nMeshing:\n" CLI_MESH_HELP, stdout);
         if (options[OPT_RECORD].name)
             fputs("\nConvergence:\n" CLI_CONVERGENCE_HELP, stdout);
+        if (options[OPT_SOLVE_CHECKPOINT].name)
+            fputs("\nCheckpoints:\n" CLI_CHECKPOINT_HELP, stdout);
         if (options[OPT_POINT].name) {
             fputs("\nScene:\n" CLI_SCENE_HELP, stdout);
             fputs(CLI_LIGHT_HELP, stdout);

@@ -69,6 +69,7 @@ enum {
     OPT_EXR_FLOAT,
     OPT_SOLVER, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_SOLUTION,        /* SOLVE */
     OPT_SAVE_SOLUTION, OPT_REFINE_THRESHOLD, OPT_MAX_MEMORY, OPT_PLOT, OPT_RECORD,
+    OPT_SOLVE_CHECKPOINT, OPT_SOLVE_CHECKPOINT_INTERVAL, OPT_SOLVE_RESUME,
     OPT_EMIT, OPT_ALBEDO,                                               /* SCENE */
     OPT_POINT, OPT_SPOT, OPT_SUN, OPT_TIME, OPT_SKY, OPT_LUMINAIRE, OPT_ENVIRONMENT,
     OPT_ENVIRONMENT_ROTATE, OPT_UNIT, OPT_NORTH,
@@ -121,7 +122,10 @@ enum {
     [OPT_SOLUTION] = {"solution", 0, true}, [OPT_SAVE_SOLUTION] = {"save-solution", 0, true}, \
     [OPT_REFINE_THRESHOLD] = {"refine-threshold", 0, true},                                \
     [OPT_MAX_MEMORY] = {"max-memory", 0, true}, [OPT_PLOT] = {"plot", 0, true},             \
-    [OPT_RECORD] = {"record", 0, true}
+    [OPT_RECORD] = {"record", 0, true},                                                    \
+    [OPT_SOLVE_CHECKPOINT] = {"checkpoint", 0, true},                                      \
+    [OPT_SOLVE_CHECKPOINT_INTERVAL] = {"checkpoint-interval", 0, true},                    \
+    [OPT_SOLVE_RESUME] = {"resume", 0, true}
 
 /* The help of the options `render` and `solve` share (SOLVE, FORMFACTOR, SCENE, BASE but
  * -o), the same for both: a solution file of one is a solution file of the other. */
@@ -187,6 +191,22 @@ enum {
     "  --record FILE.json   the solution at every step (sweeps; shooting: every n/16\n"    \
     "                       shots; hierarchical: sweeps and refinement passes) with its\n" \
     "                       residual, as JSON (radiosity: base64 float32 RGB per patch)\n"
+
+/* The help of --checkpoint, --checkpoint-interval and --resume (SOLVE group), printed
+ * after the command's own. */
+#define CLI_CHECKPOINT_HELP                                                                \
+    "  --checkpoint FILE    write the solve's state to FILE (atomically) every\n"          \
+    "                       --checkpoint-interval seconds: dense solvers the form-factor\n" \
+    "                       rows done, then the iterate; hierarchical the links and B;\n"  \
+    "                       SIGINT or SIGTERM (Ctrl-C) then stop any solver at its next\n" \
+    "                       step, write one and end the run (status 130, no output file)\n" \
+    "  --checkpoint-interval S  seconds between checkpoints (default "                     \
+    CLI_STR(CLI_CHECKPOINT_INTERVAL) "; 0: at every\n"                                    \
+    "                       step: a round of rows, a sweep, n/16 shots)\n"                 \
+    "  --resume FILE        continue the solve of this checkpoint (same scene, mesh,\n"    \
+    "                       --solver and solver options; others are refused): the\n"      \
+    "                       outputs are those of an uninterrupted run. Checkpoints go on\n" \
+    "                       to FILE unless --checkpoint names another\n"
 
 /* What Ctrl-C does, for the help of every command that solves. */
 #define CLI_INTERRUPT_HELP                                                                 \
@@ -451,6 +471,9 @@ typedef struct cli_solve {
                                        applied by cli_solve_scene before meshing */
     const char *plot_path;          /* --plot: the convergence plot (SVG) */
     const char *record_path;        /* --record: the snapshots (JSON) */
+    const char *checkpoint_path;    /* --checkpoint (or --resume's file): NULL none */
+    const char *resume_path;        /* --resume */
+    double checkpoint_interval;     /* --checkpoint-interval, seconds */
 } cli_solve;
 
 /* Parses the SOLVE options (after cli_parse_shared, whose threads, seed, quadrature and
@@ -469,6 +492,8 @@ typedef struct cli_solved {
     bool from_file; /* B came from --solution: nothing solved, `report` is empty */
     rad_scene_solve_report report; /* rad_solve_scene's: the solver it chose, and all */
     double seconds_load, seconds_mesh, seconds_inputs, seconds_save;
+    bool checkpoint_stop; /* stopped by a signal with --checkpoint: the checkpoint holds
+                             the state, nothing else is to be written (cli_checkpoint_stop) */
 } cli_solved;
 
 /* The part `render` and `solve` share: loads SCENE (NULL = the built-in Cornell box),
@@ -479,6 +504,10 @@ typedef struct cli_solved {
 rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
                            const cli_solve *solve, cli_solved *out, rad_error *error);
 void cli_solved_free(cli_solved *solved);
+
+/* After a solve stopped at a checkpoint (cli_solved.checkpoint_stop): rank 0 says where to
+ * resume from; returns EXIT_INTERRUPTED. The command then writes nothing. */
+int cli_checkpoint_stop(const char *command, const cli_solve *solve);
 
 /* The --stats fields of the solution: scene, patches, rays, phase times, solver,
  * iterations, residuals and form-factor checks (or the solution file it came from). */
@@ -531,6 +560,34 @@ void cli_viewfactor_plot_begin(cli_viewfactor_plot *p, const char *path,
 /* Writes the plot (nothing without a path); frees the history. */
 rad_status cli_viewfactor_plot_end(cli_viewfactor_plot *p, const char *scene,
                                    uint32_t surfaces, rad_error *error);
+
+/* Seconds between checkpoints unless --checkpoint-interval says (viewfactors, solve,
+ * render). */
+#define CLI_CHECKPOINT_INTERVAL 600
+
+/* What the checkpointing commands share (cli_checkpoint.c): SIGINT and SIGTERM raise the
+ * stop flag (a second one ends the run at once), and "checkpoint" progress reports are
+ * counted, not drawn. For tests, RADIOSITY_STOP_AFTER_CHECKPOINTS=K acts as SIGTERM once K
+ * checkpoints are written, so that a run can be interrupted at a known point without
+ * timing, and RADIOSITY_WAIT_AFTER_CHECKPOINTS=K waits there (up to a minute) for a real
+ * SIGINT or SIGTERM, so that a test's signal always arrives mid-run. */
+typedef struct cli_checkpoints {
+    long stop_after, wait_after, written; /* 0: never */
+    rad_progress_fn next; /* gets every other report (the progress line, --plot) */
+    void *next_user;
+    void (*previous_int)(int);
+    void (*previous_term)(int);
+} cli_checkpoints;
+
+/* Installs the handlers and, on a rank that reports progress (*progress may be NULL),
+ * wraps *progress; returns the stop flag for the library's options. */
+const volatile int *cli_checkpoints_begin(cli_checkpoints *c, rad_progress_fn *progress,
+                                          void **progress_user);
+/* Puts the previous signal handlers back. */
+void cli_checkpoints_end(cli_checkpoints *c);
+
+/* Parses --checkpoint-interval into *seconds (false after printing for a bad value). */
+bool cli_parse_checkpoint_interval(const char *value, double *seconds);
 
 /* Prints an error and returns false when path is a folder or its folder is not writable. */
 bool cli_output_writable(const char *path);

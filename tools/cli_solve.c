@@ -81,6 +81,24 @@ bool cli_parse_solve(const cli_args *args, const cli_shared *shared, cli_solve *
     solve->record_path = args->value[OPT_RECORD];
     if (!cli_convergence_paths_ok(solve->plot_path, solve->record_path))
         return false;
+    solve->resume_path = args->value[OPT_SOLVE_RESUME];
+    solve->checkpoint_path =
+        args->value[OPT_SOLVE_CHECKPOINT] ? args->value[OPT_SOLVE_CHECKPOINT] : solve->resume_path;
+    solve->checkpoint_interval = CLI_CHECKPOINT_INTERVAL;
+    if (args->value[OPT_SOLVE_CHECKPOINT_INTERVAL]) {
+        if (!solve->checkpoint_path) {
+            cli_error("--checkpoint-interval: give --checkpoint FILE (or --resume FILE) too");
+            return false;
+        }
+        if (!cli_parse_checkpoint_interval(args->value[OPT_SOLVE_CHECKPOINT_INTERVAL],
+                                           &solve->checkpoint_interval))
+            return false;
+    }
+    if (solve->solution_path && solve->checkpoint_path) {
+        cli_error("--solution with %s: nothing is solved, so there is nothing to checkpoint",
+                  solve->resume_path ? "--resume" : "--checkpoint");
+        return false;
+    }
     if (solve->solution_path && (solve->plot_path || solve->record_path)) {
         cli_error("%s with --solution: nothing is solved, so there is no convergence to "
                   "watch", solve->plot_path ? "--plot" : "--record");
@@ -114,7 +132,8 @@ bool cli_solve_outputs_writable(const cli_shared *shared, const cli_solve *solve
            (!shared->stats_path || cli_output_writable(shared->stats_path)) &&
            (!solve->save_solution_path || cli_output_writable(solve->save_solution_path)) &&
            (!solve->plot_path || cli_output_writable(solve->plot_path)) &&
-           (!solve->record_path || cli_output_writable(solve->record_path));
+           (!solve->record_path || cli_output_writable(solve->record_path)) &&
+           (!solve->checkpoint_path || cli_output_writable(solve->checkpoint_path));
 }
 
 static volatile sig_atomic_t interrupt_requested;
@@ -232,17 +251,29 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         goto done;
     void (*previous)(int) = SIG_DFL;
     interrupt_requested = 0;
-    if (stoppable) {
+    cli_checkpoints checkpoints;
+    if (solve->checkpoint_path) { /* every solver stops at a checkpoint */
+        options.checkpoint = solve->checkpoint_path;
+        options.checkpoint_interval = solve->checkpoint_interval;
+        options.resume = solve->resume_path;
+        options.stop = cli_checkpoints_begin(&checkpoints, &options.progress,
+                                             &options.progress_user);
+    } else if (stoppable) {
         options.stop = &interrupt_requested;
         previous = signal(SIGINT, on_interrupt);
     }
     cli_progress_mark();
     status = rad_solve_scene(out->scene, out->mesh, &options, out->B, &out->report, error);
-    if (stoppable)
+    if (solve->checkpoint_path)
+        cli_checkpoints_end(&checkpoints);
+    else if (stoppable)
         signal(SIGINT, previous == SIG_ERR ? SIG_DFL : previous);
     cli_progress_end();
     status = cli_convergence_end(&convergence, status, error);
-    if (status != RAD_OK || !solve->save_solution_path || !writer)
+    out->checkpoint_stop = status == RAD_OK && solve->checkpoint_path && out->report.interrupted;
+    if (status == RAD_OK && writer && out->report.resumed)
+        cli_summary("resumed from %s", solve->resume_path);
+    if (status != RAD_OK || !solve->save_solution_path || !writer || out->checkpoint_stop)
         goto done;
     double t_save = rad_clock_seconds();
     status = rad_solution_write(out->scene, out->mesh, out->B, solve->save_solution_path, error);
@@ -252,6 +283,15 @@ done:
     if (status != RAD_OK)
         cli_solved_free(out);
     return status;
+}
+
+int cli_checkpoint_stop(const char *command, const cli_solve *solve)
+{
+    if (rad_rank() == 0)
+        cli_error("%s: interrupted: %s holds the solve so far (nothing else was written); "
+                  "continue with --resume %s",
+                  command, solve->checkpoint_path, solve->checkpoint_path);
+    return EXIT_INTERRUPTED;
 }
 
 void cli_solved_free(cli_solved *solved)
@@ -283,6 +323,10 @@ void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *st
         return;
     }
     stats_string(stats, "solver", rad_solver_name(r->solver));
+    if (solve->checkpoint_path) {
+        stats_integer(stats, "checkpoints_written", r->checkpoints);
+        stats_bool(stats, "resumed", r->resumed);
+    }
     stats_bool(stats, "solver_chosen", r->solver_chosen);
     stats_string(stats, "solver_reason", r->reason);
     stats_integer(stats, "iterations", r->iterations);

@@ -194,6 +194,10 @@ int command_render(int argc, char **argv)
         exit_code = cli_ranks_failed(&error);
         goto done;
     }
+    if (solved.checkpoint_stop) { /* the checkpoint holds the solve: no image */
+        exit_code = cli_checkpoint_stop("render", &s.solve);
+        goto done;
+    }
     t_solved = rad_clock_seconds();
     rad_camera camera = cli_view_camera(&s.view, solved.scene);
     if (s.specular)

@@ -97,6 +97,10 @@ int command_solve(int argc, char **argv)
         exit_code = cli_ranks_failed(&error);
         goto done;
     }
+    if (solved.checkpoint_stop) { /* the checkpoint holds it: no output */
+        exit_code = cli_checkpoint_stop("solve", &solve);
+        goto done;
+    }
     if (rad_rank() != 0) { /* rank 0 writes */
         exit_code = EXIT_OK;
         goto done;

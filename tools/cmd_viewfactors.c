@@ -6,10 +6,8 @@
  * share the rows (the library does) and rank 0 alone does the rest and writes.
  */
 #include <math.h>
-#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "cli.h"
 #include "cli_ranks.h"
@@ -99,46 +97,6 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_REPAIR_ROWS] = {"repair-rows", 0, false},
     [OPT_REPAIR_MAX_CHANGE] = {"repair-max-change", 0, true},
     [OPT_REPAIR_MAX_REMOVED] = {"repair-max-removed", 0, true}};
-
-/* Seconds between checkpoints unless --checkpoint-interval says. */
-#define DEFAULT_CHECKPOINT_INTERVAL 600.0
-
-/* SIGINT or SIGTERM with --checkpoint: stop after the current round of rows. */
-static volatile sig_atomic_t stop_requested;
-
-static void on_stop_signal(int signal_number)
-{
-    stop_requested = 1;
-    signal(signal_number, SIG_DFL); /* a second one ends the run at once */
-}
-
-/* The progress of a checkpointed run: "checkpoint" reports are counted, not drawn. For
- * tests, RADIOSITY_STOP_AFTER_CHECKPOINTS=K acts as SIGTERM once K checkpoints are
- * written, so that a run can be interrupted at a known point without timing, and
- * RADIOSITY_WAIT_AFTER_CHECKPOINTS=K waits there (up to a minute) for a real SIGINT or
- * SIGTERM, so that a test's signal always arrives mid-run. */
-typedef struct checkpoint_progress {
-    long stop_after; /* 0: never */
-    long wait_after; /* 0: never */
-    long written;
-    rad_progress_fn next; /* gets every other report (the progress line, --plot) */
-    void *next_user;
-} checkpoint_progress;
-
-static void progress_with_checkpoints(void *user, const char *phase, double fraction)
-{
-    checkpoint_progress *c = user;
-    if (strcmp(phase, "checkpoint") != 0) {
-        c->next(c->next_user, phase, fraction);
-        return;
-    }
-    c->written++;
-    if (c->stop_after > 0 && c->written >= c->stop_after)
-        stop_requested = 1;
-    if (c->wait_after > 0 && c->written == c->wait_after)
-        for (int k = 0; k < 6000 && !stop_requested; k++)
-            nanosleep(&(struct timespec){0, 10000000}, NULL);
-}
 
 /* --repair-rows' default limits (relative change of a factor, share of exchange). */
 #define REPAIR_MAX_CHANGE 0.05
@@ -314,27 +272,16 @@ int command_viewfactors(int argc, char **argv)
     cli_memory_budget(max_memory);
     vf.resume = args.value[OPT_RESUME];
     vf.checkpoint = args.value[OPT_CHECKPOINT] ? args.value[OPT_CHECKPOINT] : vf.resume;
-    vf.checkpoint_interval = DEFAULT_CHECKPOINT_INTERVAL;
+    vf.checkpoint_interval = CLI_CHECKPOINT_INTERVAL;
     if (args.value[OPT_CHECKPOINT_INTERVAL]) {
         if (!vf.checkpoint) {
             cli_error("--checkpoint-interval: give --checkpoint FILE (or --resume FILE) too");
             return EXIT_USAGE;
         }
-        if (!cli_parse_double("checkpoint-interval", args.value[OPT_CHECKPOINT_INTERVAL],
-                              &vf.checkpoint_interval))
+        if (!cli_parse_checkpoint_interval(args.value[OPT_CHECKPOINT_INTERVAL],
+                                           &vf.checkpoint_interval))
             return EXIT_USAGE;
-        if (!(vf.checkpoint_interval >= 0 && vf.checkpoint_interval <= 1e9)) {
-            cli_error("--checkpoint-interval: must be between 0 and 1e9 seconds");
-            return EXIT_USAGE;
-        }
     }
-    checkpoint_progress checkpoints = {0, 0, 0, NULL, NULL};
-    const char *stop_after = getenv("RADIOSITY_STOP_AFTER_CHECKPOINTS");
-    if (stop_after)
-        checkpoints.stop_after = strtol(stop_after, NULL, 10);
-    const char *wait_after = getenv("RADIOSITY_WAIT_AFTER_CHECKPOINTS");
-    if (wait_after)
-        checkpoints.wait_after = strtol(wait_after, NULL, 10);
     const char *output = shared.output, *stats_path = shared.stats_path;
     rad_viewfactor_write_options write = {RAD_VIEWFACTOR_CSV, false, false};
     if (output)
@@ -399,24 +346,12 @@ int command_viewfactors(int argc, char **argv)
     if (!cli_ranks_ok(status, &error))
         goto fail;
     cli_progress_mark();
-    void (*previous_int)(int) = SIG_DFL, (*previous_term)(int) = SIG_DFL;
-    if (vf.checkpoint) {
-        stop_requested = 0;
-        vf.stop = &stop_requested;
-        if (vf.progress) { /* rank 0 (the library tells only rank 0 of checkpoints) */
-            checkpoints.next = vf.progress;
-            checkpoints.next_user = vf.progress_user;
-            vf.progress = progress_with_checkpoints;
-            vf.progress_user = &checkpoints;
-        }
-        previous_int = signal(SIGINT, on_stop_signal);
-        previous_term = signal(SIGTERM, on_stop_signal);
-    }
+    cli_checkpoints checkpoints;
+    if (vf.checkpoint) /* SIGINT and SIGTERM stop at the next round, with a checkpoint */
+        vf.stop = cli_checkpoints_begin(&checkpoints, &vf.progress, &vf.progress_user);
     status = rad_viewfactor_matrix_compute(scene, &vf, &matrix, &report, &error);
-    if (vf.checkpoint) {
-        signal(SIGINT, previous_int == SIG_ERR ? SIG_DFL : previous_int);
-        signal(SIGTERM, previous_term == SIG_ERR ? SIG_DFL : previous_term);
-    }
+    if (vf.checkpoint)
+        cli_checkpoints_end(&checkpoints);
     if (!cli_ranks_ok(status, &error))
         goto fail;
     cli_progress_end();

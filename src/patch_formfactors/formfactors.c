@@ -10,15 +10,23 @@
  * pairs and the ranks sum their matrices, every cell being non-zero on one rank at most, so
  * every rank ends with the whole matrix, bitwise the serial one (a pair's value depends on
  * the pair and the seed only). Memory per rank is therefore not divided.
+ *
+ * With a checkpoint (solve_checkpoint.h; formfactors_compute_checkpointed) each rank's rows
+ * go in CHECKPOINT_ROUNDS rounds of equal cost, and between two the ranks may write one:
+ * the rows done so far (row i: its F_ij and F_ji for j > i) gathered at rank 0. A resumed
+ * run puts the checkpoint's rows in rank 0's matrix and shares only the others, so the
+ * matrix is bitwise the uninterrupted run's.
  */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/memory.h"
 #include "parallel/partition.h"
 #include "parallel/ranks.h"
+#include "solve/solve_checkpoint.h"
 
 /* The dense matrix may take at most this share of the machine's physical memory. */
 #define MATRIX_MEMORY_SHARE 0.75
@@ -128,10 +136,248 @@ static rad_status gather_matrix(float *F, size_t n, const uint8_t *rows, rad_sta
     return RAD_OK;
 }
 
+/* ---- checkpoints between rounds of rows ---- */
+
+/* Rounds of rows between which a checkpoint may be written: each rank's rows in this many
+ * slices of equal pair count. */
+#define CHECKPOINT_ROUNDS 64u
+
+typedef struct row_checkpoints {
+    solve_checkpoint *cp;
+    const float *F;
+    size_t n;
+    const uint32_t *order;   /* this rank's rows, in rounds */
+    const uint32_t *end;     /* end of each round in order[] */
+    const uint8_t *resumed;  /* rank 0: rows from the resumed checkpoint, in F already */
+    uint32_t resumed_rows;   /* how many (every rank) */
+    rad_status status;       /* a checkpoint could not be written */
+    rad_error error;
+} row_checkpoints;
+
+/* Puts row i of the FORMFACTORS kind: i, then F_ij and F_ji for j > i. */
+static void sink_row(byte_sink *sink, const float *F, size_t n, uint32_t i)
+{
+    sink_u32(sink, i);
+    for (size_t j = (size_t)i + 1; j < n; j++)
+        sink_floats(sink, &F[i * n + j], 1);
+    for (size_t j = (size_t)i + 1; j < n; j++)
+        sink_floats(sink, &F[j * n + i], 1);
+}
+
+/* Collective: rank 0's body of every rank's rows done (after `rounds` rounds). */
+static rad_status rows_body(row_checkpoints *c, uint32_t rounds, byte_sink *body,
+                            uint32_t *count, rad_error *error)
+{
+    byte_sink mine = {0};
+    uint32_t done = c->end[rounds - 1];
+    for (uint32_t k = 0; k < done; k++)
+        sink_row(&mine, c->F, c->n, c->order[k]);
+    for (uint32_t i = 0; c->resumed && i < c->n; i++)
+        if (c->resumed[i])
+            sink_row(&mine, c->F, c->n, i);
+    uint64_t rows = done + (c->resumed ? c->resumed_rows : 0);
+    ranks_sum(&rows, 1);
+    *count = (uint32_t)rows;
+    rad_status status = mine.failed ? rad_fail(error, RAD_ERR_NOMEM,
+                                                "out of memory for a checkpoint's rows")
+                                    : RAD_OK;
+    status = ranks_agree(status, "writing a checkpoint", error);
+    if (status != RAD_OK) {
+        sink_free(&mine);
+        return status;
+    }
+    body->off = ranks_rank() != 0;
+    sink_u32(body, (uint32_t)c->n);
+    sink_u32(body, *count);
+    if (ranks_count() == 1) {
+        sink_bytes(body, mine.bytes, mine.size);
+        sink_free(&mine);
+        return RAD_OK;
+    }
+    void *gathered = NULL;
+    uint64_t *sizes = rad_alloc_array((size_t)ranks_count(), sizeof(uint64_t));
+    status = ranks_agree(sizes ? RAD_OK : rad_fail(error, RAD_ERR_NOMEM, "out of memory"),
+                         "writing a checkpoint", error);
+    if (status == RAD_OK)
+        status = ranks_gather(mine.bytes, mine.size, &gathered, sizes, error);
+    sink_free(&mine);
+    if (status == RAD_OK && ranks_rank() == 0) {
+        uint64_t total = 0;
+        for (int r = 0; r < ranks_count(); r++)
+            total += sizes[r];
+        sink_bytes(body, gathered, (size_t)total);
+    }
+    free(gathered);
+    free(sizes);
+    return status;
+}
+
+/* After round r: writes a checkpoint when one is due; true to stop the rows. Collective:
+ * over ranks, a rank that failed before its rows (`failed`, out of memory: it calls this
+ * once) stops every rank here. */
+static bool after_round(void *user, uint32_t round, bool failed)
+{
+    row_checkpoints *c = user;
+    if (ranks_count() > 1 && ranks_failures(failed) > 0) {
+        if (!failed)
+            c->status =
+                rad_fail(&c->error, RAD_ERR_INVALID, "form factors: another rank failed");
+        return true;
+    }
+    if (failed)
+        return true;
+    if (round + 1 >= CHECKPOINT_ROUNDS)
+        return false; /* the rows are done: the solver's first step checkpoints next */
+    bool stop;
+    if (!solve_checkpoint_due(c->cp, &stop))
+        return false;
+    byte_sink body = {0};
+    uint32_t count = 0;
+    rad_status status = rows_body(c, round + 1, &body, &count, &c->error);
+    if (status == RAD_OK)
+        status = solve_checkpoint_write(c->cp, SOLVE_CHECKPOINT_FORMFACTORS, &body,
+                                        c->n ? (double)count / c->n : 1, &c->error);
+    sink_free(&body);
+    if (status != RAD_OK) {
+        c->status = status;
+        return true;
+    }
+    if (stop)
+        c->cp->interrupted = true;
+    return stop;
+}
+
+/* The rows of a FORMFACTORS checkpoint being resumed: done[i] for each (every rank), their
+ * values in F on rank 0 only (the ranks' matrices are summed). */
+static rad_status resume_rows(solve_checkpoint *cp, float *F, size_t n, uint8_t *done,
+                              uint32_t *count, rad_error *error)
+{
+    byte_source src;
+    *count = 0;
+    if (!solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_FORMFACTORS, &src))
+        return RAD_OK;
+    const char *path = cp->resume_path;
+    bool here = ranks_rank() == 0;
+    uint32_t size = source_u32(&src), rows = source_u32(&src);
+    if (size != n || rows > n)
+        return rad_fail(error, RAD_ERR_PARSE, "%s: rows of %u patches (%u of them), not %zu",
+                        path, size, rows, n);
+    for (uint32_t r = 0; r < rows; r++) {
+        uint32_t i = source_u32(&src);
+        if (src.short_read || i >= n || done[i])
+            return rad_fail(error, RAD_ERR_PARSE, "%s: row %u: %s", path, i,
+                            src.short_read ? "truncated" : "repeated or beyond the patches");
+        if (source_left(&src) < 8 * (n - 1 - (size_t)i))
+            return rad_fail(error, RAD_ERR_PARSE, "%s: row %u: truncated", path, i);
+        done[i] = 1;
+        for (int half = 0; half < 2; half++)
+            for (size_t j = (size_t)i + 1; j < n; j++) {
+                float f;
+                source_floats(&src, &f, 1);
+                if (!(f >= 0 && isfinite(f)))
+                    return rad_fail(error, RAD_ERR_PARSE,
+                                    "%s: row %u: a form factor that is not finite and >= 0",
+                                    path, i);
+                if (here)
+                    F[half ? j * n + i : i * n + j] = f;
+            }
+    }
+    if (source_left(&src))
+        return rad_fail(error, RAD_ERR_PARSE, "%s: %zu unexpected bytes after the rows", path,
+                        source_left(&src));
+    *count = rows;
+    return RAD_OK;
+}
+
+/* This rank's rows of those not done, in rounds of equal cost (pairs): order[] and
+ * end[CHECKPOINT_ROUNDS]; *mine[i] = 1 for each. Collective. */
+static rad_status plan_rounds(size_t n, const uint8_t *done, uint32_t **order, uint32_t *end,
+                              uint8_t **mine, rad_error *error)
+{
+    double *cost = rad_alloc_array(n, sizeof(*cost));
+    uint32_t *owner = rad_alloc_array(n, sizeof(*owner));
+    *order = rad_alloc_array(n ? n : 1, sizeof(**order));
+    *mine = rad_alloc_array(n, 1);
+    rad_status status = cost && owner && *order && *mine ? RAD_OK : RAD_ERR_NOMEM;
+    for (size_t i = 0; status == RAD_OK && i < n; i++)
+        cost[i] = done[i] ? 0 : (double)(n - 1 - i) + 1;
+    if (status == RAD_OK && ranks_count() > 1)
+        status = partition_by_cost(cost, (uint32_t)n, ranks_count(), owner, error);
+    double total = 0;
+    uint32_t count = 0;
+    for (size_t i = 0; status == RAD_OK && i < n; i++) {
+        (*mine)[i] = !done[i] && (ranks_count() == 1 || owner[i] == (uint32_t)ranks_rank());
+        if ((*mine)[i]) {
+            (*order)[count++] = (uint32_t)i;
+            total += cost[i];
+        }
+    }
+    /* round r ends at the first row whose cumulative cost reaches (r + 1) / ROUNDS */
+    double sum = 0;
+    uint32_t k = 0;
+    for (uint32_t r = 0; status == RAD_OK && r < CHECKPOINT_ROUNDS; r++) {
+        double limit = total * (r + 1) / CHECKPOINT_ROUNDS;
+        while (k < count && (sum < limit || r + 1 == CHECKPOINT_ROUNDS))
+            sum += cost[(*order)[k++]];
+        end[r] = k;
+    }
+    free(cost);
+    free(owner);
+    if (status != RAD_OK)
+        rad_fail(error, RAD_ERR_NOMEM, "out of memory sharing %zu rows", n);
+    return ranks_agree(status, "form factors", error);
+}
+
+/* The rows with checkpoints: after resume_rows, this rank's others in rounds. Sets *mine
+ * (this rank's rows, for gather_matrix). */
+static rad_status rows_in_rounds(const rad_mesh *mesh, const rad_tracer *occluders,
+                                 const rad_formfactor_options *options, solve_checkpoint *cp,
+                                 dense_sink *sink, uint8_t **mine,
+                                 rad_formfactor_report *report, rad_error *error)
+{
+    size_t n = sink->n;
+    uint8_t *done = rad_alloc_array(n, 1);
+    uint32_t *order = NULL, end[CHECKPOINT_ROUNDS], resumed = 0;
+    rad_status status = done ? RAD_OK : rad_fail(error, RAD_ERR_NOMEM, "out of memory");
+    if (status == RAD_OK)
+        status = resume_rows(cp, sink->F, n, done, &resumed, error);
+    status = ranks_agree(status, "reading the checkpoint", error);
+    if (status == RAD_OK) {
+        solve_checkpoint_resumed(cp);
+        status = plan_rounds(n, done, &order, end, mine, error);
+    }
+    row_checkpoints c = {cp,     sink->F, n, order, end, ranks_rank() == 0 ? done : NULL,
+                         resumed, RAD_OK,  {0}};
+    pair_rounds rounds = {order, end, CHECKPOINT_ROUNDS, after_round, &c, 0};
+    if (status == RAD_OK)
+        status = pair_engine_run_rounds(mesh, occluders, options, &rounds, store_pair, sink,
+                                        report, error);
+    if (status == RAD_OK && c.status != RAD_OK) {
+        status = c.status;
+        if (error)
+            *error = c.error;
+    }
+    if (status == RAD_OK && ranks_rank() == 0)
+        for (size_t i = 0; i < n; i++)
+            (*mine)[i] |= done[i]; /* rank 0 holds the resumed rows */
+    free(done);
+    free(order);
+    return status;
+}
+
 rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occluders,
                                    const rad_formfactor_options *options,
                                    rad_formfactors **out, rad_formfactor_report *report,
                                    rad_error *error)
+{
+    return formfactors_compute_checkpointed(mesh, occluders, options, NULL, out, report,
+                                            error);
+}
+
+rad_status formfactors_compute_checkpointed(const rad_mesh *mesh, const rad_tracer *occluders,
+                                            const rad_formfactor_options *options,
+                                            solve_checkpoint *cp, rad_formfactors **out,
+                                            rad_formfactor_report *report, rad_error *error)
 {
     *out = NULL;
     size_t n = mesh->patch_count;
@@ -170,11 +416,25 @@ rad_status rad_formfactors_compute(const rad_mesh *mesh, const rad_tracer *occlu
     if (!report)
         report = &local;
     uint8_t *rows = NULL;
-    status = share_rows(n, &rows, error);
     double start = rad_clock_seconds();
-    if (status == RAD_OK)
-        status = pair_engine_run(mesh, occluders, options, rows, store_pair, &sink, report,
-                                 error);
+    if (cp) {
+        status = rows_in_rounds(mesh, occluders, options, cp, &sink, &rows, report, error);
+        if (status == RAD_OK && cp->interrupted) { /* the checkpoint holds the rows done */
+            free(rows);
+            free(F);
+            free(result);
+            return RAD_OK;
+        }
+        if (status == RAD_OK && ranks_count() == 1) {
+            free(rows);
+            rows = NULL;
+        }
+    } else {
+        status = share_rows(n, &rows, error);
+        if (status == RAD_OK)
+            status = pair_engine_run(mesh, occluders, options, rows, store_pair, &sink,
+                                     report, error);
+    }
     double rank_seconds = rad_clock_seconds() - start;
     if (rows)
         status = gather_matrix(F, n, rows, status, report, error);

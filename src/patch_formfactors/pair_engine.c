@@ -452,11 +452,39 @@ static unsigned strata_for(uint32_t rays)
     return k < 1 ? 1 : k > MAX_STRATA ? MAX_STRATA : k;
 }
 
+/* The rows of one call (all, a rank's share, or rounds of them) and their progress. */
+typedef struct row_plan {
+    const uint8_t *rows;   /* NULL: every row of [0, n) */
+    pair_rounds *rounds;   /* NULL: one pass over [0, n) */
+} row_plan;
+
+static rad_status run(const rad_mesh *mesh, const rad_tracer *occluders,
+                      const rad_formfactor_options *options, row_plan plan, pair_sink_fn sink,
+                      void *sink_data, rad_formfactor_report *report, rad_error *error);
+
 rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
                            const rad_formfactor_options *options, const uint8_t *rows,
                            pair_sink_fn sink, void *sink_data, rad_formfactor_report *report,
                            rad_error *error)
 {
+    return run(mesh, occluders, options, (row_plan){rows, NULL}, sink, sink_data, report,
+               error);
+}
+
+rad_status pair_engine_run_rounds(const rad_mesh *mesh, const rad_tracer *occluders,
+                                  const rad_formfactor_options *options, pair_rounds *rounds,
+                                  pair_sink_fn sink, void *sink_data,
+                                  rad_formfactor_report *report, rad_error *error)
+{
+    return run(mesh, occluders, options, (row_plan){NULL, rounds}, sink, sink_data, report,
+               error);
+}
+
+static rad_status run(const rad_mesh *mesh, const rad_tracer *occluders,
+                      const rad_formfactor_options *options, row_plan plan, pair_sink_fn sink,
+                      void *sink_data, rad_formfactor_report *report, rad_error *error)
+{
+    const uint8_t *rows = plan.rows;
     rad_formfactor_options defaults = {0};
     if (!options)
         options = &defaults;
@@ -531,21 +559,48 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
     double start = rad_clock_seconds();
     double total_pairs = (double)n * (n - 1) / 2;
     uint64_t rows_done = 0;
+    if (plan.rounds) { /* the rows in rounds, a callback between two */
+        pair_rounds *r = plan.rounds;
+        uint32_t total = r->rounds ? r->end[r->rounds - 1] : 0;
+        r->stopped_after = r->rounds;
+        for (uint32_t round = 0; round < r->rounds; round++) {
+            uint32_t first = round ? r->end[round - 1] : 0, last = r->end[round];
 #pragma omp parallel num_threads(threads)
-    {
-        int thread = omp_get_thread_num();
+            {
+                int thread = omp_get_thread_num();
 #pragma omp for schedule(dynamic, 1)
-        for (uint32_t i = 0; i < n; i++) {
-            if (!rows || rows[i])
-                row(&e, &work[thread], thread, i);
-            uint64_t done;
+                for (uint32_t k = first; k < last; k++) {
+                    row(&e, &work[thread], thread, r->order[k]);
+                    uint64_t done;
 #pragma omp atomic capture
-            done = ++rows_done;
-            if (thread == 0 && options->progress) {
-                /* pairs done when the first `done` rows are finished (rows go in order) */
-                double pairs_done = (double)done * n - (double)done * (done + 1) / 2;
-                options->progress(options->progress_user, "form factors",
-                                  total_pairs > 0 ? pairs_done / total_pairs : 1);
+                    done = ++rows_done;
+                    if (thread == 0 && options->progress)
+                        options->progress(options->progress_user, "form factors",
+                                          total ? (double)done / total : 1);
+                }
+            }
+            if (r->after_round && r->after_round(r->user, round, false)) {
+                r->stopped_after = round + 1;
+                break;
+            }
+        }
+    } else {
+#pragma omp parallel num_threads(threads)
+        {
+            int thread = omp_get_thread_num();
+#pragma omp for schedule(dynamic, 1)
+            for (uint32_t i = 0; i < n; i++) {
+                if (!rows || rows[i])
+                    row(&e, &work[thread], thread, i);
+                uint64_t done;
+#pragma omp atomic capture
+                done = ++rows_done;
+                if (thread == 0 && options->progress) {
+                    /* pairs done when the first `done` rows are finished (rows go in order) */
+                    double pairs_done = (double)done * n - (double)done * (done + 1) / 2;
+                    options->progress(options->progress_user, "form factors",
+                                      total_pairs > 0 ? pairs_done / total_pairs : 1);
+                }
             }
         }
     }
@@ -570,6 +625,8 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
 nomem:
     status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for form factors of %u patches", n);
 done:
+    if (status != RAD_OK && plan.rounds && plan.rounds->after_round)
+        plan.rounds->after_round(plan.rounds->user, 0, true); /* failed before the rows */
     if (work)
         for (int t = 0; t < threads; t++) {
             batch *b[2] = {&work[t].first, &work[t].refine};

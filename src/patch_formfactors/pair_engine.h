@@ -25,4 +25,24 @@ rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,
                            pair_sink_fn sink, void *sink_data, rad_formfactor_report *report,
                            rad_error *error);
 
+/* Rows in rounds, for a caller that checkpoints between them (solve_checkpoint.h): round r
+ * computes the rows order[end[r - 1] .. end[r]) (end[-1] = 0), then after_round(user, r,
+ * false) runs on the calling thread, outside the parallel work, and ends the run early when
+ * it returns true (stopped_after then holds r + 1 rounds done; else `rounds`). A run that
+ * fails before its rows (out of memory) calls after_round(user, 0, true) once, so that a
+ * caller whose after_round is collective over MPI ranks stays in step with the others. */
+typedef struct pair_rounds {
+    const uint32_t *order;
+    const uint32_t *end;
+    uint32_t rounds;
+    bool (*after_round)(void *user, uint32_t round, bool failed);
+    void *user;
+    uint32_t stopped_after;
+} pair_rounds;
+
+rad_status pair_engine_run_rounds(const rad_mesh *mesh, const rad_tracer *occluders,
+                                  const rad_formfactor_options *options, pair_rounds *rounds,
+                                  pair_sink_fn sink, void *sink_data,
+                                  rad_formfactor_report *report, rad_error *error);
+
 #endif

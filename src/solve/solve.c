@@ -206,6 +206,13 @@ void solve_progress(solve_params *params, double criterion)
 rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
                      rad_rgb *B, rad_solve_report *report, rad_error *error)
 {
+    return solve_checkpointed(system, options, NULL, B, report, error);
+}
+
+rad_status solve_checkpointed(const rad_system *system, const rad_solve_options *options,
+                              solve_checkpoint *cp, rad_rgb *B, rad_solve_report *report,
+                              rad_error *error)
+{
     rad_solve_report local;
     if (!report)
         report = &local;
@@ -234,6 +241,7 @@ rad_status rad_solve(const rad_system *system, const rad_solve_options *options,
     }
     double start = wall_seconds();
     params.start = start;
+    params.checkpoint = cp;
     switch (options ? options->solver : RAD_SOLVER_JACOBI) {
     case RAD_SOLVER_AUTO:
     case RAD_SOLVER_JACOBI:

@@ -16,6 +16,13 @@
 #include "core/error.h"
 #include "solve/solve_internal.h"
 
+/* A checkpoint's vectors: the iterate, three channel arrays. */
+static void put_iterate(const void *user, byte_sink *body)
+{
+    const double *const *x = user;
+    sink_channels(body, x[0], x[1], x[2], (uint32_t)(x[3] - x[0]));
+}
+
 rad_status solve_gauss_seidel(const rad_system *system, solve_params *params, rad_rgb *B,
                               rad_solve_report *report, rad_error *error)
 {
@@ -51,7 +58,30 @@ rad_status solve_gauss_seidel(const rad_system *system, solve_params *params, ra
     if (params->observer)
         solve_observe(params, system, solve_step(params, n, 0, "gauss-seidel", NAN), x0, x1, x2,
                       NULL, true);
+    solve_checkpoint *cp = params->checkpoint;
+    byte_source resumed;
+    if (solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_ITERATE, &resumed)) {
+        iterate_state state;
+        if (!iterate_body_read(cp, n, 1, NULL, NULL, &state, &resumed, error)) {
+            free(work);
+            return RAD_ERR_PARSE;
+        }
+        source_channels(&resumed, x0, x1, x2, n);
+        sweeps = state.iterations;
+        criterion = state.criterion;
+        smallest = state.smallest;
+        solve_checkpoint_resumed(cp);
+    }
     while (sweeps < params->max_iterations) {
+        if (cp) { /* between sweeps */
+            const double *x[4] = {x0, x1, x2, x0 + n};
+            iterate_state state = {sweeps, criterion, smallest, UINT32_MAX};
+            rad_status status = RAD_OK;
+            if (iterate_step(cp, system, &state, put_iterate, x, &status, error)) {
+                free(work);
+                return status;
+            }
+        }
         double sum = 0, largest = -1;
         uint32_t worst = 0;
         for (uint32_t i = 0; i < n; i++) {

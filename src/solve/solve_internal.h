@@ -18,6 +18,7 @@
 #include <stdint.h>
 
 #include "radiosity.h"
+#include "solve/solve_checkpoint.h"
 
 /* The options of rad_solve after validation and defaults. */
 typedef struct solve_params {
@@ -36,6 +37,8 @@ typedef struct solve_params {
     double observe_seconds;  /* spent observing, left out of rad_solve_step.seconds */
     rad_rgb *observed;       /* n values: B in the observer's layout (Jacobi, Gauss-Seidel) */
     uint32_t last_shooter;   /* shooting: the patch of the last shot, or UINT32_MAX */
+    solve_checkpoint *checkpoint; /* NULL: none; else iterate_step between sweeps (shots),
+                                     and a resumed ITERATE state taken at the start */
 } solve_params;
 
 /* Sums across patches are split into at most this many contiguous blocks of rows, each

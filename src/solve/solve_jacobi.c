@@ -25,6 +25,13 @@
 #include "parallel/ranks.h"
 #include "solve/solve_internal.h"
 
+/* A checkpoint's vectors: the iterate B_k, three channel arrays. */
+static void put_iterate(const void *user, byte_sink *body)
+{
+    const double *const *x = user;
+    sink_channels(body, x[0], x[1], x[2], (uint32_t)(x[3] - x[0]));
+}
+
 rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb *B,
                         rad_solve_report *report, rad_error *error)
 {
@@ -57,7 +64,30 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
     rad_solve_step observed = {0};
     if (params->observer)
         observed = solve_step(params, n, 0, "gather", NAN);
+    solve_checkpoint *cp = params->checkpoint;
+    byte_source resumed;
+    if (solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_ITERATE, &resumed)) {
+        iterate_state state;
+        if (!iterate_body_read(cp, n, 1, NULL, NULL, &state, &resumed, error)) {
+            free(work);
+            return RAD_ERR_PARSE;
+        }
+        source_channels(&resumed, old[0], old[1], old[2], n);
+        sweeps = state.iterations;
+        criterion = state.criterion;
+        smallest = state.smallest;
+        solve_checkpoint_resumed(cp);
+    }
     while (sweeps < params->max_iterations) {
+        if (cp) { /* between sweeps: B_sweeps in old[] */
+            const double *x[4] = {old[0], old[1], old[2], old[0] + n};
+            iterate_state state = {sweeps, criterion, smallest, UINT32_MAX};
+            rad_status status = RAD_OK;
+            if (iterate_step(cp, system, &state, put_iterate, x, &status, error)) {
+                free(work);
+                return status;
+            }
+        }
         const double *x0 = old[0], *x1 = old[1], *x2 = old[2];
         double *y0 = cur[0], *y1 = cur[1], *y2 = cur[2];
 #pragma omp parallel for schedule(dynamic, 16) num_threads(threads) \

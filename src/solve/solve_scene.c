@@ -11,13 +11,17 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <omp.h>
 
+#include "core/alloc.h"
+#include "core/clock.h"
 #include "core/error.h"
 #include "core/memory.h"
 #include "solve/hierarchical/hierarchy.h"
+#include "solve/solve_checkpoint.h"
 
 /* The automatic choice keeps the dense matrix to this share of the machine's memory (the
  * form-factor computation itself refuses above 3/4). */
@@ -140,10 +144,41 @@ static rad_status name_patch(const rad_scene *scene, const rad_mesh *mesh, uint3
                     scene->surfaces[mesh->patches[patch].surface].name, patch, copy);
 }
 
+/* A resumed ITERATE checkpoint's matrix in place of computing it (*ff NULL: none). */
+static rad_status resumed_matrix(solve_checkpoint *cp, uint32_t n, rad_solver solver,
+                                 rad_formfactors **ff, rad_formfactor_report *report,
+                                 rad_error *error)
+{
+    byte_source source;
+    *ff = NULL;
+    if (!solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_ITERATE, &source))
+        return RAD_OK;
+    rad_formfactors *m = rad_alloc_array(1, sizeof(*m));
+    float *F = rad_alloc_array((size_t)n * n, sizeof(float));
+    iterate_state state;
+    if (!m || !F) {
+        free(m);
+        free(F);
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the %u x %u matrix of %s", n,
+                        n, cp->resume_path);
+    }
+    if (!iterate_body_read(cp, n, solver == RAD_SOLVER_SHOOT ? 2 : 1, F, report, &state,
+                           &source, error)) {
+        free(m);
+        free(F);
+        return error ? error->status : RAD_ERR_PARSE;
+    }
+    m->n = n;
+    m->F = F;
+    *ff = m;
+    cp->formfactors = *report;
+    return RAD_OK;
+}
+
 static rad_status solve_dense(const rad_scene *scene, const rad_mesh *mesh, const rad_patch_inputs *inputs,
                               const rad_tracer *occluders, const rad_scene_solve_options *o,
-                              rad_solver solver, rad_rgb *B, rad_scene_solve_report *r,
-                              rad_error *error)
+                              rad_solver solver, solve_checkpoint *cp, rad_rgb *B,
+                              rad_scene_solve_report *r, rad_error *error)
 {
     if (solver == RAD_SOLVER_DIRECT && mesh->patch_count > RAD_DIRECT_MAX_PATCHES)
         return rad_fail(error, RAD_ERR_UNSUPPORTED,
@@ -154,10 +189,27 @@ static rad_status solve_dense(const rad_scene *scene, const rad_mesh *mesh, cons
                                          o->threads, o->progress, o->progress_user};
     rad_formfactors *ff = NULL;
     double t0 = seconds_now();
-    rad_status status =
-        rad_formfactors_compute(mesh, occluders, &ff_options, &ff, &r->formfactors, error);
+    rad_status status = RAD_OK;
+    if (cp) {
+        cp->job.quadrature = o->quadrature;
+        status = cp->resume_path ? solve_checkpoint_read(cp, error) : RAD_OK;
+        if (status == RAD_OK)
+            status = resumed_matrix(cp, mesh->patch_count, solver, &ff, &r->formfactors, error);
+        if (status != RAD_OK)
+            return status;
+        r->resumed = cp->resume_path != NULL;
+    }
+    if (!ff)
+        status = formfactors_compute_checkpointed(mesh, occluders, &ff_options, cp, &ff,
+                                                  &r->formfactors, error);
     if (status != RAD_OK)
         return status;
+    if (cp && cp->interrupted) { /* the checkpoint holds the rows done */
+        r->interrupted = true;
+        return RAD_OK;
+    }
+    if (cp)
+        cp->formfactors = r->formfactors;
     rad_formfactors_check(ff, mesh, &r->check);
     double t1 = seconds_now();
     r->seconds_form_factors = t1 - t0;
@@ -166,11 +218,15 @@ static rad_status solve_dense(const rad_scene *scene, const rad_mesh *mesh, cons
                                        true,      o->threads,   o->progress,
                                        o->progress_user, o->observer, o->observer_user,
                                        o->observe_every};
-    status = rad_solve(&system, &solve_options, B, &r->solve, error);
+    status = solve_checkpointed(&system, &solve_options, cp, B, &r->solve, error);
     rad_formfactors_destroy(ff);
     r->seconds_solve = seconds_now() - t1;
     if (status != RAD_OK)
         return name_patch(scene, mesh, r->solve.patch, status, error);
+    if (cp && cp->interrupted) { /* the checkpoint holds the iterate */
+        r->interrupted = true;
+        return RAD_OK;
+    }
     if (r->formfactors.rows_trimmed > 0) {
         uint32_t p = r->formfactors.largest_row;
         rad_warn(o->log, o->log_user,
@@ -196,8 +252,8 @@ static rad_status solve_dense(const rad_scene *scene, const rad_mesh *mesh, cons
 
 static rad_status solve_hierarchy(const rad_scene *scene, const rad_mesh *mesh, const rad_patch_inputs *inputs,
                                   const rad_tracer *occluders,
-                                  const rad_scene_solve_options *o, rad_rgb *B,
-                                  rad_scene_solve_report *r, rad_error *error)
+                                  const rad_scene_solve_options *o, solve_checkpoint *cp,
+                                  rad_rgb *B, rad_scene_solve_report *r, rad_error *error)
 {
     uint64_t budget = solver_budget(o), link_budget = budget;
     if (budget) {
@@ -233,8 +289,17 @@ static rad_status solve_hierarchy(const rad_scene *scene, const rad_mesh *mesh, 
                                o->progress_user,    o->observer,        o->observer_user};
     double t0 = seconds_now();
     r->hierarchy.patch = UINT32_MAX;
-    rad_status status =
-        rad_solve_hierarchical(mesh, inputs, occluders, &h, B, &r->hierarchy, error);
+    rad_status status = RAD_OK;
+    if (cp) {
+        cp->job.refine_threshold = o->refine_threshold;
+        cp->job.link_budget = link_budget;
+        status = cp->resume_path ? solve_checkpoint_read(cp, error) : RAD_OK;
+        if (status != RAD_OK)
+            return status;
+        r->resumed = cp->resume_path != NULL;
+    }
+    status = solve_hierarchical_checkpointed(mesh, inputs, occluders, &h, cp, B, &r->hierarchy,
+                                             error);
     r->seconds_solve = seconds_now() - t0;
     if (status != RAD_OK)
         return name_patch(scene, mesh, r->hierarchy.patch, status, error);
@@ -243,7 +308,9 @@ static rad_status solve_hierarchy(const rad_scene *scene, const rad_mesh *mesh, 
     r->residual = hr->residual;
     r->converged = hr->converged;
     r->interrupted = hr->interrupted;
-    if (hr->interrupted)
+    if (hr->interrupted && cp && cp->path)
+        ; /* the caller tells of the checkpoint */
+    else if (hr->interrupted)
         rad_warn(o->log, o->log_user,
                  "interrupted: refinement and gathering stopped after %u passes and %u "
                  "sweeps (residual %.3g); going on with the solution so far",
@@ -325,11 +392,36 @@ rad_status rad_solve_scene(const rad_scene *scene, const rad_mesh *mesh,
     }
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
+    /* checkpoints: the job here, its solver's options there (solve_dense, solve_hierarchy) */
+    solve_checkpoint checkpoint = {0}, *cp = NULL;
+    if (status == RAD_OK && (o.checkpoint || o.resume)) {
+        cp = &checkpoint;
+        cp->path = o.checkpoint;
+        cp->interval = o.checkpoint_interval > 0 ? o.checkpoint_interval : 0;
+        cp->last = rad_clock_seconds();
+        cp->stop = o.stop;
+        cp->progress = o.progress;
+        cp->progress_user = o.progress_user;
+        cp->resume_path = o.resume;
+        cp->job = (solve_checkpoint_job){0, mesh->patch_count, (uint32_t)r.solver, 0,
+                                         o.visibility_rays, o.max_iterations, o.seed,
+                                         o.tolerance, 0, 0};
+        status = rad_solution_fingerprint(scene, mesh, &cp->job.fingerprint, error);
+    }
     if (status == RAD_OK)
         status = r.solver == RAD_SOLVER_HIERARCHICAL
-                     ? solve_hierarchy(scene, mesh, inputs, occluders, &o, B, &r, error)
-                     : solve_dense(scene, mesh, inputs, occluders, &o, r.solver, B, &r, error);
+                     ? solve_hierarchy(scene, mesh, inputs, occluders, &o, cp, B, &r, error)
+                     : solve_dense(scene, mesh, inputs, occluders, &o, r.solver, cp, B, &r,
+                                   error);
+    if (cp) {
+        r.checkpoints = cp->written;
+        r.interrupted = r.interrupted || cp->interrupted;
+        solve_checkpoint_resumed(cp);
+    }
     rad_tracer_destroy(occluders);
+    if (status == RAD_OK && cp && cp->interrupted) /* no solution: the checkpoint has it */
+        for (uint32_t i = 0; i < mesh->patch_count; i++)
+            B[i] = inputs->source[i];
     /* every value finite and at least the patch's own source term (what comes in is >= 0) */
     for (uint32_t i = 0; status == RAD_OK && i < mesh->patch_count; i++) {
         rad_rgb *b = &B[i];

@@ -114,6 +114,23 @@ static void add_ambient(const rad_system *system, const rad_rgb *dB, rad_rgb *B)
     }
 }
 
+/* Shots between two checkpoint steps (each step a clock read, and over MPI ranks two small
+ * collectives): a sixteenth of the patches. */
+#define SHOOT_CHECKPOINT_DIVISOR 16u
+
+/* A checkpoint's vectors: B, then the unshot dB. */
+typedef struct shoot_vectors {
+    const rad_rgb *B, *dB;
+    uint32_t n;
+} shoot_vectors;
+
+static void put_vectors(const void *user, byte_sink *body)
+{
+    const shoot_vectors *v = user;
+    sink_rgbs(body, v->B, v->n);
+    sink_rgbs(body, v->dB, v->n);
+}
+
 rad_status solve_shoot(const rad_system *system, solve_params *params, rad_rgb *B,
                        rad_solve_report *report, rad_error *error)
 {
@@ -133,6 +150,25 @@ rad_status solve_shoot(const rad_system *system, solve_params *params, rad_rgb *
         w[j] = (rad_rgb){rho.r / area[j], rho.g / area[j], rho.b / area[j]};
     }
 
+    solve_checkpoint *cp = params->checkpoint;
+    const uint32_t checkpoint_every =
+        n / SHOOT_CHECKPOINT_DIVISOR > 0 ? n / SHOOT_CHECKPOINT_DIVISOR : 1;
+    double criterion = INFINITY, smallest = INFINITY;
+    uint32_t shots = 0;
+    byte_source resumed;
+    if (solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_ITERATE, &resumed)) {
+        iterate_state state;
+        if (!iterate_body_read(cp, n, 2, NULL, NULL, &state, &resumed, error)) {
+            free(work);
+            return RAD_ERR_PARSE;
+        }
+        source_rgbs(&resumed, B, n);
+        source_rgbs(&resumed, dB, n);
+        shots = state.iterations;
+        smallest = state.smallest;
+        params->last_shooter = state.last_shooter;
+        solve_checkpoint_resumed(cp);
+    }
     const uint32_t blocks = solve_block_count(n);
     shoot_block block[SOLVE_BLOCKS];
     for (uint32_t b = 0; b < blocks; b++)
@@ -142,9 +178,16 @@ rad_status solve_shoot(const rad_system *system, solve_params *params, rad_rgb *
     const double scale = solve_criterion_scale(system);
     const int threads = params->threads;
     (void)threads; /* unused without OpenMP */
-    double criterion = INFINITY, smallest = INFINITY;
-    uint32_t shots = 0;
     for (;;) {
+        if (cp && shots % checkpoint_every == 0) { /* between shots */
+            shoot_vectors v = {B, dB, n};
+            iterate_state state = {shots, criterion, smallest, params->last_shooter};
+            rad_status status = RAD_OK;
+            if (iterate_step(cp, system, &state, put_vectors, &v, &status, error)) {
+                free(work);
+                return status;
+            }
+        }
         double unshot = 0, best = -1;
         uint32_t shooter = 0;
         for (uint32_t b = 0; b < blocks; b++) {

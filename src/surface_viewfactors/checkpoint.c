@@ -1,23 +1,21 @@
 /*
  * checkpoint.c - the restart file of a view-factor run (checkpoint.h).
  *
- * Layout, little-endian: the magic "\x89RADVFC\n", format version (u32), surface count
+ * The container (core/checkpoint_file.h): the magic "\x89RADVFC\n", format version (u32),
+ * the body, its checksum. The body, little-endian: surface count
  * (u32), scene fingerprint (u64), accuracy (f64), ray cap (u32), seed (u64), rows in the
  * file (u32); then per row, in increasing row order, the row I (u32), its entry count (u32)
  * and per entry the column J >= I (u32, increasing), the transfer G_IJ (f64, >= 0) and its
- * error bound (f64, >= 0; > 0 when the transfer is 0: a sampled pair that saw nothing); last the FNV-1a checksum of every byte before it (u64). The
- * whole file is checked before any row is used. Written atomically (core/atomic_file.h),
- * so a run killed while writing leaves the previous checkpoint whole.
+ * error bound (f64, >= 0; > 0 when the transfer is 0: a sampled pair that saw nothing). The
+ * whole file is checked before any row is used.
  */
-#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "core/alloc.h"
-#include "core/atomic_file.h"
 #include "core/bytes.h"
+#include "core/checkpoint_file.h"
 #include "core/error.h"
 #include "core/hash.h"
 #include "surface_viewfactors/checkpoint.h"
@@ -29,7 +27,7 @@ enum {
     HEADER_BYTES = 48,  /* magic, version, rows, fingerprint, accuracy, rays, seed, count */
     ROW_BYTES = 8,      /* row, entry count */
     ENTRY_BYTES = 20,   /* column, transfer, bound */
-    CHECKSUM_BYTES = 8
+    CHECKSUM_BYTES = CHECKPOINT_FILE_TAIL
 };
 
 uint64_t vf_checkpoint_fingerprint(const rad_scene *scene)
@@ -73,8 +71,6 @@ rad_status vf_checkpoint_write(const char *path, const vf_checkpoint_job *job,
     if (!bytes)
         return rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for a checkpoint of %llu bytes",
                         path, (unsigned long long)size);
-    memcpy(bytes, checkpoint_magic, sizeof(checkpoint_magic));
-    bytes_put_u32(bytes + 8, CHECKPOINT_VERSION);
     bytes_put_u32(bytes + 12, job->rows);
     bytes_put_u64(bytes + 16, job->fingerprint);
     bytes_put_f64(bytes + 24, job->accuracy);
@@ -94,8 +90,9 @@ rad_status vf_checkpoint_write(const char *path, const vf_checkpoint_job *job,
             bytes_put_f64(p + 12, rows[I].entries[k].bound);
         }
     }
-    bytes_put_u64(p, hash_bytes(RAD_HASH_START, bytes, (size_t)size - CHECKSUM_BYTES));
-    rad_status status = rad_write_file_atomic(path, bytes, (size_t)size, error);
+    rad_status status =
+        checkpoint_file_write(path, checkpoint_magic, CHECKPOINT_VERSION, bytes, (size_t)size,
+                              error);
     free(bytes);
     return status;
 }
@@ -128,21 +125,9 @@ static rad_status parse_checkpoint(const char *path, const uint8_t *bytes, size_
                                    const vf_checkpoint_job *job, pending_row *rows,
                                    uint8_t *done, uint32_t *count, rad_error *error)
 {
-    if (size < sizeof(checkpoint_magic) ||
-        memcmp(bytes, checkpoint_magic, sizeof(checkpoint_magic)))
-        return rad_fail(error, RAD_ERR_PARSE, "%s: not a view-factor checkpoint", path);
     if (size < HEADER_BYTES + CHECKSUM_BYTES)
         return rad_fail(error, RAD_ERR_PARSE, "%s: truncated checkpoint (%zu bytes)", path,
                         size);
-    uint32_t version = bytes_get_u32(bytes + 8);
-    if (version != CHECKPOINT_VERSION)
-        return rad_fail(error, RAD_ERR_PARSE,
-                        "%s: checkpoint format version %u; this build reads version %d", path,
-                        version, CHECKPOINT_VERSION);
-    if (hash_bytes(RAD_HASH_START, bytes, size - CHECKSUM_BYTES) !=
-        bytes_get_u64(bytes + size - CHECKSUM_BYTES))
-        return rad_fail(error, RAD_ERR_PARSE,
-                        "%s: corrupted checkpoint (its checksum does not match)", path);
     rad_status status = match_job(path, bytes, job, error);
     if (status != RAD_OK)
         return status;
@@ -193,35 +178,18 @@ rad_status vf_checkpoint_read(const char *path, const vf_checkpoint_job *job,
                               rad_error *error)
 {
     *count = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return rad_fail(error, RAD_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    struct stat st;
-    rad_status status = RAD_OK;
     uint8_t *bytes = NULL;
-    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-        status = rad_fail(error, RAD_ERR_IO, "%s: not a regular file", path);
-        goto done;
-    }
-    size_t size = (size_t)st.st_size;
-    bytes = rad_alloc_array(size ? size : 1, 1);
-    if (!bytes) {
-        status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory (%zu bytes)", path, size);
-        goto done;
-    }
-    if (size && fread(bytes, 1, size, f) != size) {
-        status = rad_fail(error, RAD_ERR_IO, "%s: read failed", path);
-        goto done;
-    }
-    status = parse_checkpoint(path, bytes, size, job, rows, done, count, error);
+    size_t size = 0;
+    rad_status status = checkpoint_file_read(path, checkpoint_magic, CHECKPOINT_VERSION,
+                                             "view-factor checkpoint", &bytes, &size, error);
+    if (status == RAD_OK)
+        status = parse_checkpoint(path, bytes, size, job, rows, done, count, error);
     if (status != RAD_OK)
         for (uint32_t I = 0; I < job->rows; I++) {
             free(rows[I].entries);
             rows[I] = (pending_row){0};
             done[I] = 0;
         }
-done:
-    fclose(f);
     free(bytes);
     return status;
 }

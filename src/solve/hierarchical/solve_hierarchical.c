@@ -15,6 +15,12 @@
  * sweep the leaves' new B go to every rank, which then measures the change and pulls over
  * the whole tree exactly as one process does: each rank's links and sums are the serial
  * run's, so the solution is bitwise the serial one for any rank count.
+ *
+ * With a checkpoint (solve/solve_checkpoint.h) the state is written at the top of the loop
+ * and between the sweeps to the tolerance when one is due, and always before the final
+ * gather (the longest step, whose stop leaves that checkpoint standing): the links of every
+ * rank gathered at rank 0, each once. A resumed run rebuilds the tree, keeps the links it
+ * receives and goes on from the same point (hierarchy_checkpoint.h).
  */
 #include <math.h>
 #include <omp.h>
@@ -30,6 +36,7 @@
 #include "core/vec3.h"
 #include "solve/hierarchical/final_gather.h"
 #include "solve/hierarchical/hierarchy.h"
+#include "solve/hierarchical/hierarchy_checkpoint.h"
 #include "solve/hierarchical/rank_share.h"
 #include "parallel/ranks.h"
 
@@ -319,10 +326,163 @@ static double refine_fraction(uint32_t passes, uint32_t nodes)
     return 1 - 0.1 * pow(0.9, passes - 0.9 * expected);
 }
 
+/* ---- checkpoints (hierarchy_checkpoint.h) ---- */
+
+/* Every leaf's `down` by leaf-order position, from its owner over ranks. Collective. */
+static void leaves_down(hsolver *s, rad_rgb *by_position)
+{
+    const hier_tree *t = &s->tree;
+    for (uint32_t k = 0; k < t->node_count; k++)
+        if (t->nodes[k].patch != HNODE_NONE &&
+            (!s->over_ranks || s->share.role[k] == RECEIVER_OWN))
+            by_position[t->nodes[k].first] = s->down[k];
+    if (s->over_ranks)
+        rank_share_exchange(&s->share, s->mesh->patch_count, by_position);
+}
+
+/* Collective: writes the state as a HIERARCHY checkpoint: the links of every rank at rank 0
+ * (those every rank holds from rank 0 only). */
+static rad_status write_state(hsolver *s, solve_checkpoint *cp, hier_loop_state *state,
+                              rad_error *error)
+{
+    uint32_t n = s->mesh->patch_count;
+    rad_rgb *down = rad_alloc_array(n, sizeof(rad_rgb));
+    hlink *mine = s->store.links;
+    size_t count = s->store.count;
+    rad_status status = down ? RAD_OK : rad_fail(error, RAD_ERR_NOMEM, "out of memory");
+    if (s->over_ranks && status == RAD_OK && s->share.rank != 0) {
+        mine = rad_alloc_array(count ? count : 1, sizeof(hlink));
+        if (!mine)
+            status = rad_fail(error, RAD_ERR_NOMEM, "out of memory");
+        size_t kept = 0;
+        for (size_t l = 0; mine && l < count; l++)
+            if (s->share.role[s->store.links[l].receiver] != RECEIVER_SHARED)
+                mine[kept++] = s->store.links[l];
+        count = kept;
+    }
+    if (s->over_ranks)
+        status = ranks_agree(status, "writing a checkpoint", error);
+    if (status == RAD_OK)
+        leaves_down(s, down);
+    state->capacity = s->store.capacity;
+    state->peak_bytes = s->store.peak_bytes;
+    if (s->over_ranks) /* the rays every rank traced on its own, in one count */
+        ranks_sum(&state->rays, 1);
+    void *gathered = NULL;
+    uint64_t *sizes = NULL;
+    if (status == RAD_OK && s->over_ranks) {
+        sizes = rad_alloc_array((size_t)ranks_count(), sizeof(uint64_t));
+        status = ranks_agree(sizes ? RAD_OK : rad_fail(error, RAD_ERR_NOMEM, "out of memory"),
+                             "writing a checkpoint", error);
+        if (status == RAD_OK)
+            status = ranks_gather(mine, count * sizeof(hlink), &gathered, sizes, error);
+        if (status == RAD_OK && ranks_rank() == 0) {
+            count = 0;
+            for (int r = 0; r < ranks_count(); r++)
+                count += sizes[r] / sizeof(hlink);
+        }
+    }
+    byte_sink body = {0};
+    body.off = ranks_rank() != 0;
+    if (status == RAD_OK)
+        hier_checkpoint_put(&body, state, n, gathered ? gathered : mine, count, s->patch_B,
+                            down);
+    if (status == RAD_OK)
+        status = solve_checkpoint_write(cp, SOLVE_CHECKPOINT_HIERARCHY, &body, 1, error);
+    sink_free(&body);
+    free(gathered);
+    free(sizes);
+    if (mine != s->store.links)
+        free(mine);
+    free(down);
+    return status;
+}
+
+/* Collective, between sweeps: writes the state when a checkpoint is due (or always);
+ * true when the solver is to stop here (cp->interrupted) or the write failed (*status). */
+static bool checkpoint_step(hsolver *s, solve_checkpoint *cp, hier_loop_state *state,
+                            bool always, rad_status *status, rad_error *error)
+{
+    bool stop = false;
+    bool due = solve_checkpoint_due(cp, &stop);
+    if (!due && !(always && cp->path))
+        return false;
+    *status = write_state(s, cp, state, error);
+    if (*status != RAD_OK)
+        return true;
+    cp->interrupted = stop;
+    return stop;
+}
+
+/* The resumed state: this rank's links, B and the leaves' down; false (error set) for a
+ * state that does not fit this tree. */
+static bool resume_state(hsolver *s, solve_checkpoint *cp, hier_loop_state *state,
+                         rad_error *error)
+{
+    byte_source source;
+    if (!solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_HIERARCHY, &source))
+        return true;
+    uint32_t n = s->mesh->patch_count;
+    rad_rgb *down = rad_alloc_array(n, sizeof(rad_rgb));
+    uint8_t *keep = NULL;
+    if (s->over_ranks && (keep = rad_alloc_array(s->tree.node_count, 1)))
+        for (uint32_t k = 0; k < s->tree.node_count; k++)
+            keep[k] = s->share.role[k] != RECEIVER_ELSEWHERE;
+    hlink *links = NULL;
+    size_t count = 0, capacity = 0;
+    bool ok = down && (!s->over_ranks || keep);
+    if (!ok)
+        rad_fail(error, RAD_ERR_NOMEM, "out of memory resuming from %s", cp->resume_path);
+    else
+        ok = hier_checkpoint_get(&source, cp->resume_path, &s->tree, n, keep, state, &links,
+                                 &count, &capacity, s->patch_B, down, error);
+    hlink *spare = NULL;
+    if (ok) {
+        if (s->over_ranks) /* this rank's share of the links: its store from them alone */
+            capacity = count ? count : 1;
+        spare = rad_alloc_array(capacity, sizeof(hlink));
+        ok = spare != NULL;
+        if (!ok)
+            rad_fail(error, RAD_ERR_NOMEM, "out of memory for the links of %s",
+                     cp->resume_path);
+    }
+    if (ok) {
+        free(s->store.links);
+        free(s->store.spare);
+        s->store.links = links;
+        s->store.spare = spare;
+        s->store.count = count;
+        s->store.capacity = capacity;
+        s->store.peak_bytes = s->over_ranks ? (uint64_t)capacity * 2 * sizeof(hlink)
+                                            : state->peak_bytes;
+        for (uint32_t k = 0; k < s->tree.node_count; k++)
+            if (s->tree.nodes[k].patch != HNODE_NONE)
+                s->down[k] = down[s->tree.nodes[k].first];
+        pull(s);
+        links = NULL;
+        solve_checkpoint_resumed(cp);
+    }
+    free(links);
+    free(down);
+    free(keep);
+    return ok;
+}
+
 rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *inputs,
                                   const rad_tracer *occluders,
                                   const rad_hierarchy_options *options, rad_rgb *B,
                                   rad_hierarchy_report *report, rad_error *error)
+{
+    return solve_hierarchical_checkpointed(mesh, inputs, occluders, options, NULL, B, report,
+                                           error);
+}
+
+rad_status solve_hierarchical_checkpointed(const rad_mesh *mesh,
+                                           const rad_patch_inputs *inputs,
+                                           const rad_tracer *occluders,
+                                           const rad_hierarchy_options *options,
+                                           solve_checkpoint *cp, rad_rgb *B,
+                                           rad_hierarchy_report *report, rad_error *error)
 {
     rad_hierarchy_options o = {0};
     if (options)
@@ -450,9 +610,46 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
     uint64_t rays_shared = 0; /* over ranks: traced alike on every rank, counted once */
     bool refining = links_anywhere(&s), converged = false;
     uint32_t quiet_passes = 0;
-    while (!stopped(&s, &o) && rep.iterations < max_sweeps && !s.diverged) {
+    /* a checkpoint: the state at its points (loop_state), resumed or written */
+    hier_loop_state resumed = {0};
+    rad_status checkpointed = RAD_OK;
+    bool halt = false; /* a checkpoint's stop, or its failure */
+    if (cp) {
+        rad_status status = resume_state(&s, cp, &resumed, error) ? RAD_OK : RAD_ERR_PARSE;
+        if (s.over_ranks)
+            status = ranks_agree(status, "resuming the hierarchical solver", error);
+        if (status != RAD_OK) {
+            hsolver_free(&s);
+            return status == RAD_ERR_PARSE && error ? error->status : status;
+        }
+        if (resumed.phase) {
+            rep.iterations = resumed.iterations;
+            rep.passes = resumed.passes;
+            rep.rays = s.over_ranks && s.share.rank != 0 ? 0 : resumed.rays;
+            rep.memory_capped = resumed.memory_capped;
+            rays_shared = resumed.rays_shared;
+            quiet_passes = resumed.quiet_passes;
+            refining = resumed.refining;
+            converged = resumed.converged;
+            sweep_change = resumed.sweep_change;
+        }
+    }
+#define LOOP_STATE(at, first_change)                                                        \
+    (hier_loop_state)                                                                      \
+    {                                                                                      \
+        (at), rep.iterations, rep.passes, quiet_passes, rep.rays, rays_shared,             \
+            rep.memory_capped, refining, converged, sweep_change, (first_change), 0, 0     \
+    }
+    bool resume_gather = resumed.phase == HIER_IN_GATHER;
+    bool skip_loop = resumed.phase == HIER_BEFORE_FINAL;
+    while (!skip_loop &&
+           !(cp && !resume_gather &&
+             (halt = checkpoint_step(&s, cp, &LOOP_STATE(HIER_AT_PASS, 0), false,
+                                     &checkpointed, error))) &&
+           !stopped(&s, &o) && rep.iterations < max_sweeps && !s.diverged) {
         size_t split = 0;
-        if (refining && !rep.memory_capped && rep.passes < MAX_PASSES) {
+        if (resume_gather) { /* straight back to the sweeps to the tolerance */
+        } else if (refining && !rep.memory_capped && rep.passes < MAX_PASSES) {
             double tr = now_seconds();
             refine_result rr;
             update_brightness(&s);
@@ -498,9 +695,12 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             continue;
         }
         /* nothing split: sweep to the tolerance, then look once more */
-        double first = sweep_change;
-        while (sweep_change > tolerance && rep.iterations < max_sweeps && !stopped(&s, &o) &&
-               !s.diverged) {
+        double first = resume_gather ? resumed.first : sweep_change;
+        resume_gather = false;
+        while (sweep_change > tolerance && rep.iterations < max_sweeps &&
+               !(cp && (halt = checkpoint_step(&s, cp, &LOOP_STATE(HIER_IN_GATHER, first),
+                                               false, &checkpointed, error))) &&
+               !stopped(&s, &o) && !s.diverged) {
             sweep_change = sweep_observed(&s, &ob, "gather");
             rep.iterations++;
             if (o.progress && first > tolerance && sweep_change > 0)
@@ -509,6 +709,8 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
                                                   log(first / tolerance))));
         }
         rep.seconds_gather += now_seconds() - tg;
+        if (halt)
+            break;
         if (sweep_change <= tolerance && (quiet_passes > 0 || !refining ||
                                           rep.memory_capped || rep.passes >= MAX_PASSES)) {
             converged = true;
@@ -517,9 +719,24 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
         quiet_passes++;
         refining = links_anywhere(&s);
     }
+    if (checkpointed != RAD_OK) {
+        hsolver_free(&s);
+        return checkpointed;
+    }
     if (o.progress)
         o.progress(o.progress_user, "gather", 1);
-    if (!stopped(&s, &o) && links_anywhere(&s) && !s.diverged) {
+    if (!halt && !stopped(&s, &o) && links_anywhere(&s) && !s.diverged) {
+        if (cp && cp->path) { /* the final gather is long: its stop goes back to here */
+            sort_by_receiver(&s); /* as it is after any sweep (and resumed links) */
+            checkpoint_step(&s, cp, &LOOP_STATE(HIER_BEFORE_FINAL, 0), true, &checkpointed,
+                            error);
+            if (checkpointed != RAD_OK) {
+                hsolver_free(&s);
+                return checkpointed;
+            }
+        }
+        if (cp && cp->interrupted)
+            goto final_done;
         double tf = now_seconds();
         s.correction = rad_alloc_array(nodes, sizeof(rad_rgb));
         s.scale = rad_alloc_array(nodes, sizeof(rad_rgb));
@@ -565,7 +782,11 @@ rad_status rad_solve_hierarchical(const rad_mesh *mesh, const rad_patch_inputs *
             o.progress(o.progress_user, "final gather", 1);
         rep.seconds_final = now_seconds() - tf;
     }
+final_done:
+#undef LOOP_STATE
     rep.interrupted = stopped(&s, &o);
+    if (cp && cp->path && rep.interrupted)
+        cp->interrupted = true; /* the last checkpoint written stands for this point */
     rep.converged = converged && !rep.interrupted;
     rep.change = sweep_change;
     /* the sweep_change of the B handed out: one more sweep, measured and not applied */
