@@ -81,8 +81,7 @@ void emitters_free(emitter_set *set)
     memset(set, 0, sizeof(*set));
 }
 
-void emitters_sample(const emitter_set *set, const rad_scene *scene, double u0, double u1,
-                     double u2, emitter_sample *sample)
+uint32_t emitters_index(const emitter_set *set, double u0)
 {
     /* the first k with cdf[k] > u0 */
     uint32_t lo = 0, hi = set->count - 1;
@@ -93,7 +92,13 @@ void emitters_sample(const emitter_set *set, const rad_scene *scene, double u0, 
         else
             lo = mid + 1;
     }
-    uint32_t t = set->triangle[lo];
+    return lo;
+}
+
+void emitters_sample(const emitter_set *set, const rad_scene *scene, double u0, double u1,
+                     double u2, emitter_sample *sample)
+{
+    uint32_t t = set->triangle[emitters_index(set, u0)];
     const rad_triangle *tri = &scene->triangles[t];
     rad_vec3 a = scene->positions[tri->vertex[0]], b = scene->positions[tri->vertex[1]],
              c = scene->positions[tri->vertex[2]];

@@ -47,6 +47,10 @@ typedef struct emitter_sample {
     bool two_sided;     /* the triangle's surface radiates from both sides */
 } emitter_sample;
 
+/* The emitting triangle (an index into set->triangle) that u0 in [0,1) picks: the first
+ * k with cdf[k] > u0. The set must not be empty. */
+uint32_t emitters_index(const emitter_set *set, double u0);
+
 /* u0 picks the triangle, (u1, u2) the point; all in [0,1). The set must not be empty. */
 void emitters_sample(const emitter_set *set, const rad_scene *scene, double u0, double u1,
                      double u2, emitter_sample *sample);

@@ -25,20 +25,6 @@
 
 static double wrap(double u) { return u < 1 ? u : u - 1; }
 
-/* The emitting triangle emitters_sample picks for u0: the first k with cdf[k] > u0. */
-static uint32_t emitter_index(const emitter_set *set, double u0)
-{
-    uint32_t lo = 0, hi = set->count - 1;
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (set->cdf[mid] > u0)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
-}
-
 static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
                            rad_vec3 n, double leave, uint32_t count, double turn, uint32_t first,
                            double shift1, double shift2, bool by_triangle,
@@ -56,7 +42,7 @@ static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_v
             /* evenly spaced choices (k + turn) / count, so each triangle gets its share of
              * consecutive samples, and its own Halton points (bases 2, 3) on it */
             u0 = (k + turn) / count;
-            uint32_t t = emitter_index(set, u0);
+            uint32_t t = emitters_index(set, u0);
             if (t != current) {
                 current = t;
                 local = 0;
