@@ -597,8 +597,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     if (gather_rays > MAX_GATHER_RAYS)
         gather_rays = MAX_GATHER_RAYS;
 
-    /* the emitters' direct light at every pixel sample or at every vertex, and its patch
-     * means to take out of the solution first */
+    /* the emitters' direct light at every pixel sample (with its patch means to take out of
+     * the solution first) or at every vertex */
     rad_direct_light direct_light = options->scene && rad_scene_has_emitter(options->scene)
                                         ? options->direct_light
                                         : RAD_DIRECT_SOLUTION;
@@ -657,11 +657,12 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                         lights_ptr, tracer};
     if (direct_light != RAD_DIRECT_SOLUTION) {
         /* what gather rays meet: the reflected light (B - E) / pi at the vertices */
-        near = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1, sizeof(*near));
+        if (direct_light == RAD_DIRECT_PIXEL) /* where the pixels gather themselves */
+            near = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1, sizeof(*near));
         reflected = rad_alloc_array(display.vertex_count, sizeof(*reflected));
         rad_rgb *outgoing = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1,
                                             sizeof(*outgoing));
-        bool made = near && reflected && outgoing;
+        bool made = (near || direct_light == RAD_DIRECT_VERTEX) && reflected && outgoing;
         for (uint32_t p = 0; made && p < mesh->patch_count; p++)
             outgoing[p] = rgb_max0(rgb_add(B[p], rgb_scale(inputs->exitance[p], -1)));
         display_hidden_patches(mesh, tracer, leave, hidden, near, NEAR_DISTANCE);
@@ -672,14 +673,14 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         view.reflected = reflected;
     } else
         display_hidden_patches(mesh, tracer, leave, hidden, NULL, 0);
-    if (!display_mesh_radiance_weighted(mesh, &display, shaded ? shaded : B, hidden, radiance))
-        goto nomem;
     if (direct_light == RAD_DIRECT_VERTEX) {
         status = vertex_radiance(options, mesh, &display, &emitters, scene_tracer, &view,
                                  inputs, lookup, hidden, leave, threads, radiance, error);
         if (status != RAD_OK)
             goto done;
-    }
+    } else if (!display_mesh_radiance_weighted(mesh, &display, shaded ? shaded : B, hidden,
+                                               radiance))
+        goto nomem;
 
     float t_near = (float)(RAD_CAMERA_NEAR * diagonal);
 
@@ -760,7 +761,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                      emitters_ptr, options->scene,
                      emitter_samples, per_row,
                      edge_k * edge_k, scene_tracer,
-                     direct_light == RAD_DIRECT_PIXEL ? near : NULL, &view,
+                     near,      &view,
                      gather_rays};
 
     /* over several MPI ranks the rows are dealt out in turn (every pixel's random numbers
