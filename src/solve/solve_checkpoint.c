@@ -403,6 +403,20 @@ void iterate_body_begin(const solve_checkpoint *cp, const rad_system *system,
     sink_u32(body, state->last_shooter);
 }
 
+bool iterate_resume_sweeps(solve_checkpoint *cp, uint32_t n, double *x0, double *x1,
+                           double *x2, iterate_state *state, bool *resumed, rad_error *error)
+{
+    byte_source source;
+    *resumed = solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_ITERATE, &source);
+    if (!*resumed)
+        return true;
+    if (!iterate_body_read(cp, n, 1, NULL, NULL, state, &source, error))
+        return false;
+    source_channels(&source, x0, x1, x2, n);
+    solve_checkpoint_resumed(cp);
+    return true;
+}
+
 bool iterate_body_read(const solve_checkpoint *cp, uint32_t n, uint32_t vectors, float *F,
                        rad_formfactor_report *formfactors, iterate_state *state,
                        byte_source *source, rad_error *error)

@@ -59,18 +59,16 @@ rad_status solve_gauss_seidel(const rad_system *system, solve_params *params, ra
         solve_observe(params, system, solve_step(params, n, 0, "gauss-seidel", NAN), x0, x1, x2,
                       NULL, true);
     solve_checkpoint *cp = params->checkpoint;
-    byte_source resumed;
-    if (solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_ITERATE, &resumed)) {
-        iterate_state state;
-        if (!iterate_body_read(cp, n, 1, NULL, NULL, &state, &resumed, error)) {
-            free(work);
-            return RAD_ERR_PARSE;
-        }
-        source_channels(&resumed, x0, x1, x2, n);
-        sweeps = state.iterations;
-        criterion = state.criterion;
-        smallest = state.smallest;
-        solve_checkpoint_resumed(cp);
+    iterate_state resumed_state;
+    bool resumed;
+    if (!iterate_resume_sweeps(cp, n, x0, x1, x2, &resumed_state, &resumed, error)) {
+        free(work);
+        return RAD_ERR_PARSE;
+    }
+    if (resumed) {
+        sweeps = resumed_state.iterations;
+        criterion = resumed_state.criterion;
+        smallest = resumed_state.smallest;
     }
     while (sweeps < params->max_iterations) {
         if (cp) { /* between sweeps */

@@ -65,18 +65,16 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
     if (params->observer)
         observed = solve_step(params, n, 0, "gather", NAN);
     solve_checkpoint *cp = params->checkpoint;
-    byte_source resumed;
-    if (solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_ITERATE, &resumed)) {
-        iterate_state state;
-        if (!iterate_body_read(cp, n, 1, NULL, NULL, &state, &resumed, error)) {
-            free(work);
-            return RAD_ERR_PARSE;
-        }
-        source_channels(&resumed, old[0], old[1], old[2], n);
-        sweeps = state.iterations;
-        criterion = state.criterion;
-        smallest = state.smallest;
-        solve_checkpoint_resumed(cp);
+    iterate_state resumed_state;
+    bool resumed;
+    if (!iterate_resume_sweeps(cp, n, old[0], old[1], old[2], &resumed_state, &resumed, error)) {
+        free(work);
+        return RAD_ERR_PARSE;
+    }
+    if (resumed) {
+        sweeps = resumed_state.iterations;
+        criterion = resumed_state.criterion;
+        smallest = resumed_state.smallest;
     }
     while (sweeps < params->max_iterations) {
         if (cp) { /* between sweeps: B_sweeps in old[] */
