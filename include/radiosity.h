@@ -1821,6 +1821,19 @@ typedef struct rad_lit_mesh_options {
                                   (rad_patch_inputs_build of this scene and mesh; n must be
                                   mesh->patch_count): every vertex then also carries its
                                   irradiance, see rad_lit_mesh_write */
+    /* NULL, or the scene B was solved for: when it has emitters and direct_light is not
+     * RAD_DIRECT_SOLUTION, every vertex carries the light computed at it, as the default
+     * render shows it (rad_render_options.direct_light, RAD_DIRECT_VERTEX: the emitters'
+     * direct light by 1024 light samples MIS with 512 cosine rays, a final gather of the
+     * solution's reflected light by 1024 rays, plus here the sharp sources' direct light
+     * by one shadow ray each), instead of the area-weighted mean of its patches' B; the
+     * illuminance (with inputs) is then that incident light. Costs about 2600 rays per
+     * vertex. Patches show their mean albedo (the file has no textures). */
+    const rad_scene *scene;
+    rad_direct_light direct_light; /* RAD_DIRECT_VERTEX (default) or RAD_DIRECT_SOLUTION;
+                                      RAD_DIRECT_PIXEL, an image's mode, acts as VERTEX */
+    uint64_t seed;                 /* of the vertex light's rays */
+    int threads;                   /* 0 = all cores */
 } rad_lit_mesh_options;
 
 /* Writes the mesh lit by B (per-patch exitance) by the extension of path:

@@ -326,3 +326,62 @@ void test_obj_box(test_obj *t, double x0, double y0, double z0, double x1, doubl
         test_obj_rectangle(t, 2, z0, x0, y0, x1, y1, -1);
     test_obj_rectangle(t, 2, z1, x0, y0, x1, y1, 1);
 }
+
+/* A little-endian float. */
+static float little_f32(const uint8_t *p)
+{
+    uint32_t bits = (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 |
+                    (uint32_t)p[3] << 24;
+    float v;
+    memcpy(&v, &bits, sizeof(v));
+    return v;
+}
+
+/* The vertex element's three float properties `names` of a binary PLY (any property
+ * order, float/uchar/int types) of the file `name` in the test folder, malloc'd as
+ * count x 3 floats; NULL when one is missing. */
+float *test_ply_vertex_floats(const char *name, const char *const names[3], uint32_t *count)
+{
+    *count = 0;
+    size_t size = 0;
+    uint8_t *bytes = test_read_bytes(test_path(name), &size);
+    const char *end = bytes ? strstr((const char *)bytes, "end_header\n") : NULL;
+    if (!end) {
+        free(bytes);
+        return NULL;
+    }
+    size_t header = (size_t)(end - (const char *)bytes) + strlen("end_header\n");
+    size_t record = 0, offset[3] = {SIZE_MAX, SIZE_MAX, SIZE_MAX};
+    uint32_t vertices = 0;
+    bool in_vertex = false;
+    for (const char *line = (const char *)bytes; line < end;) {
+        const char *next = strchr(line, '\n');
+        char text[128] = {0}, type[32], property[64];
+        memcpy(text, line, (size_t)(next - line) < sizeof(text) - 1 ? (size_t)(next - line)
+                                                                    : sizeof(text) - 1);
+        unsigned u;
+        if (sscanf(text, "element vertex %u", &u) == 1) {
+            in_vertex = true;
+            vertices = u;
+        } else if (strncmp(text, "element ", 8) == 0) {
+            in_vertex = false;
+        } else if (in_vertex && sscanf(text, "property %31s %63s", type, property) == 2) {
+            for (int k = 0; k < 3; k++)
+                if (strcmp(property, names[k]) == 0 && strcmp(type, "float") == 0)
+                    offset[k] = record;
+            record += strcmp(type, "uchar") == 0 ? 1 : 4;
+        }
+        line = next + 1;
+    }
+    float *values = NULL;
+    if (offset[0] != SIZE_MAX && offset[1] != SIZE_MAX && offset[2] != SIZE_MAX &&
+        header + (size_t)vertices * record <= size) {
+        values = calloc(3 * (size_t)vertices + 1, sizeof(*values));
+        for (uint32_t v = 0; v < vertices; v++)
+            for (int k = 0; k < 3; k++)
+                values[3 * v + k] = little_f32(bytes + header + v * record + offset[k]);
+        *count = vertices;
+    }
+    free(bytes);
+    return values;
+}

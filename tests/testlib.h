@@ -70,6 +70,9 @@ const char *test_read_text(const char *path);
 /* The whole file, malloc'd (the caller frees it), its length in *size; NULL (and *size 0)
  * when it cannot be read. */
 uint8_t *test_read_bytes(const char *path, size_t *size);
+/* The vertex element's three float properties `names` of the binary PLY `name` in the
+ * test folder, malloc'd as count x 3 floats; NULL when one is missing. */
+float *test_ply_vertex_floats(const char *name, const char *const names[3], uint32_t *count);
 
 bool test_file_exists(const char *path);
 

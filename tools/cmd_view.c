@@ -350,7 +350,8 @@ static bool check_lit_mesh(const char *path, const unsigned char *bytes, size_t 
 /* ---- a scene, solved ------------------------------------------------------------------ */
 
 /* The lit mesh of the solution as .glb bytes (written to a temporary folder, read back). */
-static bool lit_mesh_bytes(const cli_solved *solved, unsigned char **bytes, size_t *size)
+static bool lit_mesh_bytes(const cli_solved *solved, const cli_shared *shared,
+                           unsigned char **bytes, size_t *size)
 {
     const char *tmp = getenv("TMPDIR");
     char folder[4096], file[4200];
@@ -360,7 +361,11 @@ static bool lit_mesh_bytes(const cli_solved *solved, unsigned char **bytes, size
         return false;
     }
     snprintf(file, sizeof(file), "%s/lit.glb", folder);
-    rad_lit_mesh_options write = {.inputs = solved->inputs};
+    /* the light computed at the vertices, as `solve` and `render` take it by default */
+    rad_lit_mesh_options write = {.inputs = solved->inputs,
+                                  .scene = solved->scene,
+                                  .seed = shared->seed,
+                                  .threads = shared->threads};
     rad_error error = {0};
     bool ok = rad_lit_mesh_write(solved->mesh, solved->B, file, &write, &error) == RAD_OK;
     if (!ok)
@@ -805,7 +810,7 @@ int command_view(int argc, char **argv)
             goto done;
         }
         cli_progress_end();
-        if (!lit_mesh_bytes(&solved, &glb, &glb_size) ||
+        if (!lit_mesh_bytes(&solved, &shared, &glb, &glb_size) ||
             !check_lit_mesh("the lit mesh", glb, glb_size, &triangles))
             goto done;
     }

@@ -21,6 +21,7 @@
 #include "lit_mesh/lit_mesh.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -32,6 +33,7 @@
 #include "core/vec3.h"
 #include "image/tonemap.h"
 #include "reconstruct/display_mesh.h"
+#include "render/vertex_radiance.h"
 
 typedef enum lit_mesh_format { FORMAT_UNKNOWN, FORMAT_PLY, FORMAT_GLB, FORMAT_OBJ } lit_mesh_format;
 
@@ -132,6 +134,13 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
                         "written",
                         path, inputs->n, mesh->patch_count);
 
+    if (options && options->threads < 0)
+        return rad_fail(error, RAD_ERR_INVALID, "%s: thread count %d is negative", path,
+                        options->threads);
+    /* the light computed at the vertices, as the default render shows it */
+    bool vertex_light = options && options->scene && options->direct_light != RAD_DIRECT_SOLUTION &&
+                        rad_scene_has_emitter(options->scene);
+    rad_patch_inputs *built = NULL;
     rad_status status = RAD_OK;
     rad_vec3 *position = NULL, *normal = NULL;
     rad_rgb *radiance = NULL, *display = NULL, *irradiance = NULL, *illuminance = NULL;
@@ -151,11 +160,37 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
         goto done;
     }
     display_mesh_positions(mesh, &shown, position);
-    if (!display_mesh_radiance(mesh, &shown, B, radiance)) {
+    if (vertex_light) {
+        if (inputs)
+            illuminance = rad_alloc_array(n, sizeof(*illuminance));
+        const rad_patch_inputs *used = inputs;
+        if (!used)
+            status = rad_patch_inputs_build(options->scene, mesh, &built, error);
+        if (status == RAD_OK && inputs && !illuminance)
+            status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for the illuminance of "
+                              "%u vertices", path, n);
+        if (status == RAD_OK)
+            status = vertex_radiance_of_solution(
+                mesh, &shown, B, options->scene, used ? used : built, options->seed,
+                options->threads > 0 ? options->threads : omp_get_max_threads(), radiance,
+                illuminance, error);
+        if (status != RAD_OK)
+            goto done;
+        for (uint32_t v = 0; v < n; v++)
+            if (!(isfinite(radiance[v].r) && isfinite(radiance[v].g) && isfinite(radiance[v].b)) ||
+                (illuminance && !(isfinite(illuminance[v].r) && isfinite(illuminance[v].g) &&
+                                  isfinite(illuminance[v].b)))) {
+                status = rad_fail(error, RAD_ERR_INVALID,
+                                  "%s: vertex %u has a radiance that is not finite; nothing "
+                                  "was written",
+                                  path, v);
+                goto done;
+            }
+    } else if (!display_mesh_radiance(mesh, &shown, B, radiance)) {
         status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for %u vertices", path, n);
         goto done;
     }
-    if (inputs) {
+    if (inputs && !vertex_light) {
         irradiance = rad_alloc_array(mesh->patch_count, sizeof(*irradiance));
         illuminance = rad_alloc_array(n, sizeof(*illuminance));
         if (!irradiance || !illuminance) {
@@ -227,6 +262,7 @@ done:
     free(luminance);
     free(irradiance);
     free(illuminance);
+    rad_patch_inputs_destroy(built);
     display_mesh_free(&shown);
     return status;
 }

@@ -38,7 +38,7 @@
 #include "lights/emitters.h"
 #include "parallel/ranks.h"
 #include "render/progress.h"
-#include "render/vertex_light.h"
+#include "render/vertex_radiance.h"
 #include "reconstruct/display_mesh.h"
 #include "scene/patch_materials.h"
 #include "trace/ray.h"
@@ -478,61 +478,6 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
     return RAD_OK;
 }
 
-/* The vertices' radiance from the light there (vertex_light.h): the emission plus the
- * albedo the hits multiply by (rho / pi; 1 / pi where the vertices hold irradiance:
- * textures, or an irradiance image) times the emitters' direct and the gathered
- * irradiance, replacing the values interpolated from the patches; then made displayable
- * (T-vertices, added vertices). The sharp sources' light is the hits' own, as before. */
-static rad_status vertex_radiance(const rad_render_options *options, const rad_mesh *mesh,
-                                  const display_mesh *display, const emitter_set *emitters,
-                                  const rad_tracer *scene_tracer, const gather_view *view,
-                                  const rad_patch_inputs *inputs,
-                                  const patch_material_lookup *lookup, const uint8_t *hidden,
-                                  double leave, int threads, rad_rgb *radiance,
-                                  rad_error *error)
-{
-    uint32_t n = mesh->patch_count ? mesh->patch_count : 1;
-    size_t vertices = display->vertex_count ? display->vertex_count : 1;
-    rad_rgb *factor = rad_alloc_array(n, sizeof(*factor));
-    rad_rgb *emission = rad_alloc_array(n, sizeof(*emission));
-    rad_rgb *vertex_factor = rad_alloc_array(vertices, sizeof(*vertex_factor));
-    rad_rgb *vertex_emission = rad_alloc_array(vertices, sizeof(*vertex_emission));
-    rad_rgb *direct = rad_alloc_array(vertices, sizeof(*direct));
-    rad_rgb *gathered = rad_alloc_array(vertices, sizeof(*gathered));
-    rad_status status = RAD_OK;
-    if (!factor || !emission || !vertex_factor || !vertex_emission || !direct || !gathered) {
-        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for rendering");
-        goto done;
-    }
-    for (uint32_t p = 0; p < mesh->patch_count; p++) {
-        bool holds_irradiance =
-            options->irradiance || patch_material_textured(lookup, mesh->patches[p].material);
-        factor[p] = holds_irradiance ? (rad_rgb){1, 1, 1} : inputs->albedo[p];
-        emission[p] = holds_irradiance ? (rad_rgb){0, 0, 0} : inputs->exitance[p];
-    }
-    if (!display_mesh_radiance_weighted(mesh, NULL, factor, hidden, vertex_factor) ||
-        !display_mesh_radiance_weighted(mesh, NULL, emission, hidden, vertex_emission)) {
-        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for rendering");
-        goto done;
-    }
-    status = vertex_light(emitters, options->scene, mesh, scene_tracer, view, hidden, leave,
-                          options->seed, threads, direct, gathered, error);
-    if (status != RAD_OK)
-        goto done;
-    for (uint32_t v = 0; v < mesh->vertex_count; v++)
-        radiance[v] = rgb_add(vertex_emission[v],
-                              rgb_mul(vertex_factor[v], rgb_add(direct[v], gathered[v])));
-    display_mesh_constrain(mesh, display, radiance);
-done:
-    free(factor);
-    free(emission);
-    free(vertex_factor);
-    free(vertex_emission);
-    free(direct);
-    free(gathered);
-    return status;
-}
-
 rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
                       const rad_render_options *options, rad_image *image, rad_error *error)
 {
@@ -585,10 +530,8 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     rad_vec3 lo, hi;
     v3_bounds(mesh->vertices, mesh->vertex_count, &lo, &hi);
     double diagonal = mesh->vertex_count ? v3_length(v3_sub(hi, lo)) : 1;
-    double largest = fmax(fmax(fmax(fabs(lo.x), fabs(hi.x)), fmax(fabs(lo.y), fabs(hi.y))),
-                          fmax(fabs(lo.z), fabs(hi.z)));
     /* hit points are float: their error grows with the distance from the origin */
-    double leave = RAD_SURFACE_LEAVE_DIAGONAL * diagonal + RAD_SURFACE_LEAVE_COORDINATE * largest;
+    double leave = vertex_radiance_leave(mesh);
     uint32_t emitter_samples =
         options->direct_samples ? options->direct_samples : RAD_DEFAULT_DIRECT_SAMPLES;
     if (emitter_samples > MAX_DIRECT_SAMPLES)
@@ -674,8 +617,23 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     } else
         display_hidden_patches(mesh, tracer, leave, hidden, NULL, 0);
     if (direct_light == RAD_DIRECT_VERTEX) {
-        status = vertex_radiance(options, mesh, &display, &emitters, scene_tracer, &view,
-                                 inputs, lookup, hidden, leave, threads, radiance, error);
+        vertex_radiance_job job = {
+            .mesh = mesh,
+            .display = &display,
+            .scene = options->scene,
+            .inputs = inputs,
+            .lookup = lookup,
+            .irradiance = options->irradiance,
+            .emitters = &emitters,
+            .scene_tracer = scene_tracer,
+            .view = &view,
+            .sharp = NULL, /* each hit adds them */
+            .hidden = hidden,
+            .leave = leave,
+            .seed = options->seed,
+            .threads = threads,
+        };
+        status = vertex_radiance(&job, radiance, NULL, error);
         if (status != RAD_OK)
             goto done;
     } else if (!display_mesh_radiance_weighted(mesh, &display, shaded ? shaded : B, hidden,

@@ -58,21 +58,24 @@ static void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_fr
 
 rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const rad_mesh *mesh,
                         const rad_tracer *occluders, const gather_view *view,
-                        const uint8_t *hidden, double leave, uint64_t seed, int threads,
-                        rad_rgb *direct, rad_rgb *gathered, rad_error *error)
+                        const light_set *sharp, const uint8_t *hidden, double leave,
+                        uint64_t seed, int threads, rad_rgb *direct, rad_rgb *gathered,
+                        rad_error *error)
 {
     uint32_t n = mesh->vertex_count;
     for (uint32_t v = 0; v < n; v++)
         direct[v] = gathered[v] = (rad_rgb){0, 0, 0};
     if (n == 0)
         return RAD_OK;
+    const uint32_t sharp_rays = sharp ? light_set_capacity(sharp, LIGHTS_SHARP, 0) : 0;
     const uint32_t samples = VERTEX_EMITTER_SAMPLES, gather = VERTEX_GATHER_RAYS;
+    const uint32_t capacity = samples > sharp_rays ? samples : sharp_rays; /* shadow rays */
     const uint32_t cosines_per_vertex =
         VERTEX_COSINE_RAYS > gather ? VERTEX_COSINE_RAYS : gather;
     vertex_frame *frame = rad_alloc_array(n, sizeof(*frame));
-    rad_ray *rays = rad_alloc_array((size_t)threads * samples, sizeof(*rays));
-    rad_rgb *values = rad_alloc_array((size_t)threads * samples, sizeof(*values));
-    uint8_t *blocked = rad_alloc_array((size_t)threads * samples, sizeof(*blocked));
+    rad_ray *rays = rad_alloc_array((size_t)threads * capacity, sizeof(*rays));
+    rad_rgb *values = rad_alloc_array((size_t)threads * capacity, sizeof(*values));
+    uint8_t *blocked = rad_alloc_array((size_t)threads * capacity, sizeof(*blocked));
     rad_ray *cosine_rays = rad_alloc_array((size_t)threads * cosines_per_vertex,
                                            sizeof(*cosine_rays));
     rad_hit *hits = rad_alloc_array((size_t)threads * cosines_per_vertex, sizeof(*hits));
@@ -86,9 +89,9 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
             if (!(f->weight > 0))
                 continue;
             int thread = omp_get_thread_num();
-            rad_ray *light = &rays[(size_t)thread * samples];
-            rad_rgb *value = &values[(size_t)thread * samples];
-            uint8_t *shadowed = &blocked[(size_t)thread * samples];
+            rad_ray *light = &rays[(size_t)thread * capacity];
+            rad_rgb *value = &values[(size_t)thread * capacity];
+            uint8_t *shadowed = &blocked[(size_t)thread * capacity];
             rad_ray *cosine = &cosine_rays[(size_t)thread * cosines_per_vertex];
             rad_hit *hit = &hits[(size_t)thread * cosines_per_vertex];
             double *cos_x = &cosines[(size_t)thread * cosines_per_vertex];
@@ -115,6 +118,14 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
                     rgb_add_to(&sum, emitter_cosine_value_weighted(set, scene, &cosine[k], &hit[k],
                                                                    cos_x[k], VERTEX_COSINE_RAYS,
                                                                    1 / share));
+            }
+            if (sharp_rays > 0) { /* after the emitters' random numbers: theirs unchanged */
+                uint32_t count = light_set_rays(sharp, LIGHTS_SHARP, x, nv, off, 0, 1, 0, &rng,
+                                                light, value);
+                rad_tracer_occluded(occluders, light, count, shadowed);
+                for (uint32_t k = 0; k < count; k++)
+                    if (!shadowed[k])
+                        rgb_add_to(&sum, value[k]);
             }
             direct[v] = sum;
 

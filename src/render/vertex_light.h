@@ -19,12 +19,14 @@
 #include "render/gather.h"
 
 /* Per mesh vertex v (mesh->vertex_count values): direct[v], the emitters' direct
- * irradiance (traced against `occluders`, the scene's triangles), and gathered[v], the
+ * irradiance (traced against `occluders`, the scene's triangles), plus with `sharp` the
+ * sharp sources' (point, spot, luminaire, sun: one shadow ray each), and gathered[v], the
  * irradiance the solution's reflected light brings (`view`). A vertex of hidden patches
  * alone gets 0. Deterministic per seed for any thread count. */
 rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const rad_mesh *mesh,
                         const rad_tracer *occluders, const gather_view *view,
-                        const uint8_t *hidden, double leave, uint64_t seed, int threads,
-                        rad_rgb *direct, rad_rgb *gathered, rad_error *error);
+                        const light_set *sharp, const uint8_t *hidden, double leave,
+                        uint64_t seed, int threads, rad_rgb *direct, rad_rgb *gathered,
+                        rad_error *error);
 
 #endif

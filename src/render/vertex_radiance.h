@@ -1,0 +1,59 @@
+/*
+ * vertex_radiance.h - the radiance at a solution's display vertices from the light
+ * computed there (vertex_light.h): what the default render interpolates over its display
+ * triangles and what the lit mesh carries, from one function (internal).
+ *
+ * A vertex shows E / pi + f (H_emitters + H_gathered [+ H_sharp]), with E and f = rho / pi
+ * the area-weighted means of its visible patches' exitance and albedo (f = 1 / pi and
+ * E = 0 where the vertex holds irradiance: a textured patch in an image, whose hits read
+ * the texel, or an irradiance image); then T-vertices and added vertices are made
+ * displayable. The render adds the sharp sources (point, spot, luminaire, sun) at each
+ * hit; the lit mesh, which has no hits, adds them at the vertex.
+ */
+#ifndef RAD_RENDER_VERTEX_RADIANCE_H
+#define RAD_RENDER_VERTEX_RADIANCE_H
+
+#include "lights/direct_light.h"
+#include "lights/emitters.h"
+#include "radiosity.h"
+#include "reconstruct/display_mesh.h"
+#include "render/gather.h"
+#include "scene/patch_materials.h"
+
+typedef struct vertex_radiance_job {
+    const rad_mesh *mesh;
+    const display_mesh *display;
+    const rad_scene *scene;
+    const rad_patch_inputs *inputs;      /* the patch inputs B was solved with */
+    const patch_material_lookup *lookup; /* NULL, or its textured patches hold irradiance */
+    bool irradiance;                     /* every vertex holds irradiance */
+    const emitter_set *emitters;
+    const rad_tracer *scene_tracer;      /* the scene's triangles */
+    const gather_view *view;             /* what the gather rays meet */
+    const light_set *sharp;              /* NULL, or the sharp sources to add at vertices */
+    const uint8_t *hidden;               /* patches no one sees */
+    double leave;                        /* how far rays start off a surface */
+    uint64_t seed;
+    int threads;
+} vertex_radiance_job;
+
+/* radiance[v] for the display's vertices; irradiance (NULL, or display->vertex_count
+ * values) gets each vertex's incident irradiance H_emitters + H_gathered [+ H_sharp]. */
+rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
+                           rad_rgb *irradiance, rad_error *error);
+
+/* How far rays start off a surface of this mesh: past the float rounding of hit points at
+ * the scene's size and distance from the origin (scene units). */
+double vertex_radiance_leave(const rad_mesh *mesh);
+
+/* The same for a solution alone (the lit mesh): builds what rad_render has at hand (the
+ * display's tracer, the hidden patches, the reflected light the gather meets, the
+ * emitters and the scene's tracer) and adds the sharp sources at the vertices. Every patch
+ * shows its mean albedo (no textures). */
+rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh *display,
+                                       const rad_rgb *B, const rad_scene *scene,
+                                       const rad_patch_inputs *inputs, uint64_t seed,
+                                       int threads, rad_rgb *radiance, rad_rgb *irradiance,
+                                       rad_error *error);
+
+#endif
