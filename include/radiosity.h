@@ -1603,8 +1603,11 @@ typedef struct rad_render_options {
      *   out first;
      * RAD_DIRECT_SOLUTION: interpolated from the solution like the rest (the classic
      *   radiosity image).
-     * A scene without emissive surfaces gets the classic image in every mode (point, spot,
-     * luminaire and sun light is computed at each pixel in all of them).
+     * Without emissive surfaces, RAD_DIRECT_VERTEX still computes the final gather at the
+     * vertices when the scene has light sources (its rays that leave the scene meet the sky
+     * and environment lights: their direct light); a scene with neither gets the classic
+     * image, and so does RAD_DIRECT_PIXEL without emissive surfaces. Point, spot,
+     * luminaire and sun light is computed at each pixel in every mode.
      * direct_samples 0 = RAD_DEFAULT_DIRECT_SAMPLES (RAD_DIRECT_PIXEL only). */
     rad_direct_light direct_light;
     uint32_t direct_samples;
@@ -1821,7 +1824,8 @@ typedef struct rad_lit_mesh_options {
                                   (rad_patch_inputs_build of this scene and mesh; n must be
                                   mesh->patch_count): every vertex then also carries its
                                   irradiance, see rad_lit_mesh_write */
-    /* NULL, or the scene B was solved for: when it has emitters and direct_light is not
+    /* NULL, or the scene B was solved for: when it has emitters or light sources
+     * (rad_light) and direct_light is not
      * RAD_DIRECT_SOLUTION, every vertex carries the light computed at it, as the default
      * render shows it (rad_render_options.direct_light, RAD_DIRECT_VERTEX: the emitters'
      * direct light by 1024 light samples MIS with 512 cosine rays, a final gather of the

@@ -29,7 +29,7 @@ static const char usage[] =
     "  --exposure EV        display colour: radiance times 2^EV (default: automatic)\n"
     "  --direct MODE        vertex (default): the light computed at each vertex, as\n"
     "                       `render` does (about 2600 rays a vertex); solution: the\n"
-    "                       patches' mean radiosity (always, without emitting surfaces)\n"
+    "                       patches' mean radiosity (always, with no emitter or light)\n"
     CLI_TWO_SIDED_HELP
     CLI_SOLVE_HELP;
 

@@ -138,8 +138,8 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
         return rad_fail(error, RAD_ERR_INVALID, "%s: thread count %d is negative", path,
                         options->threads);
     /* the light computed at the vertices, as the default render shows it */
-    bool vertex_light = options && options->scene && options->direct_light != RAD_DIRECT_SOLUTION &&
-                        rad_scene_has_emitter(options->scene);
+    bool vertex_light = options && options->direct_light != RAD_DIRECT_SOLUTION &&
+                        vertex_radiance_applies(options->scene);
     rad_patch_inputs *built = NULL;
     rad_status status = RAD_OK;
     rad_vec3 *position = NULL, *normal = NULL;

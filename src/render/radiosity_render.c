@@ -542,9 +542,14 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
 
     /* the emitters' direct light at every pixel sample (with its patch means to take out of
      * the solution first) or at every vertex */
-    rad_direct_light direct_light = options->scene && rad_scene_has_emitter(options->scene)
-                                        ? options->direct_light
-                                        : RAD_DIRECT_SOLUTION;
+    /* per pixel: the emitters' light; at the vertices: theirs, the sky's (the gather
+     * rays that leave the scene) and the light reflected (the sharp sources' is the
+     * hits' own either way) */
+    rad_direct_light direct_light = options->direct_light;
+    if (direct_light == RAD_DIRECT_PIXEL && !(options->scene && rad_scene_has_emitter(options->scene)))
+        direct_light = RAD_DIRECT_SOLUTION;
+    if (direct_light == RAD_DIRECT_VERTEX && !vertex_radiance_applies(options->scene))
+        direct_light = RAD_DIRECT_SOLUTION;
     if (direct_light == RAD_DIRECT_PIXEL || direct_light == RAD_DIRECT_VERTEX) {
         status = emitters_build(options->scene, &emitters, error);
         if (status == RAD_OK)

@@ -14,6 +14,11 @@
 #include "core/vec3.h"
 #include "render/vertex_light.h"
 
+bool vertex_radiance_applies(const rad_scene *scene)
+{
+    return scene && (rad_scene_has_emitter(scene) || scene->light_count > 0);
+}
+
 double vertex_radiance_leave(const rad_mesh *mesh)
 {
     if (mesh->vertex_count == 0)

@@ -42,6 +42,10 @@ typedef struct vertex_radiance_job {
 rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
                            rad_rgb *irradiance, rad_error *error);
 
+/* Whether the light at the vertices has anything to compute for this scene: emitting
+ * surfaces or light sources (else the solution's patch values are all there is). */
+bool vertex_radiance_applies(const rad_scene *scene);
+
 /* How far rays start off a surface of this mesh: past the float rounding of hit points at
  * the scene's size and distance from the origin (scene units). */
 double vertex_radiance_leave(const rad_mesh *mesh);
