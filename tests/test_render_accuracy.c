@@ -58,22 +58,24 @@ static void test_cornell(void)
     CHECK(rad_image_compare(a, reference, NULL, &classic, NULL, &error) == RAD_OK);
     CHECK(rad_image_compare(v, reference, NULL, &vertex, NULL, &error) == RAD_OK);
     CHECK(rad_image_compare(b, reference, NULL, &per_pixel, NULL, &error) == RAD_OK);
-    printf("Cornell box 128 x 128 against the path tracer (16384 spp):\n"
+    printf("Cornell box 128 x 128 against the path tracer (65536 spp):\n"
            "  classic render:          block rel RMSE %.4f, pixel rel RMSE %.4f\n"
            "  direct light at vertices (default): block rel RMSE %.4f, pixel rel RMSE %.4f\n"
            "  direct light per pixel:  block rel RMSE %.4f, pixel rel RMSE %.4f\n",
            classic.block_relative_rmse, classic.pixel_relative_rmse,
            vertex.block_relative_rmse, vertex.pixel_relative_rmse,
            per_pixel.block_relative_rmse, per_pixel.pixel_relative_rmse);
-    /* measured 2026-12-02 (seed 0, 2 threads), with the emitters' penumbrae refined in the
-     * mesh (shadow_refine.c) and the emitter samples one Halton point in all three
-     * dimensions (emitter_light.c): classic 0.0255 / 0.0278, at the vertices 0.0104 /
-     * 0.0168, per pixel 0.0084 / 0.0167 (before those two changes the classic render was
-     * 0.0393 / 0.0407 and the per-pixel one 0.0158 / 0.0220); from seed to seed the
-     * per-pixel render's blocks move by a few tenths of a percent (its noise). The pixel
-     * measure is bounded below by the reference's own noise, about 1.6 % a pixel. */
+    /* measured 2026-12-02 (seed 0, 2 threads) against the 65536-spp reference (its own
+     * noise 0.07 % on blocks and 0.34 % a pixel, tests/data/README.md): classic 0.0252 /
+     * 0.0271, at the vertices 0.0102 / 0.0157, per pixel 0.0081 / 0.0157. Against the
+     * earlier 16384-spp reference the same renders read 0.0255 / 0.0278, 0.0104 / 0.0168 and
+     * 0.0084 / 0.0167: the pixel measure is the renders' own error, not the reference's
+     * noise; 60 % of its square comes from 1 % of the pixels, on the floor along the
+     * blocks' feet (contact shadows interpolated over patches). The issue asks for 0.01 /
+     * 0.01 at 128 x 128: neither is met yet by the default. From seed to seed the per-pixel
+     * render's blocks move by a few tenths of a percent (its noise). */
     CHECK(classic.block_relative_rmse < 0.030 && classic.pixel_relative_rmse < 0.033);
-    CHECK(vertex.block_relative_rmse < 0.012 && vertex.pixel_relative_rmse < 0.019);
+    CHECK(vertex.block_relative_rmse < 0.012 && vertex.pixel_relative_rmse < 0.018);
     CHECK(vertex.block_relative_rmse < 0.6 * classic.block_relative_rmse);
     CHECK(vertex.pixel_relative_rmse < 0.7 * classic.pixel_relative_rmse);
     CHECK_NEAR(vertex.mean_a.g, vertex.mean_b.g, 0.01);
@@ -90,7 +92,7 @@ static void test_cornell(void)
         CHECK(rad_image_compare(c, reference, NULL, &d, NULL, &error) == RAD_OK);
         printf("  direct light per pixel, %-12s block rel RMSE %.4f, pixel rel RMSE %.4f\n",
                rad_solver_name(others[k]), d.block_relative_rmse, d.pixel_relative_rmse);
-        CHECK(d.block_relative_rmse < 0.014 && d.pixel_relative_rmse < 0.019);
+        CHECK(d.block_relative_rmse < 0.014 && d.pixel_relative_rmse < 0.018);
         rad_image_destroy(c);
     }
     rad_image_destroy(a);
