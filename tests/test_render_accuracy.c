@@ -67,15 +67,16 @@ static void test_cornell(void)
            per_pixel.block_relative_rmse, per_pixel.pixel_relative_rmse);
     /* measured 2026-12-02 (seed 0, 2 threads) against the 65536-spp reference (its own
      * noise 0.07 % on blocks and 0.34 % a pixel, tests/data/README.md): classic 0.0252 /
-     * 0.0271, at the vertices 0.0102 / 0.0157, per pixel 0.0081 / 0.0157. Against the
+     * 0.0271, at the vertices 0.0098 / 0.0134 (0.0102 / 0.0157 before buried vertices took
+     * their open neighbours' light, vertex_light.c), per pixel 0.0081 / 0.0157. Against the
      * earlier 16384-spp reference the same renders read 0.0255 / 0.0278, 0.0104 / 0.0168 and
      * 0.0084 / 0.0167: the pixel measure is the renders' own error, not the reference's
-     * noise; 60 % of its square comes from 1 % of the pixels, on the floor along the
-     * blocks' feet (contact shadows interpolated over patches). The issue asks for 0.01 /
-     * 0.01 at 128 x 128: neither is met yet by the default. From seed to seed the per-pixel
+     * noise; 60 % of its square came from 1 % of the pixels, on the floor along the
+     * blocks' feet, most of it the floor patches running under the blocks. The issue asks
+     * for 0.01 / 0.01 at 128 x 128: the default meets the blocks' 1 %, not the pixels'. From seed to seed the per-pixel
      * render's blocks move by a few tenths of a percent (its noise). */
     CHECK(classic.block_relative_rmse < 0.030 && classic.pixel_relative_rmse < 0.033);
-    CHECK(vertex.block_relative_rmse < 0.012 && vertex.pixel_relative_rmse < 0.018);
+    CHECK(vertex.block_relative_rmse < 0.011 && vertex.pixel_relative_rmse < 0.015);
     CHECK(vertex.block_relative_rmse < 0.6 * classic.block_relative_rmse);
     CHECK(vertex.pixel_relative_rmse < 0.7 * classic.pixel_relative_rmse);
     CHECK_NEAR(vertex.mean_a.g, vertex.mean_b.g, 0.01);

@@ -205,14 +205,16 @@ static void test_room_on_ground(void)
     /* measured 2026-12-02, with the emitter's penumbrae refined in the mesh
      * (shadow_refine.c), which makes 4538 patches, so the automatic choice is the
      * hierarchical solver, and the emitters' direct light and a final gather computed at
-     * every vertex (vertex_light.c): the room's surfaces -5.4 % (floor) to -4.5 %; with the
+     * every vertex (vertex_light.c): the room's surfaces -5.1 % (wall_left) to -3.6 %
+     * (floor) (-5.4 % on the floor before the vertices under the table's feet took their
+     * open neighbours' light, vertex_light.c); with the
      * patch values interpolated instead -10.8 % to -5.6 %; before the refinement (3920
      * patches, gather) -14 % to -4 %; without the proximity refinement either
      * (--proximity-levels 0: the automatic size of the whole scene) -29 % to -12 %. The
      * ground seen through the window (+10.4 %; +54 % with the patch values, +280 % before
      * the refinement) is held with the per-pixel direct light below */
     double worst = check_render(scene_path, scene, surface, reference_mean, "", "ground", 0,
-                                0.07);
+                                0.065);
     printf("default render: largest difference %.1f %% (the issue asks for 5 %%)\n",
            100 * worst);
     /* the emitters' direct light at every pixel: measured -7.2 % (table) to -5.2 % in the
@@ -223,13 +225,13 @@ static void test_room_on_ground(void)
                          0.25, 0.10);
     printf("--direct pixel: largest difference %.1f %%\n", 100 * worst);
     /* every solver honours the refinements and the vertex light: Gauss-Seidel and shooting
-     * on the default's mesh (measured -3.9 % (table) to -2.4 %, better than the
+     * on the default's mesh (measured -3.3 % (ceiling) to -1.4 %, better than the
      * hierarchical solver the automatic choice takes at its default threshold), the
      * hierarchical solver on its own finer default patches with the proximity refinement
-     * asked for (it is off by default there): measured -4.6 % (floor) to -2.1 % */
+     * asked for (it is off by default there): measured -3.3 % (floor) to -2.3 % */
     static const char *const solvers[] = {"--solver gauss-seidel", "--solver shoot",
                                           "--solver hierarchical --proximity-levels 3"};
-    static const double tolerances[] = {0.05, 0.05, 0.06};
+    static const double tolerances[] = {0.045, 0.045, 0.045};
     for (size_t k = 0; k < sizeof(solvers) / sizeof(solvers[0]); k++) {
         worst = check_render(scene_path, scene, surface, reference_mean, solvers[k], "ground",
                              0, tolerances[k]);

@@ -56,6 +56,50 @@ static void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_fr
     }
 }
 
+/* A vertex whose point lies inside a closed object (a floor patch that runs under a box
+ * standing on it: most of its gather rays meet the backs of the box's one-sided faces)
+ * has no light of its own, yet its patch shows outside the box; interpolating its zero
+ * would darken that visible part toward the box's foot. It takes instead the mean of the
+ * vertices it shares a visible patch with that are not buried (left as it is when it has
+ * none). Buried means that 7/8 of its gather rays met the back of a one-sided surface
+ * that does not emit: a ceiling vertex just above a lamp's back keeps its own dark value,
+ * whose contrast is what makes the image find the light's rim (rim pixels are found by the
+ * luminance spread of their first samples and of their row neighbours; with that
+ * contrast gone a rim pixel whose samples miss the light's sliver stays dark). Measured on
+ * the Cornell box at 128 x 128 against the 65536-spp reference (block / pixel relative
+ * RMSE): the CLI's mesh 0.97 % / 1.57 % -> 0.94 % / 1.34 %; without the proximity
+ * refinement 1.02 % / 1.57 % -> 0.98 % / 1.34 %; the error it took away sat along the
+ * blocks' feet on the floor. */
+static void buried_from_neighbours(const rad_mesh *mesh, const uint8_t *hidden,
+                                   uint32_t *buried, rad_rgb *direct, rad_rgb *gathered)
+{
+    /* buried[v]: 0 open, 1 buried with no open neighbour yet, 1 + m with m of them */
+    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        const rad_patch *patch = &mesh->patches[p];
+        if (hidden && hidden[p])
+            continue;
+        for (uint32_t k = 0; k < patch->vertex_count; k++) {
+            uint32_t v = patch->vertex[k];
+            for (uint32_t j = 0; buried[v] && j < patch->vertex_count; j++) {
+                uint32_t u = patch->vertex[j];
+                if (buried[u])
+                    continue;
+                if (buried[v] == 1) /* its first open neighbour: the mean starts */
+                    direct[v] = gathered[v] = (rad_rgb){0, 0, 0};
+                rgb_add_to(&direct[v], direct[u]);
+                rgb_add_to(&gathered[v], gathered[u]);
+                buried[v]++;
+            }
+        }
+    }
+    for (uint32_t v = 0; v < mesh->vertex_count; v++)
+        if (buried[v] > 1) {
+            double count = buried[v] - 1;
+            direct[v] = rgb_scale(direct[v], 1 / count);
+            gathered[v] = rgb_scale(gathered[v], 1 / count);
+        }
+}
+
 rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const rad_mesh *mesh,
                         const rad_tracer *occluders, const gather_view *view,
                         const light_set *sharp, const uint8_t *hidden, double leave,
@@ -80,9 +124,12 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
                                            sizeof(*cosine_rays));
     rad_hit *hits = rad_alloc_array((size_t)threads * cosines_per_vertex, sizeof(*hits));
     double *cosines = rad_alloc_array((size_t)threads * cosines_per_vertex, sizeof(*cosines));
-    bool ok = frame && rays && values && blocked && cosine_rays && hits && cosines;
+    uint32_t *buried = rad_alloc_array(n, sizeof(*buried));
+    bool ok = frame && rays && values && blocked && cosine_rays && hits && cosines && buried;
     if (ok) {
         vertex_frames(mesh, hidden, frame);
+        for (uint32_t v = 0; v < n; v++)
+            buried[v] = 0;
 #pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
         for (int64_t v = 0; v < (int64_t)n; v++) {
             const vertex_frame *f = &frame[v];
@@ -133,12 +180,22 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
             emitter_cosine_rays(x, nv, off, gather, &rng, cosine, cos_x);
             rad_tracer_intersect(view->tracer, cosine, gather, hit);
             rad_rgb seen = {0, 0, 0};
-            for (uint32_t k = 0; k < gather; k++)
+            uint32_t backs = 0; /* rays that met the back of a one-sided surface */
+            for (uint32_t k = 0; k < gather; k++) {
                 rgb_add_to(&seen, gather_seen(view, &cosine[k], &hit[k]));
+                if (hit[k].triangle != RAD_NO_HIT && !hit[k].front) {
+                    uint32_t p = view->patch_of[hit[k].triangle];
+                    const rad_rgb e = view->exitance ? view->exitance[p] : (rad_rgb){0, 0, 0};
+                    backs += !mesh->patches[p].twin && e.r == 0 && e.g == 0 && e.b == 0;
+                }
+            }
             gathered[v] = rgb_scale(seen, RAD_PI / gather);
+            buried[v] = backs > gather - gather / 8; /* enclosed: 7/8 of the rays */
         }
+        buried_from_neighbours(mesh, hidden, buried, direct, gathered);
     }
     free(frame);
+    free(buried);
     free(rays);
     free(values);
     free(blocked);
