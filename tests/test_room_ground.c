@@ -206,8 +206,8 @@ static void test_room_on_ground(void)
      * (shadow_refine.c), which makes 4538 patches, so the automatic choice is the
      * hierarchical solver, and the emitters' direct light and a final gather computed at
      * every vertex (vertex_light.c): the room's surfaces -5.1 % (wall_left) to -3.6 %
-     * (floor) (-5.4 % on the floor before the vertices under the table's feet took their
-     * open neighbours' light, vertex_light.c); with the
+     * (floor) (-5.4 % on the floor before buried vertices took their open neighbours'
+     * light, vertex_light.c); with the
      * patch values interpolated instead -10.8 % to -5.6 %; before the refinement (3920
      * patches, gather) -14 % to -4 %; without the proximity refinement either
      * (--proximity-levels 0: the automatic size of the whole scene) -29 % to -12 %. The
