@@ -10,7 +10,9 @@
  * (RADIOSITY_STOP_AFTER_CHECKPOINTS, which acts as SIGTERM at a known point, without
  * timing) must exit 130 and write neither the solution nor the lit mesh; resumed with
  * another thread count, they must write exactly the uninterrupted run's bytes. K = 3 is in
- * the dense solvers' form-factor rows (64 rounds), K = N - 1 in their iterate; for the
+ * the dense solvers' form-factor rows (64 rounds), K = N - 1 in their iterate, K = N
+ * during their last sweep (the direct solver: K = 63, during the last round of rows,
+ * honoured before its LU); for the
  * hierarchical solver K runs from the first refinement passes to the checkpoint before the
  * final gather. `render` does the same for its .pfm. A real SIGINT (to the
  * hierarchical solver, which without --checkpoint would go on with the solution so far)
@@ -134,16 +136,33 @@ static void solver_checkpoints(const char *solver)
         stop_and_resume(solver, n - 1); /* a sweep to the tolerance, the last */
         stop_and_resume(solver, n);     /* before the final gather */
     } else {
-        /* (a stop after the N-th, at the last sweep, comes when nothing is left to stop:
-         * the run ends whole) */
         stop_and_resume(solver, 3);     /* form-factor rows */
         stop_and_resume(solver, n - 1); /* the iterate */
+        stop_and_resume(solver, n);     /* during the last sweep (shots): honoured after it */
     }
+}
+
+/* The direct solver checkpoints only between its 64 rounds of form-factor rows (63), none
+ * in its LU: a stop in the rows, and one during the last round, which is honoured before
+ * the LU (F alone is written; the resumed run factors it again). */
+static void direct_checkpoints(void)
+{
+    CHECK(test_run_tool("solve --solver direct " SCENE " --threads 2 --save-solution full.sol "
+                        "-o full.ply --quiet") == 0);
+    CHECK(test_run_tool("solve --solver direct " SCENE " --threads 2 --checkpoint all.bin "
+                        "--checkpoint-interval 0 --save-solution all.sol --stats all.json "
+                        "--quiet") == 0);
+    CHECK(test_same_bytes(test_path("full.sol"), test_path("all.sol")));
+    long n = checkpoints_written("all.json");
+    CHECK(n == 63);
+    stop_and_resume("direct", 3);
+    stop_and_resume("direct", n);
 }
 
 int main(void)
 {
     const char *solvers[] = {"gather", "gauss-seidel", "shoot", "hierarchical"};
+    direct_checkpoints();
     for (int s = 0; s < 4; s++)
         solver_checkpoints(solvers[s]);
     /* full.sol is the hierarchical solver's now */

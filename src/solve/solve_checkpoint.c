@@ -276,9 +276,7 @@ static rad_status read_here(solve_checkpoint *cp, rad_error *error)
         solve_checkpoint_job job = get_job(p);
         status = match_job(cp->resume_path, &job, &cp->job, error);
         bool hierarchical = job.solver == RAD_SOLVER_HIERARCHICAL;
-        if (status == RAD_OK && (hierarchical != (kind == SOLVE_CHECKPOINT_HIERARCHY) ||
-                                 (job.solver == RAD_SOLVER_DIRECT &&
-                                  kind == SOLVE_CHECKPOINT_ITERATE)))
+        if (status == RAD_OK && hierarchical != (kind == SOLVE_CHECKPOINT_HIERARCHY))
             status = rad_fail(error, RAD_ERR_PARSE,
                               "%s: a state of kind %u, which the %s solver does not write",
                               cp->resume_path, kind, solver_word(job.solver));
@@ -337,14 +335,22 @@ void solve_checkpoint_resumed(solve_checkpoint *cp)
     cp->resumed_kind = 0;
 }
 
-bool solve_checkpoint_due(solve_checkpoint *cp, bool *stop)
+bool solve_checkpoint_stop_raised(const solve_checkpoint *cp)
 {
-    *stop = false;
     if (!cp || !cp->path)
         return false;
     bool stop_here = cp->stop && *cp->stop;
     if (ranks_count() > 1)
         stop_here = ranks_failures(stop_here) > 0;
+    return stop_here;
+}
+
+bool solve_checkpoint_due(solve_checkpoint *cp, bool *stop)
+{
+    *stop = false;
+    if (!cp || !cp->path)
+        return false;
+    bool stop_here = solve_checkpoint_stop_raised(cp);
     int write = stop_here || rad_clock_seconds() - cp->last >= cp->interval;
     if (ranks_count() > 1)
         ranks_broadcast(&write, sizeof(write));
@@ -487,4 +493,20 @@ bool iterate_step(solve_checkpoint *cp, const rad_system *system, const iterate_
         return true;
     cp->interrupted = stop;
     return stop;
+}
+
+bool iterate_stop(solve_checkpoint *cp, const rad_system *system, const iterate_state *state,
+                  void (*put)(const void *user, byte_sink *body), const void *user,
+                  rad_status *status, rad_error *error)
+{
+    if (!solve_checkpoint_stop_raised(cp))
+        return false;
+    byte_sink body = {0};
+    iterate_body_begin(cp, system, state, &body);
+    if (put)
+        put(user, &body);
+    *status = solve_checkpoint_write(cp, SOLVE_CHECKPOINT_ITERATE, &body, 1, error);
+    sink_free(&body);
+    cp->interrupted = *status == RAD_OK;
+    return true;
 }

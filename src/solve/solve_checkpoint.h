@@ -6,7 +6,9 @@
  * and go on bitwise as if it had not:
  *   FORMFACTORS  the dense solvers' form-factor rows done (formfactors.c, between rounds);
  *   ITERATE      the whole (trimmed) F and the iterate of Jacobi, Gauss-Seidel or shooting
- *                (between sweeps or shots; the solver's own file writes its part);
+ *                (between sweeps or shots, or after the last one when a stop came during
+ *                it; the solver's own file writes its part); for the direct solver F alone
+ *                (a stop before or during its LU, which is started again on resuming);
  *   HIERARCHY    the hierarchical solver's links, B and loop state (between sweeps;
  *                solve_hierarchical.c writes it).
  * The container is core/checkpoint_file.h; the header holds the job (below) and the kind.
@@ -102,6 +104,10 @@ bool solve_checkpoint_resuming(const solve_checkpoint *cp, uint32_t kind, byte_s
 /* Drops the resumed body (after the solver took its state from it). */
 void solve_checkpoint_resumed(solve_checkpoint *cp);
 
+/* Collective: whether a stop was raised on any rank (false without a path). Cheap: a read,
+ * and over ranks one small collective. */
+bool solve_checkpoint_stop_raised(const solve_checkpoint *cp);
+
 /* Collective, between steps of a solver: whether to write a checkpoint now (the interval
  * has passed by rank 0's clock, or a stop was raised on any rank); *stop tells the
  * latter. False without a path. Cheap: the clock, and over ranks two small collectives. */
@@ -130,12 +136,18 @@ rad_status solve_hierarchical_checkpointed(const rad_mesh *mesh,
 
 /* The ITERATE kind: the whole matrix (trimmed), its report's counts and trim, the solver's
  * scalars, then the solver's vectors (n rad_rgb each: Jacobi and Gauss-Seidel B, shooting
- * B and the unshot dB). */
+ * B and the unshot dB; none for the direct solver: iterate_vectors). */
 typedef struct iterate_state {
     uint32_t iterations;        /* sweeps or shots done */
     double criterion, smallest; /* the last criterion; the smallest (divergence watch) */
     uint32_t last_shooter;      /* shooting; UINT32_MAX otherwise */
 } iterate_state;
+
+/* The vectors an ITERATE checkpoint of `solver` holds after F. */
+static inline uint32_t iterate_vectors(rad_solver solver)
+{
+    return solver == RAD_SOLVER_SHOOT ? 2 : solver == RAD_SOLVER_DIRECT ? 0 : 1;
+}
 
 /* Starts an ITERATE body on rank 0 (elsewhere the sink stays off): F, its report, state. */
 void iterate_body_begin(const solve_checkpoint *cp, const rad_system *system,
@@ -144,6 +156,16 @@ void iterate_body_begin(const solve_checkpoint *cp, const rad_system *system,
  * when one is due (`put` adds the solver's vectors to it); true when the solver is to stop
  * here (cp->interrupted) or the checkpoint could not be written (*status). */
 bool iterate_step(solve_checkpoint *cp, const rad_system *system, const iterate_state *state,
+                  void (*put)(const void *user, byte_sink *body), const void *user,
+                  rad_status *status, rad_error *error);
+/* Collective, after a dense solver's last step or during a step that cannot be resumed
+ * part way (the direct solver's LU): when a stop was raised on any rank, writes an ITERATE
+ * checkpoint of `state` (`put`, unless NULL, adds the solver's vectors) and returns true:
+ * the solver is to stop (cp->interrupted), or *status says why the checkpoint could not be
+ * written. False (nothing written) otherwise. A resumed run must not take a further step
+ * from a final state (the sweep solvers stop at once when its criterion meets the
+ * tolerance), so that it ends as the uninterrupted run did. */
+bool iterate_stop(solve_checkpoint *cp, const rad_system *system, const iterate_state *state,
                   void (*put)(const void *user, byte_sink *body), const void *user,
                   rad_status *status, rad_error *error);
 /* Puts three channel arrays as n rad_rgb. */

@@ -7,6 +7,12 @@
  * factorisation (grey scenes need one instead of three). The elimination of the rows below
  * each pivot is spread over threads, one row per thread at a time, so the result does not
  * depend on the thread count.
+ *
+ * With a checkpoint (solve_checkpoint.h) a stop raised before the LU, between two of its
+ * panels or after the last substitution writes F alone (an ITERATE checkpoint without
+ * vectors) and ends the solve there: a factorisation is not resumed part way, the resumed
+ * run factors F again and gives the same bytes. No checkpoint is written on the interval
+ * meanwhile (it would hold nothing the form factors' last one does not).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -68,6 +74,15 @@ static double build_matrix(const rad_system *system, int k, double *m)
     return largest;
 }
 
+/* Collective (every rank factors the same matrix): when a stop was raised, writes F as the
+ * checkpoint and returns true (cp->interrupted, or *status when it could not be written). */
+static bool stop_here(solve_checkpoint *cp, const rad_system *system, rad_status *status,
+                      rad_error *error)
+{
+    iterate_state state = {0, INFINITY, INFINITY, UINT32_MAX};
+    return cp && iterate_stop(cp, system, &state, NULL, NULL, status, error);
+}
+
 /* Factors the panel of columns [k0, k1) of rows [k0, n) with partial pivoting (rows are
  * swapped across the whole matrix), leaving L below the diagonal of the panel and U on
  * and above it. The columns right of the panel are only swapped, not updated. */
@@ -118,11 +133,14 @@ static rad_status factor_panel(double *m, uint32_t n, uint32_t k0, uint32_t k1,
  * pass (one row per thread), which reads the big trailing matrix once per panel instead of
  * once per column. */
 static rad_status factor(double *m, uint32_t n, uint32_t *pivot, double largest, int threads,
-                         rad_error *error)
+                         const rad_system *system, solve_checkpoint *cp, rad_error *error)
 {
     (void)threads; /* unused without OpenMP */
     for (uint32_t k0 = 0; k0 < n; k0 += DIRECT_BLOCK) {
         const uint32_t k1 = n - k0 < DIRECT_BLOCK ? n : k0 + DIRECT_BLOCK;
+        rad_status stopped = RAD_OK;
+        if (stop_here(cp, system, &stopped, error))
+            return stopped;
         rad_status status = factor_panel(m, n, k0, k1, pivot, largest, error);
         if (status != RAD_OK)
             return status;
@@ -211,8 +229,9 @@ rad_status solve_direct(const rad_system *system, solve_params *params, rad_rgb 
         if (solved[k])
             continue;
         double largest = build_matrix(system, k, m);
-        status = factor(m, n, pivot, largest, params->threads, error);
-        if (status != RAD_OK)
+        status = factor(m, n, pivot, largest, params->threads, system, params->checkpoint,
+                        error);
+        if (status != RAD_OK || (params->checkpoint && params->checkpoint->interrupted))
             goto done;
         for (int c = k; c < 3; c++) {
             if (solved[c] || (c != k && !same_albedo(system, k, c)))
@@ -226,11 +245,16 @@ rad_status solve_direct(const rad_system *system, solve_params *params, rad_rgb 
         }
     }
 
+    if (stop_here(params->checkpoint, system, &status, error))
+        goto done;
     report->iterations = 0;
     report->criterion = solve_residual(system, B, params->threads);
     report->converged = report->criterion <= params->tolerance;
 
 done:
+    if (status == RAD_OK && params->checkpoint && params->checkpoint->interrupted)
+        for (uint32_t i = 0; i < n; i++) /* no solution: the checkpoint has F */
+            B[i] = system->exitance[i];
     free(pivot);
     free(x);
     free(m);

@@ -70,7 +70,8 @@ rad_status solve_gauss_seidel(const rad_system *system, solve_params *params, ra
         criterion = resumed_state.criterion;
         smallest = resumed_state.smallest;
     }
-    while (sweeps < params->max_iterations) {
+    /* (a resumed final state, whose criterion met the tolerance, takes no further sweep) */
+    while (sweeps < params->max_iterations && !(criterion <= params->tolerance)) {
         if (cp) { /* between sweeps */
             const double *x[4] = {x0, x1, x2, x0 + n};
             iterate_state state = {sweeps, criterion, smallest, UINT32_MAX};
@@ -115,6 +116,15 @@ rad_status solve_gauss_seidel(const rad_system *system, solve_params *params, ra
                           x0, x1, x2, NULL, true);
     }
 
+    if (cp) { /* a stop during the last sweep */
+        const double *x[4] = {x0, x1, x2, x0 + n};
+        iterate_state state = {sweeps, criterion, smallest, UINT32_MAX};
+        rad_status status = RAD_OK;
+        if (iterate_stop(cp, system, &state, put_iterate, x, &status, error)) {
+            free(work);
+            return status;
+        }
+    }
     for (uint32_t i = 0; i < n; i++)
         B[i] = (rad_rgb){x0[i], x1[i], x2[i]};
     report->iterations = sweeps;

@@ -76,7 +76,8 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
         criterion = resumed_state.criterion;
         smallest = resumed_state.smallest;
     }
-    while (sweeps < params->max_iterations) {
+    /* (a resumed final state, whose criterion met the tolerance, takes no further sweep) */
+    while (sweeps < params->max_iterations && !(criterion <= params->tolerance)) {
         if (cp) { /* between sweeps: B_sweeps in old[] */
             const double *x[4] = {old[0], old[1], old[2], old[0] + n};
             iterate_state state = {sweeps, criterion, smallest, UINT32_MAX};
@@ -139,7 +140,16 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
             break;
     }
 
-    /* old[] holds the newest iterate */
+    /* old[] holds the newest iterate; a stop during the last sweep is honoured here */
+    if (cp) {
+        const double *x[4] = {old[0], old[1], old[2], old[0] + n};
+        iterate_state state = {sweeps, criterion, smallest, UINT32_MAX};
+        rad_status status = RAD_OK;
+        if (iterate_stop(cp, system, &state, put_iterate, x, &status, error)) {
+            free(work);
+            return status;
+        }
+    }
     for (uint32_t i = 0; i < n; i++)
         B[i] = (rad_rgb){old[0][i], old[1][i], old[2][i]};
     report->iterations = sweeps;

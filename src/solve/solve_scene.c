@@ -162,7 +162,7 @@ static rad_status resumed_matrix(solve_checkpoint *cp, uint32_t n, rad_solver so
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the %u x %u matrix of %s", n,
                         n, cp->resume_path);
     }
-    if (!iterate_body_read(cp, n, solver == RAD_SOLVER_SHOOT ? 2 : 1, F, report, &state,
+    if (!iterate_body_read(cp, n, iterate_vectors(solver), F, report, &state,
                            &source, error)) {
         free(m);
         free(F);

@@ -226,6 +226,15 @@ rad_status solve_shoot(const rad_system *system, solve_params *params, rad_rgb *
         params->last_shooter = shooter;
     }
 
+    if (cp) { /* a stop during the last shots (the ambient term is added after resuming) */
+        shoot_vectors v = {B, dB, n};
+        iterate_state state = {shots, criterion, smallest, params->last_shooter};
+        rad_status status = RAD_OK;
+        if (iterate_stop(cp, system, &state, put_vectors, &v, &status, error)) {
+            free(work);
+            return status;
+        }
+    }
     if (params->ambient)
         add_ambient(system, dB, B);
     report->iterations = shots;

@@ -4,7 +4,9 @@
  * every solver under 2 and 3 ranks (the built-in Cornell box, 411 patches). The stop comes
  * after a known number of checkpoints (RADIOSITY_STOP_AFTER_CHECKPOINTS, which acts as
  * SIGTERM there), so no timing is involved: in the dense solvers' form-factor rows (each
- * rank's rows, gathered at rank 0) and in their iterate; in the hierarchical solver's
+ * rank's rows, gathered at rank 0) and in their iterate, and during the last sweep (the
+ * direct solver: during its last round of rows, F written before its LU); in the
+ * hierarchical solver's
  * refinement and before its final gather (each rank's links gathered at rank 0 and dealt
  * out again on resuming). Across rank counts: a 3-rank hierarchical checkpoint continued by
  * 2 ranks (stopped again), then serially; a 2-rank checkpoint of form-factor rows resumed
@@ -59,8 +61,8 @@ static void stop_and_resume(const char *solver, int ranks, long k, int resume_ra
 
 int main(void)
 {
-    const char *solvers[] = {"gather", "gauss-seidel", "shoot", "hierarchical"};
-    for (int s = 0; s < 4; s++) {
+    const char *solvers[] = {"gather", "gauss-seidel", "shoot", "hierarchical", "direct"};
+    for (int s = 0; s < 5; s++) {
         char arguments[256];
         snprintf(arguments, sizeof(arguments),
                  "solve --solver %s " SCENE " --threads 2 --save-solution serial-%s.sol "
@@ -75,6 +77,13 @@ int main(void)
     const char *at = strstr(test_read_text(test_path("count.json")), "\"checkpoints_written\":");
     long steps = at ? strtol(at + strlen("\"checkpoints_written\":"), NULL, 10) : 0;
     CHECK(steps > 10);
+    /* the gather solver's: 63 between its rows' rounds, then one before each sweep */
+    CHECK(test_run_tool("solve --solver gather " SCENE " --checkpoint count.bin "
+                        "--checkpoint-interval 0 --stats count.json --save-solution count.sol "
+                        "--quiet") == 0);
+    at = strstr(test_read_text(test_path("count.json")), "\"checkpoints_written\":");
+    long sweeps_steps = at ? strtol(at + strlen("\"checkpoints_written\":"), NULL, 10) : 0;
+    CHECK(sweeps_steps > 66);
 
     /* dense: 63 checkpoints between the 64 rounds of each rank's rows, then the iterate;
      * hierarchical: its refinement, and the checkpoint before the final gather */
@@ -84,6 +93,10 @@ int main(void)
     stop_and_resume("gather", 3, 66, 3);
     stop_and_resume("shoot", 3, 70, 3);
     stop_and_resume("hierarchical", 3, steps, 3);
+    /* a stop during the last sweep, honoured after it; the direct solver's during its
+     * rows' last round, honoured before its LU (F alone in the checkpoint) */
+    stop_and_resume("gather", 2, sweeps_steps, 2);
+    stop_and_resume("direct", 2, 63, 3);
 
     /* across rank counts */
     stop_and_resume("gather", 2, 5, 3);
