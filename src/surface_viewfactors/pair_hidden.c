@@ -233,12 +233,31 @@ static bool shape_hides(const pair_hidden_context *c, uint32_t g, uint32_t k,
     return shape_contains(&c->planes->shape[k], n, crossings, count, slack);
 }
 
-/* A probe point of the polygon: 0.8 of the way from its centroid to corner 0, or to the
- * corner opposite. */
-static rad_vec3 probe_point(const vf_polygon *polygon, unsigned which)
+/* A probe point of the polygon: `share` of the way from its centroid to corner 0, or to
+ * the corner opposite. */
+static rad_vec3 probe_point(const vf_polygon *polygon, unsigned which, double share)
 {
     rad_vec3 corner = polygon->vertex[which == 0 ? 0 : polygon->count / 2];
-    return v3_lerp(polygon->centroid, corner, 0.8);
+    return v3_lerp(polygon->centroid, corner, share);
+}
+
+/* The probe segments' points: PROBE_SHARE of the way out; a segment that gets through is
+ * cast again once from PROBE_SHARE_AGAIN before it counts as through. A tracer need not be
+ * watertight where triangles meet, and symmetric shapes put segments exactly there (two
+ * unit squares facing each other across a wall of 0.75 quads cross it at a corner four
+ * quads share, which Embree let through on one machine and not on another). */
+#define PROBE_SHARE 0.8
+#define PROBE_SHARE_AGAIN 0.7305
+
+static void probe_segment(const vf_polygon *p, const vf_polygon *q, unsigned k, double share,
+                          rad_ray *ray)
+{
+    unsigned a = k / 4, b = (k / 2) % 2;
+    rad_vec3 x = probe_point(p, a, share), y = probe_point(q, b, share);
+    if (k % 2 == 0)
+        ray_set(ray, x, v3_sub(y, x), RAD_SEGMENT_END_EPSILON, 1 - RAD_SEGMENT_END_EPSILON);
+    else
+        ray_set(ray, y, v3_sub(x, y), RAD_SEGMENT_END_EPSILON, 1 - RAD_SEGMENT_END_EPSILON);
 }
 
 /* Triangles each probe segment reports at most (the first it crosses, then the next...). */
@@ -252,24 +271,30 @@ static bool probe(const pair_hidden_context *c, const vf_polygon *p, const vf_po
                   uint32_t groups[PROBE_GROUPS], unsigned *count,
                   pair_hidden_work *work)
 {
-    rad_ray rays[2 * PAIR_HIDDEN_PROBES];
-    rad_hit hits[2 * PAIR_HIDDEN_PROBES];
-    unsigned n = 0;
-    for (unsigned a = 0; a < 2; a++)
-        for (unsigned b = 0; b < 2; b++) {
-            rad_vec3 x = probe_point(p, a), y = probe_point(q, b);
-            ray_set(&rays[n++], x, v3_sub(y, x), RAD_SEGMENT_END_EPSILON,
-                    1 - RAD_SEGMENT_END_EPSILON);
-            ray_set(&rays[n++], y, v3_sub(x, y), RAD_SEGMENT_END_EPSILON,
-                    1 - RAD_SEGMENT_END_EPSILON);
-        }
+    rad_ray rays[2 * PAIR_HIDDEN_PROBES], again_rays[2 * PAIR_HIDDEN_PROBES];
+    rad_hit hits[2 * PAIR_HIDDEN_PROBES], again_hits[2 * PAIR_HIDDEN_PROBES];
+    unsigned n = 2 * PAIR_HIDDEN_PROBES, through[2 * PAIR_HIDDEN_PROBES], missed = 0;
+    for (unsigned k = 0; k < n; k++)
+        probe_segment(p, q, k, PROBE_SHARE, &rays[k]);
     rad_tracer_intersect(c->tracer, rays, n, hits);
     work->rays += n;
+    for (unsigned k = 0; k < n; k++)
+        if (hits[k].triangle == RAD_NO_HIT) {
+            probe_segment(p, q, k, PROBE_SHARE_AGAIN, &again_rays[missed]);
+            through[missed++] = k;
+        }
+    if (missed > 0) {
+        rad_tracer_intersect(c->tracer, again_rays, missed, again_hits);
+        work->rays += missed;
+        for (unsigned m = 0; m < missed; m++) {
+            if (again_hits[m].triangle == RAD_NO_HIT)
+                return false;
+            rays[through[m]] = again_rays[m];
+            hits[through[m]] = again_hits[m];
+        }
+    }
     *count = 0;
     unsigned times[PROBE_GROUPS];
-    for (unsigned k = 0; k < n; k++)
-        if (hits[k].triangle == RAD_NO_HIT)
-            return false;
     /* the triangles each segment crosses after its first, up to PROBE_HITS */
     for (unsigned round = 0;; round++) {
         for (unsigned k = 0; k < n; k++) {
