@@ -410,16 +410,20 @@ void iterate_body_begin(const solve_checkpoint *cp, const rad_system *system,
 }
 
 bool iterate_resume_sweeps(solve_checkpoint *cp, uint32_t n, double *x0, double *x1,
-                           double *x2, iterate_state *state, bool *resumed, rad_error *error)
+                           double *x2, uint32_t *sweeps, double *criterion, double *smallest,
+                           rad_error *error)
 {
     byte_source source;
-    *resumed = solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_ITERATE, &source);
-    if (!*resumed)
+    iterate_state state;
+    if (!solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_ITERATE, &source))
         return true;
-    if (!iterate_body_read(cp, n, 1, NULL, NULL, state, &source, error))
+    if (!iterate_body_read(cp, n, 1, NULL, NULL, &state, &source, error))
         return false;
     source_channels(&source, x0, x1, x2, n);
     solve_checkpoint_resumed(cp);
+    *sweeps = state.iterations;
+    *criterion = state.criterion;
+    *smallest = state.smallest;
     return true;
 }
 

@@ -182,9 +182,11 @@ bool iterate_body_read(const solve_checkpoint *cp, uint32_t n, uint32_t vectors,
 /* Reads three channel arrays from n rad_rgb. */
 void source_channels(byte_source *source, double *x0, double *x1, double *x2, uint32_t n);
 /* A one-vector sweep solver's resume (Jacobi, Gauss-Seidel): when `cp` resumes an ITERATE
- * checkpoint, B into x0, x1, x2 and its state into *state, and *resumed = true. False
- * (error set, naming the file) for a damaged body. */
+ * checkpoint, B into x0, x1, x2 and the sweeps done, the criterion and the smallest one so
+ * far into *sweeps, *criterion and *smallest (left as they are otherwise). False (error
+ * set, naming the file) for a damaged body. */
 bool iterate_resume_sweeps(solve_checkpoint *cp, uint32_t n, double *x0, double *x1,
-                           double *x2, iterate_state *state, bool *resumed, rad_error *error);
+                           double *x2, uint32_t *sweeps, double *criterion, double *smallest,
+                           rad_error *error);
 
 #endif

@@ -59,16 +59,9 @@ rad_status solve_gauss_seidel(const rad_system *system, solve_params *params, ra
         solve_observe(params, system, solve_step(params, n, 0, "gauss-seidel", NAN), x0, x1, x2,
                       NULL, true);
     solve_checkpoint *cp = params->checkpoint;
-    iterate_state resumed_state;
-    bool resumed;
-    if (!iterate_resume_sweeps(cp, n, x0, x1, x2, &resumed_state, &resumed, error)) {
+    if (!iterate_resume_sweeps(cp, n, x0, x1, x2, &sweeps, &criterion, &smallest, error)) {
         free(work);
         return RAD_ERR_PARSE;
-    }
-    if (resumed) {
-        sweeps = resumed_state.iterations;
-        criterion = resumed_state.criterion;
-        smallest = resumed_state.smallest;
     }
     /* (a resumed final state, whose criterion met the tolerance, takes no further sweep) */
     while (sweeps < params->max_iterations && !(criterion <= params->tolerance)) {

@@ -65,16 +65,9 @@ rad_status solve_jacobi(const rad_system *system, solve_params *params, rad_rgb 
     if (params->observer)
         observed = solve_step(params, n, 0, "gather", NAN);
     solve_checkpoint *cp = params->checkpoint;
-    iterate_state resumed_state;
-    bool resumed;
-    if (!iterate_resume_sweeps(cp, n, old[0], old[1], old[2], &resumed_state, &resumed, error)) {
+    if (!iterate_resume_sweeps(cp, n, old[0], old[1], old[2], &sweeps, &criterion, &smallest, error)) {
         free(work);
         return RAD_ERR_PARSE;
-    }
-    if (resumed) {
-        sweeps = resumed_state.iterations;
-        criterion = resumed_state.criterion;
-        smallest = resumed_state.smallest;
     }
     /* (a resumed final state, whose criterion met the tolerance, takes no further sweep) */
     while (sweeps < params->max_iterations && !(criterion <= params->tolerance)) {
