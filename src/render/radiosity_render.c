@@ -608,14 +608,10 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         if (direct_light == RAD_DIRECT_PIXEL) /* where the pixels gather themselves */
             near = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1, sizeof(*near));
         reflected = rad_alloc_array(display.vertex_count, sizeof(*reflected));
-        rad_rgb *outgoing = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1,
-                                            sizeof(*outgoing));
-        bool made = (near || direct_light == RAD_DIRECT_VERTEX) && reflected && outgoing;
-        for (uint32_t p = 0; made && p < mesh->patch_count; p++)
-            outgoing[p] = rgb_max0(rgb_add(B[p], rgb_scale(inputs->exitance[p], -1)));
+        bool made = (near || direct_light == RAD_DIRECT_VERTEX) && reflected;
         display_hidden_patches(mesh, tracer, leave, hidden, near, NEAR_DISTANCE);
-        made = made && display_mesh_radiance_weighted(mesh, &display, outgoing, hidden, reflected);
-        free(outgoing);
+        made = made && vertex_radiance_reflected(mesh, &display, B, inputs->exitance, hidden,
+                                                 reflected);
         if (!made)
             goto nomem;
         view.reflected = reflected;

@@ -31,6 +31,21 @@ double vertex_radiance_leave(const rad_mesh *mesh)
     return RAD_SURFACE_LEAVE_DIAGONAL * diagonal + RAD_SURFACE_LEAVE_COORDINATE * largest;
 }
 
+bool vertex_radiance_reflected(const rad_mesh *mesh, const display_mesh *display,
+                               const rad_rgb *B, const rad_rgb *exitance,
+                               const uint8_t *hidden, rad_rgb *reflected)
+{
+    rad_rgb *outgoing = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1,
+                                        sizeof(*outgoing));
+    if (!outgoing)
+        return false;
+    for (uint32_t p = 0; p < mesh->patch_count; p++)
+        outgoing[p] = rgb_max0(rgb_add(B[p], rgb_scale(exitance[p], -1)));
+    bool made = display_mesh_radiance_weighted(mesh, display, outgoing, hidden, reflected);
+    free(outgoing);
+    return made;
+}
+
 rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
                            rad_rgb *irradiance, rad_error *error)
 {
@@ -94,13 +109,12 @@ rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh 
     size_t vertices = display->vertex_count ? display->vertex_count : 1;
     rad_vec3 *positions = rad_alloc_array(vertices, sizeof(*positions));
     uint8_t *hidden = rad_alloc_array(n, sizeof(*hidden));
-    rad_rgb *outgoing = rad_alloc_array(n, sizeof(*outgoing));
     rad_rgb *reflected = rad_alloc_array(vertices, sizeof(*reflected));
     rad_tracer *tracer = NULL, *scene_tracer = NULL;
     emitter_set emitters = {0};
     light_set lights;
     rad_status status = RAD_OK;
-    if (!positions || !hidden || !outgoing || !reflected) {
+    if (!positions || !hidden || !reflected) {
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light at the vertices");
         goto done;
     }
@@ -118,9 +132,7 @@ rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh 
         goto done;
     /* what the gather rays meet: the reflected light (B - E) / pi at the vertices */
     display_hidden_patches(mesh, tracer, leave, hidden, NULL, 0);
-    for (uint32_t p = 0; p < mesh->patch_count; p++)
-        outgoing[p] = rgb_max0(rgb_add(B[p], rgb_scale(inputs->exitance[p], -1)));
-    if (!display_mesh_radiance_weighted(mesh, display, outgoing, hidden, reflected)) {
+    if (!vertex_radiance_reflected(mesh, display, B, inputs->exitance, hidden, reflected)) {
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light at the vertices");
         goto done;
     }
@@ -151,7 +163,6 @@ done:
     emitters_free(&emitters);
     free(positions);
     free(hidden);
-    free(outgoing);
     free(reflected);
     return status;
 }

@@ -46,6 +46,13 @@ rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
  * surfaces or light sources (else the solution's patch values are all there is). */
 bool vertex_radiance_applies(const rad_scene *scene);
 
+/* What gather rays meet: the light the patches reflect, (B - E) / pi, at the display's
+ * vertices (patches in `hidden` left out), into reflected[display->vertex_count]. False
+ * when out of memory. */
+bool vertex_radiance_reflected(const rad_mesh *mesh, const display_mesh *display,
+                               const rad_rgb *B, const rad_rgb *exitance,
+                               const uint8_t *hidden, rad_rgb *reflected);
+
 /* How far rays start off a surface of this mesh: past the float rounding of hit points at
  * the scene's size and distance from the origin (scene units). */
 double vertex_radiance_leave(const rad_mesh *mesh);
