@@ -112,7 +112,6 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 #define RAD_DEFAULT_EMISSIVITY 0.9      /* rad_surface.emissivity when the file gives none */
 #define RAD_DEFAULT_RENDER_SPP 16       /* rad_render_options.samples_per_pixel */
 #define RAD_DEFAULT_DIRECT_SAMPLES 8    /* rad_render_options.direct_samples */
-#define RAD_DEFAULT_RENDER_GATHER_RAYS 16 /* rad_render_options.gather_rays */
 #define RAD_DEFAULT_EDGE_SAMPLES 64     /* rad_render_options.edge_samples */
 #define RAD_DEFAULT_MAX_DEPTH 5         /* max_depth of rad_render_options (mirror
                                            reflections) and rad_raytrace_options */
@@ -1589,34 +1588,31 @@ typedef struct rad_render_options {
      * light alone; misses and mirrors show nothing. Needs `scene`. */
     bool irradiance;
     /* How the emitters' direct light (emissive surfaces; with `scene`) reaches the image:
-     * RAD_DIRECT_VERTEX (the default): computed at every mesh vertex (1024 light samples
-     *   and 512 cosine rays, MIS, at a point a tenth of the way into the vertex's patches)
-     *   together with a final gather there (1024 cosine rays meeting the solution's
-     *   reflected light (B - E) / pi, or the sky), and interpolated: the vertex shows
-     *   E / pi + rho / pi (H_emitters + H_gathered); soft shadows, contact shadows and the
-     *   light next to creases follow the light, not patch means, and the image has no
-     *   pixel noise;
-     * RAD_DIRECT_PIXEL: computed at every pixel sample by `direct_samples` shadow rays to
-     *   points of the emitters (stratified over the pixel's samples; exact soft shadows, a
-     *   little noise), the rest (light reflected more than once, the sky) from the
-     *   solution with the direct light's patch means (16 x 32 samples per patch) taken
-     *   out first;
+     * RAD_DIRECT_VERTEX (the default): computed at every mesh vertex, at a point a tenth of
+     *   the way into the vertex's patches, together with a final gather there (1024 cosine
+     *   rays meeting the solution's reflected light (B - E) / pi, or the sky), and
+     *   interpolated: the vertex shows E / pi + rho / pi (H_emitters + H_gathered); soft
+     *   shadows, contact shadows and the light next to creases follow the light, not patch
+     *   means, and the image has no pixel noise;
+     * RAD_DIRECT_PIXEL: H_emitters computed at every pixel sample by `direct_samples`
+     *   shadow rays to points of the emitters (stratified over the pixel's samples; exact
+     *   soft shadows, a little noise in penumbrae), the rest (H_gathered) at the vertices as
+     *   above;
      * RAD_DIRECT_SOLUTION: interpolated from the solution like the rest (the classic
      *   radiosity image).
-     * Without emissive surfaces, RAD_DIRECT_VERTEX still computes the final gather at the
-     * vertices when the scene has light sources (its rays that leave the scene meet the sky
-     * and environment lights: their direct light); a scene with neither gets the classic
-     * image, and so does RAD_DIRECT_PIXEL without emissive surfaces. Point, spot,
-     * luminaire and sun light is computed at each pixel in every mode.
+     * H_emitters, wherever it is computed: with at most 64 emitting triangles of uniform
+     * emission, their unshadowed irradiance is summed exactly (Lambert's contour formula)
+     * and the shadow rays say what share of it gets through (the ratio estimator of Heitz,
+     * Hill and McGuire 2018: exact where nothing blocks the light); otherwise 1024 light
+     * samples a vertex (MIS with 512 cosine rays) or `direct_samples` a pixel sample (MIS
+     * with as many).
+     * Without emissive surfaces, both compute the final gather at the vertices when the
+     * scene has light sources (its rays that leave the scene meet the sky and environment
+     * lights: their direct light); a scene with neither gets the classic image. Point,
+     * spot, luminaire and sun light is computed at each pixel in every mode.
      * direct_samples 0 = RAD_DEFAULT_DIRECT_SAMPLES (RAD_DIRECT_PIXEL only). */
     rad_direct_light direct_light;
     uint32_t direct_samples;
-    /* With RAD_DIRECT_PIXEL: at a patch with another surface within 1.5 patch widths (a
-     * crease, a contact, a corner), the light reflected more than once is gathered at each
-     * pixel sample by `gather_rays` cosine-weighted rays meeting the solution (B - E
-     * interpolated; the sky where they leave) instead of being interpolated; 0 =
-     * RAD_DEFAULT_RENDER_GATHER_RAYS. */
-    uint32_t gather_rays;
 } rad_render_options;
 
 /* Radiance at every mesh vertex: the area-weighted average of B/pi over the patches that

@@ -1,27 +1,19 @@
 /*
- * emitter_light.c - the direct light of emissive surfaces at a point and on each patch
- * (emitter_light.h).
+ * emitter_light.c - the direct light of emissive surfaces at a point (emitter_light.h).
  */
 #include "render/emitter_light.h"
 
 #include <math.h>
 #include <stdbool.h>
-#include <omp.h>
-#include <stdlib.h>
 
-#include "core/alloc.h"
-#include "core/error.h"
 #include "core/hemisphere.h"
 #include "core/random.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
-#include "mesh/patch_point.h"
+#include "geometry/contour.h"
 #include "scene/material_at.h"
 #include "trace/ray.h"
 
-#define PATCH_EMITTER_POINTS 4u  /* per side: 16 points per patch */
-#define PATCH_EMITTER_SAMPLES 32u /* per point: 512 light samples per patch */
-#define PATCH_EMITTER_STREAM 0xE3177E2ull
 
 static double wrap(double u) { return u < 1 ? u : u - 1; }
 
@@ -92,6 +84,15 @@ uint32_t emitter_light_rays_mis(const emitter_set *set, const rad_scene *scene, 
                       rays, irradiance);
 }
 
+uint32_t emitter_light_rays_alone(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
+                                  rad_vec3 n, double leave, uint32_t count, double turn,
+                                  uint32_t first, double shift1, double shift2, rad_ray *rays,
+                                  rad_rgb *irradiance)
+{
+    return light_rays(set, scene, x, n, leave, count, turn, first, shift1, shift2, false, 0,
+                      rays, irradiance);
+}
+
 uint32_t emitter_light_rays_by_triangle(const emitter_set *set, const rad_scene *scene,
                                         rad_vec3 x, rad_vec3 n, double leave, uint32_t count,
                                         double turn, double shift1, double shift2,
@@ -157,71 +158,50 @@ rad_rgb emitter_cosine_value_weighted(const emitter_set *set, const rad_scene *s
                                   ((p_cosine * p_cosine + p_light * p_light) * count));
 }
 
-rad_status emitter_patch_direct(const emitter_set *set, const rad_scene *scene,
-                                const rad_mesh *mesh, const rad_tracer *occluders,
-                                double leave, uint64_t seed, int threads, rad_rgb *direct,
-                                rad_error *error)
+bool emitter_unshadowed_exact(const emitter_set *set, const rad_scene *scene)
 {
-    uint32_t n = mesh->patch_count;
-    for (uint32_t p = 0; p < n; p++)
-        direct[p] = (rad_rgb){0, 0, 0};
-    if (set->count == 0 || n == 0)
-        return RAD_OK;
-    const uint32_t points = PATCH_EMITTER_POINTS * PATCH_EMITTER_POINTS;
-    const uint32_t total = points * PATCH_EMITTER_SAMPLES; /* of each kind, per patch */
-    size_t size = (size_t)threads * total;
-    rad_ray *rays = rad_alloc_array(size, sizeof(*rays));
-    rad_rgb *values = rad_alloc_array(size, sizeof(*values));
-    uint8_t *blocked = rad_alloc_array(size, sizeof(*blocked));
-    rad_ray *cosine_rays = rad_alloc_array(size, sizeof(*cosine_rays));
-    rad_hit *hits = rad_alloc_array(size, sizeof(*hits));
-    double *cosines = rad_alloc_array(size, sizeof(*cosines));
-    bool ok = rays && values && blocked && cosine_rays && hits && cosines;
-    if (ok) {
-#pragma omp parallel for schedule(dynamic, 32) num_threads(threads)
-        for (int64_t p = 0; p < (int64_t)n; p++) {
-            size_t base = (size_t)omp_get_thread_num() * total;
-            const rad_patch *patch = &mesh->patches[p];
-            rad_rng rng = rad_rng_seed(seed ^ PATCH_EMITTER_STREAM, (uint64_t)p, 0);
-            double turn = rad_rng_uniform(&rng), shift1 = rad_rng_uniform(&rng),
-                   shift2 = rad_rng_uniform(&rng);
-            double off = 2 * patch->bulge + leave;
-            uint32_t count = 0;
-            for (uint32_t q = 0; q < points; q++) {
-                double s = ((q % PATCH_EMITTER_POINTS) + rad_rng_uniform(&rng)) / PATCH_EMITTER_POINTS;
-                double t = ((q / PATCH_EMITTER_POINTS) + rad_rng_uniform(&rng)) / PATCH_EMITTER_POINTS;
-                rad_vec3 x = patch_point(mesh, patch, s, t);
-                /* every point samples the whole light and its hemisphere; consecutive Halton
-                 * points (one shift for the patch) make the patch's samples cover the light
-                 * evenly */
-                count += emitter_light_rays_mis(set, scene, x, patch->normal, off,
-                                                PATCH_EMITTER_SAMPLES, turn,
-                                                q * PATCH_EMITTER_SAMPLES, shift1, shift2,
-                                                &rays[base + count], &values[base + count]);
-                emitter_cosine_rays(x, patch->normal, off, PATCH_EMITTER_SAMPLES, &rng,
-                                    &cosine_rays[base + q * PATCH_EMITTER_SAMPLES],
-                                    &cosines[base + q * PATCH_EMITTER_SAMPLES]);
-            }
-            rad_tracer_occluded(occluders, &rays[base], count, &blocked[base]);
-            rad_tracer_intersect(occluders, &cosine_rays[base], total, &hits[base]);
-            rad_rgb sum = {0, 0, 0};
-            for (uint32_t k = 0; k < count; k++)
-                if (!blocked[base + k])
-                    rgb_add_to(&sum, values[base + k]);
-            for (uint32_t k = 0; k < total; k++)
-                rgb_add_to(&sum, emitter_cosine_value(set, scene, &cosine_rays[base + k],
-                                                      &hits[base + k], cosines[base + k],
-                                                      PATCH_EMITTER_SAMPLES));
-            direct[p] = rgb_scale(sum, 1.0 / points); /* the mean of the points' estimates */
+    if (set->count > EMITTER_ANALYTIC_MAX)
+        return false;
+    for (uint32_t k = 0; k < set->count; k++)
+        if (material_emission_texture(scene, scene->triangles[set->triangle[k]].material))
+            return false;
+    return true;
+}
+
+rad_rgb emitter_unshadowed_irradiance(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
+                                      rad_vec3 n)
+{
+    rad_rgb sum = {0, 0, 0};
+    for (uint32_t k = 0; k < set->count; k++) {
+        uint32_t t = set->triangle[k];
+        const uint32_t *v = scene->triangles[t].vertex;
+        rad_vec3 corner[3] = {scene->positions[v[0]], scene->positions[v[1]],
+                              scene->positions[v[2]]};
+        rad_vec3 normal = v3_cross(v3_sub(corner[1], corner[0]), v3_sub(corner[2], corner[0]));
+        double length = v3_length(normal);
+        if (!(length > 0))
+            continue;
+        normal = v3_scale(normal, 1 / length);
+        double F = contour_point_to_polygon(x, n, corner, 3, normal, 0);
+        if (triangle_two_sided(scene, t)) { /* the back: the same triangle turned over */
+            rad_vec3 turned[3] = {corner[0], corner[2], corner[1]};
+            F += contour_point_to_polygon(x, n, turned, 3, v3_scale(normal, -1), 0);
         }
+        if (F > 0)
+            rgb_add_to(&sum, rgb_scale(material_emission_at(scene, t, 1.0 / 3, 1.0 / 3), RAD_PI * F));
     }
-    free(rays);
-    free(values);
-    free(blocked);
-    free(cosine_rays);
-    free(hits);
-    free(cosines);
-    if (!ok)
-        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the emitters' direct light");
-    return RAD_OK;
+    return sum;
+}
+
+void emitter_to_unshadowed(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
+                           rad_vec3 n, rad_rgb *irradiance, uint32_t count)
+{
+    rad_rgb all = {0, 0, 0};
+    for (uint32_t k = 0; k < count; k++)
+        rgb_add_to(&all, irradiance[k]);
+    rad_rgb open = emitter_unshadowed_irradiance(set, scene, x, n);
+    rad_rgb scale = {all.r > 0 ? open.r / all.r : 0, all.g > 0 ? open.g / all.g : 0,
+                     all.b > 0 ? open.b / all.b : 0};
+    for (uint32_t k = 0; k < count; k++)
+        irradiance[k] = rgb_mul(irradiance[k], scale);
 }

@@ -1,7 +1,7 @@
 /*
  * emitter_light.h - the direct light of emissive surfaces at a point, as shadow-ray pairs
- * (internal): what the radiosity render adds at each pixel sample for exact soft shadows,
- * and the same averaged over each patch, which it takes out of the solution first.
+ * (internal): what the radiosity render adds at each pixel sample (--direct pixel) or
+ * computes at each mesh vertex (the default), and the work plane's illuminance.
  *
  * Like the light sources' (lights/direct_light.h), a query returns pairs (shadow segment,
  * irradiance at x if the segment is unblocked); the caller traces them in a batch. Each
@@ -34,6 +34,12 @@ uint32_t emitter_light_rays_mis(const emitter_set *set, const rad_scene *scene, 
                                 rad_vec3 n, double leave, uint32_t count, double turn,
                                 uint32_t first, double shift1, double shift2, rad_ray *rays,
                                 rad_rgb *irradiance);
+/* The same samples without MIS (light sampling alone: no cosine rays go with them), for
+ * emitter_to_unshadowed. */
+uint32_t emitter_light_rays_alone(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
+                                  rad_vec3 n, double leave, uint32_t count, double turn,
+                                  uint32_t first, double shift1, double shift2, rad_ray *rays,
+                                  rad_rgb *irradiance);
 
 /* The same for one point that takes all `count` samples at once (a mesh vertex): the
  * triangle choices are evenly spaced, (k + turn) / count, so each emitting triangle gets
@@ -66,13 +72,30 @@ rad_rgb emitter_cosine_value_weighted(const emitter_set *set, const rad_scene *s
                                       const rad_ray *ray, const rad_hit *hit, double cos_x,
                                       uint32_t count, double light_per_cosine);
 
-/* Per patch, the mean over the patch of the emitters' direct irradiance (shadows
- * included): PATCH_EMITTER_POINTS^2 points, PATCH_EMITTER_SAMPLES samples each, traced
- * against `occluders` (the scene's triangles, or the patches). Deterministic per seed for
- * any thread count. */
-rad_status emitter_patch_direct(const emitter_set *set, const rad_scene *scene,
-                                const rad_mesh *mesh, const rad_tracer *occluders,
-                                double leave, uint64_t seed, int threads, rad_rgb *direct,
-                                rad_error *error);
+/* Most emitting triangles for which the unshadowed irradiance is summed exactly (each costs
+ * one contour integral per query, about as much as a few shadow rays). */
+#define EMITTER_ANALYTIC_MAX 64u
+
+/* Whether the emitters' unshadowed irradiance can be computed exactly at any point: at
+ * most EMITTER_ANALYTIC_MAX emitting triangles, each of uniform emitted radiance (no
+ * emission texture). */
+bool emitter_unshadowed_exact(const emitter_set *set, const rad_scene *scene);
+
+/* The emitters' irradiance at x (unit normal n) with no shadows, exactly: for each emitting
+ * triangle pi L_e F(x), F Lambert's point-to-polygon factor (contour.h) over the part of
+ * the triangle in front of x's surface, on the triangle's emitting side (both sides when
+ * two-sided). Only when emitter_unshadowed_exact. With it, the shadowed irradiance is that
+ * times the share of the light samples' unshadowed irradiance that gets through (the ratio
+ * estimator of Heitz, Hill and McGuire 2018): exact where nothing blocks, and its noise
+ * only that of the visibility. */
+rad_rgb emitter_unshadowed_irradiance(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
+                                      rad_vec3 n);
+
+/* Scales the `count` light samples of one query at x (light sampling alone, each channel)
+ * so they sum to the exact unshadowed irradiance there: the unblocked ones then sum to the
+ * ratio estimate. Only when emitter_unshadowed_exact. */
+void emitter_to_unshadowed(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
+                           rad_vec3 n, rad_rgb *irradiance, uint32_t count);
+
 
 #endif

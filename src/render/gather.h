@@ -3,8 +3,7 @@
  * the surfaces reflect, (B - E) / pi interpolated at the hit from the display vertices
  * (emission left out: the gathering point takes the emitters' direct light its own way),
  * the twin's value on the back of a two-sided patch, and the sky where the ray leaves the
- * scene. Used by the per-pixel gather next to creases (radiosity_render.c) and by the
- * gather at the mesh's vertices (vertex_light.c). It does not trace: the caller traces its
+ * scene. Used by the gather at the mesh's vertices (vertex_light.c). It does not trace: the caller traces its
  * rays in batches against `tracer`.
  */
 #ifndef RAD_RENDER_GATHER_H

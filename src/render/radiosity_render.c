@@ -49,9 +49,6 @@
 #define LIGHT_STREAM 0x5EED11647ull /* the same for shadow rays toward light sources */
 #define LIGHT_BATCH 65536u         /* shadow rays traced together, at most */
 #define MAX_DIRECT_SAMPLES 1024u   /* emitter samples per pixel sample, at most */
-#define GATHER_STREAM 0x5EED6A7Eull /* the final gather's directions */
-#define MAX_GATHER_RAYS 1024u      /* final-gather rays per pixel sample, at most */
-#define NEAR_DISTANCE 1.5          /* a surface this many patch widths away is near */
 #define EMITTER_STREAM 0x5EEDE3177ull /* the per-pixel shifts of the emitters' samples */
 
 /* One thread's rays of one image row, compacted bounce by bounce. */
@@ -82,12 +79,6 @@ typedef struct row_work {
     rad_rgb *cosine_factor;
     uint32_t *cosine_sample;
     uint32_t cosine_count, cosine_capacity;
-    /* final-gather rays from hits next to a crease or contact, closest-hit queries */
-    rad_ray *gather_rays;
-    rad_hit *gather_hits;
-    rad_rgb *gather_factor;
-    uint32_t *gather_sample;
-    uint32_t gather_count, gather_capacity;
 } row_work;
 
 typedef struct shading {
@@ -112,15 +103,12 @@ typedef struct shading {
     const emitter_set *emitters;    /* NULL: the emitters' direct light comes from the
                                        solution, interpolated, not per pixel */
     const rad_scene *scene;
+    bool emitters_exact;            /* their unshadowed light summed exactly (ratio
+                                       estimator: emitter_light.h), no cosine rays */
     uint32_t emitter_samples;       /* per pixel sample */
     size_t per_row;                 /* first samples of a row: W k^2 */
     uint32_t edge_strata;           /* edge samples of an edge pixel */
     const rad_tracer *scene_tracer; /* the scene's own triangles: the emitters hit */
-    const uint8_t *near;            /* per patch: next to a crease or contact, where the
-                                       light reflected more than once is gathered at the
-                                       pixel (NULL: interpolated everywhere) */
-    const gather_view *view;        /* what a gather ray meets (NULL: no gather) */
-    uint32_t gather_rays;           /* per pixel sample */
 } shading;
 
 static double mean_luminance(const rad_rgb *samples, unsigned count)
@@ -199,14 +187,6 @@ static uint32_t twin_triangle(const shading *sh, uint32_t twin, rad_vec3 point, 
  * cosine-weighted rays, adding what the emitters they hit send. */
 static void flush_lights(const shading *sh, row_work *w)
 {
-    if (w->gather_count) {
-        rad_tracer_intersect(sh->view->tracer, w->gather_rays, w->gather_count, w->gather_hits);
-        for (uint32_t k = 0; k < w->gather_count; k++) {
-            rad_rgb L = gather_seen(sh->view, &w->gather_rays[k], &w->gather_hits[k]);
-            rgb_add_to(&w->sum[w->gather_sample[k]], rgb_mul(L, w->gather_factor[k]));
-        }
-        w->gather_count = 0;
-    }
     if (w->cosine_count) {
         rad_tracer_intersect(sh->scene_tracer, w->cosine_rays, w->cosine_count, w->cosine_hits);
         for (uint32_t k = 0; k < w->cosine_count; k++) {
@@ -257,11 +237,24 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
         rad_rng per_pixel = rad_rng_seed(sh->seed ^ EMITTER_STREAM, w->row, pixel);
         double turn = rad_rng_uniform(&per_pixel), shift1 = rad_rng_uniform(&per_pixel),
                shift2 = rad_rng_uniform(&per_pixel);
-        count += emitter_light_rays_mis(sh->emitters, sh->scene, point, patch->normal, leave,
-                                        sh->emitter_samples, turn,
-                                        index * sh->emitter_samples, shift1, shift2,
-                                        &w->light_rays[w->light_count + count],
-                                        &w->light_value[w->light_count + count]);
+        rad_ray *rays = &w->light_rays[w->light_count + count];
+        rad_rgb *values = &w->light_value[w->light_count + count];
+        if (sh->emitters_exact) {
+            /* the unshadowed light exactly, shared out over the samples: those that get
+             * through bring their share */
+            uint32_t made = emitter_light_rays_alone(sh->emitters, sh->scene, point,
+                                                     patch->normal, leave, sh->emitter_samples,
+                                                     turn, index * sh->emitter_samples, shift1,
+                                                     shift2, rays, values);
+            emitter_to_unshadowed(sh->emitters, sh->scene, point, patch->normal, values, made);
+            count += made;
+        } else
+            count += emitter_light_rays_mis(sh->emitters, sh->scene, point, patch->normal, leave,
+                                            sh->emitter_samples, turn,
+                                            index * sh->emitter_samples, shift1, shift2, rays,
+                                            values);
+    }
+    if (sh->emitters && !sh->emitters_exact) {
         uint32_t c = w->cosine_count;
         emitter_cosine_rays(point, patch->normal, leave, sh->emitter_samples, &rng,
                             &w->cosine_rays[c], &w->cosine_of[c]);
@@ -277,26 +270,6 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
         w->light_sample[q] = slot;
     }
     w->light_count += count;
-}
-
-/* Queues the final gather of a hit next to a crease or contact: gather_rays
- * cosine-weighted directions (stratified, turned at random), each adding
- * factor x pi / gather_rays x the radiance it meets. */
-static void queue_gather(const shading *sh, row_work *w, uint32_t slot, rad_vec3 point,
-                         const rad_patch *patch, rad_rgb factor)
-{
-    if (w->gather_count + sh->gather_rays > w->gather_capacity)
-        flush_lights(sh, w);
-    rad_rng rng = rad_rng_seed(sh->seed ^ GATHER_STREAM, w->row, slot);
-    double cosines[MAX_GATHER_RAYS];
-    emitter_cosine_rays(point, patch->normal, 2 * patch->bulge + sh->leave, sh->gather_rays, &rng,
-                        &w->gather_rays[w->gather_count], cosines);
-    rad_rgb each = rgb_scale(factor, RAD_PI / sh->gather_rays);
-    for (uint32_t k = w->gather_count; k < w->gather_count + sh->gather_rays; k++) {
-        w->gather_factor[k] = each;
-        w->gather_sample[k] = slot;
-    }
-    w->gather_count += sh->gather_rays;
 }
 
 /* Adds each hit's interpolated radiance (times the ray's weight) to its sample and, when
@@ -340,15 +313,7 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
         rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit_u - hit_v),
                                        rgb_add(rgb_scale(L[v[1]], hit_u), rgb_scale(L[v[2]], hit_v)));
         rad_rgb albedo = sh->inputs ? sh->inputs->albedo[patch_index] : (rad_rgb){0, 0, 0};
-        bool gathered = sh->near && sh->near[patch_index] && !sh->irradiance;
-        if (gathered) {
-            /* next to a crease or contact: the emitted radiance at the point, and the light
-             * reflected more than once gathered here rather than interpolated */
-            interpolated = rgb_scale(sh->inputs->exitance[patch_index], 1 / RAD_PI);
-            if (patch_material_textured(sh->textures, sh->mesh->patches[patch_index].material))
-                interpolated = textured_radiance(sh, &w->rays[r], hit, patch_index,
-                                                 (rad_rgb){0, 0, 0}, &albedo);
-        } else if (sh->irradiance) {
+        if (sh->irradiance) {
             /* the vertices hold irradiance / pi; the sharp sources come below, whole */
             interpolated = rgb_scale(interpolated, RAD_PI);
             albedo = (rad_rgb){RAD_PI, RAD_PI, RAD_PI};
@@ -364,9 +329,6 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
                                 ray->origin[2] + (double)hit->t * ray->direction[2]);
             queue_lights(sh, w, w->sample[r], point, &sh->mesh->patches[patch_index],
                          rgb_scale(rgb_mul(weight, albedo), 1.0 / RAD_PI));
-            if (gathered)
-                queue_gather(sh, w, w->sample[r], point, &sh->mesh->patches[patch_index],
-                             rgb_scale(rgb_mul(weight, albedo), 1.0 / RAD_PI));
         }
         if (!mirrors || !sh->materials || sh->irradiance)
             continue;
@@ -414,7 +376,7 @@ static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work 
  * (B - E) / rho - H_sharp (0 where rho is 0), elsewhere the exitance B - rho H_sharp. All
  * NULL when there is no scene or neither textures nor light sources. */
 static rad_status inputs_begin(const rad_render_options *options, const rad_mesh *mesh,
-                               const rad_rgb *B, const rad_rgb *emitter_direct, bool need,
+                               const rad_rgb *B, bool need,
                                patch_material_lookup **lookup,
                                const rad_patch_inputs **inputs, rad_patch_inputs **built,
                                rad_rgb **shaded, rad_error *error)
@@ -432,14 +394,13 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
         return rad_fail(error, RAD_ERR_INVALID,
                         "render: an irradiance image needs the scene (options.scene)");
     if (!scene || (scene->texture_count == 0 && scene->light_count == 0 && !options->irradiance &&
-                   !emitter_direct && !need))
+                   !need))
         return RAD_OK;
     rad_status status = RAD_OK;
     if (scene->texture_count > 0)
         status = patch_material_lookup_create(scene, lookup, error);
     if (status != RAD_OK ||
-        (!*lookup && scene->light_count == 0 && !options->irradiance && !emitter_direct &&
-         !need))
+        (!*lookup && scene->light_count == 0 && !options->irradiance && !need))
         return status;
     if (!options->inputs) {
         status = rad_patch_inputs_build(scene, mesh, built, error);
@@ -453,11 +414,8 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
         const double *b = &B[p].r, *e = &(*inputs)->exitance[p].r;
         const double *rho = &(*inputs)->albedo[p].r;
-        /* what the hits add themselves: the sharp sources', and the emitters' */
-        rad_rgb sharp = (*inputs)->direct_sharp[p];
-        if (emitter_direct)
-            sharp = rgb_add(sharp, emitter_direct[p]);
-        const double *h = &sharp.r;
+        /* what the hits add themselves: the sharp sources' */
+        const double *h = &(*inputs)->direct_sharp[p].r;
         double *out = &(*shaded)[p].r;
         if (options->irradiance) {
             /* (B - E) / rho is the irradiance; a black patch shows its direct light only */
@@ -515,8 +473,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
     emitter_set emitters = {0};
     const emitter_set *emitters_ptr = NULL;
     rad_tracer *scene_tracer = NULL;
-    rad_rgb *emitter_direct = NULL;
-    uint8_t *hidden = NULL, *near = NULL;
+    uint8_t *hidden = NULL;
     rad_rgb *reflected = NULL;
     bool agreed = false; /* every rank has passed ranks_agree (collective over MPI ranks) */
     status = display_mesh_build(mesh, true, &display, error);
@@ -536,18 +493,13 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
         options->direct_samples ? options->direct_samples : RAD_DEFAULT_DIRECT_SAMPLES;
     if (emitter_samples > MAX_DIRECT_SAMPLES)
         emitter_samples = MAX_DIRECT_SAMPLES;
-    uint32_t gather_rays = options->gather_rays ? options->gather_rays : RAD_DEFAULT_RENDER_GATHER_RAYS;
-    if (gather_rays > MAX_GATHER_RAYS)
-        gather_rays = MAX_GATHER_RAYS;
 
-    /* the emitters' direct light at every pixel sample (with its patch means to take out of
-     * the solution first) or at every vertex */
-    /* per pixel: the emitters' light; at the vertices: theirs, the sky's (the gather
-     * rays that leave the scene) and the light reflected (the sharp sources' is the
+    /* at the vertices: the emitters' light (unless each pixel takes it), the sky's (the
+     * gather rays that leave the scene) and the light reflected (the sharp sources' is the
      * hits' own either way) */
     rad_direct_light direct_light = options->direct_light;
     if (direct_light == RAD_DIRECT_PIXEL && !(options->scene && rad_scene_has_emitter(options->scene)))
-        direct_light = RAD_DIRECT_SOLUTION;
+        direct_light = RAD_DIRECT_VERTEX; /* no emitter light to take per pixel */
     if (direct_light == RAD_DIRECT_VERTEX && !vertex_radiance_applies(options->scene))
         direct_light = RAD_DIRECT_SOLUTION;
     if (direct_light == RAD_DIRECT_PIXEL || direct_light == RAD_DIRECT_VERTEX) {
@@ -557,18 +509,10 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                                                  &scene_tracer, error);
         if (status != RAD_OK)
             goto done;
-        if (direct_light == RAD_DIRECT_PIXEL) {
-            emitter_direct = rad_alloc_array(mesh->patch_count, sizeof(*emitter_direct));
-            if (!emitter_direct)
-                goto nomem;
-            status = emitter_patch_direct(&emitters, options->scene, mesh, scene_tracer,
-                                          leave, options->seed, threads, emitter_direct, error);
-            if (status != RAD_OK)
-                goto done;
+        if (direct_light == RAD_DIRECT_PIXEL)
             emitters_ptr = &emitters;
-        }
     }
-    status = inputs_begin(options, mesh, B, emitter_direct, direct_light == RAD_DIRECT_VERTEX,
+    status = inputs_begin(options, mesh, B, direct_light != RAD_DIRECT_SOLUTION,
                           &lookup, &inputs, &built_inputs,
                           &shaded, error);
     if (status != RAD_OK)
@@ -603,21 +547,14 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                         display.patch_of, NULL,
                         B,      inputs ? inputs->exitance : NULL,
                         lights_ptr, tracer};
+    display_hidden_patches(mesh, tracer, leave, hidden, NULL, 0);
     if (direct_light != RAD_DIRECT_SOLUTION) {
         /* what gather rays meet: the reflected light (B - E) / pi at the vertices */
-        if (direct_light == RAD_DIRECT_PIXEL) /* where the pixels gather themselves */
-            near = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1, sizeof(*near));
         reflected = rad_alloc_array(display.vertex_count, sizeof(*reflected));
-        bool made = (near || direct_light == RAD_DIRECT_VERTEX) && reflected;
-        display_hidden_patches(mesh, tracer, leave, hidden, near, NEAR_DISTANCE);
-        made = made && vertex_radiance_reflected(mesh, &display, B, inputs->exitance, hidden,
-                                                 reflected);
-        if (!made)
+        if (!reflected ||
+            !vertex_radiance_reflected(mesh, &display, B, inputs->exitance, hidden, reflected))
             goto nomem;
         view.reflected = reflected;
-    } else
-        display_hidden_patches(mesh, tracer, leave, hidden, NULL, 0);
-    if (direct_light == RAD_DIRECT_VERTEX) {
         vertex_radiance_job job = {
             .mesh = mesh,
             .display = &display,
@@ -631,6 +568,7 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
             .sharp = NULL, /* each hit adds them */
             .hidden = hidden,
             .leave = leave,
+            .gathered_only = direct_light == RAD_DIRECT_PIXEL,
             .seed = options->seed,
             .threads = threads,
         };
@@ -690,13 +628,6 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                 goto nomem;
         }
         if (emitters_ptr) {
-            w->gather_capacity = LIGHT_BATCH;
-            w->gather_rays = rad_alloc_array(LIGHT_BATCH, sizeof(*w->gather_rays));
-            w->gather_hits = rad_alloc_array(LIGHT_BATCH, sizeof(*w->gather_hits));
-            w->gather_factor = rad_alloc_array(LIGHT_BATCH, sizeof(*w->gather_factor));
-            w->gather_sample = rad_alloc_array(LIGHT_BATCH, sizeof(*w->gather_sample));
-            if (!w->gather_rays || !w->gather_hits || !w->gather_factor || !w->gather_sample)
-                goto nomem;
             w->cosine_capacity = LIGHT_BATCH;
             w->cosine_rays = rad_alloc_array(LIGHT_BATCH, sizeof(*w->cosine_rays));
             w->cosine_hits = rad_alloc_array(LIGHT_BATCH, sizeof(*w->cosine_hits));
@@ -718,10 +649,9 @@ rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *
                      k * k,     options->seed,
                      options->irradiance,
                      emitters_ptr, options->scene,
+                     emitters_ptr && emitter_unshadowed_exact(emitters_ptr, options->scene),
                      emitter_samples, per_row,
-                     edge_k * edge_k, scene_tracer,
-                     near,      &view,
-                     gather_rays};
+                     edge_k * edge_k, scene_tracer};
 
     /* over several MPI ranks the rows are dealt out in turn (every pixel's random numbers
      * are its own, so each row comes out as in a serial run), then summed: every pixel is
@@ -849,10 +779,6 @@ done:
             free(work[th].edge_pixel);
             free(work[th].first_surface);
             free(work[th].corner_surface);
-            free(work[th].gather_rays);
-            free(work[th].gather_hits);
-            free(work[th].gather_factor);
-            free(work[th].gather_sample);
             free(work[th].cosine_rays);
             free(work[th].cosine_hits);
             free(work[th].cosine_of);
@@ -867,9 +793,7 @@ done:
     rad_tracer_destroy(tracer);
     rad_tracer_destroy(scene_tracer);
     emitters_free(&emitters);
-    free(emitter_direct);
     free(hidden);
-    free(near);
     free(reflected);
     display_mesh_free(&display);
     free(radiance);

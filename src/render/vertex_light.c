@@ -109,6 +109,7 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
     uint32_t n = mesh->vertex_count;
     for (uint32_t v = 0; v < n; v++)
         direct[v] = gathered[v] = (rad_rgb){0, 0, 0};
+    const bool exact = emitter_unshadowed_exact(set, scene);
     if (n == 0)
         return RAD_OK;
     const uint32_t sharp_rays = sharp ? light_set_capacity(sharp, LIGHTS_SHARP, 0) : 0;
@@ -151,7 +152,17 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
             rad_vec3 x = v3_add(mesh->vertices[v], v3_scale(f->inward, VERTEX_INWARD / f->weight));
             double off = 2 * f->bulge + leave;
             rad_rgb sum = {0, 0, 0};
-            if (set->count > 0) {
+            if (set->count > 0 && exact) {
+                /* the unshadowed light exactly, times the share of the samples' that gets
+                 * through */
+                uint32_t count = emitter_light_rays_by_triangle(
+                    set, scene, x, nv, off, samples, turn, shift1, shift2, 0, light, value);
+                emitter_to_unshadowed(set, scene, x, nv, value, count);
+                rad_tracer_occluded(occluders, light, count, shadowed);
+                for (uint32_t k = 0; k < count; k++)
+                    if (!shadowed[k])
+                        rgb_add_to(&sum, value[k]);
+            } else if (set->count > 0) {
                 const double share = (double)VERTEX_COSINE_RAYS / samples;
                 uint32_t count = emitter_light_rays_by_triangle(
                     set, scene, x, nv, off, samples, turn, shift1, shift2, share, light, value);

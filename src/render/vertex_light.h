@@ -1,7 +1,9 @@
 /*
  * vertex_light.h - the light arriving at each mesh vertex, computed at the point rather
  * than averaged over patches (internal): the emitters' direct irradiance (1024 shadow rays
- * shared evenly by the emitting triangles, MIS with 512 cosine rays) and the irradiance
+ * shared evenly by the emitting triangles: the share that gets through of their exact
+ * unshadowed irradiance when emitter_unshadowed_exact, else MIS with 512 cosine rays)
+ * and the irradiance
  * gathered from the solution's reflected light (a final gather: 1024 cosine-weighted rays
  * meeting (B - E) / pi, the sky where they leave). The default render interpolates these point values over the display
  * triangles, so soft shadows, contact shadows and the light next to creases follow the

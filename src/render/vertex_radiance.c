@@ -75,9 +75,10 @@ rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light at the vertices");
         goto done;
     }
-    status = vertex_light(job->emitters, job->scene, mesh, job->scene_tracer, job->view,
-                          job->sharp, job->hidden, job->leave, job->seed, job->threads, direct,
-                          gathered, error);
+    const emitter_set none = {0};
+    status = vertex_light(job->gathered_only ? &none : job->emitters, job->scene, mesh,
+                          job->scene_tracer, job->view, job->sharp, job->hidden, job->leave,
+                          job->seed, job->threads, direct, gathered, error);
     if (status != RAD_OK)
         goto done;
     for (uint32_t v = 0; v < mesh->vertex_count; v++) {

@@ -33,6 +33,7 @@ typedef struct vertex_radiance_job {
     const light_set *sharp;              /* NULL, or the sharp sources to add at vertices */
     const uint8_t *hidden;               /* patches no one sees */
     double leave;                        /* how far rays start off a surface */
+    bool gathered_only;                  /* H_emitters left out: each pixel adds its own */
     uint64_t seed;
     int threads;
 } vertex_radiance_job;
