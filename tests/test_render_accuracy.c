@@ -6,9 +6,10 @@
  * renders: the classic one (--direct solution: the emitters' direct light interpolated from
  * the patches), the default (--direct vertex: the emitters' direct light and a final
  * gather of the solution computed at every mesh vertex, then interpolated: no noise) and
- * the one with the emitters' direct light at every pixel (--direct pixel: shadow rays,
- * MIS; the light reflected more than once gathered at pixels next to creases and
- * contacts); each is held to what it measures today, and the default must beat the
+ * the one with the emitters' direct light at every pixel (--direct pixel: shadow rays;
+ * the light reflected more than once from the vertices' gather); both light-at-the-vertex
+ * renders show it on the mesh split where the emitters' shadows bend the light
+ * (light_refine.h); each is held to what it measures today, and the default must beat the
  * classic one. A furnace checks that the direct light at pixels and at vertices stays
  * unbiased where every wall is an emitter.
  */
@@ -73,10 +74,16 @@ static void test_cornell(void)
      * 0.0084 / 0.0167: the pixel measure is the renders' own error, not the reference's
      * noise; 60 % of its square came from 1 % of the pixels, on the floor along the
      * blocks' feet, most of it the floor patches running under the blocks. The issue asks
-     * for 0.01 / 0.01 at 128 x 128: the default meets the blocks' 1 %, not the pixels'. From seed to seed the per-pixel
-     * render's blocks move by a few tenths of a percent (its noise). */
+     * for 0.01 / 0.01 at 128 x 128. Later the same day: the emitters' unshadowed light
+     * summed exactly (contour integrals, the shadow rays giving the share that gets
+     * through) read 0.0097 / 0.0132 at the vertices and 0.0078 / 0.0122 per pixel (the
+     * rest from the vertices' gather instead of patch means); then the light shown on the
+     * mesh split where the shadows bend it (light_refine.h: 3742 -> 7198 patches, for
+     * display) 0.0080 / 0.0114 at the vertices and 0.0078 / 0.0131 per pixel: the default
+     * meets the blocks' 1 %, not the pixels'. From seed to seed the renders' blocks move by
+     * a few tenths of a percent (the gather's noise at the vertices, the light's rim). */
     CHECK(classic.block_relative_rmse < 0.030 && classic.pixel_relative_rmse < 0.033);
-    CHECK(vertex.block_relative_rmse < 0.011 && vertex.pixel_relative_rmse < 0.015);
+    CHECK(vertex.block_relative_rmse < 0.009 && vertex.pixel_relative_rmse < 0.0125);
     CHECK(vertex.block_relative_rmse < 0.6 * classic.block_relative_rmse);
     CHECK(vertex.pixel_relative_rmse < 0.7 * classic.pixel_relative_rmse);
     CHECK_NEAR(vertex.mean_a.g, vertex.mean_b.g, 0.01);

@@ -340,19 +340,23 @@ static float little_f32(const uint8_t *p)
 /* The vertex element's three float properties `names` of a binary PLY (any property
  * order, float/uchar/int types) of the file `name` in the test folder, malloc'd as
  * count x 3 floats; NULL when one is missing. */
-float *test_ply_vertex_floats(const char *name, const char *const names[3], uint32_t *count)
+/* Where a binary PLY's parts are: the vertex records after `header` bytes, `record` bytes
+ * each, the float properties `names` (NULL: not wanted) at offset[k] in a record
+ * (SIZE_MAX: missing), then `faces` faces, whose list is "uchar int vertex_indices" when
+ * `int_lists`. False when the header has no end. */
+typedef struct ply_layout {
+    size_t header, record, offset[3];
+    uint32_t vertices, faces;
+    bool int_lists;
+} ply_layout;
+
+static bool ply_layout_of(const uint8_t *bytes, const char *const names[3], ply_layout *out)
 {
-    *count = 0;
-    size_t size = 0;
-    uint8_t *bytes = test_read_bytes(test_path(name), &size);
     const char *end = bytes ? strstr((const char *)bytes, "end_header\n") : NULL;
-    if (!end) {
-        free(bytes);
-        return NULL;
-    }
-    size_t header = (size_t)(end - (const char *)bytes) + strlen("end_header\n");
-    size_t record = 0, offset[3] = {SIZE_MAX, SIZE_MAX, SIZE_MAX};
-    uint32_t vertices = 0;
+    if (!end)
+        return false;
+    *out = (ply_layout){(size_t)(end - (const char *)bytes) + strlen("end_header\n"), 0,
+                        {SIZE_MAX, SIZE_MAX, SIZE_MAX}, 0, 0, false};
     bool in_vertex = false;
     for (const char *line = (const char *)bytes; line < end;) {
         const char *next = strchr(line, '\n');
@@ -362,26 +366,70 @@ float *test_ply_vertex_floats(const char *name, const char *const names[3], uint
         unsigned u;
         if (sscanf(text, "element vertex %u", &u) == 1) {
             in_vertex = true;
-            vertices = u;
+            out->vertices = u;
+        } else if (sscanf(text, "element face %u", &u) == 1) {
+            in_vertex = false;
+            out->faces = u;
         } else if (strncmp(text, "element ", 8) == 0) {
             in_vertex = false;
+        } else if (strcmp(text, "property list uchar int vertex_indices") == 0) {
+            out->int_lists = true;
         } else if (in_vertex && sscanf(text, "property %31s %63s", type, property) == 2) {
-            for (int k = 0; k < 3; k++)
+            for (int k = 0; names && k < 3; k++)
                 if (strcmp(property, names[k]) == 0 && strcmp(type, "float") == 0)
-                    offset[k] = record;
-            record += strcmp(type, "uchar") == 0 ? 1 : 4;
+                    out->offset[k] = out->record;
+            out->record += strcmp(type, "uchar") == 0 ? 1 : 4;
         }
         line = next + 1;
     }
+    return true;
+}
+
+float *test_ply_vertex_floats(const char *name, const char *const names[3], uint32_t *count)
+{
+    *count = 0;
+    size_t size = 0;
+    uint8_t *bytes = test_read_bytes(test_path(name), &size);
+    ply_layout ply;
     float *values = NULL;
-    if (offset[0] != SIZE_MAX && offset[1] != SIZE_MAX && offset[2] != SIZE_MAX &&
-        header + (size_t)vertices * record <= size) {
-        values = calloc(3 * (size_t)vertices + 1, sizeof(*values));
-        for (uint32_t v = 0; v < vertices; v++)
+    if (ply_layout_of(bytes, names, &ply) && ply.offset[0] != SIZE_MAX &&
+        ply.offset[1] != SIZE_MAX && ply.offset[2] != SIZE_MAX &&
+        ply.header + (size_t)ply.vertices * ply.record <= size) {
+        values = calloc(3 * (size_t)ply.vertices + 1, sizeof(*values));
+        for (uint32_t v = 0; values && v < ply.vertices; v++)
             for (int k = 0; k < 3; k++)
-                values[3 * v + k] = little_f32(bytes + header + v * record + offset[k]);
-        *count = vertices;
+                values[3 * v + k] = little_f32(bytes + ply.header + v * ply.record + ply.offset[k]);
+        *count = values ? ply.vertices : 0;
     }
     free(bytes);
     return values;
+}
+
+uint32_t *test_ply_triangles(const char *name, uint32_t *count)
+{
+    *count = 0;
+    size_t size = 0;
+    uint8_t *bytes = test_read_bytes(test_path(name), &size);
+    ply_layout ply;
+    uint32_t *triangles = NULL;
+    if (ply_layout_of(bytes, NULL, &ply) && ply.int_lists &&
+        ply.header + (size_t)ply.vertices * ply.record + (size_t)ply.faces * 13 <= size) {
+        const uint8_t *face = bytes + ply.header + (size_t)ply.vertices * ply.record;
+        triangles = calloc(3 * (size_t)ply.faces + 1, sizeof(*triangles));
+        for (uint32_t f = 0; triangles && f < ply.faces; f++, face += 13) {
+            if (face[0] != 3) {
+                free(triangles);
+                triangles = NULL;
+                break;
+            }
+            for (int k = 0; k < 3; k++) {
+                const uint8_t *q = face + 1 + 4 * k;
+                triangles[3 * f + k] = (uint32_t)q[0] | (uint32_t)q[1] << 8 |
+                                       (uint32_t)q[2] << 16 | (uint32_t)q[3] << 24;
+            }
+        }
+        *count = triangles ? ply.faces : 0;
+    }
+    free(bytes);
+    return triangles;
 }

@@ -73,6 +73,10 @@ uint8_t *test_read_bytes(const char *path, size_t *size);
 /* The vertex element's three float properties `names` of the binary PLY `name` in the
  * test folder, malloc'd as count x 3 floats; NULL when one is missing. */
 float *test_ply_vertex_floats(const char *name, const char *const names[3], uint32_t *count);
+/* The triangles of the binary PLY `name` (faces of 3 corners, "property list uchar int
+ * vertex_indices", after the vertices), malloc'd as count x 3 vertex indices; NULL when the
+ * file has another layout or a face that is not a triangle. */
+uint32_t *test_ply_triangles(const char *name, uint32_t *count);
 
 bool test_file_exists(const char *path);
 

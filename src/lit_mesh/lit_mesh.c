@@ -33,6 +33,7 @@
 #include "core/vec3.h"
 #include "image/tonemap.h"
 #include "reconstruct/display_mesh.h"
+#include "render/light_refine.h"
 #include "render/vertex_radiance.h"
 
 typedef enum lit_mesh_format { FORMAT_UNKNOWN, FORMAT_PLY, FORMAT_GLB, FORMAT_OBJ } lit_mesh_format;
@@ -108,35 +109,13 @@ static rad_status patch_irradiance(const rad_mesh *mesh, const rad_rgb *B,
     return RAD_OK;
 }
 
-rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char *path,
-                              const rad_lit_mesh_options *options, rad_error *error)
+/* Writes the validated solution: `inputs` (NULL: built where needed) are the patch inputs
+ * the light is computed with, `illuminance_wanted` whether the vertices carry it. */
+static rad_status write_lit_mesh(const rad_mesh *mesh, const rad_rgb *B, const char *path,
+                                 const rad_lit_mesh_options *options,
+                                 const rad_patch_inputs *inputs, bool illuminance_wanted,
+                                 lit_mesh_format format, rad_error *error)
 {
-    if (!path || !*path)
-        return rad_fail(error, RAD_ERR_INVALID, "rad_lit_mesh_write: no path");
-    lit_mesh_format format = format_of(path);
-    if (format == FORMAT_UNKNOWN)
-        return rad_fail(error, RAD_ERR_INVALID,
-                        "%s: unknown mesh format (use .ply, .glb or .obj)", path);
-    if (options && options->fixed_exposure && !isfinite(options->exposure))
-        return rad_fail(error, RAD_ERR_INVALID, "%s: exposure %g is not a finite number", path,
-                        options->exposure);
-    /* a NaN or infinite radiosity is never written as a result */
-    for (uint32_t i = 0; i < mesh->patch_count; i++)
-        if (!(isfinite(B[i].r) && isfinite(B[i].g) && isfinite(B[i].b)))
-            return rad_fail(error, RAD_ERR_INVALID,
-                            "%s: patch %u has a radiosity that is not finite; nothing was "
-                            "written",
-                            path, i);
-    const rad_patch_inputs *inputs = options ? options->inputs : NULL;
-    if (inputs && inputs->n != mesh->patch_count)
-        return rad_fail(error, RAD_ERR_INVALID,
-                        "%s: the patch inputs have %u patches, the mesh %u; nothing was "
-                        "written",
-                        path, inputs->n, mesh->patch_count);
-
-    if (options && options->threads < 0)
-        return rad_fail(error, RAD_ERR_INVALID, "%s: thread count %d is negative", path,
-                        options->threads);
     /* the light computed at the vertices, as the default render shows it */
     bool vertex_light = options && options->direct_light != RAD_DIRECT_SOLUTION &&
                         vertex_radiance_applies(options->scene);
@@ -161,12 +140,12 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
     }
     display_mesh_positions(mesh, &shown, position);
     if (vertex_light) {
-        if (inputs)
+        if (illuminance_wanted)
             illuminance = rad_alloc_array(n, sizeof(*illuminance));
         const rad_patch_inputs *used = inputs;
         if (!used)
             status = rad_patch_inputs_build(options->scene, mesh, &built, error);
-        if (status == RAD_OK && inputs && !illuminance)
+        if (status == RAD_OK && illuminance_wanted && !illuminance)
             status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for the illuminance of "
                               "%u vertices", path, n);
         if (status == RAD_OK)
@@ -190,7 +169,7 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
         status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for %u vertices", path, n);
         goto done;
     }
-    if (inputs && !vertex_light) {
+    if (illuminance_wanted && !vertex_light) {
         irradiance = rad_alloc_array(mesh->patch_count, sizeof(*irradiance));
         illuminance = rad_alloc_array(n, sizeof(*illuminance));
         if (!irradiance || !illuminance) {
@@ -264,5 +243,54 @@ done:
     free(illuminance);
     rad_patch_inputs_destroy(built);
     display_mesh_free(&shown);
+    return status;
+}
+
+rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char *path,
+                              const rad_lit_mesh_options *options, rad_error *error)
+{
+    if (!path || !*path)
+        return rad_fail(error, RAD_ERR_INVALID, "rad_lit_mesh_write: no path");
+    lit_mesh_format format = format_of(path);
+    if (format == FORMAT_UNKNOWN)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "%s: unknown mesh format (use .ply, .glb or .obj)", path);
+    if (options && options->fixed_exposure && !isfinite(options->exposure))
+        return rad_fail(error, RAD_ERR_INVALID, "%s: exposure %g is not a finite number", path,
+                        options->exposure);
+    /* a NaN or infinite radiosity is never written as a result */
+    for (uint32_t i = 0; i < mesh->patch_count; i++)
+        if (!(isfinite(B[i].r) && isfinite(B[i].g) && isfinite(B[i].b)))
+            return rad_fail(error, RAD_ERR_INVALID,
+                            "%s: patch %u has a radiosity that is not finite; nothing was "
+                            "written",
+                            path, i);
+    const rad_patch_inputs *inputs = options ? options->inputs : NULL;
+    if (inputs && inputs->n != mesh->patch_count)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "%s: the patch inputs have %u patches, the mesh %u; nothing was "
+                        "written",
+                        path, inputs->n, mesh->patch_count);
+
+    if (options && options->threads < 0)
+        return rad_fail(error, RAD_ERR_INVALID, "%s: thread count %d is negative", path,
+                        options->threads);
+    /* the light computed at the vertices, as the default render shows it, on a finer mesh
+     * where the emitters' shadows bend it (light_refine.h) */
+    bool vertex_light = options && options->direct_light != RAD_DIRECT_SOLUTION &&
+                        vertex_radiance_applies(options->scene);
+    if (!vertex_light)
+        return write_lit_mesh(mesh, B, path, options, inputs, inputs != NULL, format, error);
+    light_refined refined;
+    rad_status status = light_refine(options->scene, mesh, B, inputs,
+                                     options->threads > 0 ? options->threads
+                                                          : omp_get_max_threads(),
+                                     &refined, error);
+    if (status == RAD_OK)
+        status = refined.mesh ? write_lit_mesh(refined.mesh, refined.B, path, options,
+                                               refined.inputs, inputs != NULL, format, error)
+                              : write_lit_mesh(mesh, B, path, options, inputs, inputs != NULL,
+                                               format, error);
+    light_refined_free(&refined);
     return status;
 }

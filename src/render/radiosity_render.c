@@ -35,6 +35,7 @@
 #include "render/camera.h"
 #include "render/emitter_light.h"
 #include "render/gather.h"
+#include "render/light_refine.h"
 #include "lights/emitters.h"
 #include "parallel/ranks.h"
 #include "render/progress.h"
@@ -436,12 +437,10 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
     return RAD_OK;
 }
 
-rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
-                      const rad_render_options *options, rad_image *image, rad_error *error)
+static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
+                              const rad_render_options *options, rad_image *image,
+                              rad_error *error)
 {
-    rad_render_options defaults = {0};
-    if (!options)
-        options = &defaults;
     uint32_t W = image->width, H = image->height;
     camera_frame frame;
     rad_status status = camera_frame_make(camera, W, H, &frame, error);
@@ -802,5 +801,35 @@ done:
     rad_patch_inputs_destroy(built_inputs);
     free(shaded);
     free(first_triangle);
+    return status;
+}
+
+rad_status rad_render(const rad_mesh *mesh, const rad_rgb *B, const rad_camera *camera,
+                      const rad_render_options *options, rad_image *image, rad_error *error)
+{
+    rad_render_options defaults = {0};
+    if (!options)
+        options = &defaults;
+    if (options->inputs && options->inputs->n != mesh->patch_count)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "render: the patch inputs are for %u patches, the mesh has %u",
+                        options->inputs->n, mesh->patch_count);
+    if (options->direct_light == RAD_DIRECT_SOLUTION || options->threads < 0)
+        return render_mesh(mesh, B, camera, options, image, error);
+    /* the light at the vertices is shown on a finer mesh where the emitters' shadows bend
+     * it (light_refine.h) */
+    light_refined refined;
+    rad_status status = light_refine(options->scene, mesh, B, options->inputs,
+                                     options->threads > 0 ? options->threads
+                                                          : omp_get_max_threads(),
+                                     &refined, error);
+    status = ranks_agree(status, "render", error);
+    if (status == RAD_OK && refined.mesh) {
+        rad_render_options finer = *options;
+        finer.inputs = refined.inputs;
+        status = render_mesh(refined.mesh, refined.B, camera, &finer, image, error);
+    } else if (status == RAD_OK)
+        status = render_mesh(mesh, B, camera, options, image, error);
+    light_refined_free(&refined);
     return status;
 }

@@ -17,26 +17,9 @@
 
 #define VERTEX_EMITTER_SAMPLES 1024u /* light samples per vertex */
 #define VERTEX_COSINE_RAYS 512u     /* their MIS partners: cosine rays toward the emitters */
-/* final-gather rays per vertex */
 #define VERTEX_GATHER_RAYS 1024u    /* final-gather rays per vertex */
 #define VERTEX_STREAM 0xE3177E3ull
-/* A vertex's point: this share of the way to its patches' mean centre. On a crease or a
- * contact the light changes fastest next to the vertex (a contact shadow's foot), so its
- * exact limit there, interpolated linearly over the patch, would pull the patch's values
- * down; a point a tenth of the way in stands for the vertex's neighbourhood. Measured on
- * the Cornell box at 128 x 128 against the path tracer (block / pixel relative RMSE):
- * 1e-3 1.57 % / 1.95 %, 0.1 1.17 % / 1.72 %, 0.25 1.20 % / 1.70 %, 0.5 1.60 % / 1.83 %. */
-#define VERTEX_INWARD 0.1 /* a vertex's point: this share of the way to its patches' centre */
-
-/* Each vertex's side (its visible patches' normal: a region is planar), the way into those
- * patches, how far their cells may lie behind the input triangles, and their area (0: a
- * vertex of hidden patches alone). */
-typedef struct vertex_frame {
-    rad_vec3 normal, inward;
-    double bulge, weight;
-} vertex_frame;
-
-static void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *frame)
+void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *frame)
 {
     for (uint32_t v = 0; v < mesh->vertex_count; v++)
         frame[v] = (vertex_frame){v3(0, 0, 0), v3(0, 0, 0), 0, 0};

@@ -20,6 +20,26 @@
 #include "radiosity.h"
 #include "render/gather.h"
 
+/* A vertex's point: this share of the way to its patches' mean centre. On a crease or a
+ * contact the light changes fastest next to the vertex (a contact shadow's foot), so its
+ * exact limit there, interpolated linearly over the patch, would pull the patch's values
+ * down; a point a tenth of the way in stands for the vertex's neighbourhood. Measured on
+ * the Cornell box at 128 x 128 against the path tracer (block / pixel relative RMSE):
+ * 1e-3 1.57 % / 1.95 %, 0.1 1.17 % / 1.72 %, 0.25 1.20 % / 1.70 %, 0.5 1.60 % / 1.83 %. */
+#define VERTEX_INWARD 0.1
+
+/* Each vertex's side (its visible patches' normal: a region is planar), the way into those
+ * patches (area-weighted: the point is vertex + VERTEX_INWARD x inward / weight), how far
+ * their cells may lie behind the input triangles, and their area (0: a vertex of hidden
+ * patches alone). */
+typedef struct vertex_frame {
+    rad_vec3 normal, inward;
+    double bulge, weight;
+} vertex_frame;
+
+/* frame[v] for the mesh's vertices, patches marked in `hidden` (NULL: none) left out. */
+void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *frame);
+
 /* Per mesh vertex v (mesh->vertex_count values): direct[v], the emitters' direct
  * irradiance (traced against `occluders`, the scene's triangles), plus with `sharp` the
  * sharp sources' (point, spot, luminaire, sun: one shadow ray each), and gathered[v], the

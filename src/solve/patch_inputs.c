@@ -12,6 +12,7 @@
 #include <stdlib.h>
 
 #include "core/alloc.h"
+#include "solve/patch_inputs.h"
 #include "core/error.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
@@ -30,11 +31,8 @@ void rad_patch_inputs_destroy(rad_patch_inputs *inputs)
     free(inputs);
 }
 
-rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
-                                  rad_patch_inputs **out, rad_error *error)
+rad_patch_inputs *patch_inputs_alloc(uint32_t n)
 {
-    *out = NULL;
-    uint32_t n = mesh->patch_count;
     rad_patch_inputs *in = rad_alloc_array(1, sizeof(*in));
     if (in) {
         in->n = n;
@@ -45,9 +43,21 @@ rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
         in->direct_sharp = rad_alloc_array(n, sizeof(*in->direct_sharp));
         in->source = rad_alloc_array(n, sizeof(*in->source));
     }
-    if (!in || !in->area || !in->albedo || !in->exitance || !in->direct || !in->direct_sharp ||
-        !in->source) {
+    if (in && (!in->area || !in->albedo || !in->exitance || !in->direct || !in->direct_sharp ||
+               !in->source)) {
         rad_patch_inputs_destroy(in);
+        in = NULL;
+    }
+    return in;
+}
+
+rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
+                                  rad_patch_inputs **out, rad_error *error)
+{
+    *out = NULL;
+    uint32_t n = mesh->patch_count;
+    rad_patch_inputs *in = patch_inputs_alloc(n);
+    if (!in) {
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u patches", n);
     }
     for (uint32_t i = 0; i < n; i++)

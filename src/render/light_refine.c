@@ -1,0 +1,352 @@
+/*
+ * light_refine.c - a finer mesh to show the light on, where the emitters' shadows bend it
+ * (light_refine.h).
+ */
+#include "render/light_refine.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/alloc.h"
+#include "core/edge_key.h"
+#include "core/error.h"
+#include "core/rgb.h"
+#include "core/vec3.h"
+#include "lights/emitters.h"
+#include "render/emitter_light.h"
+#include "render/vertex_light.h"
+#include "render/vertex_radiance.h"
+#include "solve/patch_inputs.h"
+#include "trace/ray.h"
+
+enum { SEES_NONE, SEES_PART, SEES_ALL };
+
+/* What a mesh being refined knows of each vertex: the share of the emitters' light that
+ * reaches it (its point, as vertex_light takes it) and how that share reads. */
+typedef struct vertex_share {
+    double share;
+    uint8_t sees;
+} vertex_share;
+
+typedef struct refine_state {
+    const rad_scene *scene;
+    const emitter_set *set;
+    const rad_tracer *occluders;
+    double leave;
+    int threads;
+} refine_state;
+
+/* share[v] for the vertices from `first` on. */
+static bool measure_shares(const refine_state *st, const rad_mesh *mesh, uint32_t first,
+                           vertex_share *share)
+{
+    uint32_t n = mesh->vertex_count;
+    vertex_frame *frame = rad_alloc_array(n ? n : 1, sizeof(*frame));
+    rad_ray *rays = rad_alloc_array((size_t)st->threads * LIGHT_REFINE_PROBES, sizeof(*rays));
+    rad_rgb *values = rad_alloc_array((size_t)st->threads * LIGHT_REFINE_PROBES, sizeof(*values));
+    uint8_t *blocked = rad_alloc_array((size_t)st->threads * LIGHT_REFINE_PROBES, 1);
+    bool ok = frame && rays && values && blocked;
+    if (ok) {
+        vertex_frames(mesh, NULL, frame);
+#pragma omp parallel for schedule(dynamic, 64) num_threads(st->threads)
+        for (int64_t v = first; v < (int64_t)n; v++) {
+            const vertex_frame *f = &frame[v];
+            share[v] = (vertex_share){0, SEES_NONE};
+            if (!(f->weight > 0))
+                continue;
+            size_t base = (size_t)omp_get_thread_num() * LIGHT_REFINE_PROBES;
+            rad_vec3 nv = v3_normalize(f->normal);
+            rad_vec3 x = v3_add(mesh->vertices[v], v3_scale(f->inward, VERTEX_INWARD / f->weight));
+            uint32_t count = emitter_light_rays_by_triangle(
+                st->set, st->scene, x, nv, 2 * f->bulge + st->leave, LIGHT_REFINE_PROBES, 0.5,
+                0.5, 0.5, 0, &rays[base], &values[base]);
+            rad_tracer_occluded(st->occluders, &rays[base], count, &blocked[base]);
+            double all = 0, through = 0;
+            for (uint32_t k = 0; k < count; k++) {
+                double y = rgb_luminance(values[base + k]);
+                all += y;
+                through += blocked[base + k] ? 0 : y;
+            }
+            if (!(all > 0))
+                continue;
+            double s = through / all;
+            share[v] = (vertex_share){s, s >= 1 ? SEES_ALL : s > 0 ? SEES_PART : SEES_NONE};
+        }
+    }
+    free(frame);
+    free(rays);
+    free(values);
+    free(blocked);
+    return ok;
+}
+
+/* Whether the light bends inside the patch: its corners read differently. */
+static bool bends(const rad_patch *patch, const vertex_share *share)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    bool none = false, part = false, all = false;
+    for (uint32_t k = 0; k < patch->vertex_count; k++) {
+        const vertex_share *s = &share[patch->vertex[k]];
+        lo = fmin(lo, s->share);
+        hi = fmax(hi, s->share);
+        none |= s->sees == SEES_NONE;
+        part |= s->sees == SEES_PART;
+        all |= s->sees == SEES_ALL;
+    }
+    return (all && (none || part)) || (none && part) || hi - lo > LIGHT_REFINE_SHARE;
+}
+
+/* The midpoint vertex of edge (a, b), made once per edge (open addressing on the key). */
+typedef struct midpoints {
+    uint64_t *key;
+    uint32_t *vertex;
+    size_t mask;
+} midpoints;
+
+static uint32_t midpoint(midpoints *table, rad_mesh *mesh, uint32_t a, uint32_t b)
+{
+    uint64_t key = edge_key(a, b);
+    for (size_t slot = edge_key_hash(key) & table->mask;; slot = (slot + 1) & table->mask) {
+        if (table->key[slot] == key)
+            return table->vertex[slot];
+        if (table->key[slot] == UINT64_MAX) {
+            table->key[slot] = key;
+            uint32_t v = mesh->vertex_count++;
+            mesh->vertices[v] = v3_scale(v3_add(mesh->vertices[a], mesh->vertices[b]), 0.5);
+            table->vertex[slot] = v;
+            return v;
+        }
+    }
+}
+
+/* A piece of `patch` with these corners: its area and centroid from them (a quad as two
+ * triangles), the rest the patch's. */
+static rad_patch piece(const rad_patch *patch, const rad_mesh *mesh, const uint32_t *corner,
+                       uint32_t count)
+{
+    rad_patch out = *patch;
+    out.vertex_count = count;
+    memcpy(out.vertex, corner, count * sizeof(*corner));
+    double area = 0;
+    rad_vec3 centre = v3(0, 0, 0);
+    for (uint32_t k = 1; k + 1 < count; k++) {
+        rad_vec3 a = mesh->vertices[corner[0]], b = mesh->vertices[corner[k]],
+                 c = mesh->vertices[corner[k + 1]];
+        double t = 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+        area += t;
+        centre = v3_add(centre, v3_scale(v3_add(a, v3_add(b, c)), t / 3));
+    }
+    out.area = area;
+    out.centroid = area > 0 ? v3_scale(centre, 1 / area) : patch->centroid;
+    return out;
+}
+
+/* The next mesh: each patch marked in `split` in four (in its place, so the twins still
+ * come last), *parent updated to the new patches. */
+static rad_status split_patches(const rad_mesh *mesh, const uint8_t *split, uint32_t splits,
+                                uint32_t **parent, rad_mesh **out, rad_error *error)
+{
+    rad_mesh *next = rad_alloc_array(1, sizeof(*next));
+    midpoints table = {0};
+    size_t slots = 16;
+    while (slots < 8 * (size_t)splits)
+        slots *= 2;
+    uint32_t *new_index = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1,
+                                          sizeof(*new_index));
+    uint32_t patches = mesh->patch_count + 3 * splits;
+    uint32_t *next_parent = rad_alloc_array(patches ? patches : 1, sizeof(*next_parent));
+    if (next) {
+        *next = *mesh;
+        next->vertices = rad_alloc_array((size_t)mesh->vertex_count + 5 * (size_t)splits,
+                                         sizeof(*next->vertices));
+        next->patches = rad_alloc_array(patches ? patches : 1, sizeof(*next->patches));
+    }
+    table.key = rad_alloc_array(slots, sizeof(*table.key));
+    table.vertex = rad_alloc_array(slots, sizeof(*table.vertex));
+    table.mask = slots - 1;
+    if (!next || !next->vertices || !next->patches || !table.key || !table.vertex ||
+        !new_index || !next_parent) {
+        rad_mesh_destroy(next);
+        free(table.key);
+        free(table.vertex);
+        free(new_index);
+        free(next_parent);
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light's finer mesh");
+    }
+    memset(table.key, 0xff, slots * sizeof(*table.key));
+    memcpy(next->vertices, mesh->vertices, mesh->vertex_count * sizeof(*mesh->vertices));
+    uint32_t made = 0;
+    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        const rad_patch *patch = &mesh->patches[p];
+        new_index[p] = made;
+        if (!split[p]) {
+            next_parent[made] = (*parent)[p];
+            next->patches[made++] = *patch;
+            continue;
+        }
+        const uint32_t *v = patch->vertex;
+        uint32_t m[4];
+        for (uint32_t k = 0; k < patch->vertex_count; k++)
+            m[k] = midpoint(&table, next, v[k], v[(k + 1) % patch->vertex_count]);
+        uint32_t corners[4][4];
+        uint32_t count;
+        if (patch->vertex_count == 4) {
+            uint32_t c = next->vertex_count++;
+            next->vertices[c] = v3_scale(
+                v3_add(v3_add(mesh->vertices[v[0]], mesh->vertices[v[1]]),
+                       v3_add(mesh->vertices[v[2]], mesh->vertices[v[3]])),
+                0.25);
+            const uint32_t q[4][4] = {{v[0], m[0], c, m[3]},
+                                      {m[0], v[1], m[1], c},
+                                      {c, m[1], v[2], m[2]},
+                                      {m[3], c, m[2], v[3]}};
+            memcpy(corners, q, sizeof(q));
+            count = 4;
+        } else {
+            const uint32_t t[4][4] = {{v[0], m[0], m[2], 0},
+                                      {m[0], v[1], m[1], 0},
+                                      {m[2], m[1], v[2], 0},
+                                      {m[0], m[1], m[2], 0}};
+            memcpy(corners, t, sizeof(t));
+            count = 3;
+        }
+        for (uint32_t k = 0; k < 4; k++) {
+            next_parent[made] = (*parent)[p];
+            next->patches[made++] = piece(patch, next, corners[k], count);
+        }
+    }
+    next->patch_count = made;
+    for (uint32_t p = 0; p < made; p++)
+        if (next->patches[p].twin)
+            next->patches[p].twin = 1 + new_index[next->patches[p].twin - 1];
+    free(table.key);
+    free(table.vertex);
+    free(new_index);
+    free(*parent);
+    *parent = next_parent;
+    *out = next;
+    return RAD_OK;
+}
+
+/* The solution and the patch inputs on the finer mesh: each piece its patch's values
+ * (they are per unit area), its own area. */
+static rad_status carry_solution(const rad_mesh *fine, const uint32_t *parent, const rad_rgb *B,
+                                 const rad_patch_inputs *inputs, light_refined *out,
+                                 rad_error *error)
+{
+    uint32_t n = fine->patch_count;
+    rad_patch_inputs *in = patch_inputs_alloc(n);
+    out->B = rad_alloc_array(n, sizeof(*out->B));
+    out->inputs = in;
+    if (!out->B || !in)
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light's finer mesh");
+    for (uint32_t p = 0; p < n; p++) {
+        uint32_t q = parent[p];
+        out->B[p] = B[q];
+        in->area[p] = fine->patches[p].area;
+        in->albedo[p] = inputs->albedo[q];
+        in->exitance[p] = inputs->exitance[q];
+        in->direct[p] = inputs->direct[q];
+        in->direct_sharp[p] = inputs->direct_sharp[q];
+        in->source[p] = inputs->source[q];
+    }
+    return RAD_OK;
+}
+
+rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
+                        const rad_patch_inputs *inputs, int threads, light_refined *out,
+                        rad_error *error)
+{
+    *out = (light_refined){0};
+    /* at most as many patches again, and under a memory budget what a quarter of what is
+     * left holds */
+    size_t budget = mesh->patch_count;
+    uint64_t left = rad_memory_budget_left();
+    if (left != UINT64_MAX && left / 4 / LIGHT_REFINE_BYTES_PER_PATCH < budget)
+        budget = (size_t)(left / 4 / LIGHT_REFINE_BYTES_PER_PATCH);
+    if (!scene || !rad_scene_has_emitter(scene) || mesh->patch_count == 0 || budget < 3)
+        return RAD_OK;
+    emitter_set set = {0};
+    rad_tracer *occluders = NULL;
+    rad_patch_inputs *built = NULL;
+    rad_mesh *current = NULL;
+    uint32_t *parent = rad_alloc_array(mesh->patch_count, sizeof(*parent));
+    vertex_share *share = NULL;
+    uint8_t *split = NULL;
+    rad_status status = emitters_build(scene, &set, error);
+    if (status == RAD_OK)
+        status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &occluders, error);
+    if (status == RAD_OK && !inputs) {
+        status = rad_patch_inputs_build(scene, mesh, &built, error);
+        inputs = built;
+    }
+    if (status != RAD_OK)
+        goto done;
+    if (!parent) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light's finer mesh");
+        goto done;
+    }
+    for (uint32_t p = 0; p < mesh->patch_count; p++)
+        parent[p] = p;
+    refine_state st = {scene, &set, occluders, vertex_radiance_leave(mesh), threads};
+    const rad_mesh *at = mesh;
+    uint32_t measured = 0;
+    for (uint32_t level = 0; level < LIGHT_REFINE_LEVELS && budget >= 3; level++) {
+        vertex_share *grown =
+            rad_resize_array(share, at->vertex_count ? at->vertex_count : 1, sizeof(*share));
+        uint8_t *marks = rad_resize_array(split, at->patch_count ? at->patch_count : 1, 1);
+        if (grown)
+            share = grown;
+        if (marks)
+            split = marks;
+        if (!grown || !marks || !measure_shares(&st, at, measured, share)) {
+            status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light's finer mesh");
+            goto done;
+        }
+        measured = at->vertex_count;
+        uint32_t splits = 0;
+        for (uint32_t p = 0; p < at->patch_count; p++) {
+            const rad_patch *patch = &at->patches[p];
+            split[p] = patch->twin == 0 && budget >= 3 && bends(patch, share);
+            if (split[p]) {
+                splits++;
+                budget -= 3;
+            }
+        }
+        if (splits == 0)
+            break;
+        rad_mesh *next = NULL;
+        status = split_patches(at, split, splits, &parent, &next, error);
+        if (status != RAD_OK)
+            goto done;
+        rad_mesh_destroy(current);
+        current = next;
+        at = current;
+    }
+    if (current) {
+        status = carry_solution(current, parent, B, inputs, out, error);
+        out->mesh = current;
+        current = NULL;
+    }
+done:
+    if (status != RAD_OK)
+        light_refined_free(out);
+    rad_mesh_destroy(current);
+    rad_patch_inputs_destroy(built);
+    rad_tracer_destroy(occluders);
+    emitters_free(&set);
+    free(parent);
+    free(share);
+    free(split);
+    return status;
+}
+
+void light_refined_free(light_refined *refined)
+{
+    rad_mesh_destroy(refined->mesh);
+    free(refined->B);
+    rad_patch_inputs_destroy(refined->inputs);
+    *refined = (light_refined){0};
+}

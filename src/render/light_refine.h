@@ -1,0 +1,55 @@
+/*
+ * light_refine.h - a finer mesh to show the light on, where the emitters' shadows bend it
+ * (internal).
+ *
+ * The light at the vertices (vertex_light.h) is exact at each vertex and linear between
+ * them, so a penumbra's ends (the kink where it meets the umbra or the open light) are
+ * cut off across a whole patch: at a box's foot the light reached 4 cm into the umbra and
+ * a contact-shadow profile was 6.5 % of the open light off. This splits, for display only,
+ * the one-sided patches whose corners disagree on how much of the emitters' light reaches
+ * them: some corner sees all of it and another part or none, or some sees none and
+ * another part, or the shares seen differ by more than LIGHT_REFINE_SHARE (64 fixed points
+ * on the emitters per vertex). Quads split into four quads at their edges' midpoints and
+ * centre, triangles into four; the new corners are tested in turn, `levels` times at most,
+ * and the splits stop at a budget of added patches (and of memory). Each piece keeps its patch's
+ * radiosity, material and normal (the solution is not changed: only where its light is
+ * shown); a midpoint is shared by the two patches of a region on either side of its edge,
+ * and where only one of them splits it is a T-vertex, which the display mesh handles.
+ * Two-sided patches (and their twins) are left whole. Deterministic: fixed points on the
+ * emitters, patches in order.
+ */
+#ifndef RAD_RENDER_LIGHT_REFINE_H
+#define RAD_RENDER_LIGHT_REFINE_H
+
+#include "radiosity.h"
+
+#define LIGHT_REFINE_LEVELS 2    /* splits of a patch at most (a quarter of its edge) */
+#define LIGHT_REFINE_SHARE 0.25  /* corners' shares of the light this far apart split */
+#define LIGHT_REFINE_PROBES 64u  /* points on the emitters per vertex test */
+/* What an added patch may cost downstream, an estimate erring high: the piece and its
+ * inputs (about 250 bytes), its display triangles, their BVH (2 x 128), the light at its
+ * vertices and the buffers around it (about 600), the lit mesh's arrays. With half of what
+ * was left at 2048 bytes a patch, a lit mesh of 29,152 patches under --max-memory 40M
+ * (test_hierarchical_scaling) went 1.9 MB over the budget. */
+#define LIGHT_REFINE_BYTES_PER_PATCH 4096u
+
+/* The solution on the finer mesh: mesh (NULL when nothing was split: use the caller's),
+ * B and inputs per patch of it, each piece its patch's; destroy with light_refined_free. */
+typedef struct light_refined {
+    rad_mesh *mesh;
+    rad_rgb *B;
+    rad_patch_inputs *inputs;
+} light_refined;
+
+/* Refines `mesh` (solution B, patch inputs `inputs`, NULL: built from the scene) for the
+ * emitting surfaces of `scene`; adds at most mesh->patch_count patches, and under a
+ * memory budget (--max-memory) at most what a quarter of the budget left holds at
+ * LIGHT_REFINE_BYTES_PER_PATCH each. Nothing to do (no emitter, no split) leaves
+ * out->mesh NULL. */
+rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
+                        const rad_patch_inputs *inputs, int threads, light_refined *out,
+                        rad_error *error);
+
+void light_refined_free(light_refined *refined);
+
+#endif
