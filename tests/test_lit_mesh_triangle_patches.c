@@ -4,6 +4,10 @@
  * and each patch exactly covered by the file's triangles said to be its own (their areas
  * sum to the patch's area, each faces the patch's way and lies in its plane), on the
  * Cornell box coarse and fine, and with a two-sided surface (its twins' triangles too).
+ * The same for the table rad_lit_mesh_write gives back (rad_lit_mesh_options
+ * .triangle_patches) when the light is computed at the vertices, where patches in the
+ * blocks' penumbrae are shown split (light_refine.c): its pieces' triangles must cover
+ * their patch exactly too, and there must be more triangles than without the split.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -45,20 +49,32 @@ static rad_vec3 cross(rad_vec3 a, rad_vec3 b)
 }
 static double dot(rad_vec3 a, rad_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
-static void check_mesh(const char *label, rad_scene *scene, double patch_size)
+/* With lit_at_vertices the lit mesh takes the light at the vertices (the scene given) and
+ * the table comes from the writer; returns the file's triangle count. */
+static uint32_t check_mesh(const char *label, rad_scene *scene, double patch_size,
+                           bool lit_at_vertices)
 {
     rad_error error = {0};
     rad_mesh *mesh = NULL;
     CHECK(rad_mesh_build(scene, patch_size, &mesh, &error) == RAD_OK);
     if (!mesh)
-        return;
+        return 0;
     rad_rgb *B = calloc(mesh->patch_count, sizeof(*B));
     for (uint32_t i = 0; i < mesh->patch_count; i++)
         B[i] = (rad_rgb){1, 1, 1};
     const char *path = test_path("lit.glb");
-    CHECK(rad_lit_mesh_write(mesh, B, path, NULL, &error) == RAD_OK);
     uint32_t *patch_of = NULL, triangles = 0;
-    CHECK(rad_lit_mesh_triangle_patches(mesh, &patch_of, &triangles, &error) == RAD_OK);
+    if (lit_at_vertices) {
+        rad_lit_mesh_options options = {.scene = scene,
+                                        .threads = 2,
+                                        .triangle_patches = &patch_of,
+                                        .triangle_patch_count = &triangles};
+        CHECK(rad_lit_mesh_write(mesh, B, path, &options, &error) == RAD_OK);
+    } else {
+        CHECK(rad_lit_mesh_write(mesh, B, path, NULL, &error) == RAD_OK);
+        CHECK(rad_lit_mesh_triangle_patches(mesh, &patch_of, &triangles, &error) == RAD_OK);
+    }
+    CHECK(patch_of != NULL);
 
     size_t size = 0;
     uint8_t *bytes = test_read_bytes(path, &size);
@@ -123,6 +139,7 @@ static void check_mesh(const char *label, rad_scene *scene, double patch_size)
     free(patch_of);
     free(B);
     rad_mesh_destroy(mesh);
+    return triangles;
 }
 
 int main(void)
@@ -134,11 +151,18 @@ int main(void)
         fprintf(stderr, "%s\n", error.message);
         return 1;
     }
-    check_mesh("Cornell box, 200 mm patches", scene, 200);
-    check_mesh("Cornell box, 40 mm patches", scene, 40);
+    uint32_t whole = check_mesh("Cornell box, 200 mm patches", scene, 200, false);
+    check_mesh("Cornell box, 40 mm patches", scene, 40, false);
+    uint32_t split = check_mesh("Cornell box, 200 mm patches, light at the vertices", scene, 200,
+                                true);
+    printf("Cornell box, 200 mm patches: %u lit-mesh triangles, %u with the light at the "
+           "vertices\n",
+           whole, split);
+    CHECK(split > whole);
     CHECK(rad_scene_set_surface_flags(scene, "short_block", RAD_SURFACE_TWO_SIDED, &error) ==
           RAD_OK);
-    check_mesh("Cornell box, two-sided short block", scene, 60);
+    check_mesh("Cornell box, two-sided short block", scene, 60, false);
+    check_mesh("Cornell box, two-sided short block, light at the vertices", scene, 60, true);
     rad_scene_destroy(scene);
     return test_finish("test_lit_mesh_triangle_patches");
 }

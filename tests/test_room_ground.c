@@ -212,23 +212,29 @@ static void test_room_on_ground(void)
      * patches, gather) -14 % to -4 %; without the proximity refinement either
      * (--proximity-levels 0: the automatic size of the whole scene) -29 % to -12 %. The
      * ground seen through the window (+10.4 %; +54 % with the patch values, +280 % before
-     * the refinement) is held with the per-pixel direct light below */
+     * the refinement) is held with the per-pixel direct light below. Later the same day,
+     * with the light shown on the mesh split where the shadows bend it (light_refine.c):
+     * -5.4 % (wall_left) to -4.0 % at the hierarchical solver's default threshold (0.25),
+     * and with the automatic choice refining its links to 0.05 on a mesh this small
+     * (RAD_AUTO_REFINE_THRESHOLD): -4.1 % (wall_left) to -2.8 % (floor), the issue's 5 %
+     * met; the ground +4.5 % */
     double worst = check_render(scene_path, scene, surface, reference_mean, "", "ground", 0,
-                                0.065);
+                                0.05);
     printf("default render: largest difference %.1f %% (the issue asks for 5 %%)\n",
            100 * worst);
     /* the emitters' direct light at every pixel: measured -7.2 % (table) to -5.2 % in the
      * room; the ground -16.8 % (its light from the surfaces next to it is gathered at the
      * pixel along the facade, and moves with the mesh there: -0.8 % to -17 % measured on
-     * nearby meshes) */
+     * nearby meshes); later the same day, the rest from the vertices' gather on the finer
+     * mesh and the links at 0.05: -3.7 % in the room */
     worst = check_render(scene_path, scene, surface, reference_mean, "--direct pixel", "ground",
                          0.25, 0.10);
     printf("--direct pixel: largest difference %.1f %%\n", 100 * worst);
     /* every solver honours the refinements and the vertex light: Gauss-Seidel and shooting
-     * on the default's mesh (measured -3.3 % (ceiling) to -1.4 %, better than the
-     * hierarchical solver the automatic choice takes at its default threshold), the
-     * hierarchical solver on its own finer default patches with the proximity refinement
-     * asked for (it is off by default there): measured -3.3 % (floor) to -2.3 % */
+     * on the default's mesh (measured -3.3 % (ceiling) to -1.4 %; with the light's finer
+     * mesh -2.8 % to -2.2 %), the hierarchical solver on its own finer default patches
+     * with the proximity refinement asked for (it is off by default there): measured
+     * -3.3 % (floor) to -2.3 % (then -2.8 % to -1.9 %) */
     static const char *const solvers[] = {"--solver gauss-seidel", "--solver shoot",
                                           "--solver hierarchical --proximity-levels 3"};
     static const double tolerances[] = {0.045, 0.045, 0.045};

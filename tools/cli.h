@@ -156,7 +156,8 @@ enum {
     "                       hierarchical (the summary and --stats say which ran)\n"         \
     "  --refine-threshold X hierarchical: split a link while B x F x A exceeds X times\n"   \
     "                       the emitted power per patch (default "                     \
-    CLI_STR(RAD_DEFAULT_REFINE_THRESHOLD) "; smaller = finer)\n"  \
+    CLI_STR(RAD_DEFAULT_REFINE_THRESHOLD) "; auto " CLI_STR(RAD_AUTO_REFINE_THRESHOLD)       \
+    " to " CLI_STR(RAD_AUTO_FINE_LINKS_PATCHES) " patches)\n"                              \
     "  --max-memory SIZE    bytes the whole run may hold (K, M, G): known sizes (image,\n" \
     "                       matrix 4 n^2, trees) refused up front, links stop there,\n"    \
     "                       the rest an error (default: none; links: half of RAM)\n"       \

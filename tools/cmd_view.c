@@ -349,9 +349,11 @@ static bool check_lit_mesh(const char *path, const unsigned char *bytes, size_t 
 
 /* ---- a scene, solved ------------------------------------------------------------------ */
 
-/* The lit mesh of the solution as .glb bytes (written to a temporary folder, read back). */
+/* The lit mesh of the solution as .glb bytes (written to a temporary folder, read back),
+ * and the solution's patch of each of its triangles (*patch_of, malloc'ed). */
 static bool lit_mesh_bytes(const cli_solved *solved, const cli_shared *shared,
-                           unsigned char **bytes, size_t *size)
+                           unsigned char **bytes, size_t *size, uint32_t **patch_of,
+                           uint32_t *patch_count)
 {
     const char *tmp = getenv("TMPDIR");
     char folder[4096], file[4200];
@@ -365,7 +367,9 @@ static bool lit_mesh_bytes(const cli_solved *solved, const cli_shared *shared,
     rad_lit_mesh_options write = {.inputs = solved->inputs,
                                   .scene = solved->scene,
                                   .seed = shared->seed,
-                                  .threads = shared->threads};
+                                  .threads = shared->threads,
+                                  .triangle_patches = patch_of,
+                                  .triangle_patch_count = patch_count};
     rad_error error = {0};
     bool ok = rad_lit_mesh_write(solved->mesh, solved->B, file, &write, &error) == RAD_OK;
     if (!ok)
@@ -428,23 +432,17 @@ static bool page_surfaces(page *p, const rad_scene *scene, const rad_mesh *mesh,
     return ok;
 }
 
-/* The surface of each lit-mesh triangle, base64 of uint32 little-endian. */
-static bool page_triangle_surfaces(page *p, const rad_mesh *mesh, uint32_t triangles)
+/* The surface of each lit-mesh triangle, base64 of uint32 little-endian, from the patch of
+ * each (patch_of, count of them, as the lit mesh's writer gave them). */
+static bool page_triangle_surfaces(page *p, const rad_mesh *mesh, const uint32_t *patch_of,
+                                   uint32_t count, uint32_t triangles)
 {
-    uint32_t *patch_of = NULL, count = 0;
-    rad_error error = {0};
-    if (rad_lit_mesh_triangle_patches(mesh, &patch_of, &count, &error) != RAD_OK) {
-        cli_error("%s", error.message);
-        return false;
-    }
     if (count != triangles) {
-        free(patch_of);
         cli_error("view: the lit mesh has %u triangles, its patch table %u", triangles, count);
         return false;
     }
     unsigned char *bytes = rad_alloc_array(count ? count : 1, 4);
     if (!bytes) {
-        free(patch_of);
         cli_error("view: out of memory for the surfaces of %u triangles", count);
         return false;
     }
@@ -464,7 +462,6 @@ static bool page_triangle_surfaces(page *p, const rad_mesh *mesh, uint32_t trian
     page_base64(p, bytes, 4 * (size_t)count);
     page_text(p, "</script>\n");
     free(bytes);
-    free(patch_of);
     return true;
 }
 
@@ -792,6 +789,7 @@ int command_view(int argc, char **argv)
         return EXIT_USAGE;
     }
     uint32_t triangles = 0, compare_triangles = 0;
+    uint32_t *patch_of = NULL, patch_count = 0; /* the solution's patch of each triangle */
     const char *compare_path = args.value[OPT_COMPARE];
     unsigned char *compare_glb = NULL;
     size_t compare_size = 0;
@@ -810,7 +808,7 @@ int command_view(int argc, char **argv)
             goto done;
         }
         cli_progress_end();
-        if (!lit_mesh_bytes(&solved, &shared, &glb, &glb_size) ||
+        if (!lit_mesh_bytes(&solved, &shared, &glb, &glb_size, &patch_of, &patch_count) ||
             !check_lit_mesh("the lit mesh", glb, glb_size, &triangles))
             goto done;
     }
@@ -861,7 +859,8 @@ int command_view(int argc, char **argv)
     page_text(&html, "<script type=\"application/octet-stream\" id=\"radiosity-glb\">");
     page_base64(&html, glb, glb_size);
     page_text(&html, "</script>\n");
-    if (!lit_input && !page_triangle_surfaces(&html, solved.mesh, triangles))
+    if (!lit_input &&
+        !page_triangle_surfaces(&html, solved.mesh, patch_of, patch_count, triangles))
         goto done;
     if (!lit_input && solve.record_path &&
         !page_record(&html, solve.record_path, solved.mesh))
@@ -906,6 +905,7 @@ done:
     cli_progress_end();
     free(html.data);
     free(glb);
+    free(patch_of);
     free(compare_glb);
     if (!lit_input)
         cli_solved_free(&solved);

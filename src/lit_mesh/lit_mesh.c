@@ -110,11 +110,13 @@ static rad_status patch_irradiance(const rad_mesh *mesh, const rad_rgb *B,
 }
 
 /* Writes the validated solution: `inputs` (NULL: built where needed) are the patch inputs
- * the light is computed with, `illuminance_wanted` whether the vertices carry it. */
+ * the light is computed with, `illuminance_wanted` whether the vertices carry it, `parent`
+ * (NULL: the mesh is the solution's) the solution's patch of each of mesh's. */
 static rad_status write_lit_mesh(const rad_mesh *mesh, const rad_rgb *B, const char *path,
                                  const rad_lit_mesh_options *options,
                                  const rad_patch_inputs *inputs, bool illuminance_wanted,
-                                 lit_mesh_format format, rad_error *error)
+                                 const uint32_t *parent, lit_mesh_format format,
+                                 rad_error *error)
 {
     /* the light computed at the vertices, as the default render shows it */
     bool vertex_light = options && options->direct_light != RAD_DIRECT_SOLUTION &&
@@ -223,6 +225,20 @@ static rad_status write_lit_mesh(const rad_mesh *mesh, const rad_rgb *B, const c
     status = rad_atomic_open(&file, path, error);
     if (status != RAD_OK)
         goto done;
+    uint32_t *triangle_patch = NULL;
+    if (options && options->triangle_patches) {
+        /* the solution's patch of each triangle written (the pieces' parents) */
+        triangle_patch = rad_alloc_array(shown.triangle_count ? shown.triangle_count : 1,
+                                         sizeof(*triangle_patch));
+        if (!triangle_patch) {
+            rad_atomic_abort(&file);
+            status = rad_fail(error, RAD_ERR_NOMEM, "%s: out of memory for the patches of %u "
+                              "triangles", path, shown.triangle_count);
+            goto done;
+        }
+        for (uint32_t t = 0; t < shown.triangle_count; t++)
+            triangle_patch[t] = parent ? parent[shown.patch_of[t]] : shown.patch_of[t];
+    }
     switch (format) {
     case FORMAT_PLY: status = lit_mesh_write_ply(&lit, file.stream, path, error); break;
     case FORMAT_GLB: status = lit_mesh_write_glb(&lit, file.stream, path, error); break;
@@ -233,6 +249,11 @@ static rad_status write_lit_mesh(const rad_mesh *mesh, const rad_rgb *B, const c
         status = rad_atomic_commit(&file, error);
     else
         rad_atomic_abort(&file);
+    if (status == RAD_OK && triangle_patch) {
+        *options->triangle_patches = triangle_patch;
+        *options->triangle_patch_count = shown.triangle_count;
+    } else
+        free(triangle_patch);
 done:
     free(position);
     free(normal);
@@ -280,7 +301,8 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
     bool vertex_light = options && options->direct_light != RAD_DIRECT_SOLUTION &&
                         vertex_radiance_applies(options->scene);
     if (!vertex_light)
-        return write_lit_mesh(mesh, B, path, options, inputs, inputs != NULL, format, error);
+        return write_lit_mesh(mesh, B, path, options, inputs, inputs != NULL, NULL, format,
+                              error);
     light_refined refined;
     rad_status status = light_refine(options->scene, mesh, B, inputs,
                                      options->threads > 0 ? options->threads
@@ -288,9 +310,10 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
                                      &refined, error);
     if (status == RAD_OK)
         status = refined.mesh ? write_lit_mesh(refined.mesh, refined.B, path, options,
-                                               refined.inputs, inputs != NULL, format, error)
+                                               refined.inputs, inputs != NULL, refined.parent,
+                                               format, error)
                               : write_lit_mesh(mesh, B, path, options, inputs, inputs != NULL,
-                                               format, error);
+                                               NULL, format, error);
     light_refined_free(&refined);
     return status;
 }

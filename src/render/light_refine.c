@@ -328,7 +328,9 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
     if (current) {
         status = carry_solution(current, parent, B, inputs, out, error);
         out->mesh = current;
+        out->parent = parent;
         current = NULL;
+        parent = NULL;
     }
 done:
     if (status != RAD_OK)
@@ -347,6 +349,7 @@ void light_refined_free(light_refined *refined)
 {
     rad_mesh_destroy(refined->mesh);
     free(refined->B);
+    free(refined->parent);
     rad_patch_inputs_destroy(refined->inputs);
     *refined = (light_refined){0};
 }

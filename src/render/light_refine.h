@@ -34,11 +34,13 @@
 #define LIGHT_REFINE_BYTES_PER_PATCH 4096u
 
 /* The solution on the finer mesh: mesh (NULL when nothing was split: use the caller's),
- * B and inputs per patch of it, each piece its patch's; destroy with light_refined_free. */
+ * B and inputs per patch of it, each piece its patch's, and where each piece comes from;
+ * destroy with light_refined_free. */
 typedef struct light_refined {
     rad_mesh *mesh;
     rad_rgb *B;
     rad_patch_inputs *inputs;
+    uint32_t *parent; /* per patch of mesh: the patch of the solution's mesh it lies in */
 } light_refined;
 
 /* Refines `mesh` (solution B, patch inputs `inputs`, NULL: built from the scene) for the

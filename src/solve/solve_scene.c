@@ -283,7 +283,12 @@ static rad_status solve_hierarchy(const rad_scene *scene, const rad_mesh *mesh, 
         if (whole_run)
             link_budget -= link_budget / 4;
     }
-    rad_hierarchy_options h = {o->refine_threshold, o->visibility_rays, o->tolerance,
+    /* standing in for the dense solve on a mesh sized for it: its accuracy (radiosity.h) */
+    double threshold = o->refine_threshold;
+    if (threshold == 0 && o->solver == RAD_SOLVER_AUTO &&
+        mesh->patch_count <= RAD_AUTO_FINE_LINKS_PATCHES)
+        threshold = RAD_AUTO_REFINE_THRESHOLD;
+    rad_hierarchy_options h = {threshold,            o->visibility_rays, o->tolerance,
                                o->max_iterations,   link_budget,        o->seed,
                                o->threads,          o->stop,            o->progress,
                                o->progress_user,    o->observer,        o->observer_user};
@@ -291,7 +296,7 @@ static rad_status solve_hierarchy(const rad_scene *scene, const rad_mesh *mesh, 
     r->hierarchy.patch = UINT32_MAX;
     rad_status status = RAD_OK;
     if (cp) {
-        cp->job.refine_threshold = o->refine_threshold;
+        cp->job.refine_threshold = threshold;
         cp->job.link_budget = link_budget;
         status = cp->resume_path ? solve_checkpoint_read(cp, error) : RAD_OK;
         if (status != RAD_OK)
