@@ -82,6 +82,17 @@ static bool measure_shares(const refine_state *st, const rad_mesh *mesh, uint32_
     return ok;
 }
 
+/* The patch's longest edge. */
+static double longest_edge(const rad_patch *patch, const rad_vec3 *vertices)
+{
+    double longest = 0;
+    for (uint32_t k = 0; k < patch->vertex_count; k++)
+        longest = fmax(longest, v3_length(v3_sub(vertices[patch->vertex[(k + 1) %
+                                                                        patch->vertex_count]],
+                                                 vertices[patch->vertex[k]])));
+    return longest;
+}
+
 /* Whether the light bends inside the patch: its corners read differently. */
 static bool bends(const rad_patch *patch, const vertex_share *share)
 {
@@ -291,6 +302,11 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
     for (uint32_t p = 0; p < mesh->patch_count; p++)
         parent[p] = p;
     refine_state st = {scene, &set, occluders, vertex_radiance_leave(mesh), threads};
+    /* no piece's edge shorter than the default mesh's (the dense solvers' patch size,
+     * split by the shadow refinement's default levels) split LIGHT_REFINE_LEVELS times:
+     * a mesh already that fine (the hierarchical solver's) is left as it is */
+    const double smallest = 0.99 * rad_default_patch_size(scene, RAD_SOLVER_AUTO) /
+                            (1u << (RAD_SHADOW_LEVELS_DEFAULT + LIGHT_REFINE_LEVELS));
     const rad_mesh *at = mesh;
     uint32_t measured = 0;
     for (uint32_t level = 0; level < LIGHT_REFINE_LEVELS && budget >= 3; level++) {
@@ -309,7 +325,8 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
         uint32_t splits = 0;
         for (uint32_t p = 0; p < at->patch_count; p++) {
             const rad_patch *patch = &at->patches[p];
-            split[p] = patch->twin == 0 && budget >= 3 && bends(patch, share);
+            split[p] = patch->twin == 0 && budget >= 3 &&
+                       longest_edge(patch, at->vertices) >= 2 * smallest && bends(patch, share);
             if (split[p]) {
                 splits++;
                 budget -= 3;

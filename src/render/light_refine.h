@@ -11,7 +11,12 @@
  * another part, or the shares seen differ by more than LIGHT_REFINE_SHARE (64 fixed points
  * on the emitters per vertex). Quads split into four quads at their edges' midpoints and
  * centre, triangles into four; the new corners are tested in turn, `levels` times at most,
- * and the splits stop at a budget of added patches (and of memory). Each piece keeps its patch's
+ * and the splits stop at a budget of added patches (and of memory). No piece's edge is
+ * made shorter than the dense solvers' default patch size halved by the default shadow
+ * levels and then LIGHT_REFINE_LEVELS times: a mesh already that fine is left as it is.
+ * On the hierarchical solver's 31,210 patches of the Cornell box the split had cost 2.2 s
+ * of a 256 x 256 render (4.82 -> 7.04 s) for no gain (0.871 % / 1.077 % -> 0.872 % /
+ * 1.112 % block / pixel against a 16384-spp reference). Each piece keeps its patch's
  * radiosity, material and normal (the solution is not changed: only where its light is
  * shown); a midpoint is shared by the two patches of a region on either side of its edge,
  * and where only one of them splits it is a T-vertex, which the display mesh handles.
