@@ -307,6 +307,10 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
      * a mesh already that fine (the hierarchical solver's) is left as it is */
     const double smallest = 0.99 * rad_default_patch_size(scene, RAD_SOLVER_AUTO) /
                             (1u << (RAD_SHADOW_LEVELS_DEFAULT + LIGHT_REFINE_LEVELS));
+    if (!(smallest > 0)) { /* 0: out of memory for the mesh plan */
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light's finer mesh");
+        goto done;
+    }
     const rad_mesh *at = mesh;
     uint32_t measured = 0;
     for (uint32_t level = 0; level < LIGHT_REFINE_LEVELS && budget >= 3; level++) {
