@@ -1447,7 +1447,9 @@ typedef struct rad_scene_solve_options {
      * solvers' form-factor rows done (the rows go in 64 rounds per rank, a checkpoint
      * possible between two), then the whole matrix and the iterate between sweeps (shooting:
      * every n / 16 shots); the hierarchical solver's links, B and loop state between sweeps,
-     * and always one before its final gather (a stop during it goes back there). A resumed
+     * always one before its final gather, and between the final gather's 16 rounds of
+     * leaves (with the rounds' corrections; a stop inside a round goes back to the last
+     * checkpoint). A resumed
      * run gives B bitwise the same as an uninterrupted one, for any thread count (and rank
      * count). Written atomically; refused on resuming, naming the file, when made for
      * another scene, mesh, solver, --quadrature, --visibility-rays, --max-iterations,

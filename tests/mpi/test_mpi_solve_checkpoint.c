@@ -7,10 +7,11 @@
  * rank's rows, gathered at rank 0) and in their iterate, and during the last sweep (the
  * direct solver: during its last round of rows, F written before its LU); in the
  * hierarchical solver's
- * refinement and before its final gather (each rank's links gathered at rank 0 and dealt
- * out again on resuming). Across rank counts: a 3-rank hierarchical checkpoint continued by
- * 2 ranks (stopped again), then serially; a 2-rank checkpoint of form-factor rows resumed
- * by 3 ranks. A refused checkpoint (another --seed) under 3 ranks prints its one line once,
+ * refinement and between its final gather's rounds (each rank's links, and its leaves'
+ * corrections, gathered at rank 0 and dealt out again on resuming). Across rank counts: a
+ * 3-rank hierarchical checkpoint continued by 2 ranks (stopped again), then serially; one
+ * in the final gather's rounds under 3 ranks resumed by 2; a 2-rank checkpoint of
+ * form-factor rows resumed by 3 ranks. A refused checkpoint (another --seed) under 3 ranks prints its one line once,
  * naming the file, and writes nothing.
  */
 #include <string.h>
@@ -86,7 +87,8 @@ int main(void)
     CHECK(sweeps_steps > 66);
 
     /* dense: 63 checkpoints between the 64 rounds of each rank's rows, then the iterate;
-     * hierarchical: its refinement, and the checkpoint before the final gather */
+     * hierarchical: its refinement, and the last of those between the final gather's 16
+     * rounds (15, the last `steps`) */
     stop_and_resume("gather", 2, 3, 2);
     stop_and_resume("gauss-seidel", 2, 66, 2);
     stop_and_resume("hierarchical", 2, 3, 2);
@@ -100,6 +102,7 @@ int main(void)
 
     /* across rank counts */
     stop_and_resume("gather", 2, 5, 3);
+    stop_and_resume("hierarchical", 3, steps - 7, 2); /* half way through the final gather */
     setenv("RADIOSITY_STOP_AFTER_CHECKPOINTS", "4", 1);
     CHECK(test_run_mpi(3, "solve --solver hierarchical " SCENE " --threads 1 --checkpoint "
                           "mixed.bin --checkpoint-interval 0 --save-solution mixed.sol",

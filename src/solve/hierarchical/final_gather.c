@@ -145,14 +145,15 @@ static bool gather_leaf(const final_gather_context *c, uint32_t k, gather_buffer
 int hier_final_gather(const final_gather_context *c, rad_rgb *correction, uint64_t *rays)
 {
     const hier_tree *t = c->tree;
-    int64_t nodes = t->node_count;
+    int64_t nodes = t->node_count, first = c->first_node,
+            end = c->end_node < t->node_count ? c->end_node : t->node_count;
     uint64_t cast = 0;
     int failed = 0, stopped = 0;
 #pragma omp parallel num_threads(c->threads) reduction(+ : cast) reduction(| : failed, stopped)
     {
         gather_buffers b = {0};
 #pragma omp for schedule(dynamic, 64)
-        for (int64_t k = 0; k < nodes; k++) {
+        for (int64_t k = first; k < end; k++) {
             if (c->progress && omp_get_thread_num() == 0 && k % 8192 == 0)
                 c->progress(c->progress_user, "final gather", (double)k / (double)nodes);
             if (c->stop && *c->stop)

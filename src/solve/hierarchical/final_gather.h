@@ -27,9 +27,12 @@ typedef struct final_gather_context {
     const volatile int *stop; /* when it becomes non-zero, the gather gives up; may be NULL */
     const uint8_t *receiver_role; /* over MPI ranks: only the leaves RECEIVER_OWN gather;
                                      NULL: every leaf */
+    uint32_t first_node, end_node; /* the nodes [first_node, end_node) gather (a round of
+                                      the final gather, between checkpoints) */
 } final_gather_context;
 
-/* correction[k] for every leaf node k (over MPI ranks, this rank's own): the irradiance
+/* correction[k] for every leaf node k of the context's range (over MPI ranks, this rank's
+ * own): the irradiance
  * per unit area its ancestors' links give at its own resolution minus what they hand down
  * (their transfer x B). Adds the segments traced to *rays. Returns 1, or 0 when memory ran
  * out, or -1 when stopped (the corrections are then incomplete and must not be used). */

@@ -7,7 +7,8 @@
  * 4 converged), the last sweep's change and the gather's first (f64), the store's capacity
  * and peak bytes (u64), the patch count (u32), the link count (u64); per link its receiver
  * and source (u32), transfer and bound (f32), visible share and flags (u16, as a u32 pair);
- * then B per patch and down per leaf position (3 f64 each).
+ * then B per patch and down per leaf position (3 f64 each); in phase HIER_IN_FINAL then
+ * the final gather's rounds done (u32) and its correction per leaf position (3 f64 each).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -21,7 +22,8 @@ enum { FLAG_CAPPED = 1, FLAG_REFINING = 2, FLAG_CONVERGED = 4 };
 
 void hier_checkpoint_put(byte_sink *body, const hier_loop_state *state, uint32_t patches,
                          const hlink *links, uint64_t count, const rad_rgb *B,
-                         const rad_rgb *down_by_position)
+                         const rad_rgb *down_by_position,
+                         const rad_rgb *correction_by_position)
 {
     sink_u32(body, state->phase);
     sink_u32(body, state->iterations);
@@ -48,6 +50,10 @@ void hier_checkpoint_put(byte_sink *body, const hier_loop_state *state, uint32_t
     }
     sink_rgbs(body, B, patches);
     sink_rgbs(body, down_by_position, patches);
+    if (state->phase == HIER_IN_FINAL) {
+        sink_u32(body, state->final_rounds);
+        sink_rgbs(body, correction_by_position, patches);
+    }
 }
 
 static bool rgbs_ok(const rad_rgb *v, uint32_t n, bool nonnegative)
@@ -62,11 +68,12 @@ static bool rgbs_ok(const rad_rgb *v, uint32_t n, bool nonnegative)
 bool hier_checkpoint_get(byte_source *source, const char *path, const hier_tree *tree,
                          uint32_t patches, const uint8_t *keep, hier_loop_state *state,
                          hlink **links, size_t *count, size_t *capacity, rad_rgb *B,
-                         rad_rgb *down_by_position, rad_error *error)
+                         rad_rgb *down_by_position, rad_rgb *correction_by_position,
+                         rad_error *error)
 {
     *links = NULL;
     *count = *capacity = 0;
-    hier_loop_state s;
+    hier_loop_state s = {0};
     s.phase = source_u32(source);
     s.iterations = source_u32(source);
     s.passes = source_u32(source);
@@ -83,7 +90,7 @@ bool hier_checkpoint_get(byte_source *source, const char *path, const hier_tree 
     s.peak_bytes = source_u64(source);
     uint32_t n = source_u32(source);
     uint64_t listed = source_u64(source);
-    if (source->short_read || s.phase < HIER_AT_PASS || s.phase > HIER_BEFORE_FINAL ||
+    if (source->short_read || s.phase < HIER_AT_PASS || s.phase > HIER_IN_FINAL ||
         n != patches || !(s.sweep_change >= 0) || !(s.first >= 0)) {
         rad_fail(error, RAD_ERR_PARSE, "%s: not a whole hierarchical solver state", path);
         return false;
@@ -122,8 +129,14 @@ bool hier_checkpoint_get(byte_source *source, const char *path, const hier_tree 
     }
     source_rgbs(source, B, patches);
     source_rgbs(source, down_by_position, patches);
+    bool corrections_ok = true;
+    if (s.phase == HIER_IN_FINAL) {
+        s.final_rounds = source_u32(source);
+        source_rgbs(source, correction_by_position, patches);
+        corrections_ok = rgbs_ok(correction_by_position, patches, false);
+    }
     if (source->short_read || source_left(source) || !rgbs_ok(B, patches, true) ||
-        !rgbs_ok(down_by_position, patches, false)) {
+        !rgbs_ok(down_by_position, patches, false) || !corrections_ok) {
         free(kept);
         rad_fail(error, RAD_ERR_PARSE, "%s: %s", path,
                  source->short_read || source_left(source)

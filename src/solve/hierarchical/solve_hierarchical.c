@@ -17,10 +17,12 @@
  * run's, so the solution is bitwise the serial one for any rank count.
  *
  * With a checkpoint (solve/solve_checkpoint.h) the state is written at the top of the loop
- * and between the sweeps to the tolerance when one is due, and always before the final
- * gather (the longest step, whose stop leaves that checkpoint standing): the links of every
- * rank gathered at rank 0, each once. A resumed run rebuilds the tree, keeps the links it
- * receives and goes on from the same point (hierarchy_checkpoint.h).
+ * and between the sweeps to the tolerance when one is due, always before the final gather,
+ * and between the final gather's FINAL_ROUNDS rounds of leaves when one is due (with the
+ * corrections of the rounds done; a stop inside a round leaves the last checkpoint
+ * standing): the links of every rank gathered at rank 0, each once. A resumed run rebuilds
+ * the tree, keeps the links it receives and goes on from the same point
+ * (hierarchy_checkpoint.h).
  */
 #include <math.h>
 #include <omp.h>
@@ -48,6 +50,9 @@
 #define MAX_CORRECTION_FACTOR 1.0
 #define FULL_CHECK_EVERY 8u /* passes; the others look only at links not settled */
 #define MAX_PASSES 256u
+/* The final gather goes in this many rounds of nodes (equal index ranges), between which a
+ * checkpoint may be written. */
+#define FINAL_ROUNDS 16u
 
 typedef struct hsolver {
     const rad_mesh *mesh;
@@ -328,25 +333,28 @@ static double refine_fraction(uint32_t passes, uint32_t nodes)
 
 /* ---- checkpoints (hierarchy_checkpoint.h) ---- */
 
-/* Every leaf's `down` by leaf-order position, from its owner over ranks. Collective. */
-static void leaves_down(hsolver *s, rad_rgb *by_position)
+/* Every leaf's value[] (per node: `down`, the final gather's correction) by leaf-order
+ * position, from its owner over ranks. Collective. */
+static void leaves_by_position(hsolver *s, const rad_rgb *value, rad_rgb *by_position)
 {
     const hier_tree *t = &s->tree;
     for (uint32_t k = 0; k < t->node_count; k++)
         if (t->nodes[k].patch != HNODE_NONE &&
             (!s->over_ranks || s->share.role[k] == RECEIVER_OWN))
-            by_position[t->nodes[k].first] = s->down[k];
+            by_position[t->nodes[k].first] = value[k];
     if (s->over_ranks)
         rank_share_exchange(&s->share, s->mesh->patch_count, by_position);
 }
 
 /* Collective: writes the state as a HIERARCHY checkpoint: the links of every rank at rank 0
- * (those every rank holds from rank 0 only). */
+ * (those every rank holds from rank 0 only); in phase HIER_IN_FINAL s->correction too. */
 static rad_status write_state(hsolver *s, solve_checkpoint *cp, hier_loop_state *state,
                               rad_error *error)
 {
     uint32_t n = s->mesh->patch_count;
-    rad_rgb *down = rad_alloc_array(n, sizeof(rad_rgb));
+    bool in_final = state->phase == HIER_IN_FINAL;
+    rad_rgb *down = rad_alloc_array(in_final ? 2 * (size_t)n : n, sizeof(rad_rgb));
+    rad_rgb *correction = in_final && down ? down + n : NULL;
     hlink *mine = s->store.links;
     size_t count = s->store.count;
     rad_status status = down ? RAD_OK : rad_fail(error, RAD_ERR_NOMEM, "out of memory");
@@ -363,7 +371,9 @@ static rad_status write_state(hsolver *s, solve_checkpoint *cp, hier_loop_state 
     if (s->over_ranks)
         status = ranks_agree(status, "writing a checkpoint", error);
     if (status == RAD_OK)
-        leaves_down(s, down);
+        leaves_by_position(s, s->down, down);
+    if (status == RAD_OK && correction)
+        leaves_by_position(s, s->correction, correction);
     state->capacity = s->store.capacity;
     state->peak_bytes = s->store.peak_bytes;
     if (s->over_ranks) /* the rays every rank traced on its own, in one count */
@@ -386,7 +396,7 @@ static rad_status write_state(hsolver *s, solve_checkpoint *cp, hier_loop_state 
     body.off = ranks_rank() != 0;
     if (status == RAD_OK)
         hier_checkpoint_put(&body, state, n, gathered ? gathered : mine, count, s->patch_B,
-                            down);
+                            down, correction);
     if (status == RAD_OK)
         status = solve_checkpoint_write(cp, SOLVE_CHECKPOINT_HIERARCHY, &body, 1, error);
     sink_free(&body);
@@ -423,7 +433,8 @@ static bool resume_state(hsolver *s, solve_checkpoint *cp, hier_loop_state *stat
     if (!solve_checkpoint_resuming(cp, SOLVE_CHECKPOINT_HIERARCHY, &source))
         return true;
     uint32_t n = s->mesh->patch_count;
-    rad_rgb *down = rad_alloc_array(n, sizeof(rad_rgb));
+    rad_rgb *down = rad_alloc_array(2 * (size_t)n, sizeof(rad_rgb));
+    rad_rgb *correction = down ? down + n : NULL;
     uint8_t *keep = NULL;
     if (s->over_ranks && (keep = rad_alloc_array(s->tree.node_count, 1)))
         for (uint32_t k = 0; k < s->tree.node_count; k++)
@@ -435,7 +446,21 @@ static bool resume_state(hsolver *s, solve_checkpoint *cp, hier_loop_state *stat
         rad_fail(error, RAD_ERR_NOMEM, "out of memory resuming from %s", cp->resume_path);
     else
         ok = hier_checkpoint_get(&source, cp->resume_path, &s->tree, n, keep, state, &links,
-                                 &count, &capacity, s->patch_B, down, error);
+                                 &count, &capacity, s->patch_B, down, correction, error);
+    if (ok && state->phase == HIER_IN_FINAL && state->final_rounds >= FINAL_ROUNDS) {
+        ok = false;
+        rad_fail(error, RAD_ERR_PARSE, "%s: %u of the final gather's %u rounds done",
+                 cp->resume_path, state->final_rounds, FINAL_ROUNDS);
+    }
+    if (ok && state->phase == HIER_IN_FINAL) { /* the corrections of the rounds done */
+        s->correction = rad_alloc_array(s->tree.node_count, sizeof(rad_rgb));
+        ok = s->correction != NULL;
+        if (!ok)
+            rad_fail(error, RAD_ERR_NOMEM, "out of memory resuming from %s", cp->resume_path);
+        for (uint32_t k = 0; ok && k < s->tree.node_count; k++)
+            if (s->tree.nodes[k].patch != HNODE_NONE)
+                s->correction[k] = correction[s->tree.nodes[k].first];
+    }
     hlink *spare = NULL;
     if (ok) {
         if (s->over_ranks) /* this rank's share of the links: its store from them alone */
@@ -634,14 +659,17 @@ rad_status solve_hierarchical_checkpointed(const rad_mesh *mesh,
             sweep_change = resumed.sweep_change;
         }
     }
-#define LOOP_STATE(at, first_change)                                                        \
+#define LOOP_STATE_AT(at, first_change, rounds)                                              \
     (hier_loop_state)                                                                      \
     {                                                                                      \
         (at), rep.iterations, rep.passes, quiet_passes, rep.rays, rays_shared,             \
-            rep.memory_capped, refining, converged, sweep_change, (first_change), 0, 0     \
+            rep.memory_capped, refining, converged, sweep_change, (first_change), 0, 0,    \
+            (rounds)                                                                       \
     }
+#define LOOP_STATE(at, first_change) LOOP_STATE_AT(at, first_change, 0)
     bool resume_gather = resumed.phase == HIER_IN_GATHER;
-    bool skip_loop = resumed.phase == HIER_BEFORE_FINAL;
+    bool resume_final = resumed.phase == HIER_IN_FINAL;
+    bool skip_loop = resumed.phase == HIER_BEFORE_FINAL || resume_final;
     while (!skip_loop &&
            !(cp && !resume_gather &&
              (halt = checkpoint_step(&s, cp, &LOOP_STATE(HIER_AT_PASS, 0), false,
@@ -726,8 +754,9 @@ rad_status solve_hierarchical_checkpointed(const rad_mesh *mesh,
     if (o.progress)
         o.progress(o.progress_user, "gather", 1);
     if (!halt && !stopped(&s, &o) && links_anywhere(&s) && !s.diverged) {
-        if (cp && cp->path) { /* the final gather is long: its stop goes back to here */
-            sort_by_receiver(&s); /* as it is after any sweep (and resumed links) */
+        sort_by_receiver(&s); /* as it is after any sweep (and resumed links) */
+        if (cp && cp->path && !resume_final) { /* a stop in the final gather's first round
+                                                  goes back to here */
             checkpoint_step(&s, cp, &LOOP_STATE(HIER_BEFORE_FINAL, 0), true, &checkpointed,
                             error);
             if (checkpointed != RAD_OK) {
@@ -738,23 +767,43 @@ rad_status solve_hierarchical_checkpointed(const rad_mesh *mesh,
         if (cp && cp->interrupted)
             goto final_done;
         double tf = now_seconds();
-        s.correction = rad_alloc_array(nodes, sizeof(rad_rgb));
+        if (!s.correction) /* (resumed in the final gather: the rounds done) */
+            s.correction = rad_alloc_array(nodes, sizeof(rad_rgb));
         s.scale = rad_alloc_array(nodes, sizeof(rad_rgb));
         update_brightness(&s);
         final_gather_context fg = {mesh,       &s.tree,    occluders,  s.store.links,
                                    s.offsets,  s.node_B,   s.brightness, rays,
                                    o.seed + 2, s.threads,  o.progress, o.progress_user,
-                                   o.stop,     s.over_ranks ? s.share.role : NULL};
-        int gathered = s.correction && s.scale ? hier_final_gather(&fg, s.correction, &rep.rays)
-                                               : 0;
-        double tw = now_seconds(); /* the ranks wait here for the slowest */
-        if (s.over_ranks) { /* out of memory anywhere fails all; a stop anywhere stops all */
-            if (ranks_failures(gathered == 0) > 0)
-                gathered = 0;
-            else if (ranks_failures(gathered < 0) > 0)
-                gathered = -1;
+                                   o.stop,     s.over_ranks ? s.share.role : NULL, 0, 0};
+        int gathered = s.correction && s.scale ? 1 : 0;
+        if (s.over_ranks && ranks_failures(gathered == 0) > 0)
+            gathered = 0;
+        /* in rounds of nodes, each round's corrections depending on the node, the seed and
+         * B only: a checkpoint between two holds those done, and resuming goes on bitwise */
+        for (uint32_t round = resume_final ? resumed.final_rounds : 0;
+             gathered > 0 && round < FINAL_ROUNDS; round++) {
+            fg.first_node = (uint32_t)((uint64_t)nodes * round / FINAL_ROUNDS);
+            fg.end_node = (uint32_t)((uint64_t)nodes * (round + 1) / FINAL_ROUNDS);
+            gathered = hier_final_gather(&fg, s.correction, &rep.rays);
+            double tw = now_seconds(); /* the ranks wait here for the slowest */
+            if (s.over_ranks) { /* out of memory anywhere fails all; a stop anywhere stops
+                                   all */
+                if (ranks_failures(gathered == 0) > 0)
+                    gathered = 0;
+                else if (ranks_failures(gathered < 0) > 0)
+                    gathered = -1;
+            }
+            s.seconds_waiting += now_seconds() - tw;
+            if (gathered > 0 && cp && cp->path && round + 1 < FINAL_ROUNDS &&
+                checkpoint_step(&s, cp, &LOOP_STATE_AT(HIER_IN_FINAL, 0, round + 1), false,
+                                &checkpointed, error)) {
+                if (checkpointed != RAD_OK) {
+                    hsolver_free(&s);
+                    return checkpointed;
+                }
+                gathered = -1; /* stopped: the checkpoint holds the rounds done */
+            }
         }
-        s.seconds_waiting += now_seconds() - tw;
         if (gathered == 0) {
             hsolver_free(&s);
             return rad_fail(error, RAD_ERR_NOMEM, "out of memory in the final gather");
@@ -784,6 +833,7 @@ rad_status solve_hierarchical_checkpointed(const rad_mesh *mesh,
     }
 final_done:
 #undef LOOP_STATE
+#undef LOOP_STATE_AT
     rep.interrupted = stopped(&s, &o);
     if (cp && cp->path && rep.interrupted)
         cp->interrupted = true; /* the last checkpoint written stands for this point */
