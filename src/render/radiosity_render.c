@@ -570,7 +570,14 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B, const rad_
             .gathered_only = direct_light == RAD_DIRECT_PIXEL,
             .seed = options->seed,
             .threads = threads,
+            .over_ranks = ranks_count() > 1, /* rad_render is collective */
         };
+        if (job.over_ranks) { /* a rank that failed before is at `done`, agreeing there */
+            status = ranks_agree(RAD_OK, "render", error);
+            agreed = status != RAD_OK; /* then all stop, agreed */
+            if (status != RAD_OK)
+                goto done;
+        }
         status = vertex_radiance(&job, radiance, NULL, error);
         if (status != RAD_OK)
             goto done;

@@ -12,12 +12,75 @@
 #include "core/random.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
+#include "parallel/ranks.h"
 #include "render/emitter_light.h"
 #include "trace/ray.h"
 
 #define VERTEX_EMITTER_SAMPLES 1024u /* light samples per vertex */
 #define VERTEX_COSINE_RAYS 512u     /* their MIS partners: cosine rays toward the emitters */
 #define VERTEX_GATHER_RAYS 1024u    /* final-gather rays per vertex */
+#define VERTEX_RANK_CHUNK 64u       /* over ranks: vertices dealt out in turn, this many at
+                                       a time */
+/* Over ranks, what each vertex's light is shared as: direct, gathered (3 doubles each) and
+ * whether it is buried. */
+#define VERTEX_SHARED_DOUBLES 7u
+
+/* The rank (of `ranks`) that lights vertex v. */
+static uint32_t vertex_rank(uint32_t v, uint32_t ranks)
+{
+    return (v / VERTEX_RANK_CHUNK) % ranks;
+}
+
+/* Over ranks: every rank's vertices' direct, gathered and buried to every rank (each rank
+ * filled its own; `lit` false: it could not). False, on every rank, when any could not or
+ * ran out of memory here. Collective. */
+static bool share_vertices(uint32_t n, bool lit, rad_rgb *direct, rad_rgb *gathered,
+                           uint32_t *buried)
+{
+    const uint32_t ranks = (uint32_t)ranks_count(), rank = (uint32_t)ranks_rank();
+    uint64_t *counts = rad_alloc_array(ranks, sizeof(*counts));
+    double *mine = NULL, *all = rad_alloc_array((size_t)n * VERTEX_SHARED_DOUBLES + 1,
+                                                sizeof(double));
+    if (counts)
+        for (uint32_t v = 0; v < n; v++)
+            counts[vertex_rank(v, ranks)] += VERTEX_SHARED_DOUBLES;
+    if (counts)
+        mine = rad_alloc_array(counts[rank] + 1, sizeof(double));
+    bool ok = lit && counts && mine && all;
+    if (ranks_failures(!ok) > 0) {
+        free(counts);
+        free(mine);
+        free(all);
+        return false;
+    }
+    size_t at = 0;
+    for (uint32_t v = 0; v < n; v++)
+        if (vertex_rank(v, ranks) == rank) {
+            double *d = &mine[at];
+            d[0] = direct[v].r, d[1] = direct[v].g, d[2] = direct[v].b;
+            d[3] = gathered[v].r, d[4] = gathered[v].g, d[5] = gathered[v].b;
+            d[6] = buried[v];
+            at += VERTEX_SHARED_DOUBLES;
+        }
+    ranks_share_parts(mine, all, counts);
+    /* rank r's part holds its vertices in order: walk each part with its own cursor */
+    for (uint32_t r = 1; r < ranks; r++)
+        counts[r] += counts[r - 1];
+    for (uint32_t r = ranks; r-- > 1;)
+        counts[r] = counts[r - 1];
+    counts[0] = 0;
+    for (uint32_t v = 0; v < n; v++) {
+        const double *d = &all[counts[vertex_rank(v, ranks)]];
+        counts[vertex_rank(v, ranks)] += VERTEX_SHARED_DOUBLES;
+        direct[v] = (rad_rgb){d[0], d[1], d[2]};
+        gathered[v] = (rad_rgb){d[3], d[4], d[5]};
+        buried[v] = (uint32_t)d[6];
+    }
+    free(counts);
+    free(mine);
+    free(all);
+    return true;
+}
 #define VERTEX_STREAM 0xE3177E3ull
 void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *frame)
 {
@@ -86,14 +149,16 @@ static void buried_from_neighbours(const rad_mesh *mesh, const uint8_t *hidden,
 rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const rad_mesh *mesh,
                         const rad_tracer *occluders, const gather_view *view,
                         const light_set *sharp, const uint8_t *hidden, double leave,
-                        uint64_t seed, int threads, rad_rgb *direct, rad_rgb *gathered,
-                        rad_error *error)
+                        uint64_t seed, int threads, bool over_ranks, rad_rgb *direct,
+                        rad_rgb *gathered, rad_error *error)
 {
     uint32_t n = mesh->vertex_count;
+    const uint32_t ranks = over_ranks ? (uint32_t)ranks_count() : 1;
+    const uint32_t rank = ranks > 1 ? (uint32_t)ranks_rank() : 0;
     for (uint32_t v = 0; v < n; v++)
         direct[v] = gathered[v] = (rad_rgb){0, 0, 0};
     const bool exact = emitter_unshadowed_exact(set, scene);
-    if (n == 0)
+    if (n == 0) /* (the same on every rank) */
         return RAD_OK;
     const uint32_t sharp_rays = sharp ? light_set_capacity(sharp, LIGHTS_SHARP, 0) : 0;
     const uint32_t samples = VERTEX_EMITTER_SAMPLES, gather = VERTEX_GATHER_RAYS;
@@ -117,7 +182,7 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
 #pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
         for (int64_t v = 0; v < (int64_t)n; v++) {
             const vertex_frame *f = &frame[v];
-            if (!(f->weight > 0))
+            if (!(f->weight > 0) || vertex_rank((uint32_t)v, ranks) != rank)
                 continue;
             int thread = omp_get_thread_num();
             rad_ray *light = &rays[(size_t)thread * capacity];
@@ -186,8 +251,11 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
             gathered[v] = rgb_scale(seen, RAD_PI / gather);
             buried[v] = backs > gather - gather / 8; /* enclosed: 7/8 of the rays */
         }
-        buried_from_neighbours(mesh, hidden, buried, direct, gathered);
     }
+    if (ranks > 1) /* every rank, whether its buffers were had or not */
+        ok = share_vertices(n, ok, direct, gathered, buried);
+    if (ok)
+        buried_from_neighbours(mesh, hidden, buried, direct, gathered);
     free(frame);
     free(buried);
     free(rays);

@@ -44,11 +44,14 @@ void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *fr
  * irradiance (traced against `occluders`, the scene's triangles), plus with `sharp` the
  * sharp sources' (point, spot, luminaire, sun: one shadow ray each), and gathered[v], the
  * irradiance the solution's reflected light brings (`view`). A vertex of hidden patches
- * alone gets 0. Deterministic per seed for any thread count. */
+ * alone gets 0. Deterministic per seed for any thread count. With `over_ranks` (and
+ * several MPI ranks) collective: each rank lights its share of the vertices (chunks of
+ * VERTEX_RANK_CHUNK dealt out in turn) and every rank gets every vertex's light, bitwise
+ * the serial values; every rank returns the same status. */
 rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const rad_mesh *mesh,
                         const rad_tracer *occluders, const gather_view *view,
                         const light_set *sharp, const uint8_t *hidden, double leave,
-                        uint64_t seed, int threads, rad_rgb *direct, rad_rgb *gathered,
-                        rad_error *error);
+                        uint64_t seed, int threads, bool over_ranks, rad_rgb *direct,
+                        rad_rgb *gathered, rad_error *error);
 
 #endif

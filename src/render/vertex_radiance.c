@@ -12,6 +12,7 @@
 #include "core/rgb.h"
 #include "core/tolerance.h"
 #include "core/vec3.h"
+#include "parallel/ranks.h"
 #include "render/vertex_light.h"
 
 bool vertex_radiance_applies(const rad_scene *scene)
@@ -62,7 +63,7 @@ rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
     rad_status status = RAD_OK;
     if (!factor || !emission || !vertex_factor || !vertex_emission || !direct || !gathered) {
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light at the vertices");
-        goto done;
+        goto agree;
     }
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
         bool holds_irradiance =
@@ -71,14 +72,17 @@ rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
         emission[p] = holds_irradiance ? (rad_rgb){0, 0, 0} : job->inputs->exitance[p];
     }
     if (!display_mesh_radiance_weighted(mesh, NULL, factor, job->hidden, vertex_factor) ||
-        !display_mesh_radiance_weighted(mesh, NULL, emission, job->hidden, vertex_emission)) {
+        !display_mesh_radiance_weighted(mesh, NULL, emission, job->hidden, vertex_emission))
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light at the vertices");
+agree: /* over ranks every rank goes on to the (collective) light at the vertices, or none */
+    if (job->over_ranks)
+        status = ranks_agree(status, "render", error);
+    if (status != RAD_OK)
         goto done;
-    }
     const emitter_set none = {0};
     status = vertex_light(job->gathered_only ? &none : job->emitters, job->scene, mesh,
                           job->scene_tracer, job->view, job->sharp, job->hidden, job->leave,
-                          job->seed, job->threads, direct, gathered, error);
+                          job->seed, job->threads, job->over_ranks, direct, gathered, error);
     if (status != RAD_OK)
         goto done;
     for (uint32_t v = 0; v < mesh->vertex_count; v++) {

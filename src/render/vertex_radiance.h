@@ -36,6 +36,8 @@ typedef struct vertex_radiance_job {
     bool gathered_only;                  /* H_emitters left out: each pixel adds its own */
     uint64_t seed;
     int threads;
+    bool over_ranks; /* collective over MPI ranks, each lighting its share of the vertices
+                        (vertex_light); false: this rank alone lights them all */
 } vertex_radiance_job;
 
 /* radiance[v] for the display's vertices; irradiance (NULL, or display->vertex_count
