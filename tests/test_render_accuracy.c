@@ -44,6 +44,43 @@ static rad_image *render_cornell(rad_direct_light direct_light, rad_solver solve
     return image;
 }
 
+static double luminance_at(const rad_image *image, uint32_t x, uint32_t y)
+{
+    const float *p = &image->rgb[((size_t)y * image->width + x) * 3];
+    return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+}
+
+/* The ceiling around the light, which the pixel measure leaves out (the light and 2 pixels
+ * around it): the pixels within 3 of a light pixel (the reference's luminance above 5)
+ * that the light does not cover (below 0.2, so no rim pixel); their relative error's mean
+ * and RMS against the reference. */
+static void ceiling_ring(const rad_image *image, const rad_image *reference, double *mean,
+                         double *rms)
+{
+    const int W = (int)reference->width, H = (int)reference->height, R = 3;
+    double sum = 0, squares = 0;
+    int count = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            double ref = luminance_at(reference, (uint32_t)x, (uint32_t)y);
+            bool near_light = false;
+            for (int dy = -R; dy <= R && !near_light; dy++)
+                for (int dx = -R; dx <= R && !near_light; dx++)
+                    near_light = y + dy >= 0 && y + dy < H && x + dx >= 0 && x + dx < W &&
+                                 luminance_at(reference, (uint32_t)(x + dx),
+                                              (uint32_t)(y + dy)) > 5;
+            if (!near_light || !(ref < 0.2) || !(ref > 0))
+                continue;
+            double d = (luminance_at(image, (uint32_t)x, (uint32_t)y) - ref) / ref;
+            sum += d;
+            squares += d * d;
+            count++;
+        }
+    CHECK(count > 100);
+    *mean = count ? sum / count : 0;
+    *rms = count ? sqrt(squares / count) : 0;
+}
+
 static void test_cornell(void)
 {
     rad_image *reference = NULL;
@@ -81,10 +118,23 @@ static void test_cornell(void)
      * mesh split where the shadows bend it (light_refine.h: 3742 -> 7198 patches, for
      * display) 0.0080 / 0.0114 at the vertices and 0.0078 / 0.0131 per pixel: the default
      * meets the blocks' 1 %, not the pixels'. From seed to seed the renders' blocks move by
-     * a few tenths of a percent (the gather's noise at the vertices, the light's rim). */
+     * a few tenths of a percent (the gather's noise at the vertices, the light's rim).
+     * 2026-12-03, the lamp's back counting for buried vertices and the rim found by the
+     * surfaces met: the same 0.0080 / 0.0114 (0.0141 / 0.0114 with the first alone). */
     CHECK(classic.block_relative_rmse < 0.030 && classic.pixel_relative_rmse < 0.033);
     CHECK(vertex.block_relative_rmse < 0.009 && vertex.pixel_relative_rmse < 0.0125);
     CHECK(vertex.block_relative_rmse < 0.6 * classic.block_relative_rmse);
+    /* the ceiling around the light: a vertex in the gap above the lamp's back, left dark,
+     * darkened it by interpolation (a ring down to -51 % at 256 x 256); now such a vertex
+     * takes its open neighbours' light, as one under a block does (vertex_light.c).
+     * Measured (142 pixels): mean -1.5 %, RMS 4.0 % (the CLI's mesh, seeds 1 and 2, was
+     * -2.7 % / 5.1 % before, -1.5 % / 3.9 % after) */
+    double ring_mean, ring_rms;
+    ceiling_ring(v, reference, &ring_mean, &ring_rms);
+    printf("  the ceiling within 3 pixels of the light, at the vertices: mean %+.2f %%, RMS "
+           "%.2f %%\n",
+           100 * ring_mean, 100 * ring_rms);
+    CHECK(fabs(ring_mean) < 0.02 && ring_rms < 0.045);
     CHECK(vertex.pixel_relative_rmse < 0.7 * classic.pixel_relative_rmse);
     CHECK_NEAR(vertex.mean_a.g, vertex.mean_b.g, 0.01);
     /* the mean radiance agrees within the reference's noise and the mesh's bias */

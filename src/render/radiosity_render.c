@@ -65,7 +65,8 @@ typedef struct row_work {
     uint32_t *edge_pixel; /* the pixels of the row that get edge samples, in order */
     uint32_t *first_surface; /* per first sample: the surface its camera ray met
                                 (UINT32_MAX: none); with the direct light per pixel,
-                                edges are where these differ, not where noise does */
+                                edges are where these differ, not where noise does; at
+                                the vertices, also where some emit and some do not */
     uint32_t *corner_surface; /* the same at the row's pixel corners: 2 (W + 1) */
     /* shadow rays toward the sharp light sources from the hits of a bounce */
     rad_ray *light_rays;
@@ -134,6 +135,25 @@ static bool is_edge(const rad_rgb *samples, unsigned count, double mean)
         hi = fmax(hi, y);
     }
     return hi - lo > EDGE_CONTRAST * mean;
+}
+
+/* Whether the surfaces a pixel's corners (four, in the row's corner table) and first
+ * samples met disagree on emitting (surface_emits[s]; UINT32_MAX: none met): the pixel
+ * holds an emitter's rim. Its samples' luminance may not show it: a sliver of the light
+ * that none of them met. */
+static bool emitter_rim(const uint32_t *seen, unsigned count, const uint32_t *corner,
+                        uint32_t x, uint32_t W, const uint8_t *surface_emits)
+{
+#define EMITS(s) ((s) != UINT32_MAX && surface_emits[s])
+    bool first = EMITS(seen[0]);
+    if (EMITS(corner[x]) != first || EMITS(corner[x + 1]) != first ||
+        EMITS(corner[W + 1 + x]) != first || EMITS(corner[W + 2 + x]) != first)
+        return true;
+    for (unsigned q = 1; q < count; q++)
+        if (EMITS(seen[q]) != first)
+            return true;
+    return false;
+#undef EMITS
 }
 
 /* A textured patch's radiance at a hit: the emitted radiance at the point plus the albedo
@@ -467,6 +487,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B, const rad_
     rad_patch_inputs *built_inputs = NULL;
     rad_rgb *shaded = NULL;
     uint32_t *first_triangle = NULL;
+    uint8_t *surface_emits = NULL; /* at the vertices: per surface, whether it emits */
     light_set lights;
     const light_set *lights_ptr = NULL;
     emitter_set emitters = {0};
@@ -600,6 +621,21 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B, const rad_
     if (ray_capacity < 2 * ((size_t)W + 1))
         ray_capacity = 2 * ((size_t)W + 1); /* the corner rays */
     unsigned max_depth = options->max_depth ? options->max_depth : RAD_DEFAULT_MAX_DEPTH;
+    if (direct_light == RAD_DIRECT_VERTEX && inputs && rad_scene_has_emitter(options->scene)) {
+        /* the light's rim, found by the surfaces met (emitter_rim) */
+        uint32_t surfaces = 0;
+        for (uint32_t p = 0; p < mesh->patch_count; p++)
+            surfaces = mesh->patches[p].surface + 1 > surfaces ? mesh->patches[p].surface + 1
+                                                              : surfaces;
+        surface_emits = rad_alloc_array(surfaces ? surfaces : 1, 1);
+        if (!surface_emits)
+            goto nomem;
+        for (uint32_t p = 0; p < mesh->patch_count; p++) {
+            const rad_rgb e = inputs->exitance[p];
+            if (e.r > 0 || e.g > 0 || e.b > 0)
+                surface_emits[mesh->patches[p].surface] = 1;
+        }
+    }
     work = rad_alloc_array((size_t)threads, sizeof(*work));
     if (!work)
         goto nomem;
@@ -617,7 +653,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B, const rad_
         w->edge_pixel = rad_alloc_array(W, sizeof(*w->edge_pixel));
         if (!w->edge_pixel)
             goto nomem;
-        if (emitters_ptr) {
+        if (emitters_ptr || surface_emits) {
             w->first_surface = rad_alloc_array(per_row, sizeof(*w->first_surface));
             w->corner_surface = rad_alloc_array(2 * ((size_t)W + 1), sizeof(*w->corner_surface));
             if (!w->first_surface || !w->corner_surface)
@@ -714,7 +750,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B, const rad_
         for (uint32_t x = 0; x < W; x++) {
             /* an edge shows inside the pixel's samples, or as a step to a row neighbour
              * (samples that all fell on one side of an edge crossing the pixel) */
-            if (w->first_surface) {
+            if (emitters_ptr) {
                 /* the direct light per pixel is noisy: an edge is where the camera rays
                  * meet different surfaces (a silhouette, a crease, the light's rim) */
                 const uint32_t *seen = &w->first_surface[(size_t)x * k * k];
@@ -727,7 +763,10 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B, const rad_
             } else
                 w->edge[x] = is_edge(&w->sum[(size_t)x * k * k], k * k, w->level[x]) ||
                              (x > 0 && is_step(w->level[x], w->level[x - 1])) ||
-                             (x + 1 < W && is_step(w->level[x], w->level[x + 1]));
+                             (x + 1 < W && is_step(w->level[x], w->level[x + 1])) ||
+                             (surface_emits &&
+                              emitter_rim(&w->first_surface[(size_t)x * k * k], k * k,
+                                          w->corner_surface, x, W, surface_emits));
             if (!w->edge[x])
                 continue;
             w->edge_pixel[extra / (edge_k * edge_k)] = x;
@@ -796,6 +835,7 @@ done:
             free(work[th].light_blocked);
         }
     free(work);
+    free(surface_emits);
     rad_tracer_destroy(tracer);
     rad_tracer_destroy(scene_tracer);
     emitters_free(&emitters);
