@@ -868,14 +868,17 @@ static void check_furnace_vertex_light(const reference *furnace)
     uint32_t nL = 0, nE = 0;
     float *L = test_ply_vertex_floats("furnace_vertex.ply", radiance_names, &nL);
     float *E = test_ply_vertex_floats("furnace_vertex.ply", illuminance_names, &nE);
-    CHECK(L != NULL && E != NULL && nL == furnace->mesh->vertex_count && nE == nL);
+    /* the box's creases split its patches next to them for display (light_refine.h): the
+     * mesh's own vertices come first, then the pieces' */
+    CHECK(L != NULL && E != NULL && nL >= furnace->mesh->vertex_count && nE == nL);
     double worst_L = 0, worst_E = 0, differ = 0;
     for (uint32_t v = 0; L && E && v < nL && v < nE; v++)
         for (int k = 0; k < 3; k++) {
             worst_L = fmax(worst_L, fabs(L[3 * v + k] - 2.0) / 2.0);
             worst_E = fmax(worst_E, fabs(E[3 * v + k] - 2 * PI) / (2 * PI));
             /* computed at the vertex, not the patches' mean: not the same numbers */
-            differ = fmax(differ, fabs(L[3 * v + k] - (&furnace->radiance[v].r)[k]));
+            if (v < furnace->mesh->vertex_count)
+                differ = fmax(differ, fabs(L[3 * v + k] - (&furnace->radiance[v].r)[k]));
         }
     printf("furnace_vertex.ply (the light at the vertices): radiance within %.2e of 2, "
            "illuminance within %.2e of 2 pi (relative); largest difference from the patch "

@@ -12,6 +12,7 @@
 #include "core/alloc.h"
 #include "core/edge_key.h"
 #include "core/error.h"
+#include "core/random.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
 #include "lights/emitters.h"
@@ -27,6 +28,8 @@ enum { SEES_NONE, SEES_PART, SEES_ALL };
  * reaches it (its point, as vertex_light takes it) and how that share reads. */
 typedef struct vertex_share {
     double share;
+    double open; /* the mean of min(1, t / reach) over cosine rays: 1 in the open, less
+                    next to a concave crease or a contact */
     uint8_t sees;
 } vertex_share;
 
@@ -36,6 +39,7 @@ typedef struct refine_state {
     const rad_tracer *occluders;
     double leave;
     int threads;
+    double reach; /* the distance a crease is felt at (openness) */
 } refine_state;
 
 /* share[v] for the vertices from `first` on. */
@@ -47,18 +51,34 @@ static bool measure_shares(const refine_state *st, const rad_mesh *mesh, uint32_
     rad_ray *rays = rad_alloc_array((size_t)st->threads * LIGHT_REFINE_PROBES, sizeof(*rays));
     rad_rgb *values = rad_alloc_array((size_t)st->threads * LIGHT_REFINE_PROBES, sizeof(*values));
     uint8_t *blocked = rad_alloc_array((size_t)st->threads * LIGHT_REFINE_PROBES, 1);
-    bool ok = frame && rays && values && blocked;
+    rad_hit *hits = rad_alloc_array((size_t)st->threads * LIGHT_REFINE_PROBES, sizeof(*hits));
+    double *cosines = rad_alloc_array((size_t)st->threads * LIGHT_REFINE_PROBES, sizeof(double));
+    bool ok = frame && rays && values && blocked && hits && cosines;
     if (ok) {
         vertex_frames(mesh, NULL, frame);
 #pragma omp parallel for schedule(dynamic, 64) num_threads(st->threads)
         for (int64_t v = first; v < (int64_t)n; v++) {
             const vertex_frame *f = &frame[v];
-            share[v] = (vertex_share){0, SEES_NONE};
+            share[v] = (vertex_share){0, 1, SEES_NONE};
             if (!(f->weight > 0))
                 continue;
             size_t base = (size_t)omp_get_thread_num() * LIGHT_REFINE_PROBES;
             rad_vec3 nv = v3_normalize(f->normal);
             rad_vec3 x = v3_add(mesh->vertices[v], v3_scale(f->inward, VERTEX_INWARD / f->weight));
+            double open = 1;
+            if (st->reach > 0) {
+                rad_rng rng = rad_rng_seed(0x6f70656eu, (uint64_t)v, 0);
+                emitter_cosine_rays(x, nv, 2 * f->bulge + st->leave, LIGHT_REFINE_PROBES, &rng,
+                                    &rays[base], &cosines[base]);
+                rad_tracer_intersect(st->occluders, &rays[base], LIGHT_REFINE_PROBES, &hits[base]);
+                double sum = 0;
+                for (uint32_t k = 0; k < LIGHT_REFINE_PROBES; k++)
+                    sum += hits[base + k].triangle == RAD_NO_HIT
+                               ? 1
+                               : fmin(1, hits[base + k].t / st->reach);
+                open = sum / LIGHT_REFINE_PROBES;
+            }
+            share[v].open = open;
             uint32_t count = emitter_light_rays_by_triangle(
                 st->set, st->scene, x, nv, 2 * f->bulge + st->leave, LIGHT_REFINE_PROBES, 0.5,
                 0.5, 0.5, 0, &rays[base], &values[base]);
@@ -72,13 +92,15 @@ static bool measure_shares(const refine_state *st, const rad_mesh *mesh, uint32_
             if (!(all > 0))
                 continue;
             double s = through / all;
-            share[v] = (vertex_share){s, s >= 1 ? SEES_ALL : s > 0 ? SEES_PART : SEES_NONE};
+            share[v] = (vertex_share){s, open, s >= 1 ? SEES_ALL : s > 0 ? SEES_PART : SEES_NONE};
         }
     }
     free(frame);
     free(rays);
     free(values);
     free(blocked);
+    free(hits);
+    free(cosines);
     return ok;
 }
 
@@ -93,20 +115,26 @@ static double longest_edge(const rad_patch *patch, const rad_vec3 *vertices)
     return longest;
 }
 
-/* Whether the light bends inside the patch: its corners read differently. */
-static bool bends(const rad_patch *patch, const vertex_share *share)
+/* Whether the light bends inside the patch: 1 where its corners read the emitters' light
+ * differently, else 2 where their openness differs (a crease or a contact the reflected
+ * light bends at), else 0. */
+static int bends(const rad_patch *patch, const vertex_share *share)
 {
-    double lo = INFINITY, hi = -INFINITY;
+    double lo = INFINITY, hi = -INFINITY, open_lo = INFINITY, open_hi = -INFINITY;
     bool none = false, part = false, all = false;
     for (uint32_t k = 0; k < patch->vertex_count; k++) {
         const vertex_share *s = &share[patch->vertex[k]];
         lo = fmin(lo, s->share);
         hi = fmax(hi, s->share);
+        open_lo = fmin(open_lo, s->open);
+        open_hi = fmax(open_hi, s->open);
         none |= s->sees == SEES_NONE;
         part |= s->sees == SEES_PART;
         all |= s->sees == SEES_ALL;
     }
-    return (all && (none || part)) || (none && part) || hi - lo > LIGHT_REFINE_SHARE;
+    if ((all && (none || part)) || (none && part) || hi - lo > LIGHT_REFINE_SHARE)
+        return 1;
+    return open_hi - open_lo > LIGHT_REFINE_OPEN ? 2 : 0;
 }
 
 /* The midpoint vertex of edge (a, b), made once per edge (open addressing on the key). */
@@ -271,9 +299,10 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
                         rad_error *error)
 {
     *out = (light_refined){0};
-    /* at most as many patches again, and under a memory budget what a quarter of what is
-     * left holds */
-    size_t budget = mesh->patch_count;
+    /* at most as many patches again for the emitters' light, and half as many for the
+     * creases (or what the shadows left), and under a memory budget what a quarter of what
+     * is left holds */
+    size_t budget = (size_t)mesh->patch_count + mesh->patch_count / LIGHT_REFINE_CREASE_PART;
     uint64_t left = rad_memory_budget_left();
     if (left != UINT64_MAX && left / 4 / LIGHT_REFINE_BYTES_PER_PATCH < budget)
         budget = (size_t)(left / 4 / LIGHT_REFINE_BYTES_PER_PATCH);
@@ -301,12 +330,16 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
     }
     for (uint32_t p = 0; p < mesh->patch_count; p++)
         parent[p] = p;
-    refine_state st = {scene, &set, occluders, vertex_radiance_leave(mesh), threads};
+    refine_state st = {scene, &set, occluders, vertex_radiance_leave(mesh), threads, 0};
     /* no piece's edge shorter than the default mesh's (the dense solvers' patch size,
      * split by the shadow refinement's default levels) split LIGHT_REFINE_LEVELS times:
      * a mesh already that fine (the hierarchical solver's) is left as it is */
-    const double smallest = 0.99 * rad_default_patch_size(scene, RAD_SOLVER_AUTO) /
-                            (1u << (RAD_SHADOW_LEVELS_DEFAULT + LIGHT_REFINE_LEVELS));
+    const double patch_size = rad_default_patch_size(scene, RAD_SOLVER_AUTO);
+    const double smallest =
+        0.99 * patch_size / (1u << (RAD_SHADOW_LEVELS_DEFAULT + LIGHT_REFINE_LEVELS));
+    st.reach = LIGHT_REFINE_REACH * patch_size;
+    /* the emitters' light first */
+    size_t shadow_budget = mesh->patch_count;
     if (!(smallest > 0)) { /* 0: out of memory for the mesh plan */
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light's finer mesh");
         goto done;
@@ -327,14 +360,26 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
         }
         measured = at->vertex_count;
         uint32_t splits = 0;
+        /* the patches the emitters' light bends in first, then those at creases */
         for (uint32_t p = 0; p < at->patch_count; p++) {
             const rad_patch *patch = &at->patches[p];
-            split[p] = patch->twin == 0 && budget >= 3 &&
-                       longest_edge(patch, at->vertices) >= 2 * smallest && bends(patch, share);
-            if (split[p]) {
+            int reason = patch->twin == 0 && longest_edge(patch, at->vertices) >= 2 * smallest
+                             ? bends(patch, share)
+                             : 0;
+            split[p] = reason == 1 && shadow_budget >= 3 && budget >= 3 ? 1 : reason ? 2 : 0;
+            if (split[p] == 1) {
                 splits++;
                 budget -= 3;
+                shadow_budget -= 3;
             }
+        }
+        for (uint32_t p = 0; p < at->patch_count; p++) {
+            if (split[p] == 2 && budget >= 3) {
+                split[p] = 1;
+                splits++;
+                budget -= 3;
+            } else if (split[p] == 2)
+                split[p] = 0;
         }
         if (splits == 0)
             break;
