@@ -81,6 +81,34 @@ static void ceiling_ring(const rad_image *image, const rad_image *reference, dou
     *rms = count ? sqrt(squares / count) : 0;
 }
 
+/* The foot of the tall block's front face (image columns 41-60 at 128 x 128): in each
+ * column the face's last two pixels above the floor (the lowest of rows 101-115 where the
+ * reference's luminance is below 0.07: the face is 0.05-0.066 there, the floor from 0.075
+ * up); their relative error's mean and RMS. The face sees mostly the floor at the block's
+ * foot, which the solution's patches smear with the part under the block: gathered from
+ * them alone it came out 9 % dark (RMS 10.7 %). */
+static void block_foot(const rad_image *image, const rad_image *reference, double *mean,
+                       double *rms)
+{
+    double sum = 0, squares = 0;
+    int count = 0;
+    for (uint32_t x = 41; x <= 60; x++) {
+        uint32_t y = 115;
+        while (y > 100 && !(luminance_at(reference, x, y) < 0.07))
+            y--;
+        CHECK(y > 100);
+        for (uint32_t row = y - 1; row <= y; row++) {
+            double ref = luminance_at(reference, x, row);
+            double d = (luminance_at(image, x, row) - ref) / ref;
+            sum += d;
+            squares += d * d;
+            count++;
+        }
+    }
+    *mean = sum / count;
+    *rms = sqrt(squares / count);
+}
+
 static void test_cornell(void)
 {
     rad_image *reference = NULL;
@@ -120,9 +148,14 @@ static void test_cornell(void)
      * meets the blocks' 1 %, not the pixels'. From seed to seed the renders' blocks move by
      * a few tenths of a percent (the gather's noise at the vertices, the light's rim).
      * 2026-12-03, the lamp's back counting for buried vertices and the rim found by the
-     * surfaces met: the same 0.0080 / 0.0114 (0.0141 / 0.0114 with the first alone). */
+     * surfaces met: the same 0.0080 / 0.0114 (0.0141 / 0.0114 with the first alone).
+     * The light's finer mesh split at creases too: 0.0074 / 0.0111. 2026-12-03, the
+     * vertices' gather corrected by a second one that meets the light just computed at the
+     * vertices instead of the patches' means (vertex_radiance.h): 0.0061 / 0.0088 at the
+     * vertices, 0.0061 / 0.0111 per pixel: the issue's 1 % / 1 % at 128 x 128. */
     CHECK(classic.block_relative_rmse < 0.030 && classic.pixel_relative_rmse < 0.033);
-    CHECK(vertex.block_relative_rmse < 0.009 && vertex.pixel_relative_rmse < 0.0125);
+    CHECK(vertex.block_relative_rmse < 0.0075 && vertex.pixel_relative_rmse < 0.010);
+    CHECK(per_pixel.block_relative_rmse < 0.0075 && per_pixel.pixel_relative_rmse < 0.0125);
     CHECK(vertex.block_relative_rmse < 0.6 * classic.block_relative_rmse);
     /* the ceiling around the light: a vertex in the gap above the lamp's back, left dark,
      * darkened it by interpolation (a ring down to -51 % at 256 x 256); now such a vertex
@@ -135,6 +168,13 @@ static void test_cornell(void)
            "%.2f %%\n",
            100 * ring_mean, 100 * ring_rms);
     CHECK(fabs(ring_mean) < 0.02 && ring_rms < 0.045);
+    /* the tall block's foot: -2.4 % / 2.7 % measured with the second gather (the CLI's
+     * mesh, seed 1), -9.1 % / 10.7 % without */
+    double foot_mean, foot_rms;
+    block_foot(v, reference, &foot_mean, &foot_rms);
+    printf("  the tall block's face at its foot, at the vertices: mean %+.2f %%, RMS %.2f %%\n",
+           100 * foot_mean, 100 * foot_rms);
+    CHECK(fabs(foot_mean) < 0.04 && foot_rms < 0.05);
     CHECK(vertex.pixel_relative_rmse < 0.7 * classic.pixel_relative_rmse);
     CHECK_NEAR(vertex.mean_a.g, vertex.mean_b.g, 0.01);
     /* the mean radiance agrees within the reference's noise and the mesh's bias */

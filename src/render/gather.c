@@ -23,7 +23,7 @@ rad_rgb gather_seen(const gather_view *view, const rad_ray *ray, const rad_hit *
                                rgb_scale(view->reflected[v[2]], w)));
     }
     uint32_t twin = view->mesh->patches[view->patch_of[hit->triangle]].twin;
-    if (!twin)
+    if (!twin || !view->B)
         return (rad_rgb){0, 0, 0};
     return rgb_scale(rgb_max0(rgb_add(view->B[twin - 1], rgb_scale(view->exitance[twin - 1], -1))),
                      1 / RAD_PI);

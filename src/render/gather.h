@@ -3,7 +3,8 @@
  * the surfaces reflect, (B - E) / pi interpolated at the hit from the display vertices
  * (emission left out: the gathering point takes the emitters' direct light its own way),
  * the twin's value on the back of a two-sided patch, and the sky where the ray leaves the
- * scene. Used by the gather at the mesh's vertices (vertex_light.c). It does not trace: the caller traces its
+ * scene. A view of a change of that light (a correction: vertex_radiance.c) has B NULL and
+ * lights NULL: only `reflected` changed, so the twins' backs and the sky meet nothing. Used by the gather at the mesh's vertices (vertex_light.c). It does not trace: the caller traces its
  * rays in batches against `tracer`.
  */
 #ifndef RAD_RENDER_GATHER_H
@@ -17,7 +18,7 @@ typedef struct gather_view {
     const uint32_t (*triangles)[3]; /* the display triangles, into display vertices */
     const uint32_t *patch_of;       /* display triangle -> patch */
     const rad_rgb *reflected;       /* per display vertex: (B - E) / pi */
-    const rad_rgb *B;               /* per patch */
+    const rad_rgb *B;               /* per patch (NULL: the twins' backs meet nothing) */
     const rad_rgb *exitance;        /* per patch: E, as the solve used it */
     const light_set *lights;        /* NULL: no sky */
     const rad_tracer *tracer;       /* the display's front triangles */

@@ -585,10 +585,11 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B, const rad_
             .emitters = &emitters,
             .scene_tracer = scene_tracer,
             .view = &view,
-            .sharp = NULL, /* each hit adds them */
+            .sharp = lights_ptr && lights.sharp_count > 0 ? lights_ptr : NULL,
+            .sharp_at_hits = true, /* each hit adds them */
             .hidden = hidden,
             .leave = leave,
-            .gathered_only = direct_light == RAD_DIRECT_PIXEL,
+            .emitters_at_hits = direct_light == RAD_DIRECT_PIXEL,
             .seed = options->seed,
             .threads = threads,
             .over_ranks = ranks_count() > 1, /* rad_render is collective */

@@ -18,12 +18,11 @@
 
 #define VERTEX_EMITTER_SAMPLES 1024u /* light samples per vertex */
 #define VERTEX_COSINE_RAYS 512u     /* their MIS partners: cosine rays toward the emitters */
-#define VERTEX_GATHER_RAYS 1024u    /* final-gather rays per vertex */
 #define VERTEX_RANK_CHUNK 64u       /* over ranks: vertices dealt out in turn, this many at
                                        a time */
-/* Over ranks, what each vertex's light is shared as: direct, gathered (3 doubles each) and
- * whether it is buried. */
-#define VERTEX_SHARED_DOUBLES 7u
+/* Over ranks, what each vertex's light is shared as: direct, sharp, gathered (3 doubles
+ * each) and whether it is buried. */
+#define VERTEX_SHARED_DOUBLES 10u
 
 /* The rank (of `ranks`) that lights vertex v. */
 static uint32_t vertex_rank(uint32_t v, uint32_t ranks)
@@ -31,11 +30,11 @@ static uint32_t vertex_rank(uint32_t v, uint32_t ranks)
     return (v / VERTEX_RANK_CHUNK) % ranks;
 }
 
-/* Over ranks: every rank's vertices' direct, gathered and buried to every rank (each rank
- * filled its own; `lit` false: it could not). False, on every rank, when any could not or
- * ran out of memory here. Collective. */
-static bool share_vertices(uint32_t n, bool lit, rad_rgb *direct, rad_rgb *gathered,
-                           uint32_t *buried)
+/* Over ranks: every rank's vertices' direct, sharp, gathered and buried to every rank
+ * (each rank filled its own; `lit` false: it could not). False, on every rank, when any
+ * could not or ran out of memory here. Collective. */
+static bool share_vertices(uint32_t n, bool lit, rad_rgb *direct, rad_rgb *sharp,
+                           rad_rgb *gathered, uint32_t *buried)
 {
     const uint32_t ranks = (uint32_t)ranks_count(), rank = (uint32_t)ranks_rank();
     uint64_t *counts = rad_alloc_array(ranks, sizeof(*counts));
@@ -57,9 +56,12 @@ static bool share_vertices(uint32_t n, bool lit, rad_rgb *direct, rad_rgb *gathe
     for (uint32_t v = 0; v < n; v++)
         if (vertex_rank(v, ranks) == rank) {
             double *d = &mine[at];
-            d[0] = direct[v].r, d[1] = direct[v].g, d[2] = direct[v].b;
-            d[3] = gathered[v].r, d[4] = gathered[v].g, d[5] = gathered[v].b;
-            d[6] = buried[v];
+            const rad_rgb none = {0, 0, 0}, a = direct ? direct[v] : none,
+                          b = sharp ? sharp[v] : none;
+            d[0] = a.r, d[1] = a.g, d[2] = a.b;
+            d[3] = b.r, d[4] = b.g, d[5] = b.b;
+            d[6] = gathered[v].r, d[7] = gathered[v].g, d[8] = gathered[v].b;
+            d[9] = buried[v];
             at += VERTEX_SHARED_DOUBLES;
         }
     ranks_share_parts(mine, all, counts);
@@ -72,15 +74,19 @@ static bool share_vertices(uint32_t n, bool lit, rad_rgb *direct, rad_rgb *gathe
     for (uint32_t v = 0; v < n; v++) {
         const double *d = &all[counts[vertex_rank(v, ranks)]];
         counts[vertex_rank(v, ranks)] += VERTEX_SHARED_DOUBLES;
-        direct[v] = (rad_rgb){d[0], d[1], d[2]};
-        gathered[v] = (rad_rgb){d[3], d[4], d[5]};
-        buried[v] = (uint32_t)d[6];
+        if (direct)
+            direct[v] = (rad_rgb){d[0], d[1], d[2]};
+        if (sharp)
+            sharp[v] = (rad_rgb){d[3], d[4], d[5]};
+        gathered[v] = (rad_rgb){d[6], d[7], d[8]};
+        buried[v] = (uint32_t)d[9];
     }
     free(counts);
     free(mine);
     free(all);
     return true;
 }
+
 #define VERTEX_STREAM 0xE3177E3ull
 void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *frame)
 {
@@ -102,6 +108,17 @@ void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *fr
     }
 }
 
+/* Vertex v's three values (direct and sharp: where asked for). */
+static void vertex_light_set(rad_rgb *direct, rad_rgb *sharp, rad_rgb *gathered, uint32_t v,
+                             rad_rgb d, rad_rgb s, rad_rgb g)
+{
+    if (direct)
+        direct[v] = d;
+    if (sharp)
+        sharp[v] = s;
+    gathered[v] = g;
+}
+
 /* A vertex whose point lies inside a closed object (a floor patch that runs under a box
  * standing on it: most of its gather rays meet the backs of the box's one-sided faces)
  * has no light of its own, yet its patch shows outside the box; interpolating its zero
@@ -117,7 +134,8 @@ void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *fr
  * of the reference; counting it, block / pixel 1.164 % / 1.351 % -> 1.143 % / 1.345 %
  * against a 16384-spp 256 x 256 reference, the ring's rows within 4 %. */
 static void buried_from_neighbours(const rad_mesh *mesh, const uint8_t *hidden,
-                                   uint32_t *buried, rad_rgb *direct, rad_rgb *gathered)
+                                   uint32_t *buried, rad_rgb *direct, rad_rgb *sharp,
+                                   rad_rgb *gathered)
 {
     /* buried[v]: 0 open, 1 buried with no open neighbour yet, 1 + m with m of them */
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
@@ -131,8 +149,12 @@ static void buried_from_neighbours(const rad_mesh *mesh, const uint8_t *hidden,
                 if (buried[u])
                     continue;
                 if (buried[v] == 1) /* its first open neighbour: the mean starts */
-                    direct[v] = gathered[v] = (rad_rgb){0, 0, 0};
-                rgb_add_to(&direct[v], direct[u]);
+                    vertex_light_set(direct, sharp, gathered, v, (rad_rgb){0, 0, 0},
+                                     (rad_rgb){0, 0, 0}, (rad_rgb){0, 0, 0});
+                if (direct)
+                    rgb_add_to(&direct[v], direct[u]);
+                if (sharp)
+                    rgb_add_to(&sharp[v], sharp[u]);
                 rgb_add_to(&gathered[v], gathered[u]);
                 buried[v]++;
             }
@@ -141,28 +163,39 @@ static void buried_from_neighbours(const rad_mesh *mesh, const uint8_t *hidden,
     for (uint32_t v = 0; v < mesh->vertex_count; v++)
         if (buried[v] > 1) {
             double count = buried[v] - 1;
-            direct[v] = rgb_scale(direct[v], 1 / count);
+            if (direct)
+                direct[v] = rgb_scale(direct[v], 1 / count);
+            if (sharp)
+                sharp[v] = rgb_scale(sharp[v], 1 / count);
             gathered[v] = rgb_scale(gathered[v], 1 / count);
         }
 }
 
-rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const rad_mesh *mesh,
-                        const rad_tracer *occluders, const gather_view *view,
-                        const light_set *sharp, const uint8_t *hidden, double leave,
-                        uint64_t seed, int threads, bool over_ranks, rad_rgb *direct,
+rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *sharp,
                         rad_rgb *gathered, rad_error *error)
 {
+    const rad_mesh *mesh = job->mesh;
+    const emitter_set *set = job->emitters;
+    const rad_scene *scene = job->scene;
+    const gather_view *view = job->view;
+    const light_set *sources = job->sharp;
+    const int threads = job->threads;
     uint32_t n = mesh->vertex_count;
-    const uint32_t ranks = over_ranks ? (uint32_t)ranks_count() : 1;
+    const uint32_t ranks = job->over_ranks ? (uint32_t)ranks_count() : 1;
     const uint32_t rank = ranks > 1 ? (uint32_t)ranks_rank() : 0;
+    const rad_rgb zero = {0, 0, 0};
     for (uint32_t v = 0; v < n; v++)
-        direct[v] = gathered[v] = (rad_rgb){0, 0, 0};
-    const bool exact = emitter_unshadowed_exact(set, scene);
-    if (n == 0) /* (the same on every rank) */
-        return RAD_OK;
-    const uint32_t sharp_rays = sharp ? light_set_capacity(sharp, LIGHTS_SHARP, 0) : 0;
-    const uint32_t samples = VERTEX_EMITTER_SAMPLES, gather = VERTEX_GATHER_RAYS;
-    const uint32_t capacity = samples > sharp_rays ? samples : sharp_rays; /* shadow rays */
+        vertex_light_set(direct, sharp, gathered, v, zero, zero, zero);
+    if (n == 0 || job->gather_rays == 0) { /* (the same on every rank) */
+        return n == 0 ? RAD_OK
+                      : rad_fail(error, RAD_ERR_INVALID, "the light at the vertices: no gather rays");
+    }
+    const bool exact = set->count > 0 && emitter_unshadowed_exact(set, scene);
+    const uint32_t sharp_rays = sources ? light_set_capacity(sources, LIGHTS_SHARP, 0) : 0;
+    const uint32_t samples = set->count > 0 ? VERTEX_EMITTER_SAMPLES : 0;
+    const uint32_t gather = job->gather_rays;
+    uint32_t capacity = samples > sharp_rays ? samples : sharp_rays; /* shadow rays */
+    capacity = capacity ? capacity : 1;
     const uint32_t cosines_per_vertex =
         VERTEX_COSINE_RAYS > gather ? VERTEX_COSINE_RAYS : gather;
     vertex_frame *frame = rad_alloc_array(n, sizeof(*frame));
@@ -173,10 +206,10 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
                                            sizeof(*cosine_rays));
     rad_hit *hits = rad_alloc_array((size_t)threads * cosines_per_vertex, sizeof(*hits));
     double *cosines = rad_alloc_array((size_t)threads * cosines_per_vertex, sizeof(*cosines));
-    uint32_t *buried = rad_alloc_array(n, sizeof(*buried));
+    uint32_t *buried = rad_alloc_array(n ? n : 1, sizeof(*buried));
     bool ok = frame && rays && values && blocked && cosine_rays && hits && cosines && buried;
     if (ok) {
-        vertex_frames(mesh, hidden, frame);
+        vertex_frames(mesh, job->hidden, frame);
         for (uint32_t v = 0; v < n; v++)
             buried[v] = 0;
 #pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
@@ -191,22 +224,22 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
             rad_ray *cosine = &cosine_rays[(size_t)thread * cosines_per_vertex];
             rad_hit *hit = &hits[(size_t)thread * cosines_per_vertex];
             double *cos_x = &cosines[(size_t)thread * cosines_per_vertex];
-            rad_rng rng = rad_rng_seed(seed ^ VERTEX_STREAM, (uint64_t)v, 0);
+            rad_rng rng = rad_rng_seed(job->seed ^ VERTEX_STREAM, (uint64_t)v, 0);
             double turn = rad_rng_uniform(&rng), shift1 = rad_rng_uniform(&rng),
                    shift2 = rad_rng_uniform(&rng);
             rad_vec3 nv = v3_normalize(f->normal);
             /* inside the vertex's patches (toward their mean centre): at a contact or a
              * crease the point is on the open side, as the patches are */
             rad_vec3 x = v3_add(mesh->vertices[v], v3_scale(f->inward, VERTEX_INWARD / f->weight));
-            double off = 2 * f->bulge + leave;
+            double off = 2 * f->bulge + job->leave;
             rad_rgb sum = {0, 0, 0};
-            if (set->count > 0 && exact) {
+            if (exact) {
                 /* the unshadowed light exactly, times the share of the samples' that gets
                  * through */
                 uint32_t count = emitter_light_rays_by_triangle(
                     set, scene, x, nv, off, samples, turn, shift1, shift2, 0, light, value);
                 emitter_to_unshadowed(set, scene, x, nv, value, count);
-                rad_tracer_occluded(occluders, light, count, shadowed);
+                rad_tracer_occluded(job->occluders, light, count, shadowed);
                 for (uint32_t k = 0; k < count; k++)
                     if (!shadowed[k])
                         rgb_add_to(&sum, value[k]);
@@ -215,8 +248,8 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
                 uint32_t count = emitter_light_rays_by_triangle(
                     set, scene, x, nv, off, samples, turn, shift1, shift2, share, light, value);
                 emitter_cosine_rays(x, nv, off, VERTEX_COSINE_RAYS, &rng, cosine, cos_x);
-                rad_tracer_occluded(occluders, light, count, shadowed);
-                rad_tracer_intersect(occluders, cosine, VERTEX_COSINE_RAYS, hit);
+                rad_tracer_occluded(job->occluders, light, count, shadowed);
+                rad_tracer_intersect(job->occluders, cosine, VERTEX_COSINE_RAYS, hit);
                 for (uint32_t k = 0; k < count; k++)
                     if (!shadowed[k])
                         rgb_add_to(&sum, value[k]);
@@ -225,15 +258,19 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
                                                                    cos_x[k], VERTEX_COSINE_RAYS,
                                                                    1 / share));
             }
-            if (sharp_rays > 0) { /* after the emitters' random numbers: theirs unchanged */
-                uint32_t count = light_set_rays(sharp, LIGHTS_SHARP, x, nv, off, 0, 1, 0, &rng,
-                                                light, value);
-                rad_tracer_occluded(occluders, light, count, shadowed);
+            if (direct)
+                direct[v] = sum;
+            /* the sharp sources after the emitters' random numbers: theirs unchanged */
+            if (sharp_rays > 0 && sharp) {
+                uint32_t count = light_set_rays(sources, LIGHTS_SHARP, x, nv, off, 0, 1, 0,
+                                                &rng, light, value);
+                rad_tracer_occluded(job->occluders, light, count, shadowed);
+                rad_rgb lit = {0, 0, 0};
                 for (uint32_t k = 0; k < count; k++)
                     if (!shadowed[k])
-                        rgb_add_to(&sum, value[k]);
+                        rgb_add_to(&lit, value[k]);
+                sharp[v] = lit;
             }
-            direct[v] = sum;
 
             /* the gather: E = pi / N x the sum of the radiance met by N cosine rays */
             emitter_cosine_rays(x, nv, off, gather, &rng, cosine, cos_x);
@@ -250,9 +287,9 @@ rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const ra
         }
     }
     if (ranks > 1) /* every rank, whether its buffers were had or not */
-        ok = share_vertices(n, ok, direct, gathered, buried);
+        ok = share_vertices(n, ok, direct, sharp, gathered, buried);
     if (ok)
-        buried_from_neighbours(mesh, hidden, buried, direct, gathered);
+        buried_from_neighbours(mesh, job->hidden, buried, direct, sharp, gathered);
     free(frame);
     free(buried);
     free(rays);

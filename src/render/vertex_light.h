@@ -40,18 +40,36 @@ typedef struct vertex_frame {
 /* frame[v] for the mesh's vertices, patches marked in `hidden` (NULL: none) left out. */
 void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *frame);
 
+/* What vertex_light computes and with what. */
+typedef struct vertex_light_job {
+    const emitter_set *emitters; /* their direct light, traced against `occluders` (the
+                                    scene's triangles); empty: none */
+    const light_set *sharp;      /* NULL, or the sharp sources (point, spot, luminaire,
+                                    sun: one shadow ray each) */
+    const rad_scene *scene;
+    const rad_mesh *mesh;
+    const rad_tracer *occluders;
+    const gather_view *view;     /* what the gather rays meet */
+    uint32_t gather_rays;        /* per vertex: VERTEX_GATHER_RAYS, or fewer for a
+                                    correction (a view of a change: gather.h) */
+    const uint8_t *hidden;       /* patches no one sees (NULL: none) */
+    double leave;                /* how far rays start off a surface */
+    uint64_t seed;
+    int threads;
+    bool over_ranks; /* with several MPI ranks, collective: each rank lights its share of
+                        the vertices (chunks of VERTEX_RANK_CHUNK dealt out in turn) and
+                        every rank gets every vertex's light, bitwise the serial values;
+                        every rank returns the same status */
+} vertex_light_job;
+
+/* Final-gather rays per vertex (the first gather, from the solution's patches). */
+#define VERTEX_GATHER_RAYS 1024u
+
 /* Per mesh vertex v (mesh->vertex_count values): direct[v], the emitters' direct
- * irradiance (traced against `occluders`, the scene's triangles), plus with `sharp` the
- * sharp sources' (point, spot, luminaire, sun: one shadow ray each), and gathered[v], the
- * irradiance the solution's reflected light brings (`view`). A vertex of hidden patches
- * alone gets 0. Deterministic per seed for any thread count. With `over_ranks` (and
- * several MPI ranks) collective: each rank lights its share of the vertices (chunks of
- * VERTEX_RANK_CHUNK dealt out in turn) and every rank gets every vertex's light, bitwise
- * the serial values; every rank returns the same status. */
-rad_status vertex_light(const emitter_set *set, const rad_scene *scene, const rad_mesh *mesh,
-                        const rad_tracer *occluders, const gather_view *view,
-                        const light_set *sharp, const uint8_t *hidden, double leave,
-                        uint64_t seed, int threads, bool over_ranks, rad_rgb *direct,
+ * irradiance, sharp[v] the sharp sources', and gathered[v], the irradiance the view's
+ * reflected light brings. direct and sharp may be NULL: not asked for (nor traced). A vertex of hidden patches alone gets
+ * 0. Deterministic per seed for any thread and rank count. */
+rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *sharp,
                         rad_rgb *gathered, rad_error *error);
 
 #endif

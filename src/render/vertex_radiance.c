@@ -6,6 +6,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "core/alloc.h"
 #include "core/error.h"
@@ -14,6 +15,9 @@
 #include "core/vec3.h"
 #include "parallel/ranks.h"
 #include "render/vertex_light.h"
+
+#define CORRECTION_RAYS 128u                /* the second gather's rays per vertex */
+#define CORRECTION_STREAM 0xC0EEEC7ull      /* keeps its random numbers apart */
 
 bool vertex_radiance_applies(const rad_scene *scene)
 {
@@ -47,60 +51,141 @@ bool vertex_radiance_reflected(const rad_mesh *mesh, const display_mesh *display
     return made;
 }
 
+/* The second gather (vertex_radiance.h): gathered[v] += what the change from the view's
+ * reflected light to f_rho (direct + sharp + gathered) at the vertices brings. Collective
+ * over ranks with job->over_ranks. */
+static rad_status gather_correction(const vertex_radiance_job *job, const rad_rgb *direct,
+                                    const rad_rgb *sharp, rad_rgb *gathered,
+                                    rad_error *error)
+{
+    const rad_mesh *mesh = job->mesh;
+    const display_mesh *display = job->display;
+    size_t vertices = display->vertex_count ? display->vertex_count : 1;
+    rad_rgb *change = rad_alloc_array(vertices, sizeof(*change));
+    rad_rgb *added = rad_alloc_array(vertices, sizeof(*added));
+    rad_status status = RAD_OK;
+    if (!change || !added ||
+        !display_mesh_radiance_weighted(mesh, NULL, job->inputs->albedo, job->hidden, change))
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light at the vertices");
+    if (job->over_ranks) /* every rank goes on to the (collective) gather, or none */
+        status = ranks_agree(status, "render", error);
+    if (status == RAD_OK) {
+        for (uint32_t v = 0; v < mesh->vertex_count; v++) /* rho / pi x H, then the change */
+            change[v] = rgb_mul(change[v], rgb_add(rgb_add(direct[v], sharp[v]), gathered[v]));
+        display_mesh_constrain(mesh, display, change);
+        for (uint32_t v = 0; v < display->vertex_count; v++)
+            change[v] = rgb_add(change[v], rgb_scale(job->view->reflected[v], -1));
+        gather_view view = *job->view;
+        view.reflected = change;
+        view.B = NULL;      /* the twins' backs: unchanged */
+        view.lights = NULL; /* the sky: unchanged */
+        const emitter_set none = {0};
+        vertex_light_job light = {
+            .emitters = &none,
+            .scene = job->scene,
+            .mesh = mesh,
+            .occluders = job->scene_tracer,
+            .view = &view,
+            .gather_rays = CORRECTION_RAYS,
+            .hidden = job->hidden,
+            .leave = job->leave,
+            .seed = job->seed ^ CORRECTION_STREAM,
+            .threads = job->threads,
+            .over_ranks = job->over_ranks,
+        };
+        status = vertex_light(&light, NULL, NULL, added, error);
+    }
+    if (status == RAD_OK)
+        for (uint32_t v = 0; v < mesh->vertex_count; v++)
+            rgb_add_to(&gathered[v], added[v]);
+    free(change);
+    free(added);
+    return status;
+}
+
 rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
                            rad_rgb *irradiance, rad_error *error)
 {
     const rad_mesh *mesh = job->mesh;
     const display_mesh *display = job->display;
-    uint32_t n = mesh->patch_count ? mesh->patch_count : 1;
     size_t vertices = display->vertex_count ? display->vertex_count : 1;
+    /* the light first, then what the vertices show: the fewest arrays held at a time */
+    rad_rgb *direct = rad_alloc_array(vertices, sizeof(*direct));
+    rad_rgb *sharp = rad_alloc_array(vertices, sizeof(*sharp));
+    rad_rgb *incident = rad_alloc_array(vertices, sizeof(*incident));
+    rad_rgb *vertex_factor = NULL, *vertex_emission = NULL;
+    rad_status status = RAD_OK;
+    if (!direct || !sharp || !incident)
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light at the vertices");
+    if (job->over_ranks) /* every rank goes on to the (collective) light, or none */
+        status = ranks_agree(status, "render", error);
+    if (status != RAD_OK)
+        goto done;
+    vertex_light_job light = {
+        .emitters = job->emitters,
+        .sharp = job->sharp,
+        .scene = job->scene,
+        .mesh = mesh,
+        .occluders = job->scene_tracer,
+        .view = job->view,
+        .gather_rays = VERTEX_GATHER_RAYS,
+        .hidden = job->hidden,
+        .leave = job->leave,
+        .seed = job->seed,
+        .threads = job->threads,
+        .over_ranks = job->over_ranks,
+    };
+    status = vertex_light(&light, direct, sharp, incident, error);
+    if (status == RAD_OK)
+        status = gather_correction(job, direct, sharp, incident, error);
+    if (status != RAD_OK)
+        goto done;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++) { /* gathered, then the rest */
+        if (!job->emitters_at_hits)
+            rgb_add_to(&incident[v], direct[v]);
+        if (!job->sharp_at_hits)
+            rgb_add_to(&incident[v], sharp[v]);
+    }
+    free(direct);
+    free(sharp);
+    direct = sharp = NULL;
+
+    /* per patch, what multiplies the incident light and what is added: rho / pi and E / pi,
+     * or 1 / pi and 0 where the vertex holds irradiance; at the vertices their means */
+    uint32_t n = mesh->patch_count ? mesh->patch_count : 1;
     rad_rgb *factor = rad_alloc_array(n, sizeof(*factor));
     rad_rgb *emission = rad_alloc_array(n, sizeof(*emission));
-    rad_rgb *vertex_factor = rad_alloc_array(vertices, sizeof(*vertex_factor));
-    rad_rgb *vertex_emission = rad_alloc_array(vertices, sizeof(*vertex_emission));
-    rad_rgb *direct = rad_alloc_array(vertices, sizeof(*direct));
-    rad_rgb *gathered = rad_alloc_array(vertices, sizeof(*gathered));
-    rad_status status = RAD_OK;
-    if (!factor || !emission || !vertex_factor || !vertex_emission || !direct || !gathered) {
-        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light at the vertices");
-        goto agree;
-    }
-    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+    vertex_factor = rad_alloc_array(vertices, sizeof(*vertex_factor));
+    vertex_emission = rad_alloc_array(vertices, sizeof(*vertex_emission));
+    bool made = factor && emission && vertex_factor && vertex_emission;
+    for (uint32_t p = 0; made && p < mesh->patch_count; p++) {
         bool holds_irradiance =
             job->irradiance || patch_material_textured(job->lookup, mesh->patches[p].material);
         factor[p] = holds_irradiance ? (rad_rgb){1, 1, 1} : job->inputs->albedo[p];
         emission[p] = holds_irradiance ? (rad_rgb){0, 0, 0} : job->inputs->exitance[p];
     }
-    if (!display_mesh_radiance_weighted(mesh, NULL, factor, job->hidden, vertex_factor) ||
-        !display_mesh_radiance_weighted(mesh, NULL, emission, job->hidden, vertex_emission))
-        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light at the vertices");
-agree: /* over ranks every rank goes on to the (collective) light at the vertices, or none */
-    if (job->over_ranks)
-        status = ranks_agree(status, "render", error);
-    if (status != RAD_OK)
-        goto done;
-    const emitter_set none = {0};
-    status = vertex_light(job->gathered_only ? &none : job->emitters, job->scene, mesh,
-                          job->scene_tracer, job->view, job->sharp, job->hidden, job->leave,
-                          job->seed, job->threads, job->over_ranks, direct, gathered, error);
-    if (status != RAD_OK)
-        goto done;
-    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
-        rad_rgb incident = rgb_add(direct[v], gathered[v]);
-        radiance[v] = rgb_add(vertex_emission[v], rgb_mul(vertex_factor[v], incident));
-        if (irradiance)
-            irradiance[v] = incident;
-    }
-    display_mesh_constrain(mesh, display, radiance);
-    if (irradiance)
-        display_mesh_constrain(mesh, display, irradiance);
-done:
+    made = made &&
+           display_mesh_radiance_weighted(mesh, NULL, factor, job->hidden, vertex_factor) &&
+           display_mesh_radiance_weighted(mesh, NULL, emission, job->hidden, vertex_emission);
     free(factor);
     free(emission);
+    if (!made) {
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light at the vertices");
+        goto done;
+    }
+    for (uint32_t v = 0; v < mesh->vertex_count; v++)
+        radiance[v] = rgb_add(vertex_emission[v], rgb_mul(vertex_factor[v], incident[v]));
+    display_mesh_constrain(mesh, display, radiance);
+    if (irradiance) {
+        memcpy(irradiance, incident, display->vertex_count * sizeof(*irradiance));
+        display_mesh_constrain(mesh, display, irradiance);
+    }
+done:
+    free(direct);
+    free(sharp);
+    free(incident);
     free(vertex_factor);
     free(vertex_emission);
-    free(direct);
-    free(gathered);
     return status;
 }
 

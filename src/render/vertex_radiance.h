@@ -9,6 +9,17 @@
  * the texel, or an irradiance image); then T-vertices and added vertices are made
  * displayable. The render adds the sharp sources (point, spot, luminaire, sun) at each
  * hit; the lit mesh, which has no hits, adds them at the vertex.
+ *
+ * H_gathered is gathered twice. The first gather meets the solution's patch values,
+ * (B - E) / pi interpolated: next to a contact or in a shadow those are means over patches
+ * that the contact or the shadow edge cuts, so a point near them gathers a smeared field
+ * (the foot of a box's face, which sees mostly the floor at the box's foot, came out 20-30 %
+ * dark). The light just computed at the vertices is that field resolved at the points:
+ * f_rho (H_emitters + H_sharp + H_gathered), f_rho the vertex's mean rho / pi whatever it
+ * shows. A second gather of CORRECTION_RAYS rays meets the change from the first field to
+ * that one and adds it: the same as gathering the new field, as the gather is linear, but
+ * the change is small almost everywhere, so a quarter of the rays carries it without new
+ * noise.
  */
 #ifndef RAD_RENDER_VERTEX_RADIANCE_H
 #define RAD_RENDER_VERTEX_RADIANCE_H
@@ -30,10 +41,13 @@ typedef struct vertex_radiance_job {
     const emitter_set *emitters;
     const rad_tracer *scene_tracer;      /* the scene's triangles */
     const gather_view *view;             /* what the gather rays meet */
-    const light_set *sharp;              /* NULL, or the sharp sources to add at vertices */
+    const light_set *sharp;              /* NULL, or the scene's sharp sources */
+    bool sharp_at_hits;                  /* H_sharp left out: each hit adds its own (it
+                                            still lights the second gather's field) */
     const uint8_t *hidden;               /* patches no one sees */
     double leave;                        /* how far rays start off a surface */
-    bool gathered_only;                  /* H_emitters left out: each pixel adds its own */
+    bool emitters_at_hits;               /* H_emitters left out: each hit adds its own (it
+                                            still lights the second gather's field) */
     uint64_t seed;
     int threads;
     bool over_ranks; /* collective over MPI ranks, each lighting its share of the vertices
