@@ -18,6 +18,14 @@
 
 #define VERTEX_EMITTER_SAMPLES 1024u /* light samples per vertex */
 #define VERTEX_COSINE_RAYS 512u     /* their MIS partners: cosine rays toward the emitters */
+/* With the emitters' unshadowed light exact, a vertex first traces this share of its light
+ * samples (128: each emitting triangle's first Halton points, spread over it); when all
+ * get through or none does, that is the vertex's answer, else it traces all 1024. An
+ * occluder that the first 128 all miss is missed: one narrower than about 1/11 of the
+ * emitter's width. On the Cornell box at 256 x 256 most vertices see the whole light or
+ * none: the render 1.50 -> 1.23 s, its error the same (block / pixel 0.841 / 1.104 % ->
+ * 0.838 / 1.102 % against the 16384-spp reference). */
+#define VERTEX_SHADOW_FIRST 8u
 #define VERTEX_RANK_CHUNK 64u       /* over ranks: vertices dealt out in turn, this many at
                                        a time */
 /* Over ranks, what each vertex's light is shared as: direct, sharp, gathered (3 doubles
@@ -235,11 +243,21 @@ rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *s
             rad_rgb sum = {0, 0, 0};
             if (exact) {
                 /* the unshadowed light exactly, times the share of the samples' that gets
-                 * through */
-                uint32_t count = emitter_light_rays_by_triangle(
-                    set, scene, x, nv, off, samples, turn, shift1, shift2, 0, light, value);
-                emitter_to_unshadowed(set, scene, x, nv, value, count);
-                rad_tracer_occluded(job->occluders, light, count, shadowed);
+                 * through; a first 1/VERTEX_SHADOW_FIRST of them (each triangle's first
+                 * Halton points) all through or all blocked settles it */
+                uint32_t tried = samples / VERTEX_SHADOW_FIRST, count = 0, through = 0;
+                for (int round = 0; round < 2; round++) {
+                    count = emitter_light_rays_by_triangle(set, scene, x, nv, off, tried, turn,
+                                                           shift1, shift2, 0, light, value);
+                    emitter_to_unshadowed(set, scene, x, nv, value, count);
+                    rad_tracer_occluded(job->occluders, light, count, shadowed);
+                    through = 0;
+                    for (uint32_t k = 0; k < count; k++)
+                        through += !shadowed[k];
+                    if (tried == samples || through == 0 || through == count)
+                        break;
+                    tried = samples;
+                }
                 for (uint32_t k = 0; k < count; k++)
                     if (!shadowed[k])
                         rgb_add_to(&sum, value[k]);
