@@ -235,9 +235,11 @@ static void flush_lights(const shading *sh, row_work *w)
 static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3 point,
                          const rad_patch *patch, rad_rgb factor)
 {
-    uint32_t room = (sh->lights ? sh->lights->sharp_count : 0) + sh->emitter_samples;
+    uint32_t room = (sh->lights ? sh->lights->sharp_count : 0) +
+                    (sh->emitters ? sh->emitter_samples : 0);
     if (w->light_count + room > w->light_capacity ||
-        w->cosine_count + sh->emitter_samples > w->cosine_capacity)
+        (sh->emitters && !sh->emitters_exact &&
+         w->cosine_count + sh->emitter_samples > w->cosine_capacity))
         flush_lights(sh, w);
     rad_rng rng = rad_rng_seed(sh->seed ^ LIGHT_STREAM, w->row, slot);
     double leave = 2 * patch->bulge + sh->leave;
