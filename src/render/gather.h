@@ -4,8 +4,9 @@
  * (emission left out: the gathering point takes the emitters' direct light its own way),
  * the twin's value on the back of a two-sided patch, and the sky where the ray leaves the
  * scene. A view of a change of that light (a correction: vertex_radiance.c) has B NULL and
- * lights NULL: only `reflected` changed, so the twins' backs and the sky meet nothing. Used by the gather at the mesh's vertices (vertex_light.c). It does not trace: the caller traces its
- * rays in batches against `tracer`.
+ * lights NULL: only `reflected` changed, so the twins' backs and the sky meet nothing.
+ * Used by the gather at the mesh's vertices (vertex_light.c). It does not trace: the
+ * caller traces its rays in batches against `tracer`.
  */
 #ifndef RAD_RENDER_GATHER_H
 #define RAD_RENDER_GATHER_H

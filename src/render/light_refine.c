@@ -22,6 +22,8 @@
 #include "solve/patch_inputs.h"
 #include "trace/ray.h"
 
+#define OPENNESS_STREAM 0x6F70656Eull /* the openness rays' random numbers, their own */
+
 enum { SEES_NONE, SEES_PART, SEES_ALL };
 
 /* What a mesh being refined knows of each vertex: the share of the emitters' light that
@@ -67,7 +69,7 @@ static bool measure_shares(const refine_state *st, const rad_mesh *mesh, uint32_
             rad_vec3 x = v3_add(mesh->vertices[v], v3_scale(f->inward, VERTEX_INWARD / f->weight));
             double open = 1;
             if (st->reach > 0) {
-                rad_rng rng = rad_rng_seed(0x6f70656eu, (uint64_t)v, 0);
+                rad_rng rng = rad_rng_seed(OPENNESS_STREAM, (uint64_t)v, 0);
                 emitter_cosine_rays(x, nv, 2 * f->bulge + st->leave, LIGHT_REFINE_PROBES, &rng,
                                     &rays[base], &cosines[base]);
                 rad_tracer_intersect(st->occluders, &rays[base], LIGHT_REFINE_PROBES, &hits[base]);

@@ -13,8 +13,8 @@
  * differs (64 cosine rays per vertex, LIGHT_REFINE_OPEN below): next to a crease or a
  * contact the light the surfaces around reflect bends too (the floor in front of a
  * block's foot was 4-34 % too bright over 2-3 pixels at 256 x 256, the ceiling creases
- * 2-3 %, and the ceiling around a lamp hanging just below it darkened). Quads split into four quads at their edges' midpoints and
- * centre, triangles into four; the new corners are tested in turn, `levels` times at most,
+ * 2-3 %, and the ceiling around a lamp hanging just below it darkened). Quads split into
+ * four quads at their edges' midpoints and centre, triangles into four; the new corners are tested in turn, `levels` times at most,
  * and the splits stop at a budget of added patches (and of memory). No piece's edge is
  * made shorter than the dense solvers' default patch size halved by the default shadow
  * levels and then LIGHT_REFINE_LEVELS times: a mesh already that fine is left as it is.

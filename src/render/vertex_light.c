@@ -96,6 +96,7 @@ static bool share_vertices(uint32_t n, bool lit, rad_rgb *direct, rad_rgb *sharp
 }
 
 #define VERTEX_STREAM 0xE3177E3ull
+
 void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *frame)
 {
     for (uint32_t v = 0; v < mesh->vertex_count; v++)
@@ -194,13 +195,15 @@ rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *s
     const rad_rgb zero = {0, 0, 0};
     for (uint32_t v = 0; v < n; v++)
         vertex_light_set(direct, sharp, gathered, v, zero, zero, zero);
-    if (n == 0 || job->gather_rays == 0) { /* (the same on every rank) */
-        return n == 0 ? RAD_OK
-                      : rad_fail(error, RAD_ERR_INVALID, "the light at the vertices: no gather rays");
-    }
-    const bool exact = set->count > 0 && emitter_unshadowed_exact(set, scene);
-    const uint32_t sharp_rays = sources ? light_set_capacity(sources, LIGHTS_SHARP, 0) : 0;
-    const uint32_t samples = set->count > 0 ? VERTEX_EMITTER_SAMPLES : 0;
+    if (n == 0) /* (the same on every rank) */
+        return RAD_OK;
+    if (job->gather_rays == 0)
+        return rad_fail(error, RAD_ERR_INVALID, "the light at the vertices: no gather rays");
+    const bool emitters = set->count > 0 && direct; /* their light asked for */
+    const bool exact = emitters && emitter_unshadowed_exact(set, scene);
+    const uint32_t sharp_rays =
+        sources && sharp ? light_set_capacity(sources, LIGHTS_SHARP, 0) : 0;
+    const uint32_t samples = emitters ? VERTEX_EMITTER_SAMPLES : 0;
     const uint32_t gather = job->gather_rays;
     uint32_t capacity = samples > sharp_rays ? samples : sharp_rays; /* shadow rays */
     capacity = capacity ? capacity : 1;
@@ -261,7 +264,7 @@ rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *s
                 for (uint32_t k = 0; k < count; k++)
                     if (!shadowed[k])
                         rgb_add_to(&sum, value[k]);
-            } else if (set->count > 0) {
+            } else if (emitters) {
                 const double share = (double)VERTEX_COSINE_RAYS / samples;
                 uint32_t count = emitter_light_rays_by_triangle(
                     set, scene, x, nv, off, samples, turn, shift1, shift2, share, light, value);
@@ -279,7 +282,7 @@ rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *s
             if (direct)
                 direct[v] = sum;
             /* the sharp sources after the emitters' random numbers: theirs unchanged */
-            if (sharp_rays > 0 && sharp) {
+            if (sharp_rays > 0) {
                 uint32_t count = light_set_rays(sources, LIGHTS_SHARP, x, nv, off, 0, 1, 0,
                                                 &rng, light, value);
                 rad_tracer_occluded(job->occluders, light, count, shadowed);

@@ -73,8 +73,9 @@ typedef struct vertex_light_job {
 
 /* Per mesh vertex v (mesh->vertex_count values): direct[v], the emitters' direct
  * irradiance, sharp[v] the sharp sources', and gathered[v], the irradiance the view's
- * reflected light brings. direct and sharp may be NULL: not asked for (nor traced). A vertex of hidden patches alone gets
- * 0. Deterministic per seed for any thread and rank count. */
+ * reflected light brings. direct and sharp may be NULL: not asked for, nor traced. A
+ * vertex of hidden patches alone gets 0. Deterministic per seed for any thread and rank
+ * count. */
 rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *sharp,
                         rad_rgb *gathered, rad_error *error);
 
