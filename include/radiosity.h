@@ -1637,6 +1637,13 @@ typedef struct rad_render_options {
 void rad_reconstruct_vertices(const rad_mesh *mesh, const rad_rgb *B,
                               rad_rgb *vertex_radiance);
 
+/* Bytes the light at the vertices needs after a solve, for a memory budget's up-front
+ * check (rad_memory_budget_need): the default render's and lit mesh's per-vertex light on
+ * this mesh (their arrays and the two tracers it builds; the light's finer mesh, which
+ * takes only what is left past these, not counted). 0 when the scene has no emitter and
+ * no light source (nothing is computed at the vertices then). */
+uint64_t rad_vertex_light_bytes(const rad_scene *scene, const rad_mesh *mesh);
+
 /* Renders the mesh lit by the solution B (per patch exitance) through the camera: primary
  * rays hit the patches, radiance is interpolated from vertex values (textured surfaces:
  * options->scene above); back faces of one-sided patches and misses are black (a hit on

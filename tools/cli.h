@@ -475,6 +475,10 @@ typedef struct cli_solve {
     const char *checkpoint_path;    /* --checkpoint (or --resume's file): NULL none */
     const char *resume_path;        /* --resume */
     double checkpoint_interval;     /* --checkpoint-interval, seconds */
+    bool light_at_vertices;         /* set by the command: the light at the vertices follows
+                                       the solve (render, or a lit mesh, not --direct
+                                       solution); with --max-memory, cli_solve_scene checks
+                                       it fits before solving */
 } cli_solve;
 
 /* Parses the SOLVE options (after cli_parse_shared, whose threads, seed, quadrature and

@@ -230,6 +230,22 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
         out->from_file = true;
         goto done;
     }
+    /* the light at the vertices comes after the solve, when the solver's buffers are
+     * freed: it must fit what the scene, mesh and inputs leave, or nothing is solved */
+    if (solve->light_at_vertices && rad_memory_budget()) {
+        status = rad_memory_budget_need(rad_vertex_light_bytes(out->scene, out->mesh),
+                                        "the light at the vertices after the solve (none "
+                                        "with --direct solution)",
+                                        error);
+        if (rad_rank_count() > 1 && rad_ranks_failures(status != RAD_OK) > 0 &&
+            status == RAD_OK) {
+            status = error->status = RAD_ERR_NOMEM;
+            snprintf(error->message, sizeof(error->message),
+                     "--max-memory: the light at the vertices does not fit on another rank");
+        }
+        if (status != RAD_OK)
+            goto done;
+    }
     out->B = rad_alloc_array(out->mesh->patch_count, sizeof(*out->B));
     if (!out->B) {
         status = error->status = RAD_ERR_NOMEM;

@@ -159,6 +159,7 @@ static bool parse_settings(int argc, char **argv, render_settings *s, int *exit_
     }
     if (!cli_parse_solve(&args, &s->shared, &s->solve))
         return false;
+    s->solve.light_at_vertices = s->render.direct_light != RAD_DIRECT_SOLUTION;
     cli_parse_two_sided(&args, OPT_TWO_SIDED, &s->solve.two_sided);
     s->render.threads = s->shared.threads;
     s->render.seed = s->shared.seed;

@@ -302,12 +302,17 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
 {
     *out = (light_refined){0};
     /* at most as many patches again for the emitters' light, and half as many for the
-     * creases (or what the shadows left), and under a memory budget what a quarter of what
-     * is left holds */
+     * creases (or what the shadows left); under a memory budget no more than lets the
+     * whole finer mesh and the light at its vertices (which comes after) fit three
+     * quarters of what is left: the finer mesh is an extra, given up before the light */
     size_t budget = (size_t)mesh->patch_count + mesh->patch_count / LIGHT_REFINE_CREASE_PART;
     uint64_t left = rad_memory_budget_left();
-    if (left != UINT64_MAX && left / 4 / LIGHT_REFINE_BYTES_PER_PATCH < budget)
-        budget = (size_t)(left / 4 / LIGHT_REFINE_BYTES_PER_PATCH);
+    if (left != UINT64_MAX) {
+        uint64_t fit = left / 4 * 3 / (LIGHT_REFINE_BYTES_PER_PATCH + VERTEX_LIGHT_BYTES_PER_PATCH);
+        uint64_t room = fit > mesh->patch_count ? fit - mesh->patch_count : 0;
+        if (room < budget)
+            budget = (size_t)room;
+    }
     if (!scene || !rad_scene_has_emitter(scene) || mesh->patch_count == 0 || budget < 3)
         return RAD_OK;
     emitter_set set = {0};

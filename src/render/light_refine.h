@@ -48,12 +48,14 @@
  * (7483 patches shown), a quarter 1.069 / 1.326 (8419), a half 0.963 / 1.318 (9355), all
  * 0.966 / 1.337 (11224); before the creases 1.143 / 1.345 (7198). */
 #define LIGHT_REFINE_CREASE_PART 2u
-/* What an added patch may cost downstream, an estimate erring high: the piece and its
- * inputs (about 250 bytes), its display triangles, their BVH (2 x 128), the light at its
- * vertices and the buffers around it (about 600), the lit mesh's arrays. With half of what
- * was left at 2048 bytes a patch, a lit mesh of 29,152 patches under --max-memory 40M
- * (test_hierarchical_scaling) went 1.9 MB over the budget. */
-#define LIGHT_REFINE_BYTES_PER_PATCH 4096u
+/* What the finer mesh holds per patch besides the light at its vertices
+ * (VERTEX_LIGHT_BYTES_PER_PATCH): the piece, its inputs and B, where it comes from, the
+ * vertices. Measured (rad_memory_in_use before and after light_refine, 2 threads): 302
+ * bytes a patch of the finer mesh on a furnished room (39985 patches from 29152), 301 on
+ * the Cornell box (9355 from 3742); rounded up. Before the whole finer mesh and the light
+ * after it were counted (an added patch at 4096 bytes against a quarter of what was left),
+ * that room's lit mesh under --max-memory 32M to 38M ran the solve and then failed. */
+#define LIGHT_REFINE_BYTES_PER_PATCH 320u
 
 /* The solution on the finer mesh: mesh (NULL when nothing was split: use the caller's),
  * B and inputs per patch of it, each piece its patch's, and where each piece comes from;
@@ -66,10 +68,11 @@ typedef struct light_refined {
 } light_refined;
 
 /* Refines `mesh` (solution B, patch inputs `inputs`, NULL: built from the scene) for the
- * emitting surfaces of `scene`; adds at most mesh->patch_count patches, and under a
- * memory budget (--max-memory) at most what a quarter of the budget left holds at
- * LIGHT_REFINE_BYTES_PER_PATCH each. Nothing to do (no emitter, no split) leaves
- * out->mesh NULL. */
+ * emitting surfaces of `scene`; adds at most 1.5 x mesh->patch_count patches, and under a
+ * memory budget (--max-memory) no more than lets the finer mesh and the light at its
+ * vertices fit three quarters of the budget left, at LIGHT_REFINE_BYTES_PER_PATCH +
+ * VERTEX_LIGHT_BYTES_PER_PATCH a patch (none when the mesh alone takes that). Nothing to
+ * do (no emitter, no split) leaves out->mesh NULL. */
 rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_rgb *B,
                         const rad_patch_inputs *inputs, int threads, light_refined *out,
                         rad_error *error);

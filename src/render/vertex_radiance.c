@@ -24,6 +24,13 @@ bool vertex_radiance_applies(const rad_scene *scene)
     return scene && (rad_scene_has_emitter(scene) || scene->light_count > 0);
 }
 
+uint64_t rad_vertex_light_bytes(const rad_scene *scene, const rad_mesh *mesh)
+{
+    if (!mesh || !vertex_radiance_applies(scene))
+        return 0;
+    return (uint64_t)VERTEX_LIGHT_BYTES_PER_PATCH * mesh->patch_count;
+}
+
 double vertex_radiance_leave(const rad_mesh *mesh)
 {
     if (mesh->vertex_count == 0)
