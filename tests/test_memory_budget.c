@@ -392,6 +392,9 @@ int main(void)
              "--direct solution) needs %.1f MB, more than the ",
              800.0 * n / 1048576.0);
     expect_refused(arguments, prefix, " left of the budget of 2.0 MB\n");
+    /* the same for solve's lit mesh */
+    expect_refused("solve -o out.ply --patch-size 30 --solver hierarchical --max-memory 2M",
+                   prefix, " left of the budget of 2.0 MB\n");
     /* hierarchical: the trees and the solver's per-thread buffers come first */
     snprintf(arguments, sizeof(arguments),
              "%s --solver hierarchical --direct solution --max-memory 2M", common);

@@ -89,6 +89,7 @@ int command_solve(int argc, char **argv)
         return EXIT_USAGE;
     if (!cli_parse_solve(&args, &shared, &solve))
         return EXIT_USAGE;
+    solve.light_at_vertices = shared.output && write.direct_light == RAD_DIRECT_VERTEX;
     cli_parse_two_sided(&args, OPT_TWO_SIDED, &solve.two_sided);
     if (!cli_solve_outputs_writable(&shared, &solve))
         return EXIT_ERROR;

@@ -14,10 +14,11 @@
  * contact the light the surfaces around reflect bends too (the floor in front of a
  * block's foot was 4-34 % too bright over 2-3 pixels at 256 x 256, the ceiling creases
  * 2-3 %, and the ceiling around a lamp hanging just below it darkened). Quads split into
- * four quads at their edges' midpoints and centre, triangles into four; the new corners are tested in turn, `levels` times at most,
- * and the splits stop at a budget of added patches (and of memory). No piece's edge is
- * made shorter than the dense solvers' default patch size halved by the default shadow
- * levels and then LIGHT_REFINE_LEVELS times: a mesh already that fine is left as it is.
+ * four quads at their edges' midpoints and centre, triangles into four; the new corners
+ * are tested in turn, `levels` times at most, and the splits stop at a budget of added
+ * patches (and of memory). No piece's edge is made shorter than the dense solvers' default
+ * patch size halved by the default shadow levels and then LIGHT_REFINE_LEVELS times: a
+ * mesh already that fine is left as it is.
  * On the hierarchical solver's 31,210 patches of the Cornell box the split had cost 2.2 s
  * of a 256 x 256 render (4.82 -> 7.04 s) for no gain (0.871 % / 1.077 % -> 0.872 % /
  * 1.112 % block / pixel against a 16384-spp reference). Each piece keeps its patch's
