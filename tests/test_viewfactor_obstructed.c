@@ -4,8 +4,9 @@
  * obstruction tube inside an enclosing sphere, which sees the sphere only through the
  * tubes' open ends (Howell's coaxial-cylinder factor, and brute-force ray casting against
  * every triangle), its row summing to 1 when the blocker is a surface too, and two plates
- * seen through a slot narrower than the sampling strata. Each factor must lie within its
- * reported error bound of the reference. Not here: the unobstructed closed forms
+ * seen through a slot narrower than the sampling strata, and a street canyon of a generated
+ * city seen through the gap between buildings. Each factor must lie within its reported
+ * error bound of the reference. Not here: the unobstructed closed forms
  * (test_viewfactors.c).
  */
 #include <math.h>
@@ -376,6 +377,86 @@ static void check_proven_hidden(void)
     rad_scene_destroy(scene);
 }
 
+/* Box buildings [x0, x1] x [0, h] x [z0, z1] (walls and roof, facing out) appended to the
+ * OBJ text at n, vertices numbered from *v + 1. */
+static size_t append_building(size_t n, int *v, double x0, double x1, double z0, double z1,
+                              double h)
+{
+    const double corner[8][3] = {{x0, 0, z0}, {x1, 0, z0}, {x1, 0, z1}, {x0, 0, z1},
+                                 {x0, h, z0}, {x1, h, z0}, {x1, h, z1}, {x0, h, z1}};
+    for (int k = 0; k < 8; k++)
+        n += (size_t)snprintf(text + n, sizeof(text) - n, "v %.17g %.17g %.17g\n", corner[k][0],
+                              corner[k][1], corner[k][2]);
+    /* counter-clockwise seen from outside: -z, +x, +z, -x walls, then the roof */
+    const int face[5][4] = {{1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 8, 4}, {4, 8, 5, 1}, {5, 8, 7, 6}};
+    for (int f = 0; f < 5; f++)
+        n += (size_t)snprintf(text + n, sizeof(text) - n, "f %d %d %d %d\n", *v + face[f][0],
+                              *v + face[f][1], *v + face[f][2], *v + face[f][3]);
+    *v += 8;
+    return n;
+}
+
+/* A street canyon of a generated city block: a wall (10 x 20.9 m, facing +z) and a low roof
+ * 44-54 m away (10 x 10 m at 7.8 m, facing up) past three taller buildings; they see each
+ * other only through the street between the buildings, over about 7 % of the exchange,
+ * and only from the wall's part above the roof's plane. Sampling the whole wall, most
+ * segments weighed nothing, and a few visible ones among many blocked made a replicates'
+ * spread far below the error (seed 1 of the 1k city: 0.04 % visible, bound 80 times too
+ * small). F(roof -> wall) against brute-force ray casting, with 16 seeds. */
+static void check_street_canyon(void)
+{
+    const char *wall = test_write_file("wall.obj", "v 112 0 176\nv 122 0 176\n"
+                                                   "v 122 20.8667 176\nv 112 20.8667 176\n"
+                                                   "f 1 2 3 4\n");
+    const char *roof = test_write_file("roof.obj", "v 130 7.81022 220\nv 130 7.81022 230\n"
+                                                   "v 140 7.81022 230\nv 140 7.81022 220\n"
+                                                   "f 1 2 3 4\n");
+    int v = 0;
+    size_t n = 0;
+    n = append_building(n, &v, 112, 122, 184, 194, 22.8253);
+    n = append_building(n, &v, 112, 122, 202, 212, 24.7839);
+    n = append_building(n, &v, 130, 140, 202, 212, 14.9258);
+    const char *blocks = test_write_file("canyon_blocks.obj", text);
+    rad_scene_file files[3] = {{wall, 0, false},
+                               {roof, 0, false},
+                               {blocks, RAD_SURFACE_OBSTRUCTION, false}};
+    rad_scene *scene = NULL;
+    rad_error error = {0};
+    CHECK(rad_scene_load_files(files, 3, NULL, &scene, &error) == RAD_OK);
+    if (!scene)
+        return;
+    uint32_t W = surface_named(scene, "wall"), R = surface_named(scene, "roof");
+    double standard_error, reference = monte_carlo(scene, R, W, 2000000, &standard_error);
+    CHECK(reference > 5 * standard_error);
+    /* The segments' outcome depends on the seed. The bound is a 95 % one, so 16 seeds may
+     * see one or two outside it by chance, but none outside twice it. */
+    unsigned outside = 0;
+    double worst = 0;
+    for (uint64_t seed = 1; seed <= 16; seed++) {
+        rad_viewfactor_options options = {.seed = seed};
+        rad_viewfactor_matrix *m = NULL;
+        rad_viewfactor_report report;
+        CHECK(rad_viewfactor_matrix_compute(scene, &options, &m, &report, &error) == RAD_OK);
+        if (!m)
+            break;
+        CHECK(report.sampled_pairs == 1);
+        double bound, F = factor(m, R, W, &bound);
+        outside += fabs(F - reference) > 3 * standard_error + bound;
+        worst = fmax(worst, fabs(F - reference) / (3 * standard_error + 2 * bound));
+        if (seed == 1)
+            printf("street canyon: F(roof -> wall) %.4g, bound %.2g (seed 1); brute-force Monte "
+                   "Carlo %.4g +- %.2g\n",
+                   F, bound, reference, standard_error);
+        rad_viewfactor_matrix_destroy(m);
+    }
+    printf("  16 seeds: %u outside their bound (+ 3 standard errors); largest miss %.2f of "
+           "twice it\n",
+           outside, worst);
+    CHECK(outside <= 2);
+    CHECK(worst <= 1);
+    rad_scene_destroy(scene);
+}
+
 int main(void)
 {
     check_tube_in_tube(false);
@@ -383,5 +464,6 @@ int main(void)
     check_slot(1);
     check_slot(6);
     check_proven_hidden();
+    check_street_canyon();
     return test_finish("test_viewfactor_obstructed");
 }

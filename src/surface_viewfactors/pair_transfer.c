@@ -203,6 +203,17 @@ static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
     return n;
 }
 
+/* The one-sided 95 % upper limit of a Poisson mean when m events were seen (Wilson and
+ * Hilferty's cube-root approximation, within 1 % of the exact limit). */
+static double poisson_upper(uint32_t m)
+{
+    if (m == 0)
+        return PAIR_UNSEEN_BOUND; /* exact: -ln 0.05 */
+    double n = m + 1.0;
+    double c = 1 - 1 / (9 * n) + PAIR_ONE_SIDED_Z / (3 * sqrt(n));
+    return n * c * c * c;
+}
+
 /* Round `round` (k x k strata a side) cast and weighed. */
 static pair_round cast_round(const vf_polygon *p, const vf_polygon *q,
                              const rad_tracer *occluders, unsigned k, unsigned round,
@@ -212,13 +223,25 @@ static pair_round cast_round(const vf_polygon *p, const vf_polygon *q,
     rad_tracer_occluded(occluders, w->rays, n, w->occluded);
     double estimate[PAIR_REPLICATES], mean = 0;
     unsigned cells = k * k;
+    /* whether the segments that count (weight > 0) all agree, and how: a segment of no
+     * weight (from behind the other's plane) says nothing, so it neither breaks their
+     * agreement nor, when they are all blocked, makes a spread of 0 look like a
+     * measured one */
+    int agreed = -1; /* -1: none weighed yet; else the occluded flag they all share */
     bool all_same = true;
+    uint32_t weighed = 0, weighed_blocked = 0;
     for (unsigned r = 0; r < PAIR_REPLICATES; r++) {
         double seen = 0, total = 0;
         for (unsigned m = r * cells; m < (r + 1) * cells; m++) {
+            if (!(w->weight[m] > 0))
+                continue;
+            weighed++;
+            weighed_blocked += w->occluded[m] != 0;
             total += w->weight[m];
             seen += w->occluded[m] ? 0 : w->weight[m];
-            all_same = all_same && w->occluded[m] == w->occluded[0];
+            if (agreed < 0)
+                agreed = w->occluded[m];
+            all_same = all_same && w->occluded[m] == agreed;
         }
         estimate[r] = total > 0 ? seen / total : (w->occluded[r * cells] ? 0 : 1);
         mean += estimate[r];
@@ -231,10 +254,17 @@ static pair_round cast_round(const vf_polygon *p, const vf_polygon *q,
     pair_round result;
     result.fraction = fmin(fmax(mean, 0), 1);
     result.all_same = all_same;
-    result.unseen = all_same && w->occluded[0];
-    /* all segments agreeing has no spread: what they could all have missed (a slot
-     * narrower than a cell, an occluder between them) is bounded binomially */
-    result.bound = all_same ? PAIR_UNSEEN_BOUND / (double)n : PAIR_STUDENT_T * standard_error;
+    result.unseen = all_same && agreed == 1;
+    /* The replicates' spread says little when one outcome is rare: all segments agreeing
+     * have no spread at all, and one segment through a street between two buildings made
+     * a spread that passed for a bound 80 times too small. So the bound is at least what
+     * the rarer outcome's count allows: m of n segments are consistent with a share up to
+     * poisson_upper(m) / n (95 %); a slot narrower than a cell, an occluder between them,
+     * is what they could have missed. */
+    uint32_t rarer = weighed_blocked < weighed - weighed_blocked ? weighed_blocked
+                                                                 : weighed - weighed_blocked;
+    double rare_bound = (poisson_upper(rarer) - rarer) / (double)(weighed ? weighed : 1);
+    result.bound = all_same ? rare_bound : fmax(PAIR_STUDENT_T * standard_error, rare_bound);
     result.rays = n;
     return result;
 }

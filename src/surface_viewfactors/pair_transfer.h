@@ -10,10 +10,15 @@
  * fraction, estimated from
  * replicated stratified segments between the polygons, weighted by the kernel
  * cos cos / r^2; rounds of 4x more segments until the estimate's error bound meets the
- * target or the ray budget is spent. The bound is the replicates' spread (Student t), or,
- * when every segment of a round agreed, the binomial bound PAIR_UNSEEN_BOUND / n on what
- * they could all have missed, so a pair whose segments were all blocked still carries the
- * error it may have. The result never exceeds the unobstructed value.
+ * target or the ray budget is spent. Only segments of weight > 0 count. The bound is the
+ * replicates' spread (Student t), and at least what the rarer outcome's count allows (a
+ * Poisson limit: m of n segments visible, or blocked, are consistent with a share up to
+ * about (m + 3 + 1.6 sqrt(m)) / n): when every segment of a round agreed, the binomial
+ * PAIR_UNSEEN_BOUND / n on what they could all have missed, so a pair whose segments were
+ * all blocked still carries the error it may have; when a few got through a street among
+ * many blocked, more than their spread. The caller passes only the parts of the polygons in
+ * front of each other's planes, where the kernel is not 0. The result never exceeds the
+ * unobstructed value.
  */
 #ifndef RAD_VIEWFACTOR_PAIR_TRANSFER_H
 #define RAD_VIEWFACTOR_PAIR_TRANSFER_H
@@ -32,6 +37,9 @@
  * outcome's share is below PAIR_UNSEEN_BOUND / n with 95 % confidence (binomial: a share f
  * passes n stratified segments unseen with probability at most (1 - f)^n <= exp(-n f)). */
 #define PAIR_UNSEEN_BOUND 2.995732
+
+/* One-sided 95 % normal quantile (the rarer outcome's Poisson limit, pair_transfer.c). */
+#define PAIR_ONE_SIDED_Z 1.644854
 
 /* The unobstructed transfer, to relative tolerance `accuracy` (and *bound receives the
  * estimated absolute error). plane_epsilon as in vf_geometry. */

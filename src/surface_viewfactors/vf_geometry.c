@@ -138,6 +138,42 @@ void vf_polygon_finish(vf_polygon *polygon)
     polygon->fan[polygon->count - 3] = 1;
 }
 
+bool vf_polygon_clip_front(const vf_polygon *polygon, rad_vec3 n, double offset,
+                           vf_polygon *out)
+{
+    double height[VF_MAX_VERTICES];
+    bool all_front = true, any_front = false;
+    for (unsigned k = 0; k < polygon->count; k++) {
+        height[k] = v3_dot(n, polygon->vertex[k]) - offset;
+        all_front = all_front && height[k] > 0;
+        any_front = any_front || height[k] > 0;
+    }
+    if (!any_front)
+        return false;
+    if (out != polygon)
+        *out = *polygon;
+    if (all_front)
+        return true;
+    rad_vec3 kept[VF_MAX_VERTICES + 1];
+    unsigned count = 0;
+    for (unsigned k = 0; k < polygon->count; k++) {
+        unsigned next = (k + 1) % polygon->count;
+        double a = height[k], b = height[next];
+        if (a > 0)
+            kept[count++] = polygon->vertex[k];
+        if ((a > 0 && b <= 0) || (a <= 0 && b > 0)) /* the edge crosses the plane */
+            kept[count++] = v3_lerp(polygon->vertex[k], polygon->vertex[next], a / (a - b));
+    }
+    if (count > VF_MAX_VERTICES)
+        return true; /* the whole polygon, as said */
+    if (count < 3)
+        return false;
+    memcpy(out->vertex, kept, count * sizeof(rad_vec3));
+    out->count = count;
+    vf_polygon_finish(out);
+    return out->area > 0;
+}
+
 /* The normal from the corners' winding, then the rest (vf_polygon_finish). */
 static void finish_polygon(vf_polygon *polygon)
 {

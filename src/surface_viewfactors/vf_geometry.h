@@ -59,6 +59,14 @@ void vf_geometry_free(vf_geometry *geometry);
  * corners and unit normal are set. */
 void vf_polygon_finish(vf_polygon *polygon);
 
+/* The part of `polygon` in front of the plane n . x = offset (on it counts as behind) into
+ * `out`, which may be `polygon`; false when none of it with area is. Wholly in front: out
+ * is the polygon, bit for bit. When the part would have more than VF_MAX_VERTICES corners,
+ * out is the whole polygon: a caller integrating a kernel that vanishes behind the plane
+ * gets the same result either way, only with less of its work where it counts. */
+bool vf_polygon_clip_front(const vf_polygon *polygon, rad_vec3 n, double offset,
+                           vf_polygon *out);
+
 /* True when some corner of `polygon` lies in front of the plane (n, offset) by more than
  * epsilon. */
 static inline bool vf_polygon_in_front(const vf_polygon *polygon, rad_vec3 n, double offset,

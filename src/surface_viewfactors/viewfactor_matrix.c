@@ -150,19 +150,32 @@ static uint64_t matrix_bound_bytes(const vf_geometry *g, uint64_t *pairs)
 static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_workspace *w,
                            pair_hidden_memory *memory, pair_counts *counts, double *bound)
 {
-    const vf_polygon *p = &e->geometry->polygons[pi], *q = &e->geometry->polygons[qi];
+    const vf_polygon *whole_p = &e->geometry->polygons[pi], *whole_q = &e->geometry->polygons[qi];
     double eps = e->geometry->plane_epsilon;
     *bound = 0;
-    if (!vf_polygon_in_front(q, p->normal, v3_dot(p->normal, p->vertex[0]), eps) ||
-        !vf_polygon_in_front(p, q->normal, v3_dot(q->normal, q->vertex[0]), eps))
+    double p_offset = v3_dot(whole_p->normal, whole_p->vertex[0]),
+           q_offset = v3_dot(whole_q->normal, whole_q->vertex[0]);
+    if (!vf_polygon_in_front(whole_q, whole_p->normal, p_offset, eps) ||
+        !vf_polygon_in_front(whole_p, whole_q->normal, q_offset, eps))
         return 0;
+    /* Only the part of each in front of the other's plane exchanges anything (the kernel
+     * cos cos / r^2 is 0 elsewhere): the integrals, the occluders in between and the
+     * sampled segments are those of these parts. A segment from behind the other's plane
+     * weighs nothing: where most of a wall stood below a roof, most segments weighed
+     * nothing, and the few that did, all blocked, were taken for a measured 0 (a pair
+     * 47 % visible came out hidden). */
+    vf_polygon part_p, part_q;
+    if (!vf_polygon_clip_front(whole_p, whole_q->normal, q_offset, &part_p) ||
+        !vf_polygon_clip_front(whole_q, whole_p->normal, p_offset, &part_q))
+        return 0;
+    const vf_polygon *p = &part_p, *q = &part_q;
     counts->polygon_pairs++;
     double quadrature_error, unobstructed;
     uint64_t stream = rad_mix64(e->seed ^ rad_mix64(((uint64_t)pi << 32) | qi));
     pair_visibility visibility;
     /* a shape that alone hid one of p's earlier pairs often hides this one: an exact test
      * of a few dozen dot products, tried before any ray */
-    if (pair_hidden_by_remembered_shape(&e->hidden, memory, p, q)) {
+    if (pair_hidden_by_remembered_shape(&e->hidden, memory, whole_p, whole_q)) {
         counts->hidden_pairs++;
         return 0;
     }
@@ -172,7 +185,7 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
     counts->rays += visibility.rays;
     if (visibility.fraction == 0) {
         pair_hidden_work work = {0, 0, 0};
-        bool hidden = pair_proven_hidden(&e->hidden, memory, p, q, &work);
+        bool hidden = pair_proven_hidden(&e->hidden, memory, whole_p, whole_q, &work);
         counts->rays += work.rays;
         if (hidden) {
             counts->hidden_pairs++;
