@@ -789,8 +789,9 @@ typedef struct rad_viewfactor_matrix {
     uint32_t *column;      /* row_start[n] column indices J */
     double *value;         /* F_IJ */
     double *error_bound;   /* estimated absolute error of each F_IJ (about two standard
-                              errors of its sampled obstruction, or, when every segment
-                              agreed, the 95 % binomial bound on what they could have
+                              errors of its sampled obstruction, never less than the 95 %
+                              Poisson limit of its rarer outcome's count: when every
+                              segment agreed, the binomial bound on what they could have
                               missed; the quadrature error where integrated exactly) */
 } rad_viewfactor_matrix;
 
