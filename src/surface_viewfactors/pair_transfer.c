@@ -203,9 +203,7 @@ static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
     return n;
 }
 
-/* The one-sided 95 % upper limit of a Poisson mean when m events were seen (Wilson and
- * Hilferty's cube-root approximation, within 1 % of the exact limit). */
-static double poisson_upper(uint32_t m)
+double pair_poisson_upper(uint64_t m)
 {
     if (m == 0)
         return PAIR_UNSEEN_BOUND; /* exact: -ln 0.05 */
@@ -263,7 +261,7 @@ static pair_round cast_round(const vf_polygon *p, const vf_polygon *q,
      * is what they could have missed. */
     uint32_t rarer = weighed_blocked < weighed - weighed_blocked ? weighed_blocked
                                                                  : weighed - weighed_blocked;
-    double rare_bound = (poisson_upper(rarer) - rarer) / (double)(weighed ? weighed : 1);
+    double rare_bound = (pair_poisson_upper(rarer) - rarer) / (double)(weighed ? weighed : 1);
     result.bound = all_same ? rare_bound : fmax(PAIR_STUDENT_T * standard_error, rare_bound);
     result.rays = n;
     return result;

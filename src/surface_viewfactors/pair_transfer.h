@@ -41,6 +41,12 @@
 /* One-sided 95 % normal quantile (the rarer outcome's Poisson limit, pair_transfer.c). */
 #define PAIR_ONE_SIDED_Z 1.644854
 
+/* The one-sided 95 % upper limit of a Poisson mean when m events were seen: m = 0 gives
+ * PAIR_UNSEEN_BOUND, more Wilson and Hilferty's cube-root approximation (within 1 % of
+ * the exact limit). A sampled share's bound is at least (limit - m) / n for the rarer
+ * outcome's count m among n: the replicates' spread says little when one outcome is rare. */
+double pair_poisson_upper(uint64_t m);
+
 /* The unobstructed transfer, to relative tolerance `accuracy` (and *bound receives the
  * estimated absolute error). plane_epsilon as in vf_geometry. */
 double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accuracy,

@@ -371,8 +371,9 @@ static bool lands_on_sampled(const sky_context *c, const sky_workspace *w, rad_v
  * through a sampled tile with nothing in its way. Sampling directions, not tile points,
  * keeps the estimate's spread that of a coin toss however large the tiles are. The
  * estimate is the mean of SKY_REPLICATES independent ones; its bound a 95 % Student t of
- * their spread, or, when no ray escaped, the rule of three (3 / rays that landed, times
- * the share). Rounds of twice the rays until the bound is accuracy x sqrt(share) or
+ * their spread (at least the Poisson limit of the rarer outcome's count over the rays
+ * cast, pair_poisson_upper), or, when no ray escaped, the rule of three (3 / rays that
+ * landed, times the share). Rounds of twice the rays until the bound is accuracy x sqrt(share) or
  * SKY_RAY_FACTOR x max_rays were cast. */
 static double sample_sky(const sky_context *c, const vf_polygon *p, uint32_t pi,
                          sky_workspace *w, double share, sky_counts *counts, double *bound)
@@ -424,7 +425,12 @@ static double sample_sky(const sky_context *c, const vf_polygon *p, uint32_t pi,
         }
         for (unsigned r = 0; r < SKY_REPLICATES; r++)
             spread += (estimate[r] - mean) * (estimate[r] - mean);
-        *bound = any ? PAIR_STUDENT_T * sqrt(spread / (SKY_REPLICATES - 1) / SKY_REPLICATES)
+        /* a few rays blocked among many escaping, or the other way round: their spread
+         * says little, their count does (pair_poisson_upper) */
+        uint64_t rarer = any < landed - any ? any : landed - any;
+        double rare = (pair_poisson_upper(rarer) - (double)rarer) / (double)total;
+        *bound = any ? fmax(PAIR_STUDENT_T * sqrt(spread / (SKY_REPLICATES - 1) / SKY_REPLICATES),
+                            rare)
                      : share * fmin(3.0 / (double)(landed ? landed : 1), 1);
         if (*bound <= target)
             break;

@@ -219,7 +219,7 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
      * at most accuracy * sqrt(F0), so that a row's errors, added in quadrature, stay
      * within accuracy (the F0 of a row sum to at most 1) while small factors take few
      * rays. */
-    double f0 = fmin(unobstructed / fmin(p->area, q->area), 1);
+    double f0 = fmin(unobstructed / fmin(whole_p->area, whole_q->area), 1);
     /* the first look's rounds are taken as they came out, not cast again */
     pair_sample_visibility_resume(p, q, e->occluders, e->accuracy / sqrt(f0), e->max_rays,
                                   stream, w, &visibility);
