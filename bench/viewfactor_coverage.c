@@ -9,7 +9,10 @@
  *   RANDOM_PAIRS stored factors F_IJ (I < J) drawn at random (default 150), LARGEST_BOUNDS
  *   more with the largest error bounds (default 50), SEGMENTS per pair (default 40000);
  *   and as many pairs drawn at random among those not stored (F = 0 with no bound: proven
- *   hidden, or facing away), which brute force must find 0 within 3 s.e.
+ *   hidden, or facing away), which brute force must find 0 within 3 s.e.; and the sky
+ *   view factors of RANDOM_PAIRS surfaces drawn at random (rad_sky_viewfactors_compute)
+ *   against the share of cosine-distributed rays from uniform points that nothing stops
+ *   (SEGMENTS / 2 rays).
  * Prints one line per pair whose brute-force value lies outside bound + 3 standard errors,
  * then a summary: how many lie within bound + 3 s.e., within 2 bound + 3 s.e., the largest
  * |F - reference| / (bound + 3 s.e.), and the median bound and standard error.
@@ -77,13 +80,15 @@ static rad_vec3 surface_point(const rad_scene *s, uint32_t I, const double *cumu
                       wa * a.z + wb * b.z + wc * c.z};
 }
 
-/* Some triangle of the scene crosses the segment x -> x + d strictly inside it. */
-static bool blocked(const rad_scene *s, rad_vec3 x, rad_vec3 d)
+/* Some triangle of the scene crosses the segment x -> x + d strictly inside it (far: or
+ * anywhere beyond its start, for a ray). */
+static bool crossed(const rad_scene *s, rad_vec3 x, rad_vec3 d, double far)
 {
     for (uint32_t t = 0; t < s->triangle_count; t++) {
         const rad_triangle *tri = &s->triangles[t];
         rad_vec3 a = s->positions[tri->vertex[0]];
-        rad_vec3 e1 = sub(s->positions[tri->vertex[1]], a), e2 = sub(s->positions[tri->vertex[2]], a);
+        rad_vec3 e1 = sub(s->positions[tri->vertex[1]], a);
+        rad_vec3 e2 = sub(s->positions[tri->vertex[2]], a);
         rad_vec3 h = cross(d, e2);
         double det = dot(e1, h);
         if (fabs(det) < 1e-300)
@@ -98,10 +103,40 @@ static bool blocked(const rad_scene *s, rad_vec3 x, rad_vec3 d)
         if (v < 0 || u + v > 1)
             continue;
         double along = f * dot(e2, q);
-        if (along > 1e-6 && along < 1 - 1e-6)
+        if (along > 1e-6 && along < far)
             return true;
     }
     return false;
+}
+
+static bool blocked(const rad_scene *s, rad_vec3 x, rad_vec3 d)
+{
+    return crossed(s, x, d, 1 - 1e-6);
+}
+
+/* Surface I's sky view factor by brute force: cosine-distributed rays from uniform points
+ * of I that no triangle stops. */
+static void brute_force_sky(const rad_scene *s, uint32_t I, const double *cumulative,
+                            uint32_t rays, double *share, double *standard_error)
+{
+    uint64_t rng = 0xD1B54A32D192ED03ull ^ I;
+    uint32_t escaped = 0;
+    for (uint32_t k = 0; k < rays; k++) {
+        rad_vec3 n;
+        rad_vec3 x = surface_point(s, I, cumulative, &rng, &n);
+        rad_vec3 h = fabs(n.x) > 0.5 ? (rad_vec3){0, 1, 0} : (rad_vec3){1, 0, 0};
+        rad_vec3 t1 = cross(n, h);
+        double l = sqrt(dot(t1, t1));
+        t1 = (rad_vec3){t1.x / l, t1.y / l, t1.z / l};
+        rad_vec3 t2 = cross(n, t1);
+        double q = uniform(&rng), phi = 2 * 3.14159265358979323846 * uniform(&rng);
+        double r = sqrt(q), a = r * cos(phi), b = r * sin(phi), c = sqrt(fmax(0, 1 - q));
+        rad_vec3 d = {a * t1.x + b * t2.x + c * n.x, a * t1.y + b * t2.y + c * n.y,
+                      a * t1.z + b * t2.z + c * n.z};
+        escaped += !crossed(s, x, d, INFINITY);
+    }
+    *share = (double)escaped / rays;
+    *standard_error = sqrt(*share * (1 - *share) / rays);
 }
 
 static void brute_force(const rad_scene *s, checked *c, double *const *cumulative,
@@ -225,7 +260,8 @@ int main(int argc, char **argv)
                    c->standard_error);
     }
     count = stored_count;
-    double worst = 0, *bounds = malloc(count * sizeof(double)), *errors = malloc(count * sizeof(double));
+    double worst = 0;
+    double *bounds = malloc(count * sizeof(double)), *errors = malloc(count * sizeof(double));
     for (uint32_t k = 0; k < count; k++) {
         const checked *c = &pick[k];
         double miss = fabs(c->F - c->reference);
@@ -239,6 +275,43 @@ int main(int argc, char **argv)
                    scene->surfaces[c->I].name, scene->surfaces[c->J].name, c->F, c->bound,
                    c->reference, c->standard_error, k < largest ? "largest bounds" : "random");
     }
+    /* sky view factors of surfaces drawn at random */
+    double *sky = calloc(scene->surface_count, sizeof(double));
+    double *sky_bound = calloc(scene->surface_count, sizeof(double));
+    rad_sky_report sky_report;
+    if (rad_sky_viewfactors_compute(scene, NULL, sky, sky_bound, &sky_report, &error) != RAD_OK) {
+        fprintf(stderr, "viewfactor_coverage: %s\n", error.message);
+        return 1;
+    }
+    uint32_t sky_count = random_pairs < scene->surface_count ? random_pairs : scene->surface_count;
+    uint32_t *sky_pick = malloc((sky_count ? sky_count : 1) * sizeof(uint32_t));
+    double *sky_reference = malloc((sky_count ? sky_count : 1) * sizeof(double));
+    double *sky_error = malloc((sky_count ? sky_count : 1) * sizeof(double));
+    for (uint32_t k = 0; k < sky_count; k++) {
+        uint32_t I;
+        do
+            I = (uint32_t)(uniform(&rng) * scene->surface_count);
+        while (scene->surfaces[I].flags || areas[I] <= 0);
+        sky_pick[k] = I;
+    }
+#pragma omp parallel for schedule(dynamic, 1)
+    for (uint32_t k = 0; k < sky_count; k++)
+        brute_force_sky(scene, sky_pick[k], cumulative[sky_pick[k]], segments / 2,
+                        &sky_reference[k], &sky_error[k]);
+    uint32_t sky_within = 0, sky_within_twice = 0;
+    double sky_worst = 0;
+    for (uint32_t k = 0; k < sky_count; k++) {
+        uint32_t I = sky_pick[k];
+        double miss = fabs(sky[I] - sky_reference[k]);
+        sky_within += miss <= sky_bound[I] + 3 * sky_error[k];
+        sky_within_twice += miss <= 2 * sky_bound[I] + 3 * sky_error[k];
+        sky_worst = fmax(sky_worst, miss / (sky_bound[I] + 3 * sky_error[k]));
+        if (miss > sky_bound[I] + 3 * sky_error[k])
+            printf("outside: sky view factor of %s %.6g bound %.3g; brute force %.6g +- %.2g\n",
+                   scene->surfaces[I].name, sky[I], sky_bound[I], sky_reference[k],
+                   sky_error[k]);
+    }
+    uint32_t top = largest < n ? largest : (uint32_t)n;
     qsort(bounds, count, sizeof(double), by_double);
     qsort(errors, count, sizeof(double), by_double);
     printf("%s: %u stored factors checked (%u with the largest bounds, %u at random), %u "
@@ -246,10 +319,13 @@ int main(int argc, char **argv)
            "|F - brute force| / (bound + 3 s.e.) %.2f; median bound %.3g, median s.e. %.3g; "
            "largest bound of the run %.3g\n"
            "%u pairs not stored (F = 0, no bound): %u where brute force sees more than 3 "
-           "s.e.; largest brute-force value %.3g\n",
-           argv[1], count, largest < n ? largest : (uint32_t)n, count - (largest < n ? largest : (uint32_t)n),
+           "s.e.; largest brute-force value %.3g\n"
+           "%u sky view factors (%u rays each): %u within bound + 3 s.e., %u within 2 bound + "
+           "3 s.e.; largest miss / (bound + 3 s.e.) %.2f; largest bound of the run %.3g\n",
+           argv[1], count, top, count - top,
            segments, within, within_twice, worst, count ? bounds[count / 2] : 0,
            count ? errors[count / 2] : 0, report.largest_error_bound, count, zero_seen,
-           zero_largest);
+           zero_largest, sky_count, segments / 2, sky_within, sky_within_twice, sky_worst,
+           sky_report.largest_error_bound);
     return 0;
 }
