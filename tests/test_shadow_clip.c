@@ -6,8 +6,11 @@
  * 0.005 %). At a grid of points on the first wall the factor must not exceed the factor
  * behind any one of the faces (more occluders never show more), must be 0 wherever one
  * face alone covers the receiver, and must match the test's own Monte-Carlo integral over
- * the receiver (segments tested against every face by the test's own code). Not here: the
- * joining of triangles (test_shadow_join) and the pair integrals (test_viewfactor_obstructed).
+ * the receiver (segments tested against every face by the test's own code). A receiver
+ * given with a corner twice (as the part of a polygon in front of a plane through its
+ * corner comes) behind a face covering it: 0. The part in front of a plane
+ * (vf_polygon_clip_front): a corner on the plane kept once. Not here: the joining of
+ * triangles (test_shadow_join) and the pair integrals (test_viewfactor_obstructed).
  */
 #include <math.h>
 #include <stdio.h>
@@ -83,8 +86,73 @@ static double monte_carlo(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver, un
     return mean;
 }
 
+/* The part of a polygon in front of a plane through one of its corners keeps that corner
+ * once; a part with more corners than a polygon holds is the whole polygon. */
+static void check_clip_front(void)
+{
+    vf_polygon diamond = {0};
+    diamond.count = 4;
+    diamond.vertex[0] = v3(3, 0.5, 0);
+    diamond.vertex[1] = v3(3, 0, 0.5);
+    diamond.vertex[2] = v3(3, 0.5, 1);
+    diamond.vertex[3] = v3(3, 1, 0.5);
+    diamond.normal = v3(-1, 0, 0);
+    vf_polygon_finish(&diamond);
+    vf_polygon part;
+    CHECK(vf_polygon_clip_front(&diamond, v3(0, 0, 1), 0, &part));
+    CHECK(part.count == 4);
+    CHECK(fabs(part.area - diamond.area) <= 1e-15);
+    /* the same a hair behind the plane: still 4 corners, not a pair 1e-16 apart */
+    CHECK(vf_polygon_clip_front(&diamond, v3(0, 0, 1), 1e-16, &part));
+    CHECK(part.count == 4);
+    /* a hexagon with one corner cut off would have 7: the whole hexagon comes back */
+    vf_polygon hexagon = {0};
+    hexagon.count = 6;
+    for (unsigned k = 0; k < 6; k++)
+        hexagon.vertex[k] = v3(cos(k * pi / 3), sin(k * pi / 3), 0);
+    hexagon.normal = v3(0, 0, 1);
+    vf_polygon_finish(&hexagon);
+    CHECK(vf_polygon_clip_front(&hexagon, v3(-1, 0, 0), -0.9, &part));
+    CHECK(part.count == 6 && part.area == hexagon.area);
+    /* wholly behind: nothing */
+    CHECK(!vf_polygon_clip_front(&hexagon, v3(1, 0, 0), 2, &part));
+}
+
+/* A receiver with a corner given twice (exactly, or 3e-16 apart) behind a face that covers
+ * it: the factor is 0, as without the repeat (the repeated corner is an edge with no
+ * direction, which `separated` once took for a side with the shadow outside). */
+static void check_repeated_corner(void)
+{
+    const shadow_polygon cover = {{{-1, -1, 1}, {2, -1, 1}, {2, 2, 1}, {-1, 2, 1}}, 4};
+    for (int variant = 0; variant < 3; variant++) {
+        vf_polygon receiver = {0};
+        receiver.count = 5;
+        receiver.vertex[0] = v3(0, 0, 0);
+        receiver.vertex[1] = v3(1, 0, 0);
+        receiver.vertex[2] = v3(1, 1, 0);
+        receiver.vertex[3] = v3(0, 1, 0);
+        receiver.vertex[4] = variant == 0 ? v3(0, 1, 0) : v3(0, 1 - 3e-16 * variant, 0);
+        receiver.normal = v3(0, 0, 1);
+        vf_polygon_finish(&receiver);
+        rad_rng rng = rad_rng_seed(3, (uint64_t)variant, 0);
+        double largest = 0;
+        for (int k = 0; k < 100; k++) {
+            rad_vec3 x = v3(-0.5 + 2 * rad_rng_uniform(&rng), -0.5 + 2 * rad_rng_uniform(&rng),
+                            1.5 + rad_rng_uniform(&rng));
+            largest = fmax(largest, shadow_visible_factor_polygons(x, v3(0, 0, -1), &receiver,
+                                                                   &cover, 1, 1e-9));
+        }
+        printf("receiver with a repeated corner (%s) behind a face covering it: largest of 100 "
+               "point factors %.3g\n",
+               variant == 0 ? "exactly" : variant == 1 ? "3e-16 apart" : "6e-16 apart", largest);
+        CHECK(largest == 0);
+    }
+}
+
 int main(void)
 {
+    check_clip_front();
+    check_repeated_corner();
     /* the receiver: a wall at x = 220 facing -x; the points: a wall at z = 86 facing +z */
     vf_polygon receiver = {0};
     receiver.count = 4;

@@ -263,6 +263,7 @@ static pair_round cast_round(const vf_polygon *p, const vf_polygon *q,
                                                                  : weighed - weighed_blocked;
     double rare_bound = (pair_poisson_upper(rarer) - rarer) / (double)(weighed ? weighed : 1);
     result.bound = all_same ? rare_bound : fmax(PAIR_STUDENT_T * standard_error, rare_bound);
+    result.bound = fmin(result.bound, 1); /* a fraction: no weighed segment says no more */
     result.rays = n;
     return result;
 }
@@ -323,6 +324,8 @@ void pair_sample_visibility_resume(const vf_polygon *p, const vf_polygon *q,
                                    uint32_t max_rays, uint64_t stream, pair_workspace *w,
                                    pair_visibility *out)
 {
+    /* the stream names the pair (a bijective mix of the seed and the polygons' indices):
+     * p and q may be a caller's stack copies, at the same address for every pair */
     bool same = w->last_p == p && w->last_q == q && w->last_occluders == occluders &&
                 w->last_stream == stream;
     if (!same)

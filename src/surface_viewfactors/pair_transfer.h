@@ -7,18 +7,17 @@
  * relative tolerance. Obstructed by a few triangles: the same integral of the exact factor
  * to the part left visible by their shadows (shadow_clip.h). Obstructed by many, or when
  * the visible part breaks into too many pieces: the unobstructed value times the visible
- * fraction, estimated from
- * replicated stratified segments between the polygons, weighted by the kernel
- * cos cos / r^2; rounds of 4x more segments until the estimate's error bound meets the
- * target or the ray budget is spent. Only segments of weight > 0 count. The bound is the
- * replicates' spread (Student t), and at least what the rarer outcome's count allows (a
- * Poisson limit: m of n segments visible, or blocked, are consistent with a share up to
- * about (m + 3 + 1.6 sqrt(m)) / n): when every segment of a round agreed, the binomial
- * PAIR_UNSEEN_BOUND / n on what they could all have missed, so a pair whose segments were
- * all blocked still carries the error it may have; when a few got through a street among
- * many blocked, more than their spread. The caller passes only the parts of the polygons in
- * front of each other's planes, where the kernel is not 0. The result never exceeds the
- * unobstructed value.
+ * fraction, estimated from replicated stratified segments between the polygons, weighted
+ * by the kernel cos cos / r^2; rounds of 4x more segments until the estimate's error bound
+ * meets the target or the ray budget is spent. Only segments of weight > 0 count. The
+ * bound is the replicates' spread (Student t), and at least what the rarer outcome's count
+ * allows (a Poisson limit: m of n segments visible, or blocked, are consistent with a
+ * share up to about (m + 1.6 sqrt(m) + 2) / n, 3 / n for m = 0): when every segment of a
+ * round agreed, the binomial PAIR_UNSEEN_BOUND / n on what they could all have missed, so
+ * a pair whose segments were all blocked still carries the error it may have; when a few
+ * got through a street among many blocked, more than their spread. The caller passes only
+ * the parts of the polygons in front of each other's planes, where the kernel is not 0.
+ * The result never exceeds the unobstructed value.
  */
 #ifndef RAD_VIEWFACTOR_PAIR_TRANSFER_H
 #define RAD_VIEWFACTOR_PAIR_TRANSFER_H

@@ -19,7 +19,9 @@ typedef shadow_piece piece;
 /* Corners within 1e-12 of the piece's extent of the corner before them dropped. A clip
  * through a corner makes its crossing point again, a hair away: the zero-length edge
  * between them has no direction, so `separated` took every shadow to lie outside it and
- * the piece survived shadows that covered it (a pair 0.005 % visible came out 5.8 %). */
+ * the piece survived shadows that covered it (a pair 0.005 % visible came out 5.8 %). The
+ * receiver itself may come with repeated corners (the part of a polygon in front of a
+ * plane through one of its corners, vf_polygon_clip_front). */
 static void drop_repeated_corners(piece *p)
 {
     if (p->count < 2)
@@ -74,70 +76,20 @@ static double piece_area(const piece *p, rad_vec3 normal)
     return 0.5 * v3_dot(sum, normal);
 }
 
-/* The cone from the point x over the receiver: the planes through x and each receiver
- * edge, n . v >= offset inside. */
-typedef struct view_cone {
-    rad_vec3 normal[VF_MAX_VERTICES];
-    double offset[VF_MAX_VERTICES];
-    unsigned count;
-} view_cone;
-
-static void make_view_cone(rad_vec3 x, const vf_polygon *receiver, view_cone *cone)
-{
-    rad_vec3 middle = {0, 0, 0};
-    for (unsigned k = 0; k < receiver->count; k++)
-        middle = v3_add(middle, receiver->vertex[k]);
-    middle = v3_scale(middle, 1.0 / receiver->count);
-    cone->count = receiver->count;
-    for (unsigned k = 0; k < receiver->count; k++) {
-        rad_vec3 a = v3_sub(receiver->vertex[k], x);
-        rad_vec3 b = v3_sub(receiver->vertex[(k + 1) % receiver->count], x);
-        rad_vec3 n = v3_cross(a, b);
-        if (v3_dot(n, v3_sub(middle, x)) < 0)
-            n = v3_scale(n, -1);
-        cone->normal[k] = n;
-        cone->offset[k] = v3_dot(n, x);
-    }
-}
-
 /* The shadow of one convex occluder (`corners`, `count` of them, flat) on the receiver's
  * plane (normal N . v = offset), seen from x at height H above it; false when it casts
- * none. Counter-clockwise about N. Only the occluder's part inside the cone from x over
- * the receiver is projected: the rest casts nothing on it, and a part beside x, near its
- * height, would project 1e9 times farther out than the receiver lies (a wall beside the
- * point made shadow edges at 1e10, whose subtraction lost all precision and left a piece
- * that the next shadow should have covered: a pair 0.005 % visible came out 5.8 %). */
+ * none. Counter-clockwise about N. */
 static bool project_shadow(rad_vec3 x, double H, rad_vec3 N, double offset,
-                           const view_cone *cone, const rad_vec3 *corners, unsigned count,
-                           double epsilon, piece *shadow)
+                           const rad_vec3 *corners, unsigned count, double epsilon,
+                           piece *shadow)
 {
-    piece buffers[2];
-    piece *occluder = &buffers[0], *clipped = &buffers[1];
-    occluder->count = count;
-    memcpy(occluder->vertex, corners, count * sizeof(rad_vec3));
-    for (unsigned k = 0; k < cone->count; k++) {
-        bool inside = true, outside = true;
-        for (unsigned m = 0; m < occluder->count; m++) {
-            double d = v3_dot(cone->normal[k], occluder->vertex[m]) - cone->offset[k];
-            inside = inside && d >= 0;
-            outside = outside && d <= 0;
-        }
-        if (outside)
-            return false; /* beside the cone, or touching it */
-        if (inside)
-            continue;
-        if (!clip_half_space(occluder, cone->normal[k], cone->offset[k], clipped) ||
-            clipped->count < 3)
-            return false;
-        piece *swap = occluder;
-        occluder = clipped;
-        clipped = swap;
-    }
-    piece low, slab;
+    piece occluder, low, slab;
+    occluder.count = count;
     double top = H * (1 - 1e-9);
     bool behind = true, above = true, between = true;
-    for (unsigned k = 0; k < occluder->count; k++) {
-        double h = v3_dot(N, occluder->vertex[k]) - offset;
+    for (unsigned k = 0; k < count; k++) {
+        occluder.vertex[k] = corners[k];
+        double h = v3_dot(N, corners[k]) - offset;
         behind = behind && h <= epsilon;
         above = above && h >= top;
         between = between && h > epsilon && h < top;
@@ -145,10 +97,10 @@ static bool project_shadow(rad_vec3 x, double H, rad_vec3 N, double offset,
     if (behind || above)
         return false; /* wholly behind the receiver's plane, or not below the point */
     if (between) {
-        slab = *occluder; /* the common case: wholly in between */
+        slab = occluder; /* the common case: wholly in between */
     } else {
         /* between the plane and the point: epsilon < h < H (1 - 1e-9) */
-        if (!clip_half_space(occluder, N, offset + epsilon, &low) || low.count < 3)
+        if (!clip_half_space(&occluder, N, offset + epsilon, &low) || low.count < 3)
             return false;
         if (!clip_half_space(&low, v3_scale(N, -1), -(offset + top), &slab) || slab.count < 3)
             return false;
@@ -250,15 +202,13 @@ static double visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
     unsigned count = 1;
     pieces[0].count = receiver->count;
     memcpy(pieces[0].vertex, receiver->vertex, receiver->count * sizeof(rad_vec3));
-    view_cone cone;
-    make_view_cone(x, receiver, &cone);
+    drop_repeated_corners(&pieces[0]);
     for (uint32_t o = 0; o < occluders->count && count > 0; o++) {
         piece shadow;
         const rad_vec3 *corners = occluders->triangles ? occluders->triangles[o].corner
                                                        : occluders->polygons[o].vertex;
         unsigned corner_count = occluders->triangles ? 3 : occluders->polygons[o].count;
-        if (!project_shadow(x, H, N, offset, &cone, corners, corner_count, plane_epsilon,
-                            &shadow))
+        if (!project_shadow(x, H, N, offset, corners, corner_count, plane_epsilon, &shadow))
             continue;
         int made = subtract_shadow(pieces, count, &shadow, N, tiny, next);
         if (made < 0)

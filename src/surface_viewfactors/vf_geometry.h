@@ -61,7 +61,9 @@ void vf_polygon_finish(vf_polygon *polygon);
 
 /* The part of `polygon` in front of the plane n . x = offset (on it counts as behind) into
  * `out`, which may be `polygon`; false when none of it with area is. Wholly in front: out
- * is the polygon, bit for bit. When the part would have more than VF_MAX_VERTICES corners,
+ * is the polygon, bit for bit. A corner on the plane is kept once (corners within 1e-12 of
+ * the part's extent of each other are one). When the part would have more than
+ * VF_MAX_VERTICES corners,
  * out is the whole polygon: a caller integrating a kernel that vanishes behind the plane
  * gets the same result either way, only with less of its work where it counts. */
 bool vf_polygon_clip_front(const vf_polygon *polygon, rad_vec3 n, double offset,
