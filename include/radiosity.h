@@ -579,6 +579,10 @@ typedef struct rad_mesh {
  * out of memory. */
 double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patches);
 
+/* The patches a mesh of this patch size would have before any shadow or proximity split;
+ * 0 when out of memory. */
+double rad_mesh_patch_count_at(const rad_scene *scene, double patch_size);
+
 /* Splits every triangle (pairs of triangles forming a convex quadrilateral are merged
  * first) into patches whose edges are no longer than patch_size; the patches of
  * RAD_SURFACE_TWO_SIDED surfaces get their twins (above). */
@@ -1403,7 +1407,13 @@ uint32_t rad_solve_record_count(const rad_solve_record *record);
 #define RAD_AUTO_REFINE_THRESHOLD 0.05
 
 /* The patch size for `solver` on this scene (rad_mesh_default_patch_size of the targets
- * above; 0 when out of memory). */
+ * above; 0 when out of memory). AUTO: the dense solvers' size, unless its mesh would have
+ * more than RAD_DENSE_MAX_PATCHES patches (a scene whose own triangles are finer than that
+ * size: the automatic choice then takes the hierarchical solver anyway), then the
+ * hierarchical solver's. A furnished room of 9,942 triangles (bench/room_generator 10000,
+ * 256 x 256 against a 16384-spp path-traced reference, block / pixel relative RMSE) had
+ * 11,758 patches, one per merged input polygon, at 1.24 % / 2.10 % in 17.4 s; at the
+ * hierarchical size, 34,054 patches, 0.31 % / 0.87 % in 23.0 s. */
 double rad_default_patch_size(const rad_scene *scene, rad_solver solver);
 
 typedef struct rad_scene_solve_options {

@@ -197,13 +197,19 @@ rad_status cli_solve_scene(const char *scene_path, const cli_shared *shared,
     }
     /* the proximity refinement serves the dense solvers' automatic patch size (a scene's
      * extent says little about its rooms); an explicit --patch-size is taken as it is,
-     * and the hierarchical solver's own default leaves are ten times finer already */
+     * and the hierarchical solver's own default leaves are ten times finer already (also
+     * when the automatic choice took its size: a scene whose own triangles are finer than
+     * the dense size, rad_default_patch_size) */
+    bool hierarchical_size =
+        solve->options.solver == RAD_SOLVER_HIERARCHICAL ||
+        (solve->options.solver == RAD_SOLVER_AUTO && !(shared->patch_size > 0) && !solution &&
+         rad_mesh_patch_count_at(out->scene, patch_size) > RAD_DENSE_MAX_PATCHES);
     int proximity_levels =
         shared->proximity_levels < 0                             ? 0
         : shared->proximity_levels > 0                           ? shared->proximity_levels
         : solution                                               ? solution->proximity_levels
         : shared->patch_size > 0                                 ? 0
-        : solve->options.solver == RAD_SOLVER_HIERARCHICAL       ? 0
+        : hierarchical_size                                      ? 0
                                                                  : RAD_PROXIMITY_LEVELS_DEFAULT;
     /* a solution file's mesh is rebuilt as it was made, unless the command line says */
     int shadow_levels = shared->shadow_levels == 0 && solution ? solution->shadow_levels

@@ -522,6 +522,16 @@ double rad_mesh_default_patch_size(const rad_scene *scene, uint32_t target_patch
     return size > 0 ? size : fallback;
 }
 
+double rad_mesh_patch_count_at(const rad_scene *scene, double patch_size)
+{
+    mesh_plan plan;
+    if (!(patch_size > 0) || plan_build(scene, &plan, NULL) != RAD_OK)
+        return 0;
+    double count = plan_patch_count(&plan, patch_size);
+    plan_free(&plan);
+    return count;
+}
+
 void rad_mesh_destroy(rad_mesh *mesh)
 {
     if (!mesh)

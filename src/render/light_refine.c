@@ -341,7 +341,7 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
     /* no piece's edge shorter than the default mesh's (the dense solvers' patch size,
      * split by the shadow refinement's default levels) split LIGHT_REFINE_LEVELS times:
      * a mesh already that fine (the hierarchical solver's) is left as it is */
-    const double patch_size = rad_default_patch_size(scene, RAD_SOLVER_AUTO);
+    const double patch_size = rad_default_patch_size(scene, RAD_SOLVER_JACOBI);
     const double smallest =
         0.99 * patch_size / (1u << (RAD_SHADOW_LEVELS_DEFAULT + LIGHT_REFINE_LEVELS));
     st.reach = LIGHT_REFINE_REACH * patch_size;

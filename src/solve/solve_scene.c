@@ -47,9 +47,13 @@ static double dense_matrix_bytes(uint32_t patches, rad_solver solver)
 
 double rad_default_patch_size(const rad_scene *scene, rad_solver solver)
 {
-    return rad_mesh_default_patch_size(scene, solver == RAD_SOLVER_HIERARCHICAL
-                                                  ? RAD_HIERARCHICAL_DEFAULT_PATCHES
-                                                  : RAD_DEFAULT_PATCHES);
+    if (solver == RAD_SOLVER_HIERARCHICAL)
+        return rad_mesh_default_patch_size(scene, RAD_HIERARCHICAL_DEFAULT_PATCHES);
+    double size = rad_mesh_default_patch_size(scene, RAD_DEFAULT_PATCHES);
+    if (solver == RAD_SOLVER_AUTO && size > 0 &&
+        rad_mesh_patch_count_at(scene, size) > RAD_DENSE_MAX_PATCHES)
+        return rad_mesh_default_patch_size(scene, RAD_HIERARCHICAL_DEFAULT_PATCHES);
+    return size;
 }
 
 /* What the solver's large buffers may take: options.max_memory, and, with a memory budget
