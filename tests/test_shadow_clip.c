@@ -86,18 +86,26 @@ static double monte_carlo(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver, un
     return mean;
 }
 
+/* The convex polygon a b c d with its front normal. */
+static vf_polygon quad(rad_vec3 a, rad_vec3 b, rad_vec3 c, rad_vec3 d, rad_vec3 normal)
+{
+    vf_polygon polygon = {0};
+    polygon.count = 4;
+    polygon.vertex[0] = a;
+    polygon.vertex[1] = b;
+    polygon.vertex[2] = c;
+    polygon.vertex[3] = d;
+    polygon.normal = normal;
+    vf_polygon_finish(&polygon);
+    return polygon;
+}
+
 /* The part of a polygon in front of a plane through one of its corners keeps that corner
  * once; a part with more corners than a polygon holds is the whole polygon. */
 static void check_clip_front(void)
 {
-    vf_polygon diamond = {0};
-    diamond.count = 4;
-    diamond.vertex[0] = v3(3, 0.5, 0);
-    diamond.vertex[1] = v3(3, 0, 0.5);
-    diamond.vertex[2] = v3(3, 0.5, 1);
-    diamond.vertex[3] = v3(3, 1, 0.5);
-    diamond.normal = v3(-1, 0, 0);
-    vf_polygon_finish(&diamond);
+    vf_polygon diamond =
+        quad(v3(3, 0.5, 0), v3(3, 0, 0.5), v3(3, 0.5, 1), v3(3, 1, 0.5), v3(-1, 0, 0));
     vf_polygon part;
     CHECK(vf_polygon_clip_front(&diamond, v3(0, 0, 1), 0, &part));
     CHECK(part.count == 4);
@@ -125,14 +133,10 @@ static void check_repeated_corner(void)
 {
     const shadow_polygon cover = {{{-1, -1, 1}, {2, -1, 1}, {2, 2, 1}, {-1, 2, 1}}, 4};
     for (int variant = 0; variant < 3; variant++) {
-        vf_polygon receiver = {0};
-        receiver.count = 5;
-        receiver.vertex[0] = v3(0, 0, 0);
-        receiver.vertex[1] = v3(1, 0, 0);
-        receiver.vertex[2] = v3(1, 1, 0);
-        receiver.vertex[3] = v3(0, 1, 0);
-        receiver.vertex[4] = variant == 0 ? v3(0, 1, 0) : v3(0, 1 - 3e-16 * variant, 0);
-        receiver.normal = v3(0, 0, 1);
+        vf_polygon receiver =
+            quad(v3(0, 0, 0), v3(1, 0, 0), v3(1, 1, 0), v3(0, 1, 0), v3(0, 0, 1));
+        receiver.vertex[receiver.count++] =
+            variant == 0 ? v3(0, 1, 0) : v3(0, 1 - 3e-16 * variant, 0);
         vf_polygon_finish(&receiver);
         rad_rng rng = rad_rng_seed(3, (uint64_t)variant, 0);
         double largest = 0;
@@ -154,14 +158,8 @@ int main(void)
     check_clip_front();
     check_repeated_corner();
     /* the receiver: a wall at x = 220 facing -x; the points: a wall at z = 86 facing +z */
-    vf_polygon receiver = {0};
-    receiver.count = 4;
-    receiver.vertex[0] = v3(220, 0, 130);
-    receiver.vertex[1] = v3(220, 0, 140);
-    receiver.vertex[2] = v3(220, 23.3561, 140);
-    receiver.vertex[3] = v3(220, 23.3561, 130);
-    receiver.normal = v3(-1, 0, 0);
-    vf_polygon_finish(&receiver);
+    vf_polygon receiver = quad(v3(220, 0, 130), v3(220, 0, 140), v3(220, 23.3561, 140),
+                               v3(220, 23.3561, 130), v3(-1, 0, 0));
     rad_vec3 n = v3(0, 0, 1);
     double worst_excess = 0, worst_covered = 0, worst_z = 0, largest = 0;
     unsigned covered = 0;

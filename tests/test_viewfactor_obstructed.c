@@ -103,6 +103,26 @@ static uint32_t surface_named(const rad_scene *scene, const char *name)
     return 0;
 }
 
+/* The scene of these files and its matrix (default options); false, with nothing held,
+ * when either fails. */
+static bool load_and_compute(const rad_scene_file *files, uint32_t count, rad_scene **scene,
+                             rad_viewfactor_matrix **m, rad_viewfactor_report *report)
+{
+    rad_error error = {0};
+    *scene = NULL;
+    *m = NULL;
+    CHECK(rad_scene_load_files(files, count, NULL, scene, &error) == RAD_OK);
+    if (!*scene)
+        return false;
+    CHECK(rad_viewfactor_matrix_compute(*scene, NULL, m, report, &error) == RAD_OK);
+    if (!*m) {
+        rad_scene_destroy(*scene);
+        *scene = NULL;
+        return false;
+    }
+    return true;
+}
+
 /* F_IJ and its error bound (0 and 0 when not stored). */
 static double factor(const rad_viewfactor_matrix *m, uint32_t I, uint32_t J, double *bound)
 {
@@ -209,18 +229,11 @@ static void check_tube_in_tube(bool blocker_is_surface)
                                {blocker, blocker_is_surface ? 0 : RAD_SURFACE_OBSTRUCTION,
                                 false},
                                {sphere, 0, false}};
-    rad_scene *scene = NULL;
-    rad_error error = {0};
-    CHECK(rad_scene_load_files(files, 3, NULL, &scene, &error) == RAD_OK);
-    if (!scene)
-        return;
-    rad_viewfactor_matrix *m = NULL;
+    rad_scene *scene;
+    rad_viewfactor_matrix *m;
     rad_viewfactor_report report;
-    CHECK(rad_viewfactor_matrix_compute(scene, NULL, &m, &report, &error) == RAD_OK);
-    if (!m) {
-        rad_scene_destroy(scene);
+    if (!load_and_compute(files, 3, &scene, &m, &report))
         return;
-    }
     uint32_t T = surface_named(scene, "tube"), S = surface_named(scene, "sphere"),
              B = surface_named(scene, "blocker");
     double bound, F = factor(m, T, S, &bound);
@@ -472,24 +485,19 @@ static void check_corner_on_plane(void)
                                                        "v 2 -2 0.6\nf 1 2 3 4\n");
     rad_scene_file files[3] = {
         {floor, 0, false}, {diamond, 0, false}, {wall, RAD_SURFACE_OBSTRUCTION, false}};
-    rad_scene *scene = NULL;
-    rad_error error = {0};
-    CHECK(rad_scene_load_files(files, 3, NULL, &scene, &error) == RAD_OK);
-    if (!scene)
-        return;
-    rad_viewfactor_matrix *m = NULL;
+    rad_scene *scene;
+    rad_viewfactor_matrix *m;
     rad_viewfactor_report report;
-    CHECK(rad_viewfactor_matrix_compute(scene, NULL, &m, &report, &error) == RAD_OK);
-    if (m) {
-        uint32_t F0 = surface_named(scene, "floor"), D = surface_named(scene, "diamond");
-        double bound, F = factor(m, F0, D, &bound), standard_error;
-        double reference = monte_carlo(scene, F0, D, 400000, &standard_error);
-        printf("diamond on the floor's plane past a low wall: F %.5f, bound %.2g; brute-force "
-               "Monte Carlo %.5f +- %.2g; %llu exact\n",
-               F, bound, reference, standard_error, (unsigned long long)report.exact_pairs);
-        CHECK(report.exact_pairs == 1);
-        CHECK(fabs(F - reference) <= 3 * standard_error + bound);
-    }
+    if (!load_and_compute(files, 3, &scene, &m, &report))
+        return;
+    uint32_t F0 = surface_named(scene, "floor"), D = surface_named(scene, "diamond");
+    double bound, F = factor(m, F0, D, &bound), standard_error;
+    double reference = monte_carlo(scene, F0, D, 400000, &standard_error);
+    printf("diamond on the floor's plane past a low wall: F %.5f, bound %.2g; brute-force "
+           "Monte Carlo %.5f +- %.2g; %llu exact\n",
+           F, bound, reference, standard_error, (unsigned long long)report.exact_pairs);
+    CHECK(report.exact_pairs == 1);
+    CHECK(fabs(F - reference) <= 3 * standard_error + bound);
     rad_viewfactor_matrix_destroy(m);
     rad_scene_destroy(scene);
 }
