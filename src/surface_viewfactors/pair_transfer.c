@@ -257,8 +257,8 @@ static pair_round cast_round(const vf_polygon *p, const vf_polygon *q,
      * have no spread at all, and one segment through a street between two buildings made
      * a spread that passed for a bound 80 times too small. So the bound is at least what
      * the rarer outcome's count allows: m of n segments are consistent with a share up to
-     * poisson_upper(m) / n (95 %); a slot narrower than a cell, an occluder between them,
-     * is what they could have missed. */
+     * pair_poisson_upper(m) / n (95 %); a slot narrower than a cell, an occluder between
+     * them, is what they could have missed. */
     uint32_t rarer = weighed_blocked < weighed - weighed_blocked ? weighed_blocked
                                                                  : weighed - weighed_blocked;
     double rare_bound = (pair_poisson_upper(rarer) - rarer) / (double)(weighed ? weighed : 1);
