@@ -46,4 +46,33 @@ static inline void v3_bounds(const rad_vec3 *points, size_t count, rad_vec3 *lo,
 
 static inline int v3_is_finite(rad_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 
+/* The closed polygon `points` with each corner within `relative` of its extent (largest
+ * coordinate difference from the first corner) of the corner before it dropped, the last
+ * one against the first too: a clip through a corner makes it twice, a hair apart, and an
+ * edge of no length has no direction. Returns the corners kept. */
+static inline unsigned v3_drop_repeated(rad_vec3 *points, unsigned count, double relative)
+{
+    if (count < 2)
+        return count;
+    double extent = 0;
+    for (unsigned k = 1; k < count; k++) {
+        rad_vec3 d = v3_sub(points[k], points[0]);
+        extent = fmax(extent, fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))));
+    }
+    double tiny = relative * extent;
+    unsigned kept = 1;
+    for (unsigned k = 1; k < count; k++) {
+        rad_vec3 d = v3_sub(points[k], points[kept - 1]);
+        if (fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))) > tiny)
+            points[kept++] = points[k];
+    }
+    while (kept > 1) {
+        rad_vec3 d = v3_sub(points[kept - 1], points[0]);
+        if (fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))) > tiny)
+            break;
+        kept--;
+    }
+    return kept;
+}
+
 #endif

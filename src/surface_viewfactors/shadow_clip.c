@@ -24,27 +24,7 @@ typedef shadow_piece piece;
  * plane through one of its corners, vf_polygon_clip_front). */
 static void drop_repeated_corners(piece *p)
 {
-    if (p->count < 2)
-        return;
-    double extent = 0;
-    for (unsigned k = 1; k < p->count; k++) {
-        rad_vec3 d = v3_sub(p->vertex[k], p->vertex[0]);
-        extent = fmax(extent, fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))));
-    }
-    double tiny = 1e-12 * extent;
-    unsigned kept = 1;
-    for (unsigned k = 1; k < p->count; k++) {
-        rad_vec3 d = v3_sub(p->vertex[k], p->vertex[kept - 1]);
-        if (fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))) > tiny)
-            p->vertex[kept++] = p->vertex[k];
-    }
-    while (kept > 1) {
-        rad_vec3 d = v3_sub(p->vertex[kept - 1], p->vertex[0]);
-        if (fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))) > tiny)
-            break;
-        kept--;
-    }
-    p->count = kept;
+    p->count = v3_drop_repeated(p->vertex, p->count, 1e-12);
 }
 
 /* Keeps the part of `in` where dot(normal, v) - offset >= 0 (into `out`), repeated

@@ -167,24 +167,7 @@ bool vf_polygon_clip_front(const vf_polygon *polygon, rad_vec3 n, double offset,
     /* a corner on the plane between two in front comes out twice (as the end of one
      * crossing edge and the start of the next), or twice a hair apart: once only, as a
      * repeated corner is an edge with no direction */
-    double extent = 0;
-    for (unsigned k = 1; k < count; k++) {
-        rad_vec3 d = v3_sub(kept[k], kept[0]);
-        extent = fmax(extent, fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))));
-    }
-    unsigned distinct = count ? 1 : 0;
-    for (unsigned k = 1; k < count; k++) {
-        rad_vec3 d = v3_sub(kept[k], kept[distinct - 1]);
-        if (fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))) > 1e-12 * extent)
-            kept[distinct++] = kept[k];
-    }
-    while (distinct > 1) {
-        rad_vec3 d = v3_sub(kept[distinct - 1], kept[0]);
-        if (fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))) > 1e-12 * extent)
-            break;
-        distinct--;
-    }
-    count = distinct;
+    count = v3_drop_repeated(kept, count, 1e-12);
     if (count > VF_MAX_VERTICES)
         return true; /* the whole polygon, as said */
     if (count < 3)
