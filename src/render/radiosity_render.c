@@ -48,7 +48,8 @@
 #define EDGE_CONTRAST 0.1        /* relative luminance spread that makes an edge */
 #define EDGE_STREAM 0x5EED0EDCEull /* keeps edge samples' random numbers apart */
 #define LIGHT_STREAM 0x5EED11647ull /* the same for shadow rays toward light sources */
-#define LIGHT_BATCH 65536u         /* shadow rays traced together, at most */
+#define LIGHT_BATCH 4096u          /* shadow rays traced together, at most (Embree takes
+                                      them in chunks of 256: more only costs memory) */
 #define MAX_DIRECT_SAMPLES 1024u   /* emitter samples per pixel sample, at most */
 #define EMITTER_STREAM 0x5EEDE3177ull /* the per-pixel shifts of the emitters' samples */
 
@@ -639,6 +640,8 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B, const rad_
                 surface_emits[mesh->patches[p].surface] = 1;
         }
     }
+    const bool emitters_exact =
+        emitters_ptr && emitter_unshadowed_exact(emitters_ptr, options->scene);
     work = rad_alloc_array((size_t)threads, sizeof(*work));
     if (!work)
         goto nomem;
@@ -672,7 +675,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B, const rad_
             if (!w->light_rays || !w->light_value || !w->light_sample || !w->light_blocked)
                 goto nomem;
         }
-        if (emitters_ptr) {
+        if (emitters_ptr && !emitters_exact) { /* their MIS half (queue_lights) */
             w->cosine_capacity = LIGHT_BATCH;
             w->cosine_rays = rad_alloc_array(LIGHT_BATCH, sizeof(*w->cosine_rays));
             w->cosine_hits = rad_alloc_array(LIGHT_BATCH, sizeof(*w->cosine_hits));
@@ -694,7 +697,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B, const rad_
                      k * k,     options->seed,
                      options->irradiance,
                      emitters_ptr, options->scene,
-                     emitters_ptr && emitter_unshadowed_exact(emitters_ptr, options->scene),
+                     emitters_exact,
                      emitter_samples, per_row,
                      edge_k * edge_k, scene_tracer};
 
