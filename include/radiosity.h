@@ -1614,11 +1614,14 @@ typedef struct rad_render_options {
     bool irradiance;
     /* How the emitters' direct light (emissive surfaces; with `scene`) reaches the image:
      * RAD_DIRECT_VERTEX (the default): computed at every mesh vertex, at a point a tenth of
-     *   the way into the vertex's patches, together with a final gather there (1024 cosine
+     *   the way into the vertex's patches, together with a final gather there (1600 cosine
      *   rays meeting the solution's reflected light (B - E) / pi, or the sky), and
      *   interpolated: the vertex shows E / pi + rho / pi (H_emitters + H_gathered); soft
      *   shadows, contact shadows and the light next to creases follow the light, not patch
-     *   means, and the image has no pixel noise;
+     *   means. In a penumbra (a display triangle whose corners' shadow rays disagree, or
+     *   one of which finds a part of the light) each pixel sample computes H_emitters
+     *   itself with 64 shadow rays, as RAD_DIRECT_PIXEL does: a penumbra's kinks are not
+     *   cut off by interpolation, with a little noise there; elsewhere no pixel noise;
      * RAD_DIRECT_PIXEL: H_emitters computed at every pixel sample by `direct_samples`
      *   shadow rays to points of the emitters (stratified over the pixel's samples; exact
      *   soft shadows, a little noise in penumbrae), the rest (H_gathered) at the vertices as

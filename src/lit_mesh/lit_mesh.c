@@ -111,12 +111,13 @@ static rad_status patch_irradiance(const rad_mesh *mesh, const rad_rgb *B,
 
 /* Writes the validated solution: `inputs` (NULL: built where needed) are the patch inputs
  * the light is computed with, `illuminance_wanted` whether the vertices carry it, `parent`
- * (NULL: the mesh is the solution's) the solution's patch of each of mesh's. */
+ * (NULL: the mesh is the solution's) the solution's patch of each of mesh's, `parents`
+ * (NULL: every vertex gathers) where each vertex's gathered light comes from. */
 static rad_status write_lit_mesh(const rad_mesh *mesh, const rad_rgb *B, const char *path,
                                  const rad_lit_mesh_options *options,
                                  const rad_patch_inputs *inputs, bool illuminance_wanted,
-                                 const uint32_t *parent, lit_mesh_format format,
-                                 rad_error *error)
+                                 const uint32_t *parent, const vertex_parents *parents,
+                                 lit_mesh_format format, rad_error *error)
 {
     /* the light computed at the vertices, as the default render shows it */
     bool vertex_light = options && options->direct_light != RAD_DIRECT_SOLUTION &&
@@ -152,7 +153,7 @@ static rad_status write_lit_mesh(const rad_mesh *mesh, const rad_rgb *B, const c
                               "%u vertices", path, n);
         if (status == RAD_OK)
             status = vertex_radiance_of_solution(
-                mesh, &shown, B, options->scene, used ? used : built, options->seed,
+                mesh, &shown, B, options->scene, used ? used : built, parents, options->seed,
                 options->threads > 0 ? options->threads : omp_get_max_threads(), radiance,
                 illuminance, error);
         if (status != RAD_OK)
@@ -301,8 +302,8 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
     bool vertex_light = options && options->direct_light != RAD_DIRECT_SOLUTION &&
                         vertex_radiance_applies(options->scene);
     if (!vertex_light)
-        return write_lit_mesh(mesh, B, path, options, inputs, inputs != NULL, NULL, format,
-                              error);
+        return write_lit_mesh(mesh, B, path, options, inputs, inputs != NULL, NULL, NULL,
+                              format, error);
     light_refined refined;
     rad_status status = light_refine(options->scene, mesh, B, inputs,
                                      options->threads > 0 ? options->threads
@@ -311,9 +312,9 @@ rad_status rad_lit_mesh_write(const rad_mesh *mesh, const rad_rgb *B, const char
     if (status == RAD_OK)
         status = refined.mesh ? write_lit_mesh(refined.mesh, refined.B, path, options,
                                                refined.inputs, inputs != NULL, refined.parent,
-                                               format, error)
+                                               refined.parents, format, error)
                               : write_lit_mesh(mesh, B, path, options, inputs, inputs != NULL,
-                                               NULL, format, error);
+                                               NULL, NULL, format, error);
     light_refined_free(&refined);
     return status;
 }

@@ -139,6 +139,20 @@ static int bends(const rad_patch *patch, const vertex_share *share)
     return open_hi - open_lo > LIGHT_REFINE_OPEN ? 2 : 0;
 }
 
+/* Whether the light the surfaces around reflect bends inside the patch: its corners'
+ * openness differs (a crease or a contact). Where it does not, a vertex added inside the
+ * patch takes its gathered light from the patch's corners (vertex_parents), as the patch
+ * unsplit would show it: only the emitters' light is computed there. */
+static bool reflected_bends(const rad_patch *patch, const vertex_share *share)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    for (uint32_t k = 0; k < patch->vertex_count; k++) {
+        lo = fmin(lo, share[patch->vertex[k]].open);
+        hi = fmax(hi, share[patch->vertex[k]].open);
+    }
+    return hi - lo > LIGHT_REFINE_OPEN;
+}
+
 /* The midpoint vertex of edge (a, b), made once per edge (open addressing on the key). */
 typedef struct midpoints {
     uint64_t *key;
@@ -146,7 +160,8 @@ typedef struct midpoints {
     size_t mask;
 } midpoints;
 
-static uint32_t midpoint(midpoints *table, rad_mesh *mesh, uint32_t a, uint32_t b)
+static uint32_t midpoint(midpoints *table, rad_mesh *mesh, vertex_parents *parents, uint32_t a,
+                         uint32_t b)
 {
     uint64_t key = edge_key(a, b);
     for (size_t slot = edge_key_hash(key) & table->mask;; slot = (slot + 1) & table->mask) {
@@ -156,6 +171,7 @@ static uint32_t midpoint(midpoints *table, rad_mesh *mesh, uint32_t a, uint32_t 
             table->key[slot] = key;
             uint32_t v = mesh->vertex_count++;
             mesh->vertices[v] = v3_scale(v3_add(mesh->vertices[a], mesh->vertices[b]), 0.5);
+            parents[v] = (vertex_parents){{a, b, 0, 0}, 2};
             table->vertex[slot] = v;
             return v;
         }
@@ -185,9 +201,10 @@ static rad_patch piece(const rad_patch *patch, const rad_mesh *mesh, const uint3
 }
 
 /* The next mesh: each patch marked in `split` in four (in its place, so the twins still
- * come last), *parent updated to the new patches. */
+ * come last), *parent updated to the new patches and *parents to the new vertices. */
 static rad_status split_patches(const rad_mesh *mesh, const uint8_t *split, uint32_t splits,
-                                uint32_t **parent, rad_mesh **out, rad_error *error)
+                                const vertex_share *share, uint32_t **parent,
+                                vertex_parents **parents, rad_mesh **out, rad_error *error)
 {
     rad_mesh *next = rad_alloc_array(1, sizeof(*next));
     midpoints table = {0};
@@ -198,6 +215,11 @@ static rad_status split_patches(const rad_mesh *mesh, const uint8_t *split, uint
                                           sizeof(*new_index));
     uint32_t patches = mesh->patch_count + 3 * splits;
     uint32_t *next_parent = rad_alloc_array(patches ? patches : 1, sizeof(*next_parent));
+    vertex_parents *grown = rad_resize_array(*parents, (size_t)mesh->vertex_count +
+                                                           5 * (size_t)splits,
+                                             sizeof(*grown));
+    if (grown)
+        *parents = grown;
     if (next) {
         *next = *mesh;
         next->vertices = rad_alloc_array((size_t)mesh->vertex_count + 5 * (size_t)splits,
@@ -208,7 +230,7 @@ static rad_status split_patches(const rad_mesh *mesh, const uint8_t *split, uint
     table.vertex = rad_alloc_array(slots, sizeof(*table.vertex));
     table.mask = slots - 1;
     if (!next || !next->vertices || !next->patches || !table.key || !table.vertex ||
-        !new_index || !next_parent) {
+        !new_index || !next_parent || !grown) {
         rad_mesh_destroy(next);
         free(table.key);
         free(table.vertex);
@@ -228,9 +250,13 @@ static rad_status split_patches(const rad_mesh *mesh, const uint8_t *split, uint
             continue;
         }
         const uint32_t *v = patch->vertex;
+        const bool gathers = reflected_bends(patch, share);
         uint32_t m[4];
-        for (uint32_t k = 0; k < patch->vertex_count; k++)
-            m[k] = midpoint(&table, next, v[k], v[(k + 1) % patch->vertex_count]);
+        for (uint32_t k = 0; k < patch->vertex_count; k++) {
+            m[k] = midpoint(&table, next, grown, v[k], v[(k + 1) % patch->vertex_count]);
+            if (gathers) /* (an edge's midpoint gathers when either side's patch bends) */
+                grown[m[k]].count = 0;
+        }
         uint32_t corners[4][4];
         uint32_t count;
         if (patch->vertex_count == 4) {
@@ -239,6 +265,7 @@ static rad_status split_patches(const rad_mesh *mesh, const uint8_t *split, uint
                 v3_add(v3_add(mesh->vertices[v[0]], mesh->vertices[v[1]]),
                        v3_add(mesh->vertices[v[2]], mesh->vertices[v[3]])),
                 0.25);
+            grown[c] = (vertex_parents){{v[0], v[1], v[2], v[3]}, gathers ? 0 : 4};
             const uint32_t q[4][4] = {{v[0], m[0], c, m[3]},
                                       {m[0], v[1], m[1], c},
                                       {c, m[1], v[2], m[2]},
@@ -322,6 +349,8 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
     uint32_t *parent = rad_alloc_array(mesh->patch_count, sizeof(*parent));
     vertex_share *share = NULL;
     uint8_t *split = NULL;
+    vertex_parents *parents = rad_alloc_array(mesh->vertex_count ? mesh->vertex_count : 1,
+                                              sizeof(*parents));
     rad_status status = emitters_build(scene, &set, error);
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &occluders, error);
@@ -331,12 +360,14 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
     }
     if (status != RAD_OK)
         goto done;
-    if (!parent) {
+    if (!parent || !parents) {
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light's finer mesh");
         goto done;
     }
     for (uint32_t p = 0; p < mesh->patch_count; p++)
         parent[p] = p;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++)
+        parents[v] = (vertex_parents){{0, 0, 0, 0}, 0};
     refine_state st = {scene, &set, occluders, vertex_radiance_leave(mesh), threads, 0};
     /* no piece's edge shorter than the default mesh's (the dense solvers' patch size,
      * split by the shadow refinement's default levels) split LIGHT_REFINE_LEVELS times:
@@ -391,7 +422,7 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
         if (splits == 0)
             break;
         rad_mesh *next = NULL;
-        status = split_patches(at, split, splits, &parent, &next, error);
+        status = split_patches(at, split, splits, share, &parent, &parents, &next, error);
         if (status != RAD_OK)
             goto done;
         rad_mesh_destroy(current);
@@ -402,8 +433,10 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
         status = carry_solution(current, parent, B, inputs, out, error);
         out->mesh = current;
         out->parent = parent;
+        out->parents = parents;
         current = NULL;
         parent = NULL;
+        parents = NULL;
     }
 done:
     if (status != RAD_OK)
@@ -413,6 +446,7 @@ done:
     rad_tracer_destroy(occluders);
     emitters_free(&set);
     free(parent);
+    free(parents);
     free(share);
     free(split);
     return status;
@@ -423,6 +457,7 @@ void light_refined_free(light_refined *refined)
     rad_mesh_destroy(refined->mesh);
     free(refined->B);
     free(refined->parent);
+    free(refined->parents);
     rad_patch_inputs_destroy(refined->inputs);
     *refined = (light_refined){0};
 }

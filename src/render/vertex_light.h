@@ -7,8 +7,9 @@
  * solution's reflected light (a final gather: VERTEX_GATHER_RAYS cosine-weighted rays
  * meeting (B - E) / pi, the sky where they leave; or fewer meeting a change of that light:
  * vertex_radiance.h). The default render interpolates these point values over the display
- * triangles, so soft shadows, contact shadows and the light next to creases follow the
- * light itself, not patch means smeared over neighbours, and the image has no pixel noise.
+ * triangles (the emitters' light in penumbrae excepted: radiosity_render.c), so soft
+ * shadows, contact shadows and the light next to creases follow the light itself, not
+ * patch means smeared over neighbours.
  * Each vertex is evaluated a tenth of the way toward the centre of the patches that share
  * it (those `hidden` does not mark), on their side, so a vertex on a crease or a contact
  * takes the open side's value.
@@ -41,6 +42,21 @@ typedef struct vertex_frame {
 /* frame[v] for the mesh's vertices, patches marked in `hidden` (NULL: none) left out. */
 void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *frame);
 
+/* What a vertex's shadow rays toward the emitters found: all blocked (or none traced),
+ * some, or none blocked. A display triangle whose corners disagree, or one of which sees
+ * a part, lies in a penumbra: the default render computes the emitters' light at its
+ * pixels (radiosity_render.c). */
+enum { VERTEX_SEES_NONE, VERTEX_SEES_PART, VERTEX_SEES_ALL };
+
+/* Where a vertex's gathered light comes from: count 0, its own gather; else the mean of
+ * the gathered light of `count` (2 or 4) vertices of lower index (light_refine.h: a vertex
+ * it added where only the emitters' light bends, whose reflected light is as linear as
+ * its patch's). */
+typedef struct vertex_parents {
+    uint32_t vertex[4];
+    uint32_t count;
+} vertex_parents;
+
 /* What vertex_light computes and with what. */
 typedef struct vertex_light_job {
     const emitter_set *emitters; /* their direct light, traced against `occluders` (the
@@ -54,6 +70,9 @@ typedef struct vertex_light_job {
     uint32_t gather_rays;        /* per vertex: VERTEX_GATHER_RAYS, or fewer for a
                                     correction (a view of a change: gather.h) */
     const uint8_t *hidden;       /* patches no one sees (NULL: none) */
+    const vertex_parents *parents; /* per vertex (NULL: every vertex gathers) */
+    uint8_t *sees;               /* out, per vertex (NULL: not asked): how much of the
+                                    emitters' light its shadow rays found (VERTEX_SEES_*) */
     double leave;                /* how far rays start off a surface */
     uint64_t seed;
     int threads;

@@ -95,6 +95,7 @@ static rad_status gather_correction(const vertex_radiance_job *job, const rad_rg
             .view = &view,
             .gather_rays = CORRECTION_RAYS,
             .hidden = job->hidden,
+            .parents = job->parents,
             .leave = job->leave,
             .seed = job->seed ^ CORRECTION_STREAM,
             .threads = job->threads,
@@ -137,6 +138,8 @@ rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
         .view = job->view,
         .gather_rays = VERTEX_GATHER_RAYS,
         .hidden = job->hidden,
+        .parents = job->parents,
+        .sees = job->sees,
         .leave = job->leave,
         .seed = job->seed,
         .threads = job->threads,
@@ -148,10 +151,12 @@ rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
     if (status != RAD_OK)
         goto done;
     for (uint32_t v = 0; v < mesh->vertex_count; v++) { /* gathered, then the rest */
-        if (!job->emitters_at_hits)
-            rgb_add_to(&incident[v], direct[v]);
         if (!job->sharp_at_hits)
             rgb_add_to(&incident[v], sharp[v]);
+        if (job->without_emitters)
+            job->without_emitters[v] = incident[v];
+        if (!job->emitters_at_hits)
+            rgb_add_to(&incident[v], direct[v]);
     }
     free(direct);
     free(sharp);
@@ -183,6 +188,12 @@ rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
     for (uint32_t v = 0; v < mesh->vertex_count; v++)
         radiance[v] = rgb_add(vertex_emission[v], rgb_mul(vertex_factor[v], incident[v]));
     display_mesh_constrain(mesh, display, radiance);
+    if (job->without_emitters) {
+        rad_rgb *without = job->without_emitters;
+        for (uint32_t v = 0; v < mesh->vertex_count; v++)
+            without[v] = rgb_add(vertex_emission[v], rgb_mul(vertex_factor[v], without[v]));
+        display_mesh_constrain(mesh, display, without);
+    }
     if (irradiance) {
         memcpy(irradiance, incident, display->vertex_count * sizeof(*irradiance));
         display_mesh_constrain(mesh, display, irradiance);
@@ -198,7 +209,8 @@ done:
 
 rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh *display,
                                        const rad_rgb *B, const rad_scene *scene,
-                                       const rad_patch_inputs *inputs, uint64_t seed,
+                                       const rad_patch_inputs *inputs,
+                                       const vertex_parents *parents, uint64_t seed,
                                        int threads, rad_rgb *radiance, rad_rgb *irradiance,
                                        rad_error *error)
 {
@@ -249,6 +261,7 @@ rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh 
         .view = &view,
         .sharp = any_lights && lights.sharp_count > 0 ? &lights : NULL,
         .hidden = hidden,
+        .parents = parents,
         .leave = leave,
         .seed = seed,
         .threads = threads,

@@ -29,6 +29,7 @@
 #include "radiosity.h"
 #include "reconstruct/display_mesh.h"
 #include "render/gather.h"
+#include "render/vertex_light.h"
 #include "scene/patch_materials.h"
 
 typedef struct vertex_radiance_job {
@@ -45,6 +46,12 @@ typedef struct vertex_radiance_job {
     bool sharp_at_hits;                  /* H_sharp left out: each hit adds its own (it
                                             still lights the second gather's field) */
     const uint8_t *hidden;               /* patches no one sees */
+    const vertex_parents *parents;       /* per vertex, or NULL (vertex_light_job) */
+    uint8_t *sees;                       /* out, or NULL: per mesh vertex, what its shadow
+                                            rays found (vertex_light_job) */
+    rad_rgb *without_emitters;           /* out, or NULL: per display vertex, the radiance
+                                            without H_emitters (for the pixels that add
+                                            their own) */
     double leave;                        /* how far rays start off a surface */
     bool emitters_at_hits;               /* H_emitters left out: each hit adds its own (it
                                             still lights the second gather's field) */
@@ -63,8 +70,11 @@ rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
  * on: the per-vertex arrays, the display mesh's tracer and the scene's. Measured with
  * --max-memory's high-water mark (rad_memory_budget_peak) around the lit mesh of `solve`,
  * 2 threads, the light's finer mesh left out: 725 bytes a patch on a furnished room of
- * 29152 patches, 737 on the Cornell box's 3742; rounded up. */
-#define VERTEX_LIGHT_BYTES_PER_PATCH 800u
+ * 29152 patches, 737 on the Cornell box's 3742; rounded up (800), and 64 more for what the
+ * render adds since it computes the emitters' light in penumbrae at the pixels (the
+ * radiance without it, 24 bytes a display vertex, and a byte a vertex and a triangle: a
+ * Cornell box's hierarchical render under --max-memory 8M needed 1.5 MB of it past 800). */
+#define VERTEX_LIGHT_BYTES_PER_PATCH 864u
 
 /* Whether the light at the vertices has anything to compute for this scene: emitting
  * surfaces or light sources (else the solution's patch values are all there is). */
@@ -87,7 +97,8 @@ double vertex_radiance_leave(const rad_mesh *mesh);
  * shows its mean albedo (no textures). */
 rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh *display,
                                        const rad_rgb *B, const rad_scene *scene,
-                                       const rad_patch_inputs *inputs, uint64_t seed,
+                                       const rad_patch_inputs *inputs,
+                                       const vertex_parents *parents, uint64_t seed,
                                        int threads, rad_rgb *radiance, rad_rgb *irradiance,
                                        rad_error *error);
 
