@@ -109,6 +109,7 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 #define RAD_DEFAULT_VISIBILITY_RAYS 16  /* rad_formfactor_options.visibility_rays */
 #define RAD_DEFAULT_ACCURACY 1e-4       /* rad_viewfactor_options.accuracy */
 #define RAD_DEFAULT_MAX_RAYS 1024       /* rad_viewfactor_options.max_rays */
+#define RAD_SIGHT_RAYS_NONE UINT32_MAX  /* rad_viewfactor_options.sight_rays: none */
 #define RAD_DEFAULT_EMISSIVITY 0.9      /* rad_surface.emissivity when the file gives none */
 #define RAD_DEFAULT_RENDER_SPP 16       /* rad_render_options.samples_per_pixel */
 #define RAD_DEFAULT_DIRECT_SAMPLES 8    /* rad_render_options.direct_samples */
@@ -808,6 +809,12 @@ typedef struct rad_viewfactor_options {
                             most accuracy x sqrt(F unobstructed), so a row's sum stays
                             within accuracy, or until max_rays */
     uint32_t max_rays;   /* visibility rays per sampled polygon pair at most; 0 = 1024 */
+    uint32_t sight_rays; /* cosine-distributed rays from each surface that find which pairs
+                            see each other at all; a pair no ray of either side met is
+                            taken as F = 0, within 3 / sight_rays absolute (95 %), and is
+                            neither integrated nor proven hidden. 0 = ceil(3 / accuracy);
+                            RAD_SIGHT_RAYS_NONE: none, every pair is integrated or proven
+                            hidden (exact zeros; far slower on large open scenes) */
     uint64_t seed;
     int threads;         /* 0 = all cores */
     rad_progress_fn progress;
@@ -850,7 +857,20 @@ typedef struct rad_viewfactor_report {
                                     blocked: F = 0, stored with the bound of what the
                                     segments could have missed */
     uint64_t capped_pairs;       /* sampled pairs that reached max_rays first */
-    uint64_t rays;               /* visibility rays cast */
+    uint64_t rays;               /* visibility rays cast (not counting the sight rays) */
+    uint64_t unmet_pairs;        /* surface pairs (I, J > I) that no sight ray met: F = 0,
+                                    not stored, each within unmet_bound (95 %), neither
+                                    integrated nor proven hidden */
+    uint32_t sight_rays;         /* sight rays cast from each surface: ceil(3 / accuracy) */
+    uint64_t sight_rays_cast;    /* all of them, over every rank */
+    double unmet_bound;          /* 3 / sight_rays: no unmet pair's F_IJ or F_JI is larger
+                                    (95 %) */
+    double sight_seconds;        /* casting them and sharing the pairs they met */
+    double missed_largest;       /* the largest share of a surface's view that the pairs its
+                                    sight rays did not meet hold, by Good and Turing's
+                                    estimate (the surfaces one ray met, over the rays): about
+                                    what its row sum lacks */
+    double missed_mean;          /* the same, the mean over the surfaces */
     uint64_t nonzeros;           /* stored factors other than 0 */
     double largest_error_bound;  /* largest error_bound (absolute, in units of F) */
     double seconds;

@@ -375,19 +375,28 @@ static void check_proven_hidden(void)
     CHECK(rad_scene_load(path, NULL, &scene, &error) == RAD_OK);
     if (!scene)
         return;
-    rad_viewfactor_matrix *m = NULL;
-    rad_viewfactor_report report;
-    CHECK(rad_viewfactor_matrix_compute(scene, NULL, &m, &report, &error) == RAD_OK);
-    if (m) {
-        double bound, F = factor(m, surface_named(scene, "one"), surface_named(scene, "two"),
-                                 &bound);
-        printf("wall of 32 triangles: F %.3g bound %.3g, %llu proven hidden, %llu sampled\n", F,
-               bound, (unsigned long long)report.hidden_pairs,
-               (unsigned long long)report.sampled_pairs);
-        CHECK(F == 0 && bound == 0);
-        CHECK(report.hidden_pairs == 1);
+    /* without sight rays the pair must be proven hidden; with them (the default) no ray
+     * meets it, and it is 0 without a first look or a proof */
+    for (int sight = 0; sight < 2; sight++) {
+        rad_viewfactor_matrix *m = NULL;
+        rad_viewfactor_report report;
+        rad_viewfactor_options options = {.sight_rays = sight ? 0 : RAD_SIGHT_RAYS_NONE};
+        CHECK(rad_viewfactor_matrix_compute(scene, &options, &m, &report, &error) == RAD_OK);
+        if (m) {
+            double bound, F = factor(m, surface_named(scene, "one"),
+                                     surface_named(scene, "two"), &bound);
+            printf("wall of 32 triangles, %s: F %.3g bound %.3g, %llu proven hidden, %llu "
+                   "sampled, %llu surface pairs no sight ray met\n",
+                   sight ? "sight rays" : "no sight rays", F, bound,
+                   (unsigned long long)report.hidden_pairs,
+                   (unsigned long long)report.sampled_pairs,
+                   (unsigned long long)report.unmet_pairs);
+            CHECK(F == 0 && bound == 0);
+            CHECK(report.hidden_pairs == (sight ? 0u : 1u));
+            CHECK(sight ? report.unmet_pairs >= 1 : report.unmet_pairs == 0);
+        }
+        rad_viewfactor_matrix_destroy(m);
     }
-    rad_viewfactor_matrix_destroy(m);
     rad_scene_destroy(scene);
 }
 

@@ -49,7 +49,13 @@ static const char usage[] =
 
 /* The rest of the help (one string may hold 4095 characters in C17), after the scene's. */
 static const char usage_more[] =
-    "\nSky, repair, memory and long runs:\n"
+    "\nPairs that cannot see each other, sky, repair, memory and long runs:\n"
+    "  --sight-rays N|none  cosine-distributed rays from each surface that find the pairs\n"
+    "                       that see each other at all (default 3 / --accuracy); a pair\n"
+    "                       no ray of either side met is F = 0, within 3 / N (95 %),\n"
+    "                       and prints what such pairs hold of a row (estimated). none:\n"
+    "                       every pair is integrated or proven hidden (exact zeros, far\n"
+    "                       slower on large open scenes)\n"
     "  --sky-view-factor FILE  each surface's sky view factor (the share of its\n"
     "                       hemisphere that sees no surface, integrated like the factors)\n"
     "                       and its error bound: CSV, or a Matrix Market column for a\n"
@@ -72,9 +78,9 @@ static const char usage_more[] =
     "  --checkpoint-interval S  seconds between checkpoints (default 600; 0: after each\n"
     "                       1/64 of the rows)\n"
     "  --resume FILE        continue the job of this checkpoint (same scene, --accuracy,\n"
-    "                       --max-rays, --seed; others are refused): the output is the\n"
-    "                       one an uninterrupted run writes. Checkpoints go on to FILE\n"
-    "                       unless --checkpoint names another\n"
+    "                       --max-rays, --sight-rays, --seed; others are refused): the\n"
+    "                       output is the one an uninterrupted run writes. Checkpoints\n"
+    "                       go on to FILE unless --checkpoint names another\n"
     "  --plot FILE.svg      the fraction of polygon pairs left against time (log scale):\n"
     "                       the computation's progress; it has no iteration to converge\n";
 
@@ -82,7 +88,7 @@ enum {
     OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_FORMAT, OPT_ENCLOSURE, OPT_SCRIPT_F,
     OPT_OBSTRUCTION, OPT_TWO_SIDED, OPT_CHECKPOINT, OPT_CHECKPOINT_INTERVAL, OPT_RESUME,
     OPT_SKY_VIEW_FACTOR, OPT_REPAIR_ROWS, OPT_REPAIR_MAX_CHANGE, OPT_REPAIR_MAX_REMOVED,
-    OPT_COUNT
+    OPT_SIGHT_RAYS, OPT_COUNT
 };
 
 static const cli_option options[OPT_COUNT] = {
@@ -96,7 +102,8 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_SKY_VIEW_FACTOR] = {"sky-view-factor", 0, true},
     [OPT_REPAIR_ROWS] = {"repair-rows", 0, false},
     [OPT_REPAIR_MAX_CHANGE] = {"repair-max-change", 0, true},
-    [OPT_REPAIR_MAX_REMOVED] = {"repair-max-removed", 0, true}};
+    [OPT_REPAIR_MAX_REMOVED] = {"repair-max-removed", 0, true},
+    [OPT_SIGHT_RAYS] = {"sight-rays", 0, true}};
 
 /* --repair-rows' default limits (relative change of a factor, share of exchange). */
 #define REPAIR_MAX_CHANGE 0.05
@@ -265,6 +272,11 @@ int command_viewfactors(int argc, char **argv)
     }
     if (!cli_parse_count("max-rays", args.value[OPT_MAX_RAYS], 64, 1u << 24, &vf.max_rays))
         return EXIT_USAGE;
+    if (args.value[OPT_SIGHT_RAYS] && strcmp(args.value[OPT_SIGHT_RAYS], "none") == 0)
+        vf.sight_rays = RAD_SIGHT_RAYS_NONE;
+    else if (!cli_parse_count("sight-rays", args.value[OPT_SIGHT_RAYS], 64, 1u << 26,
+                              &vf.sight_rays))
+        return EXIT_USAGE;
     uint64_t max_memory = 0;
     if (args.value[OPT_MAX_MEMORY] &&
         !cli_parse_bytes("max-memory", args.value[OPT_MAX_MEMORY], &max_memory))
@@ -390,6 +402,11 @@ int command_viewfactors(int argc, char **argv)
                 check.largest_row_sum, closed);
     cli_summary("largest error bound of a factor %.3g (absolute)%s", report.largest_error_bound,
                 capped);
+    if (report.sight_rays)
+        cli_summary("pairs no sight ray met (%d a surface): F = 0, each within %.1e (95 %%); "
+                    "what they hold of a row, estimated: %.2g on average, %.2g at most",
+                    report.sight_rays, report.unmet_bound, report.missed_mean,
+                    report.missed_largest);
     if (check.largest > 1 || check.smallest < 0 || check.largest_planar_self > 0) {
         snprintf(error.message, sizeof(error.message),
                  "%s: internal error: a view factor outside [0, 1] or a planar F_ii > 0",
@@ -460,6 +477,13 @@ int command_viewfactors(int argc, char **argv)
     stats_integer(&stats, "unseen_pairs", report.unseen_pairs);
     stats_integer(&stats, "capped_pairs", report.capped_pairs);
     stats_integer(&stats, "rays_cast", report.rays);
+    stats_integer(&stats, "unmet_pairs", report.unmet_pairs);
+    stats_integer(&stats, "sight_rays_a_surface", report.sight_rays);
+    stats_integer(&stats, "sight_rays_cast", report.sight_rays_cast);
+    stats_number(&stats, "unmet_bound", report.unmet_bound);
+    stats_number(&stats, "sight_seconds", report.sight_seconds);
+    stats_number(&stats, "missed_share_largest", report.missed_largest);
+    stats_number(&stats, "missed_share_mean", report.missed_mean);
     stats_integer(&stats, "nonzeros", report.nonzeros);
     stats_integer(&stats, "threads", (uint64_t)report.threads);
     stats_number(&stats, "seconds_view_factors", report.seconds);
@@ -496,18 +520,26 @@ int command_viewfactors(int argc, char **argv)
         stats_integer(&stats, "ranks", (unsigned long long)rad_rank_count());
         stats_number(&stats, "load_imbalance", imbalance);
     }
+    char unmet[96] = "", sight[64] = "";
+    if (report.sight_rays) {
+        snprintf(unmet, sizeof(unmet), "%llu surface pairs no sight ray met (F = 0, within %.1e), ",
+                 (unsigned long long)report.unmet_pairs, report.unmet_bound);
+        snprintf(sight, sizeof(sight), " (and %llu sight rays)",
+                 (unsigned long long)report.sight_rays_cast);
+    }
     exit_code = cli_finish(&stats, stats_path,
-                           "%zu surfaces, %llu polygon pairs (%llu unobstructed exact, %llu "
-                           "obstructed exact, %llu sampled of which %llu saw nothing, %llu "
-                           "proven hidden), %llu rays, %llu non-zero factors, %.2f s: "
+                           "%zu surfaces, %s%llu polygon pairs (%llu unobstructed exact, "
+                           "%llu obstructed exact, %llu sampled of which %llu saw nothing, "
+                           "%llu proven hidden), %llu rays%s, %llu non-zero factors, %.2f s: "
                            "wrote %s",
-                           S, (unsigned long long)report.polygon_pairs,
+                           S, unmet, (unsigned long long)report.polygon_pairs,
                            (unsigned long long)report.unobstructed_pairs,
                            (unsigned long long)report.exact_pairs,
                            (unsigned long long)report.sampled_pairs,
                            (unsigned long long)report.unseen_pairs,
                            (unsigned long long)report.hidden_pairs,
-                           (unsigned long long)report.rays, (unsigned long long)report.nonzeros,
+                           (unsigned long long)report.rays, sight,
+                           (unsigned long long)report.nonzeros,
                            seconds, output ? output : "standard output");
     goto done;
 fail:

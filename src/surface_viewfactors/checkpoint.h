@@ -1,7 +1,7 @@
 /*
  * checkpoint.h - the restart file of a long view-factor run: the rows done so far, with
  * what identifies the job (a fingerprint of the scene's geometry and surfaces, the
- * accuracy, the ray cap and the seed), so that a resumed run continues the same job and
+ * accuracy, the ray caps and the seed), so that a resumed run continues the same job and
  * ends with the matrix an uninterrupted run gives, bitwise. Reading refuses, naming the
  * file, a checkpoint of another scene or other options and a damaged one. It does not
  * decide when to write (viewfactor_matrix.c does) and knows nothing of MPI.
@@ -21,6 +21,7 @@ typedef struct vf_checkpoint_job {
     double accuracy;      /* as used (defaults applied) */
     uint32_t max_rays;
     uint64_t seed;
+    uint32_t sight_rays;  /* 0: none */
 } vf_checkpoint_job;
 
 /* A hash of what the view factors depend on: positions, triangles (corners and surface),

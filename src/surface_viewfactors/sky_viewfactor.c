@@ -320,19 +320,6 @@ static unsigned cut_strips(const vf_polygon *p, vf_polygon *strips)
     return made;
 }
 
-/* A uniform point of the convex polygon from (s, t) in the unit square. */
-static rad_vec3 polygon_sample(const vf_polygon *p, double s, double t)
-{
-    unsigned k = 0;
-    while (k + 3 < p->count && s >= p->fan[k])
-        k++;
-    double low = k ? p->fan[k - 1] : 0, high = p->fan[k];
-    s = high > low ? (s - low) / (high - low) : 0;
-    double r = sqrt(fmin(fmax(s, 0), 1));
-    return v3_add(v3_add(v3_scale(p->vertex[0], 1 - r), v3_scale(p->vertex[k + 1], r * (1 - t))),
-                  v3_scale(p->vertex[k + 2], r * t));
-}
-
 /* The sampled tile the ray from x along d leaves the box through, or false. */
 static bool lands_on_sampled(const sky_context *c, const sky_workspace *w, rad_vec3 x,
                              rad_vec3 d, rad_vec3 *exit)
@@ -392,7 +379,7 @@ static double sample_sky(const sky_context *c, const vf_polygon *p, uint32_t pi,
             for (uint32_t done = 0; done < per_replicate;) {
                 uint32_t batch = 0;
                 for (; done < per_replicate && batch < w->pair.capacity; done++) {
-                    rad_vec3 x = polygon_sample(p, rad_rng_uniform(&rng), rad_rng_uniform(&rng));
+                    rad_vec3 x = vf_polygon_sample(p, rad_rng_uniform(&rng), rad_rng_uniform(&rng));
                     double q = rad_rng_uniform(&rng), phi = 2 * RAD_PI * rad_rng_uniform(&rng);
                     double radius = sqrt(q);
                     rad_vec3 d = v3_add(v3_add(v3_scale(t1, radius * cos(phi)),

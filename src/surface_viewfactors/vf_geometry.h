@@ -69,6 +69,10 @@ void vf_polygon_finish(vf_polygon *polygon);
 bool vf_polygon_clip_front(const vf_polygon *polygon, rad_vec3 n, double offset,
                            vf_polygon *out);
 
+/* A uniform point of the convex polygon from (s, t) in the unit square (its fan
+ * triangles by their area shares). */
+rad_vec3 vf_polygon_sample(const vf_polygon *p, double s, double t);
+
 /* True when some corner of `polygon` lies in front of the plane (n, offset) by more than
  * epsilon. */
 static inline bool vf_polygon_in_front(const vf_polygon *polygon, rad_vec3 n, double offset,

@@ -1,7 +1,9 @@
 /*
  * viewfactor_matrix.c - surface-to-surface view factors for engineers, see radiosity.h.
  *
- * Surface pairs (I, J), J >= I, are visited once, in parallel over rows I. A pair is
+ * Surface pairs (I, J), J >= I, are visited once, in parallel over rows I: with sight rays
+ * (seen_pairs.h) only the pairs some ray of either side met, the others being 0 within
+ * 3 / N; without, every pair. A pair is
  * skipped at once when either surface is planar and the other lies wholly behind (or on)
  * its plane. Otherwise every facing polygon pair (p of I, q of J) adds its transfer
  * G_pq = A_p F_pq (pair_transfer.c): 0 when pair_hidden.c proves every segment between
@@ -46,12 +48,13 @@
 #include "surface_viewfactors/pair_hidden.h"
 #include "surface_viewfactors/pair_transfer.h"
 #include "surface_viewfactors/pending_row.h"
+#include "surface_viewfactors/seen_pairs.h"
 #include "surface_viewfactors/vf_geometry.h"
 
 
 typedef struct pair_counts {
     uint64_t surface_pairs, polygon_pairs, unobstructed_pairs, hidden_pairs, obstructed_pairs,
-        exact_pairs, sampled_pairs, unseen_pairs, capped_pairs, rays;
+        exact_pairs, sampled_pairs, unseen_pairs, capped_pairs, rays, unmet_pairs;
 } pair_counts;
 
 /* Progress by polygon pairs, the unit of work (a row's cost is its polygons times the
@@ -89,12 +92,23 @@ typedef struct engine {
     const occluder_tree *tree;
     const rad_tracer *occluders;
     pair_hidden_context hidden; /* the tracer and the scene's planes, for hidden proofs */
+    const seen_pairs *seen;     /* the surface pairs some sight ray met (NULL: every pair
+                                   is integrated) */
+    const uint32_t *surfaces_after; /* per surface I: the surfaces J > I with polygons */
+    const double *polygons_after;   /* per surface I: the polygons of the surfaces J > I */
     double accuracy;
     uint32_t max_rays;
     uint64_t seed;
 } engine;
 
 static double now_seconds(void) { return rad_clock_seconds(); }
+
+/* Sight rays a surface (seen_pairs.h): enough that a pair none met is within `accuracy`
+ * absolute (95 %), at most 2^26. */
+static uint32_t sight_rays_for(double accuracy)
+{
+    return (uint32_t)fmin(ceil(SEEN_PAIRS_BOUND / accuracy), 67108864.0);
+}
 
 /* `plane` is flat and `other` lies wholly behind or on its plane. */
 static bool behind_plane(const vf_geometry *g, const vf_surface *plane, const vf_surface *other)
@@ -244,7 +258,40 @@ static bool row_push(pending_row *r, uint32_t column, double transfer, double bo
     return true;
 }
 
-/* Row I: every J >= I. False when out of memory. */
+/* Surface pair (I, J >= I) of row I into `out` when it has a transfer or a bound. False
+ * when out of memory. */
+static bool compute_surface_pair(const engine *e, uint32_t I, uint32_t J, pending_row *out,
+                                 pair_workspace *w, pair_hidden_memory *memory,
+                                 pair_counts *counts)
+{
+    const vf_geometry *g = e->geometry;
+    const vf_surface *a = &g->surfaces[I], *b = &g->surfaces[J];
+    counts->surface_pairs++;
+    if (J != I && surfaces_face_away(g, a, b)) {
+        progress_add(e->progress, (double)a->polygon_count * b->polygon_count);
+        return true;
+    }
+    double transfer = 0, variance = 0;
+    for (uint32_t pk = 0; pk < a->polygon_count; pk++) {
+        uint32_t pi = a->first_polygon + pk;
+        uint32_t q_first = J == I ? pi + 1 : b->first_polygon;
+        for (uint32_t qi = q_first; qi < b->first_polygon + b->polygon_count; qi++) {
+            double bound;
+            double G = polygon_pair(e, pi, qi, w, memory, counts, &bound);
+            transfer += G;
+            /* sampled parts are independent: their bounds add in quadrature */
+            variance += bound * bound;
+        }
+        progress_add(e->progress, b->first_polygon + b->polygon_count - q_first);
+    }
+    if (J == I)
+        transfer *= 2, variance *= 4;
+    /* a sampled 0 is kept with its bound: what the segments could have missed */
+    return !((transfer > 0 || variance > 0) && !row_push(out, J, transfer, sqrt(variance)));
+}
+
+/* Row I: every J >= I, or with sight rays, I itself (when curved) and the J > I some ray
+ * met; the others are 0 within their bound (seen_pairs.h). False when out of memory. */
 static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_workspace *w,
                         pair_counts *counts)
 {
@@ -254,34 +301,27 @@ static bool compute_row(const engine *e, uint32_t I, pending_row *out, pair_work
         return true;
     /* the row's own: its result cannot depend on which thread ran which row before */
     pair_hidden_memory memory = {0};
-    for (uint32_t J = I; J < g->surface_count; J++) {
-        const vf_surface *b = &g->surfaces[J];
-        if (b->polygon_count == 0 || (J == I && a->planar))
-            continue;
-        counts->surface_pairs++;
-        if (J != I && surfaces_face_away(g, a, b)) {
-            progress_add(e->progress, (double)a->polygon_count * b->polygon_count);
-            continue;
-        }
-        double transfer = 0, variance = 0;
-        for (uint32_t pk = 0; pk < a->polygon_count; pk++) {
-            uint32_t pi = a->first_polygon + pk;
-            uint32_t q_first = J == I ? pi + 1 : b->first_polygon;
-            for (uint32_t qi = q_first; qi < b->first_polygon + b->polygon_count; qi++) {
-                double bound;
-                double G = polygon_pair(e, pi, qi, w, &memory, counts, &bound);
-                transfer += G;
-                /* sampled parts are independent: their bounds add in quadrature */
-                variance += bound * bound;
-            }
-            progress_add(e->progress, b->first_polygon + b->polygon_count - q_first);
-        }
-        if (J == I)
-            transfer *= 2, variance *= 4;
-        /* a sampled 0 is kept with its bound: what the segments could have missed */
-        if ((transfer > 0 || variance > 0) && !row_push(out, J, transfer, sqrt(variance)))
+    if (!a->planar && !compute_surface_pair(e, I, I, out, w, &memory, counts))
+        return false;
+    if (!e->seen) {
+        for (uint32_t J = I + 1; J < g->surface_count; J++)
+            if (g->surfaces[J].polygon_count &&
+                !compute_surface_pair(e, I, J, out, w, &memory, counts))
+                return false;
+        return true;
+    }
+    const seen_pairs *seen = e->seen;
+    double met_polygons = 0;
+    for (uint64_t k = seen->row_start[I]; k < seen->row_start[I + 1]; k++) {
+        uint32_t J = seen->column[k];
+        met_polygons += g->surfaces[J].polygon_count;
+        if (!compute_surface_pair(e, I, J, out, w, &memory, counts))
             return false;
     }
+    uint64_t met = seen->row_start[I + 1] - seen->row_start[I];
+    counts->surface_pairs += e->surfaces_after[I] - met;
+    counts->unmet_pairs += e->surfaces_after[I] - met;
+    progress_add(e->progress, a->polygon_count * (e->polygons_after[I] - met_polygons));
     return true;
 }
 
@@ -343,6 +383,22 @@ static bool estimate_row_costs(const engine *e, int threads, double *cost)
         shadow_occluder occluders[PAIR_EXACT_MAX_OCCLUDERS];
         double sum = 0;
         uint32_t samples = 0;
+        if (e->seen) {
+            /* only the met pairs are visited (and a curved surface with itself) */
+            const seen_pairs *seen = e->seen;
+            uint64_t first = seen->row_start[I], met = seen->row_start[I + 1] - first;
+            double met_polygons = 0;
+            for (uint64_t k = first; k < first + met; k++)
+                met_polygons += g->surfaces[seen->column[k]].polygon_count;
+            pairs = p * met_polygons + (a->planar ? 0 : 0.5 * p * (p - 1));
+            for (uint32_t k = 0; k < COST_SAMPLES && met; k++) {
+                uint32_t J = seen->column[first + (met * (2 * k + 1)) / (2 * COST_SAMPLES)];
+                sum += pair_cost_estimate(e, a, &g->surfaces[J], occluders);
+                samples++;
+            }
+            cost[I] = pairs * (samples ? sum / samples : 1.0) + 1e-3 * p * polygons_after[I];
+            continue;
+        }
         for (uint32_t k = 0; k < COST_SAMPLES; k++) {
             uint32_t J = I + (uint32_t)(((uint64_t)(n - I) * (2 * k + 1)) / (2 * COST_SAMPLES));
             if (J >= n || g->surfaces[J].polygon_count == 0 || J == I)
@@ -610,7 +666,11 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     status = ranks_agree(status, "view factors", error);
     int rank = ranks_rank();
     /* a resumed run: rank 0 reads the rows done, and every rank learns which they are */
-    vf_checkpoint_job job = {vf_checkpoint_fingerprint(scene), n, e.accuracy, e.max_rays, e.seed};
+    uint32_t sight_rays = options->sight_rays == RAD_SIGHT_RAYS_NONE ? 0
+                          : options->sight_rays                   ? options->sight_rays
+                                                                  : sight_rays_for(e.accuracy);
+    vf_checkpoint_job job = {vf_checkpoint_fingerprint(scene), n, e.accuracy, e.max_rays, e.seed,
+                             sight_rays};
     uint32_t resumed = 0;
     if (status == RAD_OK && options->resume) {
         if (rank == 0)
@@ -637,6 +697,46 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     e.tree = tree;
     e.occluders = occluders;
     e.hidden = (pair_hidden_context){&planes, occluders, geometry.plane_epsilon};
+
+    /* the pairs some sight ray met (seen_pairs.h): every rank the same, for any rows */
+    seen_pairs seen = {0};
+    uint32_t *surfaces_after = rad_alloc_array((size_t)n + 1, sizeof(uint32_t));
+    double *polygons_after_surface = rad_alloc_array((size_t)n + 1, sizeof(double));
+    status = surfaces_after && polygons_after_surface
+                 ? RAD_OK
+                 : rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u rows", n);
+    status = ranks_agree(status, "view factors", error);
+    double sight_start = now_seconds();
+    if (status == RAD_OK) {
+        surfaces_after[n] = 0;
+        polygons_after_surface[n] = 0;
+        for (uint32_t I = n; I-- > 0;) {
+            uint32_t polygons = I + 1 < n ? geometry.surfaces[I + 1].polygon_count : 0;
+            surfaces_after[I] = surfaces_after[I + 1] + (polygons > 0);
+            polygons_after_surface[I] = polygons_after_surface[I + 1] + polygons;
+        }
+        if (sight_rays)
+            status = seen_pairs_build(scene, &geometry, occluders, sight_rays, e.seed, threads,
+                                      &seen, error);
+    }
+    double sight_seconds = now_seconds() - sight_start;
+    if (status != RAD_OK) {
+        free(surfaces_after);
+        free(polygons_after_surface);
+        for (uint32_t I = 0; I < n; I++)
+            free(rows[I].entries);
+        free(rows);
+        free(state);
+        free(mine);
+        rad_tracer_destroy(occluders);
+        occluder_tree_destroy(tree);
+        coplanar_polygons_free(&planes);
+        vf_geometry_free(&geometry);
+        return status;
+    }
+    e.seen = sight_rays ? &seen : NULL;
+    e.surfaces_after = surfaces_after;
+    e.polygons_after = polygons_after_surface;
 
     /* over several ranks: who computes which row (owner NULL: this process, all), decided
      * by rank 0 alone so that no rank can disagree; resumed rows are rank 0's already */
@@ -754,9 +854,21 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
             totals.unseen_pairs += counts.unseen_pairs;
             totals.capped_pairs += counts.capped_pairs;
             totals.rays += counts.rays;
+            totals.unmet_pairs += counts.unmet_pairs;
         }
     }
     double rank_seconds = now_seconds() - rows_start;
+    double missed_largest = 0, missed_sum = 0;
+    uint32_t missed_rows = 0;
+    for (uint32_t I = 0; sight_rays && I < n; I++)
+        if (geometry.surfaces[I].polygon_count) {
+            missed_largest = fmax(missed_largest, seen.missed[I]);
+            missed_sum += seen.missed[I];
+            missed_rows++;
+        }
+    seen_pairs_free(&seen);
+    free(surfaces_after);
+    free(polygons_after_surface);
     rad_tracer_destroy(occluders);
     occluder_tree_destroy(tree);
     coplanar_polygons_free(&planes);
@@ -773,14 +885,16 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
                                                   : "another rank ran out of memory")
                      : cp.interrupted ? RAD_OK
                                       : gather_rows(rows, state, n, error);
-        uint64_t sums[10] = {totals.surface_pairs,      totals.polygon_pairs,
+        uint64_t sums[12] = {totals.surface_pairs,      totals.polygon_pairs,
                              totals.unobstructed_pairs, totals.hidden_pairs,
                              totals.obstructed_pairs,   totals.exact_pairs,
                              totals.sampled_pairs,      totals.unseen_pairs,
-                             totals.capped_pairs,       totals.rays};
-        ranks_sum(sums, 10);
-        totals = (pair_counts){sums[0], sums[1], sums[2], sums[3], sums[4],
-                               sums[5], sums[6], sums[7], sums[8], sums[9]};
+                             totals.capped_pairs,       totals.rays,
+                             totals.unmet_pairs,        seen.rays_cast};
+        ranks_sum(sums, 12);
+        totals = (pair_counts){sums[0], sums[1], sums[2], sums[3], sums[4],  sums[5],
+                               sums[6], sums[7], sums[8], sums[9], sums[10]};
+        seen.rays_cast = sums[11];
         free(owner);
         if (status == RAD_OK && rank == 0 && !cp.interrupted)
             matrix = assemble(&geometry, rows, n);
@@ -814,6 +928,13 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         report->unseen_pairs = totals.unseen_pairs;
         report->capped_pairs = totals.capped_pairs;
         report->rays = totals.rays;
+        report->unmet_pairs = totals.unmet_pairs;
+        report->sight_rays = sight_rays;
+        report->sight_rays_cast = seen.rays_cast;
+        report->unmet_bound = sight_rays ? SEEN_PAIRS_BOUND / sight_rays : 0;
+        report->sight_seconds = sight_seconds;
+        report->missed_largest = missed_largest;
+        report->missed_mean = missed_rows ? missed_sum / missed_rows : 0;
         for (uint64_t k = 0; matrix && k < matrix->row_start[n]; k++) {
             report->nonzeros += matrix->value[k] != 0;
             report->largest_error_bound =
