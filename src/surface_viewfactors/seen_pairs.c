@@ -39,6 +39,7 @@ typedef struct seen_workspace {
     uint32_t *met;        /* per surface: how many of that one's rays met it */
     uint32_t *found;      /* the surfaces the current one's rays met */
     double *cumulative;   /* the current surface's polygon areas, summed */
+    rad_vec3 *frame;      /* the current surface's polygons' tangents, two each */
     uint32_t found_capacity, cumulative_capacity;
 } seen_workspace;
 
@@ -101,11 +102,18 @@ static bool cast_surface(const seen_job *job, uint32_t I, seen_workspace *w, hit
         if (!grown)
             return false;
         w->cumulative = grown;
+        rad_vec3 *frames = rad_resize_array(w->frame, 2 * (size_t)capacity, sizeof(rad_vec3));
+        if (!frames)
+            return false;
+        w->frame = frames;
         w->cumulative_capacity = capacity;
     }
     double total = 0;
-    for (uint32_t k = 0; k < s->polygon_count; k++)
-        w->cumulative[k] = total += g->polygons[s->first_polygon + k].area;
+    for (uint32_t k = 0; k < s->polygon_count; k++) {
+        const vf_polygon *p = &g->polygons[s->first_polygon + k];
+        w->cumulative[k] = total += p->area;
+        hemisphere_frame(p->normal, &w->frame[2 * k], &w->frame[2 * k + 1]);
+    }
     if (!(total > 0))
         return true;
     uint32_t found = 0;
@@ -117,10 +125,18 @@ static bool cast_surface(const seen_job *job, uint32_t I, seen_workspace *w, hit
                                      rad_rng_uniform(&rng) * total);
             const vf_polygon *p = &g->polygons[s->first_polygon + pk];
             double u1 = rad_rng_uniform(&rng), u2 = rad_rng_uniform(&rng);
-            double u3 = rad_rng_uniform(&rng), u4 = rad_rng_uniform(&rng);
-            rad_vec3 x = vf_polygon_sample(p, u1, u2), a, b;
-            hemisphere_frame(p->normal, &a, &b);
-            rad_vec3 d = cosine_direction(p->normal, a, b, u3, u4, 0, NULL);
+            rad_vec3 x = vf_polygon_sample(p, u1, u2);
+            /* cosine-distributed (Malley): a uniform point of the unit disc, by rejection
+             * from its square (no trigonometry), lifted onto the hemisphere */
+            double dx, dy, r2;
+            do {
+                dx = 2 * rad_rng_uniform(&rng) - 1;
+                dy = 2 * rad_rng_uniform(&rng) - 1;
+                r2 = dx * dx + dy * dy;
+            } while (r2 > 1);
+            rad_vec3 d = v3_add(v3_scale(p->normal, sqrt(1 - r2)),
+                                v3_add(v3_scale(w->frame[2 * pk], dx),
+                                       v3_scale(w->frame[2 * pk + 1], dy)));
             /* lifted off p along its normal, not along the ray: a point closer to a wall
              * than the offset must not start beyond it */
             ray_set(&w->rays[k], v3_add(x, v3_scale(p->normal, job->offset)), d, 0, INFINITY);
@@ -197,6 +213,7 @@ static bool cast_all(const seen_job *job, int threads, hit_list *lists, uint64_t
         free(w.met);
         free(w.found);
         free(w.cumulative);
+        free(w.frame);
     }
     *cast = total;
     return !failed;
