@@ -381,6 +381,15 @@ int main(void)
              "radiosity: --max-memory: the view-factor matrix of %llu surfaces (%llu pairs "
              "that face each other) needs %.1f MB, more than the ",
              surfaces, pairs, bound / 1048576.0);
+    expect_refused("viewfactors grid.vs3 -o out.csv --max-memory 3M --sight-rays none", prefix,
+                   " MB left of the budget of 3.0 MB\n");
+    /* with sight rays (the default), once they have found which pairs see each other: the
+     * floor's and the ceiling's cells all do (the smallest factor, corner to far corner,
+     * is about 1.6e-4: 30k rays from each side miss such a pair with probability 6e-5) */
+    snprintf(prefix, sizeof(prefix),
+             "radiosity: --max-memory: the view-factor matrix of %llu surfaces (%llu pairs "
+             "that some sight ray found in sight of each other) needs %.1f MB, more than the ",
+             surfaces, pairs, bound / 1048576.0);
     expect_refused("viewfactors grid.vs3 -o out.csv --max-memory 3M", prefix,
                    " MB left of the budget of 3.0 MB\n");
 

@@ -132,17 +132,23 @@ static bool surfaces_face_away(const vf_geometry *g, const vf_surface *a, const 
 }
 
 /* The most the matrix can take: every pair (I, J >= I) that the rows will visit (both
- * with polygons, not facing away, a planar surface not with itself) one pending entry
- * while computing, and its one or two entries (F_IJ and F_JI) of the assembled matrix
- * (column, value and bound) while the pending rows are still held. *pairs receives the
- * pair count. */
-static uint64_t matrix_bound_bytes(const vf_geometry *g, uint64_t *pairs)
+ * with polygons, not facing away, a planar surface not with itself; with sight rays only
+ * the met pairs) one pending entry while computing, and its one or two entries (F_IJ and
+ * F_JI) of the assembled matrix (column, value and bound) while the pending rows are
+ * still held. *pairs receives the pair count. */
+static uint64_t matrix_bound_bytes(const vf_geometry *g, const seen_pairs *seen, uint64_t *pairs)
 {
     uint64_t visited = 0, entries = 0;
     for (uint32_t I = 0; I < g->surface_count; I++) {
         const vf_surface *a = &g->surfaces[I];
         if (a->polygon_count == 0)
             continue;
+        if (seen) {
+            uint64_t met = seen->row_start[I + 1] - seen->row_start[I];
+            visited += met + !a->planar;
+            entries += 2 * met + !a->planar;
+            continue;
+        }
         for (uint32_t J = I; J < g->surface_count; J++) {
             const vf_surface *b = &g->surfaces[J];
             if (b->polygon_count == 0 || (J == I && a->planar) ||
@@ -156,6 +162,18 @@ static uint64_t matrix_bound_bytes(const vf_geometry *g, uint64_t *pairs)
     return visited * sizeof(row_entry) +
            entries * (sizeof(uint32_t) + 2 * sizeof(double)) +
            2 * ((uint64_t)g->surface_count + 1) * sizeof(uint64_t);
+}
+
+/* RAD_ERR_NOMEM, naming the matrix, when its bound (matrix_bound_bytes) does not fit the
+ * memory budget. */
+static rad_status matrix_fits(const vf_geometry *g, const seen_pairs *seen, rad_error *error)
+{
+    uint64_t pairs, bound = matrix_bound_bytes(g, seen, &pairs);
+    char what[160];
+    snprintf(what, sizeof(what), "the view-factor matrix of %u surfaces (%llu pairs that %s)",
+             g->surface_count, (unsigned long long)pairs,
+             seen ? "some sight ray found in sight of each other" : "face each other");
+    return rad_memory_budget_need(bound, what, error);
 }
 
 /* G_pq and its error bound; 0 when they do not face each other. A pair is taken as hidden
@@ -639,14 +657,10 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     coplanar_polygons planes = {0};
     pending_row *rows = NULL;
     rad_status status = vf_geometry_build(scene, &geometry, error);
-    if (status == RAD_OK && rad_memory_budget()) {
-        uint64_t pairs, bound = matrix_bound_bytes(&geometry, &pairs);
-        char what[128];
-        snprintf(what, sizeof(what),
-                 "the view-factor matrix of %u surfaces (%llu pairs that face each other)",
-                 scene->surface_count, (unsigned long long)pairs);
-        status = rad_memory_budget_need(bound, what, error);
-    }
+    /* without sight rays the matrix's bound is known now; with them, once the rays have
+     * found the pairs that see each other */
+    if (status == RAD_OK && rad_memory_budget() && options->sight_rays == RAD_SIGHT_RAYS_NONE)
+        status = matrix_fits(&geometry, NULL, error);
     if (status == RAD_OK)
         status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
     if (status == RAD_OK)
@@ -718,9 +732,13 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         if (sight_rays)
             status = seen_pairs_build(scene, &geometry, occluders, sight_rays, e.seed, threads,
                                       &seen, error);
+        if (status == RAD_OK && sight_rays && rad_memory_budget())
+            status = matrix_fits(&geometry, &seen, error);
+        status = ranks_agree(status, "view factors", error);
     }
     double sight_seconds = now_seconds() - sight_start;
     if (status != RAD_OK) {
+        seen_pairs_free(&seen);
         free(surfaces_after);
         free(polygons_after_surface);
         for (uint32_t I = 0; I < n; I++)
