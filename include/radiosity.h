@@ -807,12 +807,15 @@ typedef struct rad_viewfactor_options {
                             clipped exactly). Pairs behind more occluders sample
                             visibility until the absolute error bound of their F is at
                             most accuracy x sqrt(F unobstructed), so a row's sum stays
-                            within accuracy, or until max_rays */
+                            within accuracy, or until max_rays (pairs no sight ray met
+                            are left out, which a row sum does not recover: see
+                            sight_rays) */
     uint32_t max_rays;   /* visibility rays per sampled polygon pair at most; 0 = 1024 */
     uint32_t sight_rays; /* cosine-distributed rays from each surface that find which pairs
                             see each other at all; a pair no ray of either side met is
-                            taken as F = 0, within 3 / sight_rays absolute (95 %), and is
-                            neither integrated nor proven hidden. 0 = ceil(3 / accuracy);
+                            taken as F = 0, within 3 / sight_rays absolute (95 % for each
+                            pair), and is neither integrated nor proven hidden. 0 =
+                            ceil(-ln 0.05 / accuracy), about 3 / accuracy (at most 2^26);
                             RAD_SIGHT_RAYS_NONE: none, every pair is integrated or proven
                             hidden (exact zeros; far slower on large open scenes) */
     uint64_t seed;
@@ -861,15 +864,16 @@ typedef struct rad_viewfactor_report {
     uint64_t unmet_pairs;        /* surface pairs (I, J > I) that no sight ray met: F = 0,
                                     not stored, each within unmet_bound (95 %), neither
                                     integrated nor proven hidden */
-    uint32_t sight_rays;         /* sight rays cast from each surface: ceil(3 / accuracy) */
+    uint32_t sight_rays;         /* sight rays cast from each surface (0: none) */
     uint64_t sight_rays_cast;    /* all of them, over every rank */
-    double unmet_bound;          /* 3 / sight_rays: no unmet pair's F_IJ or F_JI is larger
-                                    (95 %) */
+    double unmet_bound;          /* 3 / sight_rays: an unmet pair's F_IJ and F_JI are at most
+                                    this (95 % for each pair) */
     double sight_seconds;        /* casting them and sharing the pairs they met */
     double missed_largest;       /* the largest share of a surface's view that the pairs its
                                     sight rays did not meet hold, by Good and Turing's
-                                    estimate (the surfaces one ray met, over the rays): about
-                                    what its row sum lacks */
+                                    estimate (the surfaces one ray met, over the rays): at
+                                    most about what its row sum lacks (it counts only the
+                                    surface's own rays) */
     double missed_mean;          /* the same, the mean over the surfaces */
     uint64_t nonzeros;           /* stored factors other than 0 */
     double largest_error_bound;  /* largest error_bound (absolute, in units of F) */

@@ -51,9 +51,10 @@ static const char usage[] =
 static const char usage_more[] =
     "\nPairs that cannot see each other, sky, repair, memory and long runs:\n"
     "  --sight-rays N|none  cosine-distributed rays from each surface that find the pairs\n"
-    "                       that see each other at all (default 3 / --accuracy); a pair\n"
-    "                       no ray of either side met is F = 0, within 3 / N (95 %),\n"
-    "                       and prints what such pairs hold of a row (estimated). none:\n"
+    "                       that see each other at all (default -ln 0.05 / --accuracy,\n"
+    "                       about 3 / --accuracy); a pair no ray of either side met is\n"
+    "                       F = 0, within 3 / N (95 % for each pair), and the run\n"
+    "                       prints what such pairs hold of a row (estimated). none:\n"
     "                       every pair is integrated or proven hidden (exact zeros, far\n"
     "                       slower on large open scenes)\n"
     "  --sky-view-factor FILE  each surface's sky view factor (the share of its\n"
@@ -404,7 +405,7 @@ int command_viewfactors(int argc, char **argv)
     cli_summary("largest error bound of a factor %.3g (absolute)%s", report.largest_error_bound,
                 capped);
     if (report.sight_rays)
-        cli_summary("pairs no sight ray met (%d a surface): F = 0, each within %.1e (95 %%); "
+        cli_summary("pairs no sight ray met (%u a surface): F = 0, each within %.1e (95 %%); "
                     "what they hold of a row, estimated: %.2g on average, %.2g at most",
                     report.sight_rays, report.unmet_bound, report.missed_mean,
                     report.missed_largest);

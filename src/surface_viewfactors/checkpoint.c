@@ -4,7 +4,8 @@
  * The container (core/checkpoint_file.h): the magic "\x89RADVFC\n", format version (u32),
  * the body, its checksum. The body, little-endian: surface count
  * (u32), scene fingerprint (u64), accuracy (f64), ray cap (u32), seed (u64), rows in the
- * file (u32); then per row, in increasing row order, the row I (u32), its entry count (u32)
+ * file (u32), sight rays a surface (u32, 0: none; format version 2, and version 1 files,
+ * made before the sight rays, are refused); then per row, in increasing row order, the row I (u32), its entry count (u32)
  * and per entry the column J >= I (u32, increasing), the transfer G_IJ (f64, >= 0) and its
  * error bound (f64, >= 0; > 0 when the transfer is 0: a sampled pair that saw nothing). The
  * whole file is checked before any row is used.

@@ -1,6 +1,7 @@
 /*
  * seen_pairs.c - the surface pairs some ray found in sight of each other, see seen_pairs.h.
  */
+#include <float.h>
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -19,9 +20,11 @@
 #define SEEN_BATCH 1024u
 
 /* Rays start this far above their point along the polygon's normal, as a fraction of the
- * scene's diagonal (above the float rounding of the tracer's coordinates, as the sky view
- * factor's rays). */
+ * scene's diagonal, and at least SEEN_RAY_ULPS float steps of its largest coordinate: above
+ * the float rounding of the tracer's coordinates, also for a model placed far from the
+ * origin (a ray that started under its own surface would meet it and be lost). */
 #define SEEN_RAY_OFFSET 1e-6
+#define SEEN_RAY_ULPS 8.0
 
 /* Salt of the rays' random streams (no other stream of the view factors uses it). */
 #define SEEN_SALT 0x7365656eu
@@ -240,7 +243,8 @@ static rad_status share_lists(hit_list *lists, uint32_t n, rad_error *error)
         if (I % (uint32_t)ranks == (uint32_t)rank) {
             mine[at++] = I;
             mine[at++] = lists[I].count;
-            memcpy(mine + at, lists[I].surfaces, lists[I].count * sizeof(uint32_t));
+            if (lists[I].count)
+                memcpy(mine + at, lists[I].surfaces, lists[I].count * sizeof(uint32_t));
             at += lists[I].count;
         }
     void *gathered = NULL;
@@ -342,16 +346,20 @@ rad_status seen_pairs_build(const rad_scene *scene, const vf_geometry *geometry,
     out->surface_count = n;
     out->rays = rays;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double largest = 0;
     for (uint32_t v = 0; v < scene->position_count; v++) {
         const double c[3] = {scene->positions[v].x, scene->positions[v].y, scene->positions[v].z};
-        for (int k = 0; k < 3; k++)
+        for (int k = 0; k < 3; k++) {
             lo[k] = fmin(lo[k], c[k]), hi[k] = fmax(hi[k], c[k]);
+            largest = fmax(largest, fabs(c[k]));
+        }
     }
     double diagonal = scene->position_count
                           ? sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                  (hi[2] - lo[2]) * (hi[2] - lo[2]))
                           : 1;
-    seen_job job = {scene, geometry, tracer, rays, seed, SEEN_RAY_OFFSET * diagonal};
+    seen_job job = {scene, geometry, tracer, rays, seed,
+                    fmax(SEEN_RAY_OFFSET * diagonal, SEEN_RAY_ULPS * FLT_EPSILON * largest)};
     hit_list *lists = rad_alloc_array(n ? n : 1, sizeof(hit_list));
     if (lists)
         memset(lists, 0, (n ? n : 1) * sizeof(hit_list));

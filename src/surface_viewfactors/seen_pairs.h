@@ -8,14 +8,16 @@
  * J first with probability exactly F_IJ (the definition of the view factor), so the
  * chance that none of I's N_I rays and none of J's N_J rays meets the other is
  * exp(-N_I F_IJ - N_J F_JI) at most, which is 5 % when the transfer G = A_I F_IJ = A_J F_JI
- * is SEEN_PAIRS_BOUND(N_I / A_I + N_J / A_J):
+ * is SEEN_PAIRS_BOUND / (N_I / A_I + N_J / A_J):
  *
  *     G <= -ln(0.05) / (N_I / A_I + N_J / A_J)   (95 %), so F_IJ <= 3.0 / N_I.
  *
  * A pair neither side's rays met is taken as 0 with that bound, without a first look or a
  * proof: in a city most facing pairs are hidden (84 % of the 20k city's), and proving them
- * cost most of the matrix's time. With N = ceil(3 / accuracy) every such factor is within
- * `accuracy` absolute, the floor of the relative accuracy the integrated pairs meet.
+ * cost most of the matrix's time. With N = ceil(-ln 0.05 / accuracy) each such factor is
+ * within `accuracy` absolute at 95 % (a per-pair statement: a pair whose factor is at the
+ * bound goes unmet one time in 20, so among many such pairs some do), the floor of the
+ * relative accuracy the integrated pairs meet.
  * Many such pairs in one row add up (a roof sees thousands of distant surfaces at 1e-6
  * each): the share of each surface's view its rays missed is estimated too (`missed`),
  * so that a run can say how much its rows may lack.

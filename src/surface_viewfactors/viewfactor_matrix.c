@@ -103,8 +103,9 @@ typedef struct engine {
 
 static double now_seconds(void) { return rad_clock_seconds(); }
 
-/* Sight rays a surface (seen_pairs.h): enough that a pair none met is within `accuracy`
- * absolute (95 %), at most 2^26. */
+/* Sight rays a surface (seen_pairs.h): ceil(-ln 0.05 / accuracy), enough that a pair none
+ * met is within `accuracy` absolute (95 % for each pair); at most 2^26, so below an
+ * accuracy of about 4.5e-8 the bound is 3 / 2^26. */
 static uint32_t sight_rays_for(double accuracy)
 {
     return (uint32_t)fmin(ceil(SEEN_PAIRS_BOUND / accuracy), 67108864.0);
@@ -776,6 +777,9 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         free(cost);
         if (ranks_failures(failed)) {
             free(owner);
+            seen_pairs_free(&seen);
+            free(surfaces_after);
+            free(polygons_after_surface);
             for (uint32_t I = 0; I < n; I++)
                 free(rows[I].entries);
             free(rows);
