@@ -840,9 +840,10 @@ typedef struct rad_viewfactor_options {
 } rad_viewfactor_options;
 
 typedef struct rad_viewfactor_report {
-    uint64_t surface_pairs;      /* surface pairs considered */
-    uint64_t polygon_pairs;      /* triangle pairs that face each other */
-    /* every facing polygon pair is one of: unobstructed_pairs, hidden_pairs, exact_pairs,
+    uint64_t surface_pairs;      /* surface pairs considered (unmet_pairs included) */
+    uint64_t polygon_pairs;      /* polygon pairs that face each other, of the surface
+                                    pairs some sight ray met (of all, without sight rays) */
+    /* every such polygon pair is one of: unobstructed_pairs, hidden_pairs, exact_pairs,
      * sampled_pairs */
     uint64_t unobstructed_pairs; /* nothing in between (shaft culling): analytic value */
     uint64_t hidden_pairs;       /* proven wholly hidden, exactly: the scene's shapes in a
