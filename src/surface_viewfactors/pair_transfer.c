@@ -140,28 +140,6 @@ void pair_workspace_free(pair_workspace *workspace)
     free(workspace->weight);
 }
 
-static inline rad_vec3 barycentric(rad_vec3 a, rad_vec3 b, rad_vec3 c, double u, double v,
-                                   double w)
-{
-    return v3(u * a.x + v * b.x + w * c.x, u * a.y + v * b.y + w * c.y,
-              u * a.z + v * b.z + w * c.z);
-}
-
-/* A point of the polygon from (s, t) in the unit square, uniform in area: a quad picks
- * one of its two triangles by area with s. */
-static rad_vec3 polygon_point(const vf_polygon *polygon, double s, double t)
-{
-    /* the fan triangle (0, k, k + 1) by area with s, then s rescaled within it */
-    unsigned k = 0;
-    while (k + 3 < polygon->count && s >= polygon->fan[k])
-        k++;
-    double low = k ? polygon->fan[k - 1] : 0, high = polygon->fan[k];
-    s = high > low ? (s - low) / (high - low) : 0;
-    double r = sqrt(fmin(fmax(s, 0), 1));
-    return barycentric(polygon->vertex[0], polygon->vertex[k + 1], polygon->vertex[k + 2], 1 - r,
-                       r * (1 - t), r * t);
-}
-
 /* One round: PAIR_REPLICATES independent stratified sets of k x k segments (k a power of
  * 2). */
 static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
@@ -192,7 +170,7 @@ static uint32_t fill_round(const vf_polygon *p, const vf_polygon *q, unsigned k,
             double t0 = ((m >> shift) + rad_rng_uniform(&rng)) * cell;
             double s1 = ((order[m] & mask) + rad_rng_uniform(&rng)) * cell;
             double t1 = ((order[m] >> shift) + rad_rng_uniform(&rng)) * cell;
-            rad_vec3 x = polygon_point(p, s0, t0), y = polygon_point(q, s1, t1);
+            rad_vec3 x = vf_polygon_sample(p, s0, t0), y = vf_polygon_sample(q, s1, t1);
             rad_vec3 d = v3_sub(y, x);
             double r2 = v3_dot(d, d);
             double cx = v3_dot(p->normal, d), cy = -v3_dot(q->normal, d);

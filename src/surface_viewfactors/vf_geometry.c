@@ -347,19 +347,6 @@ rad_status vf_geometry_build(const rad_scene *scene, vf_geometry *geometry, rad_
     return RAD_OK;
 }
 
-/* A uniform point of the convex polygon from (s, t) in the unit square. */
-rad_vec3 vf_polygon_sample(const vf_polygon *p, double s, double t)
-{
-    unsigned k = 0;
-    while (k + 3 < p->count && s >= p->fan[k])
-        k++;
-    double low = k ? p->fan[k - 1] : 0, high = p->fan[k];
-    s = high > low ? (s - low) / (high - low) : 0;
-    double r = sqrt(fmin(fmax(s, 0), 1));
-    return v3_add(v3_add(v3_scale(p->vertex[0], 1 - r), v3_scale(p->vertex[k + 1], r * (1 - t))),
-                  v3_scale(p->vertex[k + 2], r * t));
-}
-
 void vf_geometry_free(vf_geometry *geometry)
 {
     free(geometry->polygons);

@@ -13,6 +13,8 @@
 #ifndef RAD_VIEWFACTOR_VF_GEOMETRY_H
 #define RAD_VIEWFACTOR_VF_GEOMETRY_H
 
+#include <math.h>
+
 #include "radiosity.h"
 
 #define VF_MAX_VERTICES 6
@@ -69,9 +71,21 @@ void vf_polygon_finish(vf_polygon *polygon);
 bool vf_polygon_clip_front(const vf_polygon *polygon, rad_vec3 n, double offset,
                            vf_polygon *out);
 
-/* A uniform point of the convex polygon from (s, t) in the unit square (its fan
- * triangles by their area shares). */
-rad_vec3 vf_polygon_sample(const vf_polygon *p, double s, double t);
+/* A uniform point of the convex polygon from (s, t) in the unit square: the fan triangle
+ * (0, k, k + 1) by its area share with s, then s rescaled within it. Inline: the sampled
+ * segments of every obstructed pair take two points each. */
+static inline rad_vec3 vf_polygon_sample(const vf_polygon *p, double s, double t)
+{
+    unsigned k = 0;
+    while (k + 3 < p->count && s >= p->fan[k])
+        k++;
+    double low = k ? p->fan[k - 1] : 0, high = p->fan[k];
+    s = high > low ? (s - low) / (high - low) : 0;
+    double r = sqrt(fmin(fmax(s, 0), 1)), u = 1 - r, v = r * (1 - t), w = r * t;
+    const rad_vec3 *a = &p->vertex[0], *b = &p->vertex[k + 1], *c = &p->vertex[k + 2];
+    return (rad_vec3){u * a->x + v * b->x + w * c->x, u * a->y + v * b->y + w * c->y,
+                      u * a->z + v * b->z + w * c->z};
+}
 
 /* True when some corner of `polygon` lies in front of the plane (n, offset) by more than
  * epsilon. */

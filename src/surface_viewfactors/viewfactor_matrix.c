@@ -633,6 +633,22 @@ static rad_viewfactor_matrix *assemble(const vf_geometry *g, pending_row *rows, 
     return m;
 }
 
+/* Frees what the matrix's setup holds when it stops before the rows (rows may be NULL). */
+static void release_setup(pending_row *rows, uint32_t n, uint8_t *state, uint32_t *mine,
+                          rad_tracer *occluders, occluder_tree *tree, coplanar_polygons *planes,
+                          vf_geometry *geometry)
+{
+    for (uint32_t I = 0; rows && I < n; I++)
+        free(rows[I].entries);
+    free(rows);
+    free(state);
+    free(mine);
+    rad_tracer_destroy(occluders);
+    occluder_tree_destroy(tree);
+    coplanar_polygons_free(planes);
+    vf_geometry_free(geometry);
+}
+
 rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
                                          const rad_viewfactor_options *options,
                                          rad_viewfactor_matrix **out,
@@ -697,15 +713,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         }
     }
     if (status != RAD_OK) {
-        for (uint32_t I = 0; rows && I < n; I++)
-            free(rows[I].entries);
-        free(rows);
-        free(state);
-        free(mine);
-        rad_tracer_destroy(occluders);
-        occluder_tree_destroy(tree);
-        coplanar_polygons_free(&planes);
-        vf_geometry_free(&geometry);
+        release_setup(rows, n, state, mine, occluders, tree, &planes, &geometry);
         return status;
     }
     e.geometry = &geometry;
@@ -742,15 +750,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         seen_pairs_free(&seen);
         free(surfaces_after);
         free(polygons_after_surface);
-        for (uint32_t I = 0; I < n; I++)
-            free(rows[I].entries);
-        free(rows);
-        free(state);
-        free(mine);
-        rad_tracer_destroy(occluders);
-        occluder_tree_destroy(tree);
-        coplanar_polygons_free(&planes);
-        vf_geometry_free(&geometry);
+        release_setup(rows, n, state, mine, occluders, tree, &planes, &geometry);
         return status;
     }
     e.seen = sight_rays ? &seen : NULL;
@@ -780,15 +780,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
             seen_pairs_free(&seen);
             free(surfaces_after);
             free(polygons_after_surface);
-            for (uint32_t I = 0; I < n; I++)
-                free(rows[I].entries);
-            free(rows);
-            free(state);
-            free(mine);
-            rad_tracer_destroy(occluders);
-            occluder_tree_destroy(tree);
-            coplanar_polygons_free(&planes);
-            vf_geometry_free(&geometry);
+            release_setup(rows, n, state, mine, occluders, tree, &planes, &geometry);
             return rad_fail(error, RAD_ERR_NOMEM, "out of memory sharing %u rows over %d ranks",
                             n, ranks_count());
         }
