@@ -37,7 +37,7 @@ static rad_status coarse_cornell_box(rad_scene **scene, rad_mesh **mesh, rad_err
     rad_status status = rad_scene_cornell_box(scene, error);
     if (status != RAD_OK)
         return status;
-    double patch_size = rad_mesh_default_patch_size(*scene, 60);
+    double patch_size = rad_mesh_default_patch_size(*scene, 24);
     if (patch_size > 0)
         status = rad_mesh_build(*scene, patch_size, mesh, error);
     else
@@ -155,9 +155,9 @@ static rad_status other_solvers(rad_error *error)
         status = rad_scene_set_material(scene, scene->surfaces[0].name, &albedo, NULL, error);
     }
     if (status == RAD_OK)
-        status = solve_and_render(scene, 50, RAD_SOLVER_SHOOT, 2, true, error);
+        status = solve_and_render(scene, 20, RAD_SOLVER_SHOOT, 2, true, error);
     if (status == RAD_OK)
-        status = solve_and_render(scene, 40, RAD_SOLVER_DIRECT, 2, false, error);
+        status = solve_and_render(scene, 16, RAD_SOLVER_DIRECT, 2, false, error);
     rad_scene_destroy(scene);
     return status;
 }
