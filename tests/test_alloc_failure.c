@@ -171,7 +171,7 @@ static rad_status hierarchical_two_threads(rad_error *error)
     rad_rgb *B = NULL;
     rad_status status = rad_scene_cornell_box(&scene, error);
     if (status == RAD_OK)
-        status = rad_mesh_build(scene, 200, &mesh, error);
+        status = rad_mesh_build(scene, 300, &mesh, error);
     if (status == RAD_OK) {
         B = calloc(mesh->patch_count, sizeof(*B));
         if (!B)
