@@ -180,13 +180,15 @@ static int by_double(const void *a, const void *b)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fputs("usage: viewfactor_coverage SCENE [RANDOM_PAIRS [LARGEST_BOUNDS [SEGMENTS]]]\n",
+        fputs("usage: viewfactor_coverage SCENE [RANDOM_PAIRS [LARGEST_BOUNDS [SEGMENTS "
+              "[EXACT_OCCLUDERS]]]]\n",
               stderr);
         return 2;
     }
     uint32_t random_pairs = argc > 2 ? (uint32_t)atoi(argv[2]) : 150;
     uint32_t largest = argc > 3 ? (uint32_t)atoi(argv[3]) : 50;
     uint32_t segments = argc > 4 ? (uint32_t)atoi(argv[4]) : 40000;
+    uint32_t exact_occluders = argc > 5 ? (uint32_t)atoi(argv[5]) : 0;
     rad_scene *scene = NULL;
     rad_error error = {0};
     if (rad_scene_load(argv[1], NULL, &scene, &error) != RAD_OK) {
@@ -196,7 +198,7 @@ int main(int argc, char **argv)
     rad_viewfactor_matrix *m = NULL;
     rad_viewfactor_report report;
     /* the command line's defaults (seed 1), so that its figures are `radiosity viewfactors`' */
-    rad_viewfactor_options options = {.seed = 1};
+    rad_viewfactor_options options = {.seed = 1, .exact_occluders = exact_occluders};
     if (rad_viewfactor_matrix_compute(scene, &options, &m, &report, &error) != RAD_OK) {
         fprintf(stderr, "viewfactor_coverage: %s\n", error.message);
         return 1;

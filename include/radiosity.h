@@ -110,6 +110,8 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 #define RAD_DEFAULT_ACCURACY 1e-4       /* rad_viewfactor_options.accuracy */
 #define RAD_DEFAULT_MAX_RAYS 1024       /* rad_viewfactor_options.max_rays */
 #define RAD_SIGHT_RAYS_NONE UINT32_MAX  /* rad_viewfactor_options.sight_rays: none */
+#define RAD_DEFAULT_EXACT_OCCLUDERS 4   /* rad_viewfactor_options.exact_occluders */
+#define RAD_MAX_EXACT_OCCLUDERS 256     /* its largest value */
 #define RAD_DEFAULT_EMISSIVITY 0.9      /* rad_surface.emissivity when the file gives none */
 #define RAD_DEFAULT_RENDER_SPP 16       /* rad_render_options.samples_per_pixel */
 #define RAD_DEFAULT_DIRECT_SAMPLES 8    /* rad_render_options.direct_samples */
@@ -801,16 +803,25 @@ typedef struct rad_viewfactor_matrix {
 } rad_viewfactor_matrix;
 
 typedef struct rad_viewfactor_options {
-    double accuracy;     /* 0 = 1e-4. Relative error target of each factor computed by
-                            adaptive quadrature of the exact point-to-polygon factor
-                            (unobstructed, or behind up to 4 triangles whose shadows are
-                            clipped exactly). Pairs behind more occluders sample
-                            visibility until the absolute error bound of their F is at
-                            most accuracy x sqrt(F unobstructed), so a row's sum stays
-                            within accuracy, or until max_rays (pairs no sight ray met
+    double accuracy;     /* 0 = 1e-4. Relative error target of each unobstructed factor
+                            (adaptive quadrature of the exact point-to-polygon factor).
+                            Obstructed pairs: an absolute error of F of at most accuracy
+                            x sqrt(F unobstructed), so that a row's sum stays within
+                            accuracy: behind up to exact_occluders triangles by the same
+                            quadrature of the visible part (shadows clipped exactly),
+                            behind more by sampled visibility, until max_rays (pairs no
+                            sight ray met
                             are left out, which a row sum does not recover: see
                             sight_rays) */
     uint32_t max_rays;   /* visibility rays per sampled polygon pair at most; 0 = 1024 */
+    uint32_t exact_occluders; /* polygon pairs with at most this many scene triangles in
+                            between get exact shadow clipping (each quadrature point's
+                            visible part of the other polygon, with the triangles that can
+                            shade that part of the polygon only), to an absolute error of
+                            F of accuracy x sqrt(F unobstructed); pairs with more are
+                            sampled. 0 = RAD_DEFAULT_EXACT_OCCLUDERS, at most
+                            RAD_MAX_EXACT_OCCLUDERS. More: fewer sampled pairs and smaller
+                            bounds, and more time */
     uint32_t sight_rays; /* cosine-distributed rays from each surface that find which pairs
                             see each other at all; a pair no ray of either side met is
                             taken as F = 0, within 3 / sight_rays absolute (95 % for each
@@ -865,6 +876,7 @@ typedef struct rad_viewfactor_report {
     uint64_t unmet_pairs;        /* surface pairs (I, J > I) that no sight ray met: F = 0,
                                     not stored, each within unmet_bound (95 %), neither
                                     integrated nor proven hidden */
+    uint32_t exact_occluders;    /* the options' exact_occluders (the default filled in) */
     uint32_t sight_rays;         /* sight rays cast from each surface (0: none) */
     uint64_t sight_rays_cast;    /* all of them, over every rank */
     double unmet_bound;          /* 3 / sight_rays: an unmet pair's F_IJ and F_JI are at most

@@ -8,8 +8,8 @@
  * SIGTERM at a known point, without timing): it must exit 130, write no output and leave
  * a checkpoint holding some but not all rows. Resumed with another thread count, it must
  * write exactly the bytes of the uninterrupted run. A checkpoint of another scene (one
- * vertex moved), of other options (--accuracy, --seed, --sight-rays), a damaged one and a
- * file that is no checkpoint are refused with one line naming the file, exit 1 and no output.
+ * vertex moved), of other options (--accuracy, --seed, --sight-rays, --exact-occluders), a
+ * damaged one and a file that is no checkpoint are refused with one line naming the file, exit 1 and no output.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -111,7 +111,12 @@ int main(void)
     /* its rows visit only the pairs its sight rays met: not a job without them */
     CHECK(test_run_tool("viewfactors blocks.obj -o other.mtx --resume ck.bin --sight-rays none") ==
           1);
-    check_refusal("--sight-rays 29958; this run: ", "ck.bin");
+    check_refusal("--sight-rays 29958, --exact-occluders 4; this run: 0.0001, 1024, 1, 0, 4",
+                  "ck.bin");
+    /* its obstructed pairs were clipped exactly behind at most 4 triangles, not 64 */
+    CHECK(test_run_tool("viewfactors blocks.obj -o other.mtx --resume ck.bin "
+                        "--exact-occluders 64") == 1);
+    check_refusal("--exact-occluders 4; this run: 0.0001, 1024, 1, 29958, 64", "ck.bin");
     size_t size;
     uint8_t *bytes = test_read_bytes(test_path("ck.bin"), &size);
     CHECK(bytes && size > 100);

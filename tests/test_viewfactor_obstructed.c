@@ -283,10 +283,12 @@ static void check_tube_in_tube(bool blocker_is_surface)
 /* Plates 1 x 1 at z = 0 (facing up) and z = 1 (facing down); between them at z = 0.5 a
  * wall with a slot x in [0.49, 0.51] across it, 0.02 wide: narrower than the cells of
  * the first look (0.5) and of the finest sampling round (1/32). The wall is two rectangles
- * (4 triangles: shadows clipped exactly) or each split n x n (sampled). The reference
+ * (4 triangles: shadows clipped exactly) or each split n x n (sampled, unless
+ * `exact_occluders` takes them all: clipped exactly, to accuracy x sqrt(F unobstructed),
+ * F unobstructed = 0.19982 for unit squares 1 apart, Howell's catalogue). The reference
  * counts cosine rays from uniform points of the lower plate that cross z = 0.5 within the
  * slot and land on the upper plate. */
-static void check_slot(int split)
+static void check_slot(int split, uint32_t exact_occluders)
 {
     size_t n = 0;
     int v = 0;
@@ -315,7 +317,8 @@ static void check_slot(int split)
         return;
     rad_viewfactor_matrix *m = NULL;
     rad_viewfactor_report report;
-    CHECK(rad_viewfactor_matrix_compute(scene, NULL, &m, &report, &error) == RAD_OK);
+    rad_viewfactor_options options = {.exact_occluders = exact_occluders};
+    CHECK(rad_viewfactor_matrix_compute(scene, &options, &m, &report, &error) == RAD_OK);
     if (!m) {
         rad_scene_destroy(scene);
         return;
@@ -332,17 +335,18 @@ static void check_slot(int split)
     }
     double reference = (double)hits / samples;
     double standard_error = sqrt(reference * (1 - reference) / samples);
-    printf("slot 0.02 wide, wall as %d triangles: F %.6f, bound %.2g; Monte Carlo %.6f +- "
-           "%.2g; pairs: %llu exact, %llu sampled, %llu proven hidden\n",
-           4 * split * split, F, bound, reference, standard_error,
+    printf("slot 0.02 wide, wall as %d triangles, exact behind %u: F %.6f, bound %.2g; Monte "
+           "Carlo %.6f +- %.2g; pairs: %llu exact, %llu sampled, %llu proven hidden\n",
+           4 * split * split, report.exact_occluders, F, bound, reference, standard_error,
            (unsigned long long)report.exact_pairs, (unsigned long long)report.sampled_pairs,
            (unsigned long long)report.hidden_pairs);
     CHECK(F > 0);
     CHECK(fabs(F - reference) <= 3 * standard_error + bound);
     CHECK(report.hidden_pairs == 0);
-    if (split == 1) {
+    CHECK(report.exact_occluders == (exact_occluders ? exact_occluders : 4));
+    if (4u * (uint32_t)(split * split) <= report.exact_occluders) {
         CHECK(report.exact_pairs == 1);
-        CHECK(bound < 1e-4 * F + 1e-9);
+        CHECK(bound <= 1e-4 * sqrt(0.19982));
     } else {
         CHECK(report.sampled_pairs == 1);
         CHECK(bound > 0);
@@ -511,12 +515,83 @@ static void check_corner_on_plane(void)
     rad_scene_destroy(scene);
 }
 
+/* Plates 1 x 1 at z = 0 (up) and z = 1 (down) behind a grid of 50 small squares at
+ * z = 0.5 (10 x 5, 0.06 x 0.12 each, 100 triangles), against the test's own count of
+ * cosine rays from the lower plate that pass between the squares and land on the upper
+ * one. Behind the default 4 exact occluders the pair is sampled; with all 256 it is clipped
+ * exactly, to its bound, and the bound to accuracy x sqrt(F unobstructed) (0.19982). */
+static void check_occluder_grid(uint32_t exact_occluders)
+{
+    size_t n = (size_t)snprintf(text, sizeof(text),
+                                "o one\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n"
+                                "o two\nv 0 0 1\nv 0 1 1\nv 1 1 1\nv 1 0 1\nf 5 6 7 8\no grid\n");
+    int v = 8;
+    for (int i = 0; i < 10; i++)
+        for (int j = 0; j < 5; j++) {
+            double x0 = 0.02 + 0.1 * i, y0 = 0.04 + 0.2 * j, x1 = x0 + 0.06, y1 = y0 + 0.12;
+            n += (size_t)snprintf(text + n, sizeof(text) - n,
+                                  "v %.17g %.17g 0.5\nv %.17g %.17g 0.5\nv %.17g %.17g 0.5\n"
+                                  "v %.17g %.17g 0.5\nf %d %d %d %d\n",
+                                  x0, y0, x1, y0, x1, y1, x0, y1, v + 1, v + 2, v + 3, v + 4);
+            v += 4;
+        }
+    const char *path = test_write_file("grid.obj", text);
+    rad_scene *scene = NULL;
+    rad_error error = {0};
+    CHECK(rad_scene_load(path, NULL, &scene, &error) == RAD_OK);
+    if (!scene)
+        return;
+    rad_viewfactor_matrix *m = NULL;
+    rad_viewfactor_report report;
+    rad_viewfactor_options options = {.exact_occluders = exact_occluders};
+    CHECK(rad_viewfactor_matrix_compute(scene, &options, &m, &report, &error) == RAD_OK);
+    if (!m) {
+        rad_scene_destroy(scene);
+        return;
+    }
+    double bound, F = factor(m, surface_named(scene, "one"), surface_named(scene, "two"),
+                             &bound);
+    uint64_t state = 0x9E3779B97F4A7C15ull, hits = 0, samples = 4000000;
+    for (uint64_t k = 0; k < samples; k++) {
+        double x = uniform(&state), y = uniform(&state), q = uniform(&state);
+        double phi = 2 * pi * uniform(&state), r = sqrt(q), dz = sqrt(fmax(0, 1 - q));
+        double dx = r * cos(phi) / dz, dy = r * sin(phi) / dz;
+        double xm = x + 0.5 * dx, ym = y + 0.5 * dy, x1 = x + dx, y1 = y + dy;
+        if (!(x1 >= 0 && x1 <= 1 && y1 >= 0 && y1 <= 1))
+            continue;
+        bool blocked = false;
+        if (xm >= 0 && xm < 1 && ym >= 0 && ym < 1) {
+            double cx = xm - 0.1 * floor(xm / 0.1), cy = ym - 0.2 * floor(ym / 0.2);
+            blocked = cx >= 0.02 && cx <= 0.08 && cy >= 0.04 && cy <= 0.16;
+        }
+        hits += !blocked;
+    }
+    double reference = (double)hits / samples;
+    double standard_error = sqrt(reference * (1 - reference) / samples);
+    printf("plates behind a grid of 50 squares, exact behind %u: F %.6f, bound %.2g; Monte "
+           "Carlo %.6f +- %.2g; pairs: %llu exact, %llu sampled\n",
+           report.exact_occluders, F, bound, reference, standard_error,
+           (unsigned long long)report.exact_pairs, (unsigned long long)report.sampled_pairs);
+    CHECK(fabs(F - reference) <= 3 * standard_error + bound);
+    if (report.exact_occluders >= 100) {
+        CHECK(report.exact_pairs == 1 && report.sampled_pairs == 0);
+        CHECK(bound <= 1e-4 * sqrt(0.19982));
+    } else {
+        CHECK(report.sampled_pairs == 1);
+    }
+    rad_viewfactor_matrix_destroy(m);
+    rad_scene_destroy(scene);
+}
+
 int main(void)
 {
     check_tube_in_tube(false);
     check_tube_in_tube(true);
-    check_slot(1);
-    check_slot(6);
+    check_slot(1, 0);
+    check_slot(6, 0);
+    check_slot(6, RAD_MAX_EXACT_OCCLUDERS);
+    check_occluder_grid(0);
+    check_occluder_grid(RAD_MAX_EXACT_OCCLUDERS);
     check_proven_hidden();
     check_street_canyon();
     check_corner_on_plane();

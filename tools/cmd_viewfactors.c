@@ -23,8 +23,10 @@ static const char usage[] =
     "the file without its extension. Surfaces are one-sided: the front is the side from\n"
     "which the vertices run counter-clockwise; a surface need not be flat (a cylinder\n"
     "given as a mesh is one surface and may see itself). Unobstructed polygon pairs are\n"
-    "integrated analytically to --accuracy; pairs with something in between sample\n"
-    "visibility until their error bound meets it (or --max-rays). Output by the extension\n"
+    "integrated analytically to --accuracy; pairs with something in between to an\n"
+    "absolute error of F of --accuracy x sqrt(F unobstructed): behind at most\n"
+    "--exact-occluders triangles by the same integral of the part left visible, behind\n"
+    "more by sampled visibility (up to --max-rays). Output by the extension\n"
     "of -o: .mtx is Matrix Market (sparse coordinates), anything else CSV (first row\n"
     "'surface,NAME1,...,NAMEn', then one row per surface), or --format; CSV to stdout\n"
     "without -o. Obstruction surfaces have no row or column. The invariants (range,\n"
@@ -45,6 +47,9 @@ static const char usage[] =
     CLI_STR(RAD_DEFAULT_ACCURACY) ")\n"
     "  --max-rays N         visibility rays per sampled polygon pair at most\n"
     "                       (default " CLI_STR(RAD_DEFAULT_MAX_RAYS) ")\n"
+    "  --exact-occluders N  pairs behind at most N triangles are clipped exactly, not\n"
+    "                       sampled (default " CLI_STR(RAD_DEFAULT_EXACT_OCCLUDERS) ", at most "
+    CLI_STR(RAD_MAX_EXACT_OCCLUDERS) "): more, smaller bounds, longer\n"
     CLI_BASE_HELP("counts, times, invariants and error bounds");
 
 /* The rest of the help (one string may hold 4095 characters in C17), after the scene's. */
@@ -80,9 +85,10 @@ static const char usage_more[] =
     "  --checkpoint-interval S  seconds between checkpoints (default 600; 0: after each\n"
     "                       1/64 of the rows)\n"
     "  --resume FILE        continue the job of this checkpoint (same scene, --accuracy,\n"
-    "                       --max-rays, --sight-rays, --seed; others are refused): the\n"
-    "                       output is the one an uninterrupted run writes. Checkpoints\n"
-    "                       go on to FILE unless --checkpoint names another\n"
+    "                       --max-rays, --sight-rays, --exact-occluders, --seed; others\n"
+    "                       are refused): the output is the one an uninterrupted run\n"
+    "                       writes. Checkpoints go on to FILE unless --checkpoint names\n"
+    "                       another\n"
     "  --plot FILE.svg      the fraction of polygon pairs left against time (log scale):\n"
     "                       the computation's progress; it has no iteration to converge\n";
 
@@ -90,7 +96,7 @@ enum {
     OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_FORMAT, OPT_ENCLOSURE, OPT_SCRIPT_F,
     OPT_OBSTRUCTION, OPT_TWO_SIDED, OPT_CHECKPOINT, OPT_CHECKPOINT_INTERVAL, OPT_RESUME,
     OPT_SKY_VIEW_FACTOR, OPT_REPAIR_ROWS, OPT_REPAIR_MAX_CHANGE, OPT_REPAIR_MAX_REMOVED,
-    OPT_SIGHT_RAYS, OPT_COUNT
+    OPT_SIGHT_RAYS, OPT_EXACT_OCCLUDERS, OPT_COUNT
 };
 
 static const cli_option options[OPT_COUNT] = {
@@ -105,7 +111,8 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_REPAIR_ROWS] = {"repair-rows", 0, false},
     [OPT_REPAIR_MAX_CHANGE] = {"repair-max-change", 0, true},
     [OPT_REPAIR_MAX_REMOVED] = {"repair-max-removed", 0, true},
-    [OPT_SIGHT_RAYS] = {"sight-rays", 0, true}};
+    [OPT_SIGHT_RAYS] = {"sight-rays", 0, true},
+    [OPT_EXACT_OCCLUDERS] = {"exact-occluders", 0, true}};
 
 /* --repair-rows' default limits (relative change of a factor, share of exchange). */
 #define REPAIR_MAX_CHANGE 0.05
@@ -273,6 +280,9 @@ int command_viewfactors(int argc, char **argv)
         }
     }
     if (!cli_parse_count("max-rays", args.value[OPT_MAX_RAYS], 64, 1u << 24, &vf.max_rays))
+        return EXIT_USAGE;
+    if (!cli_parse_count("exact-occluders", args.value[OPT_EXACT_OCCLUDERS], 1,
+                         RAD_MAX_EXACT_OCCLUDERS, &vf.exact_occluders))
         return EXIT_USAGE;
     if (args.value[OPT_SIGHT_RAYS] && strcmp(args.value[OPT_SIGHT_RAYS], "none") == 0)
         vf.sight_rays = RAD_SIGHT_RAYS_NONE;
@@ -478,6 +488,7 @@ int command_viewfactors(int argc, char **argv)
     stats_integer(&stats, "sampled_pairs", report.sampled_pairs);
     stats_integer(&stats, "unseen_pairs", report.unseen_pairs);
     stats_integer(&stats, "capped_pairs", report.capped_pairs);
+    stats_integer(&stats, "exact_occluders", report.exact_occluders);
     stats_integer(&stats, "rays_cast", report.rays);
     stats_integer(&stats, "unmet_pairs", report.unmet_pairs);
     stats_integer(&stats, "sight_rays_a_surface", report.sight_rays);

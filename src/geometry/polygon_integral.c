@@ -22,6 +22,13 @@ static inline rad_vec3 barycentric(rad_vec3 a, rad_vec3 b, rad_vec3 c, double u,
 
 static inline bool stopped(const polygon_integral *c) { return c->failed && *c->failed; }
 
+/* Whether f is smooth on the triangle, whose points come next (polygon_integral.cell). */
+static inline bool enter(const polygon_integral *c, rad_vec3 a, rad_vec3 b, rad_vec3 d,
+                         int level)
+{
+    return c->cell ? c->cell(c->context, a, b, d, level) : c->min_depth == 0;
+}
+
 /* The 7-point rule times the area; *centre receives the 1-point (centroid) rule. */
 static double rule7(const polygon_integral *c, rad_vec3 a, rad_vec3 b, rad_vec3 d,
                     double area, double *centre)
@@ -40,50 +47,81 @@ static double rule7(const polygon_integral *c, rad_vec3 a, rad_vec3 b, rad_vec3 
 /* Integral over triangle (a, b, d) whose rule7 value is `whole`; *error accumulates the
  * estimated error of what is returned. */
 static double adapt(const polygon_integral *c, rad_vec3 a, rad_vec3 b, rad_vec3 d,
-                    double area, double whole, double tolerance, int depth, double *error)
+                    double area, double whole, double tolerance, int depth, bool smooth,
+                    double *error)
 {
     rad_vec3 ab = v3_scale(v3_add(a, b), 0.5), bd = v3_scale(v3_add(b, d), 0.5),
              da = v3_scale(v3_add(d, a), 0.5);
     double quarter = 0.25 * area, unused;
-    double part[4] = {rule7(c, a, ab, da, quarter, &unused), rule7(c, ab, b, bd, quarter, &unused),
-                      rule7(c, da, bd, d, quarter, &unused), rule7(c, ab, bd, da, quarter, &unused)};
+    /* this triangle's own cell again (its siblings' came after it) */
+    if (depth > 1)
+        enter(c, a, b, d, depth - 1);
+    rad_vec3 child[4][3] = {{a, ab, da}, {ab, b, bd}, {da, bd, d}, {ab, bd, da}};
+    double part[4];
+    bool part_smooth[4];
+    for (int k = 0; k < 4; k++) {
+        part_smooth[k] = enter(c, child[k][0], child[k][1], child[k][2], depth);
+        part[k] = rule7(c, child[k][0], child[k][1], child[k][2], quarter, &unused);
+    }
     double sum = part[0] + part[1] + part[2] + part[3];
     double difference = fabs(sum - whole);
-    if (difference <= tolerance || depth >= c->max_depth || stopped(c)) {
+    if ((difference <= tolerance && (smooth || depth >= c->min_depth)) ||
+        depth >= c->max_depth || stopped(c)) {
         *error += difference;
         return sum;
     }
     double t = 0.5 * tolerance;
-    return adapt(c, a, ab, da, quarter, part[0], t, depth + 1, error) +
-           adapt(c, ab, b, bd, quarter, part[1], t, depth + 1, error) +
-           adapt(c, da, bd, d, quarter, part[2], t, depth + 1, error) +
-           adapt(c, ab, bd, da, quarter, part[3], t, depth + 1, error);
+    return adapt(c, a, ab, da, quarter, part[0], t, depth + 1, part_smooth[0], error) +
+           adapt(c, ab, b, bd, quarter, part[1], t, depth + 1, part_smooth[1], error) +
+           adapt(c, da, bd, d, quarter, part[2], t, depth + 1, part_smooth[2], error) +
+           adapt(c, ab, bd, da, quarter, part[3], t, depth + 1, part_smooth[3], error);
 }
 
-static double integrate_triangle(const polygon_integral *c, rad_vec3 a, rad_vec3 b,
-                                 rad_vec3 d, double accuracy, double *error)
+static double triangle_area(rad_vec3 a, rad_vec3 b, rad_vec3 d)
 {
-    double area = 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(d, a)));
+    return 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(d, a)));
+}
+
+/* One fan triangle to max(accuracy |its value|, absolute): absolute is its share of the
+ * polygon's absolute tolerance. */
+static double integrate_triangle(const polygon_integral *c, rad_vec3 a, rad_vec3 b,
+                                 rad_vec3 d, double accuracy, double absolute, double *error)
+{
+    double area = triangle_area(a, b, d);
     double centre;
+    bool smooth = enter(c, a, b, d, 0);
     double whole = rule7(c, a, b, d, area, &centre);
     /* the floor keeps a pair that transfers (almost) nothing from refining forever */
-    double tolerance = fmax(accuracy * fabs(whole), 1e-15 * area);
-    if (fabs(whole - centre) <= tolerance) {
+    double tolerance = fmax(fmax(accuracy * fabs(whole), absolute), 1e-15 * area);
+    if ((smooth || c->min_depth == 0) && fabs(whole - centre) <= tolerance) {
         /* the 1-point rule already agrees: the degree-5 value is far better than that */
         *error += fabs(whole - centre);
         return whole;
     }
-    return adapt(c, a, b, d, area, whole, tolerance, 1, error);
+    return adapt(c, a, b, d, area, whole, tolerance, 1, smooth, error);
 }
 
 double polygon_integrate(const polygon_integral *integral, const rad_vec3 *polygon,
                          unsigned count, double accuracy, double *bound)
 {
-    double error = 0, sum = 0;
-    /* each fan triangle to the relative accuracy: so is their sum */
-    for (unsigned k = 1; k + 1 < count; k++)
+    return polygon_integrate_within(integral, polygon, count, accuracy, 0, bound);
+}
+
+double polygon_integrate_within(const polygon_integral *integral, const rad_vec3 *polygon,
+                                unsigned count, double accuracy, double absolute, double *bound)
+{
+    double error = 0, sum = 0, area = 0;
+    for (unsigned k = 1; k + 1 < count && absolute > 0; k++)
+        area += triangle_area(polygon[0], polygon[k], polygon[k + 1]);
+    /* each fan triangle to the relative accuracy, or its share by area of the absolute
+     * tolerance: so is their sum */
+    for (unsigned k = 1; k + 1 < count; k++) {
+        double share = area > 0 ? absolute * triangle_area(polygon[0], polygon[k],
+                                                           polygon[k + 1]) / area
+                                : 0;
         sum += integrate_triangle(integral, polygon[0], polygon[k], polygon[k + 1], accuracy,
-                                  &error);
+                                  share, &error);
+    }
     *bound = error;
     return sum;
 }

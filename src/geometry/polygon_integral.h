@@ -21,6 +21,15 @@ typedef struct polygon_integral {
     void *context;
     int max_depth;      /* deepest split of a fan triangle (4^depth cells at most) */
     const bool *failed; /* when it becomes true (set by f), the integral stops refining */
+    /* NULL, or told which triangle (a, b, d) at which level of splitting (0 = a fan
+     * triangle) the next points of f belong to, before them: f may drop what does not
+     * matter there (the occluders that cannot shade it). Level k follows level k - 1's
+     * call for the triangle containing it. Returns whether f is smooth there (nothing
+     * shades it): a triangle where it is not is split to at least min_depth levels before
+     * its rules' agreement is believed (a shadow's edge can pass between all 7 points of a
+     * large triangle, and between its children's, which then agree on a wrong value). */
+    bool (*cell)(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int level);
+    int min_depth;
 } polygon_integral;
 
 /* int over the convex polygon (count corners, counter-clockwise) of f, to the relative
@@ -28,5 +37,10 @@ typedef struct polygon_integral {
  * absolute error. */
 double polygon_integrate(const polygon_integral *integral, const rad_vec3 *polygon,
                          unsigned count, double accuracy, double *bound);
+
+/* The same to the looser of the relative `accuracy` and the absolute tolerance `absolute`
+ * on the whole integral (shared among the fan triangles by area). */
+double polygon_integrate_within(const polygon_integral *integral, const rad_vec3 *polygon,
+                                unsigned count, double accuracy, double absolute, double *bound);
 
 #endif

@@ -19,7 +19,10 @@
 #include "surface_viewfactors/pair_transfer.h"
 #include "trace/tracer_internal.h"
 
-/* Most pieces the smaller patch is cut into (at most PAIR_EXACT_MAX_OCCLUDERS planes). */
+/* Patch pairs with at most this many triangles in between get exact shadow clipping. */
+#define EXACT_PAIRS_MAX_OCCLUDERS 4u
+
+/* Most pieces the smaller patch is cut into (at most EXACT_PAIRS_MAX_OCCLUDERS planes). */
 #define MAX_PIECES 16u
 
 /* The screening tree: leaves of at most SCREEN_LEAF triangles, at most SCREEN_DEPTH deep. */
@@ -418,12 +421,12 @@ exact_outcome exact_pairs_transfer(const exact_pairs *pairs, uint32_t i, uint32_
         return EXACT_CLEAR;
     if (!clip)
         return EXACT_SAMPLE; /* the hull's faces might still prove it clear: not worth it */
-    shadow_occluder between[PAIR_EXACT_MAX_OCCLUDERS];
+    shadow_occluder between[EXACT_PAIRS_MAX_OCCLUDERS];
     uint32_t count = occluder_tree_collect(pairs->tree, p, q, pairs->epsilon, between,
-                                           PAIR_EXACT_MAX_OCCLUDERS);
+                                           EXACT_PAIRS_MAX_OCCLUDERS);
     if (count == 0)
         return EXACT_CLEAR;
-    if (count > PAIR_EXACT_MAX_OCCLUDERS)
+    if (count > EXACT_PAIRS_MAX_OCCLUDERS)
         return EXACT_SAMPLE;
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
     vf_polygon pieces[MAX_PIECES];

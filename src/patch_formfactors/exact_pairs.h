@@ -5,7 +5,7 @@
  * The view-factor engine's methods (src/surface_viewfactors/) applied to patches: the
  * occluder tree over the tracer's own triangles answers "can anything block a segment
  * between these two patches?" exactly (conservatively); when nothing can, the analytic
- * transfer is the answer and no ray is cast. When at most PAIR_EXACT_MAX_OCCLUDERS
+ * transfer is the answer and no ray is cast. When at most EXACT_PAIRS_MAX_OCCLUDERS (4)
  * triangles can, shadow clipping gives each point's visible factor exactly. Not here: the
  * unoccluded transfer and the sampled visibility (pair_engine.c).
  */

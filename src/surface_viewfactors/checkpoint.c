@@ -24,9 +24,10 @@
 static const uint8_t checkpoint_magic[8] = {0x89, 'R', 'A', 'D', 'V', 'F', 'C', '\n'};
 
 enum {
-    CHECKPOINT_VERSION = 2, /* 2: rows of pairs some sight ray met (seen_pairs.h) */
-    HEADER_BYTES = 52,  /* magic, version, rows, fingerprint, accuracy, rays, seed, count,
-                           sight rays */
+    CHECKPOINT_VERSION = 3, /* 2: rows of pairs some sight ray met (seen_pairs.h); 3: exact
+                               occluders, obstructed pairs to an absolute target */
+    HEADER_BYTES = 56,  /* magic, version, rows, fingerprint, accuracy, rays, seed, count,
+                           sight rays, exact occluders */
     ROW_BYTES = 8,      /* row, entry count */
     ENTRY_BYTES = 20,   /* column, transfer, bound */
     CHECKSUM_BYTES = CHECKPOINT_FILE_TAIL
@@ -80,6 +81,7 @@ rad_status vf_checkpoint_write(const char *path, const vf_checkpoint_job *job,
     bytes_put_u64(bytes + 36, job->seed);
     bytes_put_u32(bytes + 44, count);
     bytes_put_u32(bytes + 48, job->sight_rays);
+    bytes_put_u32(bytes + 52, job->exact_occluders);
     uint8_t *p = bytes + HEADER_BYTES;
     for (uint32_t I = 0; I < job->rows; I++) {
         if (!done[I])
@@ -115,15 +117,16 @@ static rad_status match_job(const char *path, const uint8_t *bytes, const vf_che
     uint32_t max_rays = bytes_get_u32(bytes + 32);
     uint64_t seed = bytes_get_u64(bytes + 36);
     uint32_t sight_rays = bytes_get_u32(bytes + 48);
+    uint32_t exact_occluders = bytes_get_u32(bytes + 52);
     if (accuracy != job->accuracy || max_rays != job->max_rays || seed != job->seed ||
-        sight_rays != job->sight_rays)
+        sight_rays != job->sight_rays || exact_occluders != job->exact_occluders)
         return rad_fail(error, RAD_ERR_INVALID,
                         "%s: a checkpoint made with other options (--accuracy %.17g, "
-                        "--max-rays %u, --seed %llu, --sight-rays %u; this run: %.17g, %u, "
-                        "%llu, %u)",
+                        "--max-rays %u, --seed %llu, --sight-rays %u, --exact-occluders %u; "
+                        "this run: %.17g, %u, %llu, %u, %u)",
                         path, accuracy, max_rays, (unsigned long long)seed, sight_rays,
-                        job->accuracy, job->max_rays, (unsigned long long)job->seed,
-                        job->sight_rays);
+                        exact_occluders, job->accuracy, job->max_rays,
+                        (unsigned long long)job->seed, job->sight_rays, job->exact_occluders);
     return RAD_OK;
 }
 

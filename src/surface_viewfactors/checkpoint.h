@@ -22,6 +22,7 @@ typedef struct vf_checkpoint_job {
     uint32_t max_rays;
     uint64_t seed;
     uint32_t sight_rays;  /* 0: none */
+    uint32_t exact_occluders;
 } vf_checkpoint_job;
 
 /* A hash of what the view factors depend on: positions, triangles (corners and surface),

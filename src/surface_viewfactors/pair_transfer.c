@@ -12,6 +12,7 @@
 #include "core/vec3.h"
 #include "geometry/contour.h"
 #include "geometry/polygon_integral.h"
+#include "surface_viewfactors/occluder_tree.h"
 #include "trace/ray.h"
 
 /* Deepest subdivision of the outer triangle: 4^12 cells would be far past any need. */
@@ -20,6 +21,12 @@
 /* The same behind occluders, where the integrand has kinks along penumbra edges and each
  * point costs more: what is left at this depth is reported in the error bound. */
 #define OBSTRUCTED_MAX_DEPTH 8
+
+/* A triangle of the outer polygon that something may shade is split at least this many
+ * times before the quadrature believes its rules' agreement. */
+#ifndef OBSTRUCTED_MIN_DEPTH
+#define OBSTRUCTED_MIN_DEPTH 2
+#endif
 
 /* Exact shadow clipping may spend this many (point, occluder) clippings on one pair, about
  * a millisecond, by default (pair_obstructed_exact); a pair that needs more is sampled
@@ -37,15 +44,91 @@ typedef struct outer_context {
     const shadow_polygon *joined;     /* or the same joined into polygons */
     uint32_t occluder_count;
     int max_depth;
+    int min_depth;           /* polygon_integral.min_depth */
     uint64_t work_left;      /* occluder clippings this pair may still spend */
     bool failed;             /* too many pieces somewhere, or the work budget ran out */
+    /* With culling (occluder_count <= PAIR_EXACT_MAX_OCCLUDERS): the occluders that can
+     * shade the triangle of the outer polygon the integral is at, for each level of its
+     * splitting (cull_cell), and the level the points now come from. */
+    bool culling;
+    int level;
+    uint32_t level_count[OBSTRUCTED_MAX_DEPTH + 1];
+    uint32_t level_index[OBSTRUCTED_MAX_DEPTH + 1][PAIR_EXACT_MAX_OCCLUDERS];
 } outer_context;
+
+/* Occluder o's corners. */
+static const rad_vec3 *occluder_corners(const outer_context *c, uint32_t o, unsigned *count)
+{
+    if (c->joined) {
+        *count = c->joined[o].count;
+        return c->joined[o].vertex;
+    }
+    *count = 3;
+    return c->occluders[o].corner;
+}
+
+/* Which of the level above's occluders can shade points of the triangle (a, b, d): those
+ * that cut the hull of it and the inner polygon (every segment between them lies in it),
+ * that is, are not wholly outside one of the hull's side planes (its other faces are the
+ * two polygons' planes, which the pair's occluders already cut). */
+static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int level)
+{
+    outer_context *c = context;
+    const uint32_t *from = level > 0 ? c->level_index[level - 1] : NULL;
+    uint32_t from_count = level > 0 ? c->level_count[level - 1] : c->occluder_count;
+    uint32_t *to = c->level_index[level];
+    uint32_t kept = 0;
+    vf_polygon cell;
+    cell.vertex[0] = a;
+    cell.vertex[1] = b;
+    cell.vertex[2] = d;
+    cell.count = 3;
+    cell.centroid = v3_scale(v3_add(v3_add(a, b), d), 1.0 / 3);
+    rad_vec3 normal[2 * (3 + VF_MAX_VERTICES)];
+    double offset[2 * (3 + VF_MAX_VERTICES)];
+    unsigned planes = occluder_hull_sides(&cell, c->inner, c->plane_epsilon, normal, offset);
+    for (uint32_t k = 0; k < from_count; k++) {
+        uint32_t o = from ? from[k] : k;
+        unsigned corners;
+        const rad_vec3 *corner = occluder_corners(c, o, &corners);
+        bool outside = false;
+        for (unsigned m = 0; m < planes && !outside; m++) {
+            outside = true;
+            for (unsigned v = 0; v < corners && outside; v++)
+                outside = v3_dot(normal[m], corner[v]) - offset[m] >= -c->plane_epsilon;
+        }
+        if (!outside)
+            to[kept++] = o;
+    }
+    c->level_count[level] = kept;
+    c->level = level;
+    return kept == 0;
+}
 
 static inline double point_factor(outer_context *c, rad_vec3 x)
 {
     if (c->occluder_count == 0)
         return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
                                         c->inner->normal, c->plane_epsilon);
+    if (c->culling) {
+        uint32_t count = c->level_count[c->level];
+        if (count == 0)
+            return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
+                                            c->inner->normal, c->plane_epsilon);
+        if (c->failed || c->work_left < count) {
+            c->failed = true;
+            return 0;
+        }
+        c->work_left -= count;
+        double factor = shadow_visible_factor_subset(x, c->normal, c->inner, c->occluders,
+                                                     c->joined, c->level_index[c->level],
+                                                     count, c->plane_epsilon);
+        if (factor < 0) {
+            c->failed = true;
+            return 0;
+        }
+        return factor;
+    }
     if (c->failed || c->work_left < c->occluder_count) {
         c->failed = true;
         return 0;
@@ -70,54 +153,66 @@ static double point_factor_callback(void *context, rad_vec3 x)
 
 /* G = int over the smaller polygon of F(x -> the other, as far as it is visible). */
 static double integrate_outer(outer_context *c, const vf_polygon *outer, double accuracy,
-                              double *bound)
+                              double absolute, double *bound)
 {
-    polygon_integral integral = {point_factor_callback, c, c->max_depth, &c->failed};
-    return polygon_integrate(&integral, outer->vertex, outer->count, accuracy, bound);
+    polygon_integral integral = {point_factor_callback, c, c->max_depth, &c->failed,
+                                 c->culling ? cull_cell : NULL, c->min_depth};
+    return polygon_integrate_within(&integral, outer->vertex, outer->count, accuracy, absolute,
+                                    bound);
 }
 
 double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accuracy,
                          double plane_epsilon, double *bound)
 {
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
-    outer_context c = {outer->normal, inner, plane_epsilon, NULL, NULL, 0, MAX_DEPTH, 0, false};
-    return integrate_outer(&c, outer, accuracy, bound);
+    outer_context c = {.normal = outer->normal, .inner = inner, .plane_epsilon = plane_epsilon,
+                       .max_depth = MAX_DEPTH};
+    return integrate_outer(&c, outer, accuracy, 0, bound);
 }
 
 /* The obstructed transfer behind the triangles, or behind `joined` (count of them) when not
  * NULL. */
 static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                              const shadow_occluder *occluders, const shadow_polygon *joined,
-                             uint32_t count, double accuracy, double plane_epsilon,
-                             uint64_t work_budget, double *value, double *bound)
+                             uint32_t count, double accuracy, double absolute,
+                             double plane_epsilon, uint64_t work_budget, int min_depth,
+                             double *value, double *bound)
 {
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
-    outer_context c = {outer->normal,       inner, plane_epsilon, occluders, joined, count,
-                       OBSTRUCTED_MAX_DEPTH, work_budget, false};
-    *value = integrate_outer(&c, outer, accuracy, bound);
+    outer_context c = {.normal = outer->normal,
+                       .inner = inner,
+                       .plane_epsilon = plane_epsilon,
+                       .occluders = occluders,
+                       .joined = joined,
+                       .occluder_count = count,
+                       .max_depth = OBSTRUCTED_MAX_DEPTH,
+                       .min_depth = min_depth,
+                       .work_left = work_budget,
+                       .culling = count <= PAIR_EXACT_MAX_OCCLUDERS};
+    *value = integrate_outer(&c, outer, accuracy, absolute, bound);
     return !c.failed;
 }
 
 bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
                                   const shadow_occluder *occluders, uint32_t occluder_count,
-                                  double accuracy, double plane_epsilon, uint64_t work_budget,
-                                  double *value, double *bound)
+                                  double accuracy, double absolute, double plane_epsilon,
+                                  uint64_t work_budget, double *value, double *bound)
 {
     shadow_polygon joined[PAIR_EXACT_MAX_OCCLUDERS];
     if (occluder_count > PAIR_EXACT_MAX_OCCLUDERS)
-        return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, plane_epsilon,
-                                work_budget, value, bound);
+        return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, absolute,
+                                plane_epsilon, work_budget, OBSTRUCTED_MIN_DEPTH, value, bound);
     uint32_t count = shadow_join_occluders(occluders, occluder_count, joined);
-    return obstructed_exact(p, q, NULL, joined, count, accuracy, plane_epsilon, work_budget,
-                            value, bound);
+    return obstructed_exact(p, q, NULL, joined, count, accuracy, absolute, plane_epsilon,
+                            work_budget, OBSTRUCTED_MIN_DEPTH, value, bound);
 }
 
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            const shadow_occluder *occluders, uint32_t occluder_count,
                            double accuracy, double plane_epsilon, double *value, double *bound)
 {
-    return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, plane_epsilon,
-                            EXACT_WORK_BUDGET, value, bound);
+    return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, 0, plane_epsilon,
+                            EXACT_WORK_BUDGET, 0, value, bound);
 }
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)

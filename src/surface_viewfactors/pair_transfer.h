@@ -4,8 +4,9 @@
  * Unobstructed: the outer integral of Lambert's contour formula (exact point-to-polygon
  * factor) over the smaller polygon by adaptive quadrature: a 7-point degree-5 rule on each
  * triangle, compared with its 4 children, split further where they disagree, to a
- * relative tolerance. Obstructed by a few triangles: the same integral of the exact factor
- * to the part left visible by their shadows (shadow_clip.h). Obstructed by many, or when
+ * relative tolerance. Obstructed by up to a set number of triangles: the same integral of
+ * the exact factor to the part left visible by their shadows (shadow_clip.h), each
+ * triangle of the splitting clipped by the occluders that can shade it only. By more, or when
  * the visible part breaks into too many pieces: the unobstructed value times the visible
  * fraction, estimated from replicated stratified segments between the polygons, weighted
  * by the kernel cos cos / r^2; rounds of 4x more segments until the estimate's error bound
@@ -52,31 +53,34 @@ double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accura
                          double plane_epsilon, double *bound);
 
 /* The obstructed transfer by exact shadow clipping at every quadrature point
- * (shadow_clip.h), to relative tolerance `accuracy`; false when the visible part broke into
+ * (shadow_clip.h), with the occluders that can shade the part of the outer polygon the
+ * point is in (the hull of that triangle of its splitting and the inner polygon), to
+ * relative tolerance `accuracy`; false when the visible part broke into
  * too many pieces or more than about a millisecond of clipping was needed (sample
  * instead). */
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            const shadow_occluder *occluders, uint32_t occluder_count,
                            double accuracy, double plane_epsilon, double *value, double *bound);
 
-/* The same with at most `work_budget` (point, occluder) clippings, and the occluders
+/* The same to the looser of the relative `accuracy` and the absolute tolerance `absolute`
+ * on the transfer, with at most `work_budget` (point, occluder) clippings, and the occluders
  * (at most PAIR_EXACT_MAX_OCCLUDERS of them) first joined where they share an edge in one
  * plane (shadow_join_occluders: a wall's triangles cast one shadow, not one each; the same
  * visible part, in fewer pieces). */
 bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
                                   const shadow_occluder *occluders, uint32_t occluder_count,
-                                  double accuracy, double plane_epsilon, uint64_t work_budget,
-                                  double *value, double *bound);
+                                  double accuracy, double absolute, double plane_epsilon,
+                                  uint64_t work_budget, double *value, double *bound);
 
 /* The clippings the surface view factors allow one pair: some 50 ms at most. A slot 1/50 as
  * wide as two unit plates, behind 4 triangles, needs more than 65536 (the kinks where its
  * image leaves the receiver refine to the deepest level). */
 #define PAIR_EXACT_WORK_BUDGET 262144u
 
-/* Scratch space for the sampled visibility of one thread. */
-/* Pairs with at most this many triangles in between get exact shadow clipping; pairs with
- * more are sampled. */
-#define PAIR_EXACT_MAX_OCCLUDERS 4u
+/* The most triangles in between that a pair can get exact shadow clipping behind (the
+ * surface view factors take rad_viewfactor_options.exact_occluders of them at most, the
+ * patches' form factors EXACT_PAIRS_MAX_OCCLUDERS). */
+#define PAIR_EXACT_MAX_OCCLUDERS ((uint32_t)RAD_MAX_EXACT_OCCLUDERS)
 
 /* Rounds of pair_sample_visibility at most (k = 1, 2, 4, ... 32 strata a side). */
 #define PAIR_MAX_ROUNDS 6u
@@ -89,6 +93,7 @@ typedef struct pair_round {
     uint32_t rays;
 } pair_round;
 
+/* Scratch space of one thread: the occluders of a pair and its sampled visibility. */
 typedef struct pair_workspace {
     shadow_occluder occluders[PAIR_EXACT_MAX_OCCLUDERS];
     rad_ray *rays;

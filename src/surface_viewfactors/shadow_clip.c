@@ -165,6 +165,7 @@ static int subtract_shadow(const piece *pieces, unsigned count, const piece *sha
 typedef struct occluder_list {
     const shadow_occluder *triangles; /* either triangles */
     const shadow_polygon *polygons;   /* or convex polygons */
+    const uint32_t *index;            /* NULL: 0 .. count - 1; else index[0 .. count) */
     uint32_t count;
 } occluder_list;
 
@@ -183,7 +184,8 @@ static double visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
     pieces[0].count = receiver->count;
     memcpy(pieces[0].vertex, receiver->vertex, receiver->count * sizeof(rad_vec3));
     drop_repeated_corners(&pieces[0]);
-    for (uint32_t o = 0; o < occluders->count && count > 0; o++) {
+    for (uint32_t k = 0; k < occluders->count && count > 0; k++) {
+        uint32_t o = occluders->index ? occluders->index[k] : k;
         piece shadow;
         const rad_vec3 *corners = occluders->triangles ? occluders->triangles[o].corner
                                                        : occluders->polygons[o].vertex;
@@ -209,7 +211,7 @@ double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
                              const shadow_occluder *occluders, uint32_t occluder_count,
                              double plane_epsilon)
 {
-    occluder_list list = {occluders, NULL, occluder_count};
+    occluder_list list = {occluders, NULL, NULL, occluder_count};
     return visible_factor(x, n, receiver, &list, plane_epsilon);
 }
 
@@ -217,7 +219,16 @@ double shadow_visible_factor_polygons(rad_vec3 x, rad_vec3 n, const vf_polygon *
                                       const shadow_polygon *occluders, uint32_t occluder_count,
                                       double plane_epsilon)
 {
-    occluder_list list = {NULL, occluders, occluder_count};
+    occluder_list list = {NULL, occluders, NULL, occluder_count};
+    return visible_factor(x, n, receiver, &list, plane_epsilon);
+}
+
+double shadow_visible_factor_subset(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
+                                    const shadow_occluder *triangles,
+                                    const shadow_polygon *polygons, const uint32_t *index,
+                                    uint32_t count, double plane_epsilon)
+{
+    occluder_list list = {triangles, polygons, index, count};
     return visible_factor(x, n, receiver, &list, plane_epsilon);
 }
 

@@ -40,6 +40,13 @@ double shadow_visible_factor_polygons(rad_vec3 x, rad_vec3 n, const vf_polygon *
                                       const shadow_polygon *occluders, uint32_t occluder_count,
                                       double plane_epsilon);
 
+/* The same behind the occluders index[0 .. count) of either `triangles` or `polygons` (the
+ * other NULL): the ones that can shade x, of those that can shade the pair. */
+double shadow_visible_factor_subset(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
+                                    const shadow_occluder *triangles,
+                                    const shadow_polygon *polygons, const uint32_t *index,
+                                    uint32_t count, double plane_epsilon);
+
 /* The occluding triangles joined where they can be, into `out` (room for `count`): two
  * join when they share an edge (the same corners, bit for bit), lie in one plane and their
  * union is convex with at most VF_MAX_VERTICES corners (straight corners dropped, to 1e-12

@@ -98,6 +98,7 @@ typedef struct engine {
     const double *polygons_after;   /* per surface I: the polygons of the surfaces J > I */
     double accuracy;
     uint32_t max_rays;
+    uint32_t exact_occluders; /* pairs behind at most this many triangles: shadow clipping */
     uint64_t seed;
 } engine;
 
@@ -226,7 +227,7 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
         }
     }
     uint32_t occluders = occluder_tree_collect(e->tree, p, q, eps, w->occluders,
-                                               PAIR_EXACT_MAX_OCCLUDERS);
+                                               e->exact_occluders);
     if (occluders == 0) {
         counts->unobstructed_pairs++;
         unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
@@ -234,25 +235,27 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
         return fmax(unobstructed, 0);
     }
     counts->obstructed_pairs++;
-    if (occluders <= PAIR_EXACT_MAX_OCCLUDERS) {
-        double visible, error;
-        if (pair_obstructed_exact_within(p, q, w->occluders, occluders, 0.25 * e->accuracy,
-                                         eps, PAIR_EXACT_WORK_BUDGET, &visible, &error)) {
-            counts->exact_pairs++;
-            unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
-            *bound = error;
-            return fmax(fmin(visible, unobstructed), 0);
-        }
-    }
-    counts->sampled_pairs++;
     unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
     if (!(unobstructed > 0))
         return 0;
     /* The target: the absolute error of F (seen from the smaller polygon, F0 unobstructed)
      * at most accuracy * sqrt(F0), so that a row's errors, added in quadrature, stay
      * within accuracy (the F0 of a row sum to at most 1) while small factors take few
-     * rays. */
-    double f0 = fmin(unobstructed / fmin(whole_p->area, whole_q->area), 1);
+     * points or rays. As a transfer G = A F: accuracy * sqrt(F0) * A. */
+    double smaller = fmin(whole_p->area, whole_q->area);
+    double f0 = fmin(unobstructed / smaller, 1);
+    double target = e->accuracy * sqrt(f0) * smaller;
+    if (occluders <= e->exact_occluders) {
+        double visible, error;
+        if (pair_obstructed_exact_within(p, q, w->occluders, occluders, 0.25 * e->accuracy,
+                                         0.5 * target, eps, PAIR_EXACT_WORK_BUDGET, &visible,
+                                         &error)) {
+            counts->exact_pairs++;
+            *bound = error;
+            return fmax(fmin(visible, unobstructed), 0);
+        }
+    }
+    counts->sampled_pairs++;
     /* the first look's rounds are taken as they came out, not cast again */
     pair_sample_visibility_resume(p, q, e->occluders, e->accuracy / sqrt(f0), e->max_rays,
                                   stream, w, &visibility);
@@ -357,7 +360,7 @@ enum { ROW_PENDING = 0, ROW_AT_ROOT = 1, ROW_HERE = 2 };
 
 /* What one polygon pair of the sample costs, in units of the first look's few dozen rays:
  * nothing much when they face away, the first look, then the analytic integral, the exact
- * shadow clipping of 1 to 4 occluders, or sampling behind more. */
+ * shadow clipping of up to exact_occluders occluders, or sampling behind more. */
 static double pair_cost_estimate(const engine *e, const vf_surface *a, const vf_surface *b,
                                  shadow_occluder *occluders)
 {
@@ -370,11 +373,10 @@ static double pair_cost_estimate(const engine *e, const vf_surface *a, const vf_
     if (!vf_polygon_in_front(q, p->normal, v3_dot(p->normal, p->vertex[0]), eps) ||
         !vf_polygon_in_front(p, q->normal, v3_dot(q->normal, q->vertex[0]), eps))
         return 0.05;
-    uint32_t count = occluder_tree_collect(e->tree, p, q, eps, occluders,
-                                           PAIR_EXACT_MAX_OCCLUDERS);
+    uint32_t count = occluder_tree_collect(e->tree, p, q, eps, occluders, e->exact_occluders);
     if (count == 0)
         return 1.5;
-    return count <= PAIR_EXACT_MAX_OCCLUDERS ? 2.0 + count : 8.0;
+    return count <= e->exact_occluders ? 2.0 + count : 8.0;
 }
 
 /* cost[I]: row I's polygon pairs times the mean estimated cost of COST_SAMPLES of its
@@ -661,10 +663,16 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     if (options->threads < 0 || !(options->accuracy >= 0) || options->accuracy >= 1)
         return rad_fail(error, RAD_ERR_INVALID,
                         "view factors: threads must be >= 0 and accuracy in [0, 1)");
+    if (options->exact_occluders > RAD_MAX_EXACT_OCCLUDERS)
+        return rad_fail(error, RAD_ERR_INVALID,
+                        "view factors: exact_occluders must be at most %d (it is %u)",
+                        RAD_MAX_EXACT_OCCLUDERS, options->exact_occluders);
     double start = now_seconds();
     int threads = options->threads > 0 ? options->threads : omp_get_max_threads();
     engine e = {.accuracy = options->accuracy > 0 ? options->accuracy : RAD_DEFAULT_ACCURACY,
                 .max_rays = options->max_rays ? options->max_rays : RAD_DEFAULT_MAX_RAYS,
+                .exact_occluders = options->exact_occluders ? options->exact_occluders
+                                                            : RAD_DEFAULT_EXACT_OCCLUDERS,
                 .seed = options->seed};
     if (e.max_rays < 64)
         e.max_rays = 64;
@@ -701,7 +709,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
                           : options->sight_rays                   ? options->sight_rays
                                                                   : sight_rays_for(e.accuracy);
     vf_checkpoint_job job = {vf_checkpoint_fingerprint(scene), n, e.accuracy, e.max_rays, e.seed,
-                             sight_rays};
+                             sight_rays, e.exact_occluders};
     uint32_t resumed = 0;
     if (status == RAD_OK && options->resume) {
         if (rank == 0)
@@ -944,6 +952,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         report->rays = totals.rays;
         report->unmet_pairs = totals.unmet_pairs;
         report->sight_rays = sight_rays;
+        report->exact_occluders = e.exact_occluders;
         report->sight_rays_cast = seen.rays_cast;
         report->unmet_bound = sight_rays ? SEEN_PAIRS_BOUND / sight_rays : 0;
         report->sight_seconds = sight_seconds;
