@@ -24,9 +24,7 @@
 
 /* A triangle of the outer polygon that something may shade is split at least this many
  * times before the quadrature believes its rules' agreement. */
-#ifndef OBSTRUCTED_MIN_DEPTH
 #define OBSTRUCTED_MIN_DEPTH 2
-#endif
 
 /* Exact shadow clipping may spend this many (point, occluder) clippings on one pair, about
  * a millisecond, by default (pair_obstructed_exact); a pair that needs more is sampled
@@ -47,14 +45,17 @@ typedef struct outer_context {
     int min_depth;           /* polygon_integral.min_depth */
     uint64_t work_left;      /* occluder clippings this pair may still spend */
     bool failed;             /* too many pieces somewhere, or the work budget ran out */
-    /* With culling (occluder_count <= PAIR_EXACT_MAX_OCCLUDERS): the occluders that can
-     * shade the triangle of the outer polygon the integral is at, for each level of its
-     * splitting (cull_cell), and the level the points now come from. */
-    bool culling;
-    int level;
-    uint32_t level_count[OBSTRUCTED_MAX_DEPTH + 1];
-    uint32_t level_index[OBSTRUCTED_MAX_DEPTH + 1][PAIR_EXACT_MAX_OCCLUDERS];
+    struct cull_levels *cull; /* NULL: every occluder at every point */
 } outer_context;
+
+/* The occluders that can shade the triangle of the outer polygon the integral is at, for
+ * each level of its splitting (cull_cell), and the level the points now come from. Set by
+ * cull_cell before any point: not initialised. */
+typedef struct cull_levels {
+    int level;
+    uint32_t count[OBSTRUCTED_MAX_DEPTH + 1];
+    uint32_t index[OBSTRUCTED_MAX_DEPTH + 1][PAIR_EXACT_MAX_OCCLUDERS];
+} cull_levels;
 
 /* Occluder o's corners. */
 static const rad_vec3 *occluder_corners(const outer_context *c, uint32_t o, unsigned *count)
@@ -74,9 +75,10 @@ static const rad_vec3 *occluder_corners(const outer_context *c, uint32_t o, unsi
 static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int level)
 {
     outer_context *c = context;
-    const uint32_t *from = level > 0 ? c->level_index[level - 1] : NULL;
-    uint32_t from_count = level > 0 ? c->level_count[level - 1] : c->occluder_count;
-    uint32_t *to = c->level_index[level];
+    cull_levels *cull = c->cull;
+    const uint32_t *from = level > 0 ? cull->index[level - 1] : NULL;
+    uint32_t from_count = level > 0 ? cull->count[level - 1] : c->occluder_count;
+    uint32_t *to = cull->index[level];
     uint32_t kept = 0;
     vf_polygon cell;
     cell.vertex[0] = a;
@@ -100,8 +102,8 @@ static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int lev
         if (!outside)
             to[kept++] = o;
     }
-    c->level_count[level] = kept;
-    c->level = level;
+    cull->count[level] = kept;
+    cull->level = level;
     return kept == 0;
 }
 
@@ -110,8 +112,8 @@ static inline double point_factor(outer_context *c, rad_vec3 x)
     if (c->occluder_count == 0)
         return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
                                         c->inner->normal, c->plane_epsilon);
-    if (c->culling) {
-        uint32_t count = c->level_count[c->level];
+    if (c->cull) {
+        uint32_t count = c->cull->count[c->cull->level];
         if (count == 0)
             return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
                                             c->inner->normal, c->plane_epsilon);
@@ -121,7 +123,8 @@ static inline double point_factor(outer_context *c, rad_vec3 x)
         }
         c->work_left -= count;
         double factor = shadow_visible_factor_subset(x, c->normal, c->inner, c->occluders,
-                                                     c->joined, c->level_index[c->level],
+                                                     c->joined,
+                                                     c->cull->index[c->cull->level],
                                                      count, c->plane_epsilon);
         if (factor < 0) {
             c->failed = true;
@@ -156,7 +159,7 @@ static double integrate_outer(outer_context *c, const vf_polygon *outer, double 
                               double absolute, double *bound)
 {
     polygon_integral integral = {point_factor_callback, c, c->max_depth, &c->failed,
-                                 c->culling ? cull_cell : NULL, c->min_depth};
+                                 c->cull ? cull_cell : NULL, c->min_depth};
     return polygon_integrate_within(&integral, outer->vertex, outer->count, accuracy, absolute,
                                     bound);
 }
@@ -165,8 +168,8 @@ double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accura
                          double plane_epsilon, double *bound)
 {
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
-    outer_context c = {.normal = outer->normal, .inner = inner, .plane_epsilon = plane_epsilon,
-                       .max_depth = MAX_DEPTH};
+    outer_context c = {outer->normal, inner,     plane_epsilon, NULL, NULL, 0,
+                       MAX_DEPTH,     0,         0,             false, NULL};
     return integrate_outer(&c, outer, accuracy, 0, bound);
 }
 
@@ -179,6 +182,7 @@ static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                              double *value, double *bound)
 {
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
+    cull_levels levels;
     outer_context c = {.normal = outer->normal,
                        .inner = inner,
                        .plane_epsilon = plane_epsilon,
@@ -188,7 +192,7 @@ static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                        .max_depth = OBSTRUCTED_MAX_DEPTH,
                        .min_depth = min_depth,
                        .work_left = work_budget,
-                       .culling = count <= PAIR_EXACT_MAX_OCCLUDERS};
+                       .cull = count <= PAIR_EXACT_MAX_OCCLUDERS ? &levels : NULL};
     *value = integrate_outer(&c, outer, accuracy, absolute, bound);
     return !c.failed;
 }
