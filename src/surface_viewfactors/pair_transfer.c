@@ -53,6 +53,7 @@ typedef struct outer_context {
  * cull_cell before any point: not initialised. */
 typedef struct cull_levels {
     int level;
+    bool blocked[OBSTRUCTED_MAX_DEPTH + 1]; /* one occluder hides all of q from the triangle */
     uint32_t count[OBSTRUCTED_MAX_DEPTH + 1];
     uint32_t index[OBSTRUCTED_MAX_DEPTH + 1][PAIR_EXACT_MAX_OCCLUDERS];
 } cull_levels;
@@ -68,6 +69,45 @@ static const rad_vec3 *occluder_corners(const outer_context *c, uint32_t o, unsi
     return c->occluders[o].corner;
 }
 
+/* Whether the flat convex occluder (corners, count) meets every segment from the triangle
+ * cell to the polygon q: its plane has the triangle on one side and q on the other (beyond
+ * epsilon), and it holds, by epsilon, every point where a segment between their corners
+ * crosses the plane. These points span the hull's cross-section, which is then inside it. */
+static bool blocks_all(const rad_vec3 *corner, unsigned count, const rad_vec3 *cell,
+                       const vf_polygon *q, double epsilon)
+{
+    rad_vec3 normal = v3_cross(v3_sub(corner[1], corner[0]), v3_sub(corner[2], corner[0]));
+    double length = v3_length(normal);
+    if (!(length > 0))
+        return false;
+    normal = v3_scale(normal, 1 / length);
+    double offset = v3_dot(normal, corner[0]);
+    double s[3], t[VF_MAX_VERTICES];
+    for (unsigned k = 0; k < 3; k++)
+        s[k] = v3_dot(normal, cell[k]) - offset;
+    for (unsigned k = 0; k < q->count; k++)
+        t[k] = v3_dot(normal, q->vertex[k]) - offset;
+    double sign = s[0] > 0 ? 1 : -1;
+    for (unsigned k = 0; k < 3; k++)
+        if (!(sign * s[k] > epsilon))
+            return false;
+    for (unsigned k = 0; k < q->count; k++)
+        if (!(sign * t[k] < -epsilon))
+            return false;
+    for (unsigned i = 0; i < 3; i++)
+        for (unsigned j = 0; j < q->count; j++) {
+            rad_vec3 x = v3_lerp(cell[i], q->vertex[j], s[i] / (s[i] - t[j]));
+            for (unsigned e = 0; e < count; e++) {
+                rad_vec3 edge = v3_sub(corner[(e + 1) % count], corner[e]);
+                rad_vec3 inward = v3_cross(normal, edge);
+                double inward_length = v3_length(inward);
+                if (!(v3_dot(inward, v3_sub(x, corner[e])) > epsilon * inward_length))
+                    return false;
+            }
+        }
+    return true;
+}
+
 /* Which of the level above's occluders can shade points of the triangle (a, b, d): those
  * that cut the hull of it and the inner polygon (every segment between them lies in it),
  * that is, are not wholly outside one of the hull's side planes (its other faces are the
@@ -80,6 +120,12 @@ static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int lev
     uint32_t from_count = level > 0 ? cull->count[level - 1] : c->occluder_count;
     uint32_t *to = cull->index[level];
     uint32_t kept = 0;
+    cull->level = level;
+    if (level > 0 && cull->blocked[level - 1]) {
+        cull->blocked[level] = true;
+        cull->count[level] = 0;
+        return true; /* 0 all over */
+    }
     vf_polygon cell;
     cell.vertex[0] = a;
     cell.vertex[1] = b;
@@ -99,11 +145,17 @@ static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int lev
             for (unsigned v = 0; v < corners && outside; v++)
                 outside = v3_dot(normal[m], corner[v]) - offset[m] >= -c->plane_epsilon;
         }
-        if (!outside)
-            to[kept++] = o;
+        if (outside)
+            continue;
+        if (blocks_all(corner, corners, cell.vertex, c->inner, c->plane_epsilon)) {
+            cull->blocked[level] = true;
+            cull->count[level] = 0;
+            return true;
+        }
+        to[kept++] = o;
     }
+    cull->blocked[level] = false;
     cull->count[level] = kept;
-    cull->level = level;
     return kept == 0;
 }
 
@@ -113,6 +165,8 @@ static inline double point_factor(outer_context *c, rad_vec3 x)
         return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
                                         c->inner->normal, c->plane_epsilon);
     if (c->cull) {
+        if (c->cull->blocked[c->cull->level])
+            return 0;
         uint32_t count = c->cull->count[c->cull->level];
         if (count == 0)
             return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
