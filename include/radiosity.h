@@ -840,7 +840,8 @@ typedef struct rad_viewfactor_options {
                                    one (checked between rounds of rows) and when stopped */
     double checkpoint_interval; /* seconds; 0: after every round (1/64 of the rows) */
     const char *resume;         /* NULL: none. A checkpoint of this job (same scene geometry
-                                   and surfaces, accuracy, max_rays, seed) whose rows are taken
+                                   and surfaces, accuracy, max_rays, sight_rays,
+                                   exact_occluders, seed) whose rows are taken
                                    as done; another job's is refused (RAD_ERR_INVALID naming
                                    the file). May be the checkpoint file itself */
     const volatile int *stop;   /* NULL: none. When it becomes non-zero (a signal handler),
