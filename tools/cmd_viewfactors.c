@@ -49,7 +49,8 @@ static const char usage[] =
     "                       (default " CLI_STR(RAD_DEFAULT_MAX_RAYS) ")\n"
     "  --exact-occluders N  pairs behind at most N triangles are clipped exactly, not\n"
     "                       sampled (default " CLI_STR(RAD_DEFAULT_EXACT_OCCLUDERS) ", at most "
-    CLI_STR(RAD_MAX_EXACT_OCCLUDERS) "): more, smaller bounds, longer\n"
+    CLI_STR(RAD_MAX_EXACT_OCCLUDERS) "): a larger N samples fewer\n"
+    "                       pairs, with smaller bounds, and takes longer\n"
     CLI_BASE_HELP("counts, times, invariants and error bounds");
 
 /* The rest of the help (one string may hold 4095 characters in C17), after the scene's. */
