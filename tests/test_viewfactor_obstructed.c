@@ -280,6 +280,72 @@ static void check_tube_in_tube(bool blocker_is_surface)
     rad_scene_destroy(scene);
 }
 
+/* Two unit plates, "one" at z = 0 (facing up) and "two" at z = 1 (facing down), with
+ * `between` (OBJ lines, vertices from 9 on) at z = 0.5: written as `name`, their matrix
+ * computed with `exact_occluders`. Returns F(one -> two) in *F and its bound; false when
+ * the scene or the matrix failed. */
+static bool plates_factor(const char *name, const char *between, uint32_t exact_occluders,
+                          rad_viewfactor_report *report, double *F, double *bound)
+{
+    size_t n = (size_t)snprintf(text, sizeof(text),
+                                "o one\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n"
+                                "o two\nv 0 0 1\nv 0 1 1\nv 1 1 1\nv 1 0 1\nf 5 6 7 8\n%s",
+                                between);
+    CHECK(n < sizeof(text));
+    const char *path = test_write_file(name, text);
+    rad_scene *scene = NULL;
+    rad_error error = {0};
+    CHECK(rad_scene_load(path, NULL, &scene, &error) == RAD_OK);
+    if (!scene)
+        return false;
+    rad_viewfactor_matrix *m = NULL;
+    rad_viewfactor_options options = {.exact_occluders = exact_occluders};
+    CHECK(rad_viewfactor_matrix_compute(scene, &options, &m, report, &error) == RAD_OK);
+    if (m)
+        *F = factor(m, surface_named(scene, "one"), surface_named(scene, "two"), bound);
+    rad_viewfactor_matrix_destroy(m);
+    rad_scene_destroy(scene);
+    return m != NULL;
+}
+
+/* The share of 4 M cosine rays from uniform points of the lower plate (random numbers from
+ * `seed`) that land on the upper one and that `passes` lets through z = 0.5 at (x, y): the
+ * test's own geometry, no ray tracer. */
+static double plates_monte_carlo(bool (*passes)(double x, double y), uint64_t seed,
+                                 double *standard_error)
+{
+    uint64_t state = seed, hits = 0, samples = 4000000;
+    for (uint64_t k = 0; k < samples; k++) {
+        double x = uniform(&state), y = uniform(&state), q = uniform(&state);
+        double phi = 2 * pi * uniform(&state), r = sqrt(q), dz = sqrt(fmax(0, 1 - q));
+        double dx = r * cos(phi) / dz, dy = r * sin(phi) / dz;
+        double x1 = x + dx, y1 = y + dy;
+        hits += x1 >= 0 && x1 <= 1 && y1 >= 0 && y1 <= 1 && passes(x + 0.5 * dx, y + 0.5 * dy);
+    }
+    double reference = (double)hits / samples;
+    *standard_error = sqrt(reference * (1 - reference) / samples);
+    return reference;
+}
+
+/* Rectangles at z = 0.5 as OBJ lines after `v` vertices: x0 y0 x1 y1 each. */
+static size_t write_rectangles(char *out, size_t size, double (*box)[4], int count, int v)
+{
+    size_t n = 0;
+    for (int k = 0; k < count; k++, v += 4)
+        n += (size_t)snprintf(out + n, size - n,
+                              "v %.17g %.17g 0.5\nv %.17g %.17g 0.5\nv %.17g %.17g 0.5\n"
+                              "v %.17g %.17g 0.5\nf %d %d %d %d\n",
+                              box[k][0], box[k][1], box[k][2], box[k][1], box[k][2], box[k][3],
+                              box[k][0], box[k][3], v + 1, v + 2, v + 3, v + 4);
+    return n;
+}
+
+static bool through_slot(double x, double y)
+{
+    (void)y;
+    return x >= 0.49 && x <= 0.51;
+}
+
 /* Plates 1 x 1 at z = 0 (facing up) and z = 1 (facing down); between them at z = 0.5 a
  * wall with a slot x in [0.49, 0.51] across it, 0.02 wide: narrower than the cells of
  * the first look (0.5) and of the finest sampling round (1/32). The wall is two rectangles
@@ -290,51 +356,26 @@ static void check_tube_in_tube(bool blocker_is_surface)
  * slot and land on the upper plate. */
 static void check_slot(int split, uint32_t exact_occluders)
 {
-    size_t n = 0;
-    int v = 0;
-    n += (size_t)snprintf(text + n, sizeof(text) - n,
-                          "o one\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n"
-                          "o two\nv 0 0 1\nv 0 1 1\nv 1 1 1\nv 1 0 1\nf 5 6 7 8\no wall\n");
-    v = 8;
+    static char wall[1 << 17];
+    double box[2 * 36][4];
+    int count = 0;
     const double part[2][2] = {{-2, 0.49}, {0.51, 3}};
     for (int side = 0; side < 2; side++)
         for (int i = 0; i < split; i++)
-            for (int j = 0; j < split; j++) {
-                double x0 = part[side][0] + (part[side][1] - part[side][0]) * i / split;
-                double x1 = part[side][0] + (part[side][1] - part[side][0]) * (i + 1) / split;
-                double y0 = -2 + 5.0 * j / split, y1 = -2 + 5.0 * (j + 1) / split;
-                n += (size_t)snprintf(text + n, sizeof(text) - n,
-                                      "v %.17g %.17g 0.5\nv %.17g %.17g 0.5\nv %.17g %.17g 0.5\n"
-                                      "v %.17g %.17g 0.5\nf %d %d %d %d\n",
-                                      x0, y0, x1, y0, x1, y1, x0, y1, v + 1, v + 2, v + 3, v + 4);
-                v += 4;
+            for (int j = 0; j < split; j++, count++) {
+                box[count][0] = part[side][0] + (part[side][1] - part[side][0]) * i / split;
+                box[count][2] = part[side][0] + (part[side][1] - part[side][0]) * (i + 1) / split;
+                box[count][1] = -2 + 5.0 * j / split;
+                box[count][3] = -2 + 5.0 * (j + 1) / split;
             }
-    const char *path = test_write_file("slot.obj", text);
-    rad_scene *scene = NULL;
-    rad_error error = {0};
-    CHECK(rad_scene_load(path, NULL, &scene, &error) == RAD_OK);
-    if (!scene)
-        return;
-    rad_viewfactor_matrix *m = NULL;
+    size_t n = (size_t)snprintf(wall, sizeof(wall), "o wall\n");
+    write_rectangles(wall + n, sizeof(wall) - n, box, count, 8);
     rad_viewfactor_report report;
-    rad_viewfactor_options options = {.exact_occluders = exact_occluders};
-    CHECK(rad_viewfactor_matrix_compute(scene, &options, &m, &report, &error) == RAD_OK);
-    if (!m) {
-        rad_scene_destroy(scene);
+    double F = 0, bound = 0;
+    if (!plates_factor("slot.obj", wall, exact_occluders, &report, &F, &bound))
         return;
-    }
-    double bound, F = factor(m, surface_named(scene, "one"), surface_named(scene, "two"),
-                             &bound);
-    uint64_t state = 0x2545F4914F6CDD1Dull, hits = 0, samples = 4000000;
-    for (uint64_t k = 0; k < samples; k++) {
-        double x = uniform(&state), y = uniform(&state), q = uniform(&state);
-        double phi = 2 * pi * uniform(&state), r = sqrt(q), dz = sqrt(fmax(0, 1 - q));
-        double dx = r * cos(phi) / dz, dy = r * sin(phi) / dz;
-        double xm = x + 0.5 * dx, x1 = x + dx, y1 = y + dy;
-        hits += xm >= 0.49 && xm <= 0.51 && x1 >= 0 && x1 <= 1 && y1 >= 0 && y1 <= 1;
-    }
-    double reference = (double)hits / samples;
-    double standard_error = sqrt(reference * (1 - reference) / samples);
+    double standard_error,
+        reference = plates_monte_carlo(through_slot, 0x2545F4914F6CDD1Dull, &standard_error);
     printf("slot 0.02 wide, wall as %d triangles, exact behind %u: F %.6f, bound %.2g; Monte "
            "Carlo %.6f +- %.2g; pairs: %llu exact, %llu sampled, %llu proven hidden\n",
            4 * split * split, report.exact_occluders, F, bound, reference, standard_error,
@@ -351,8 +392,6 @@ static void check_slot(int split, uint32_t exact_occluders)
         CHECK(report.sampled_pairs == 1);
         CHECK(bound > 0);
     }
-    rad_viewfactor_matrix_destroy(m);
-    rad_scene_destroy(scene);
 }
 
 /* A wall with no slot, as many triangles: the pair is proven hidden (one plane covers the
@@ -515,6 +554,15 @@ static void check_corner_on_plane(void)
     rad_scene_destroy(scene);
 }
 
+/* Between the squares of the grid below (0.06 x 0.12 at a pitch of 0.1 x 0.2). */
+static bool between_squares(double x, double y)
+{
+    if (!(x >= 0 && x < 1 && y >= 0 && y < 1))
+        return true;
+    double cx = x - 0.1 * floor(x / 0.1), cy = y - 0.2 * floor(y / 0.2);
+    return !(cx >= 0.02 && cx <= 0.08 && cy >= 0.04 && cy <= 0.16);
+}
+
 /* Plates 1 x 1 at z = 0 (up) and z = 1 (down) behind a grid of 50 small squares at
  * z = 0.5 (10 x 5, 0.06 x 0.12 each, 100 triangles), against the test's own count of
  * cosine rays from the lower plate that pass between the squares and land on the upper
@@ -522,52 +570,21 @@ static void check_corner_on_plane(void)
  * exactly, to its bound, and the bound to accuracy x sqrt(F unobstructed) (0.19982). */
 static void check_occluder_grid(uint32_t exact_occluders)
 {
-    size_t n = (size_t)snprintf(text, sizeof(text),
-                                "o one\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n"
-                                "o two\nv 0 0 1\nv 0 1 1\nv 1 1 1\nv 1 0 1\nf 5 6 7 8\no grid\n");
-    int v = 8;
+    static char grid[1 << 14];
+    double box[50][4];
     for (int i = 0; i < 10; i++)
         for (int j = 0; j < 5; j++) {
-            double x0 = 0.02 + 0.1 * i, y0 = 0.04 + 0.2 * j, x1 = x0 + 0.06, y1 = y0 + 0.12;
-            n += (size_t)snprintf(text + n, sizeof(text) - n,
-                                  "v %.17g %.17g 0.5\nv %.17g %.17g 0.5\nv %.17g %.17g 0.5\n"
-                                  "v %.17g %.17g 0.5\nf %d %d %d %d\n",
-                                  x0, y0, x1, y0, x1, y1, x0, y1, v + 1, v + 2, v + 3, v + 4);
-            v += 4;
+            double *b = box[5 * i + j];
+            b[0] = 0.02 + 0.1 * i, b[1] = 0.04 + 0.2 * j, b[2] = b[0] + 0.06, b[3] = b[1] + 0.12;
         }
-    const char *path = test_write_file("grid.obj", text);
-    rad_scene *scene = NULL;
-    rad_error error = {0};
-    CHECK(rad_scene_load(path, NULL, &scene, &error) == RAD_OK);
-    if (!scene)
-        return;
-    rad_viewfactor_matrix *m = NULL;
+    size_t n = (size_t)snprintf(grid, sizeof(grid), "o grid\n");
+    write_rectangles(grid + n, sizeof(grid) - n, box, 50, 8);
     rad_viewfactor_report report;
-    rad_viewfactor_options options = {.exact_occluders = exact_occluders};
-    CHECK(rad_viewfactor_matrix_compute(scene, &options, &m, &report, &error) == RAD_OK);
-    if (!m) {
-        rad_scene_destroy(scene);
+    double F = 0, bound = 0;
+    if (!plates_factor("grid.obj", grid, exact_occluders, &report, &F, &bound))
         return;
-    }
-    double bound, F = factor(m, surface_named(scene, "one"), surface_named(scene, "two"),
-                             &bound);
-    uint64_t state = 0x9E3779B97F4A7C15ull, hits = 0, samples = 4000000;
-    for (uint64_t k = 0; k < samples; k++) {
-        double x = uniform(&state), y = uniform(&state), q = uniform(&state);
-        double phi = 2 * pi * uniform(&state), r = sqrt(q), dz = sqrt(fmax(0, 1 - q));
-        double dx = r * cos(phi) / dz, dy = r * sin(phi) / dz;
-        double xm = x + 0.5 * dx, ym = y + 0.5 * dy, x1 = x + dx, y1 = y + dy;
-        if (!(x1 >= 0 && x1 <= 1 && y1 >= 0 && y1 <= 1))
-            continue;
-        bool blocked = false;
-        if (xm >= 0 && xm < 1 && ym >= 0 && ym < 1) {
-            double cx = xm - 0.1 * floor(xm / 0.1), cy = ym - 0.2 * floor(ym / 0.2);
-            blocked = cx >= 0.02 && cx <= 0.08 && cy >= 0.04 && cy <= 0.16;
-        }
-        hits += !blocked;
-    }
-    double reference = (double)hits / samples;
-    double standard_error = sqrt(reference * (1 - reference) / samples);
+    double standard_error,
+        reference = plates_monte_carlo(between_squares, 0x9E3779B97F4A7C15ull, &standard_error);
     printf("plates behind a grid of 50 squares, exact behind %u: F %.6f, bound %.2g; Monte "
            "Carlo %.6f +- %.2g; pairs: %llu exact, %llu sampled\n",
            report.exact_occluders, F, bound, reference, standard_error,
@@ -579,8 +596,6 @@ static void check_occluder_grid(uint32_t exact_occluders)
     } else {
         CHECK(report.sampled_pairs == 1);
     }
-    rad_viewfactor_matrix_destroy(m);
-    rad_scene_destroy(scene);
 }
 
 int main(void)

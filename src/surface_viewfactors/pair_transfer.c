@@ -94,16 +94,23 @@ static bool blocks_all(const rad_vec3 *corner, unsigned count, const rad_vec3 *c
     for (unsigned k = 0; k < q->count; k++)
         if (!(sign * t[k] < -epsilon))
             return false;
+    /* the occluder's edges as inward unit normals in its plane */
+    rad_vec3 inward[VF_MAX_VERTICES];
+    double inward_offset[VF_MAX_VERTICES];
+    for (unsigned e = 0; e < count; e++) {
+        inward[e] = v3_cross(normal, v3_sub(corner[(e + 1) % count], corner[e]));
+        double inward_length = v3_length(inward[e]);
+        if (!(inward_length > 0))
+            return false;
+        inward[e] = v3_scale(inward[e], 1 / inward_length);
+        inward_offset[e] = v3_dot(inward[e], corner[e]);
+    }
     for (unsigned i = 0; i < 3; i++)
         for (unsigned j = 0; j < q->count; j++) {
             rad_vec3 x = v3_lerp(cell[i], q->vertex[j], s[i] / (s[i] - t[j]));
-            for (unsigned e = 0; e < count; e++) {
-                rad_vec3 edge = v3_sub(corner[(e + 1) % count], corner[e]);
-                rad_vec3 inward = v3_cross(normal, edge);
-                double inward_length = v3_length(inward);
-                if (!(v3_dot(inward, v3_sub(x, corner[e])) > epsilon * inward_length))
+            for (unsigned e = 0; e < count; e++)
+                if (!(v3_dot(inward[e], x) - inward_offset[e] > epsilon))
                     return false;
-            }
         }
     return true;
 }
@@ -161,41 +168,24 @@ static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int lev
 
 static inline double point_factor(outer_context *c, rad_vec3 x)
 {
-    if (c->occluder_count == 0)
-        return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
-                                        c->inner->normal, c->plane_epsilon);
-    if (c->cull) {
+    uint32_t count = c->occluder_count;
+    const uint32_t *index = NULL; /* all of them */
+    if (c->cull && count) {
         if (c->cull->blocked[c->cull->level])
             return 0;
-        uint32_t count = c->cull->count[c->cull->level];
-        if (count == 0)
-            return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
-                                            c->inner->normal, c->plane_epsilon);
-        if (c->failed || c->work_left < count) {
-            c->failed = true;
-            return 0;
-        }
-        c->work_left -= count;
-        double factor = shadow_visible_factor_subset(x, c->normal, c->inner, c->occluders,
-                                                     c->joined,
-                                                     c->cull->index[c->cull->level],
-                                                     count, c->plane_epsilon);
-        if (factor < 0) {
-            c->failed = true;
-            return 0;
-        }
-        return factor;
+        count = c->cull->count[c->cull->level];
+        index = c->cull->index[c->cull->level];
     }
-    if (c->failed || c->work_left < c->occluder_count) {
+    if (count == 0)
+        return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
+                                        c->inner->normal, c->plane_epsilon);
+    if (c->failed || c->work_left < count) {
         c->failed = true;
         return 0;
     }
-    c->work_left -= c->occluder_count;
-    double factor = c->joined ? shadow_visible_factor_polygons(x, c->normal, c->inner, c->joined,
-                                                               c->occluder_count,
-                                                               c->plane_epsilon)
-                              : shadow_visible_factor(x, c->normal, c->inner, c->occluders,
-                                                      c->occluder_count, c->plane_epsilon);
+    c->work_left -= count;
+    double factor = shadow_visible_factor_subset(x, c->normal, c->inner, c->occluders,
+                                                 c->joined, index, count, c->plane_epsilon);
     if (factor < 0) {
         c->failed = true;
         return 0;
