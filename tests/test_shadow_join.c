@@ -5,7 +5,9 @@
  * from a point above a square receiver matches the closed form (the receiver less the
  * shadow, both rectangles seen from above their centre) as the triangles' own does;
  * triangles in two planes, meeting at a corner only, or whose union is not convex (an L)
- * are not joined, and the factor behind whatever is left is the triangles'. Not here: the
+ * are not joined, and the factor behind whatever is left is the triangles'; a 2 x 2 grid of
+ * squares in 20 shuffled orders joins into at most 4 polygons (into 1 in some order) that
+ * cast the triangles' shadow. Not here: the
  * pair integrals built on it (test_viewfactor_obstructed).
  */
 #include <math.h>
@@ -120,5 +122,34 @@ int main(void)
     count = shadow_join_occluders(l_shape, 6, joined);
     CHECK(count == 2);
     check_same_factor("L of three squares", l_shape, 6, joined, count);
+
+    /* a 2 x 2 grid of squares as 8 triangles in shuffled orders: a join can make an
+     * earlier polygon joinable (the search goes back for it); whatever joins, the shadow
+     * covers the same points, and two triangles of one square that meet first always join */
+    shadow_occluder grid[8], shuffled[8];
+    square(0.4, 1.0, 0.4, 1.0, 1, &grid[0]);
+    square(1.0, 1.6, 0.4, 1.0, 1, &grid[2]);
+    square(0.4, 1.0, 1.0, 1.6, 1, &grid[4]);
+    square(1.0, 1.6, 1.0, 1.6, 1, &grid[6]);
+    shadow_polygon grid_joined[8];
+    rad_rng order = rad_rng_seed(11, 8, 0);
+    uint32_t fewest = 8, most = 0;
+    for (int trial = 0; trial < 20; trial++) {
+        for (int k = 0; k < 8; k++)
+            shuffled[k] = grid[k];
+        for (int k = 7; k > 0; k--) {
+            int swap = (int)(rad_rng_uniform(&order) * (k + 1));
+            shadow_occluder keep = shuffled[k];
+            shuffled[k] = shuffled[swap];
+            shuffled[swap] = keep;
+        }
+        count = shadow_join_occluders(shuffled, 8, grid_joined);
+        CHECK(count >= 1 && count <= 4);
+        fewest = count < fewest ? count : fewest;
+        most = count > most ? count : most;
+        check_same_factor("2 x 2 grid, shuffled", shuffled, 8, grid_joined, count);
+    }
+    printf("2 x 2 grid in 20 orders: %u to %u polygons\n", fewest, most);
+    CHECK(fewest == 1);
     return test_finish("test_shadow_join");
 }

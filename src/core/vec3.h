@@ -7,6 +7,7 @@
 #include <math.h>
 
 #include "radiosity.h"
+#include "core/minmax.h"
 
 #define RAD_PI 3.14159265358979323846
 
@@ -57,18 +58,18 @@ static inline unsigned v3_drop_repeated(rad_vec3 *points, unsigned count, double
     double extent = 0;
     for (unsigned k = 1; k < count; k++) {
         rad_vec3 d = v3_sub(points[k], points[0]);
-        extent = fmax(extent, fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))));
+        extent = max_d(extent, max_d(fabs(d.x), max_d(fabs(d.y), fabs(d.z))));
     }
     double tiny = relative * extent;
     unsigned kept = 1;
     for (unsigned k = 1; k < count; k++) {
         rad_vec3 d = v3_sub(points[k], points[kept - 1]);
-        if (fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))) > tiny)
+        if (max_d(fabs(d.x), max_d(fabs(d.y), fabs(d.z))) > tiny)
             points[kept++] = points[k];
     }
     while (kept > 1) {
         rad_vec3 d = v3_sub(points[kept - 1], points[0]);
-        if (fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))) > tiny)
+        if (max_d(fabs(d.x), max_d(fabs(d.y), fabs(d.z))) > tiny)
             break;
         kept--;
     }

@@ -102,26 +102,87 @@ static bool project_shadow(rad_vec3 x, double H, rad_vec3 N, double offset,
     return area != 0;
 }
 
-/* True when the convex pieces a and b cannot overlap: an edge line of either has the
- * other wholly outside (both counter-clockwise about N). */
-static bool separated(const piece *a, const piece *b, rad_vec3 N)
+/* A convex shadow's edges as lines: inward[e] . v - offset[e] > 0 on its inner side;
+ * an edge of no length (a repeated corner) has none (inward 0). */
+typedef struct shadow_edges {
+    rad_vec3 inward[PIECE_MAX_VERTICES];
+    double offset[PIECE_MAX_VERTICES];
+} shadow_edges;
+
+static void edge_lines(const piece *shadow, rad_vec3 N, shadow_edges *edges)
 {
-    for (int pass = 0; pass < 2; pass++) {
-        const piece *edges = pass ? b : a, *other = pass ? a : b;
-        for (unsigned k = 0; k < edges->count; k++) {
-            rad_vec3 p0 = edges->vertex[k], p1 = edges->vertex[(k + 1) % edges->count];
-            rad_vec3 inward = v3_cross(N, v3_sub(p1, p0));
-            if (inward.x == 0 && inward.y == 0 && inward.z == 0)
-                continue; /* a repeated corner: no edge, no side */
-            double offset = v3_dot(inward, p0);
-            bool outside = true;
-            for (unsigned m = 0; m < other->count && outside; m++)
-                outside = v3_dot(inward, other->vertex[m]) - offset <= 0;
-            if (outside)
-                return true;
-        }
+    for (unsigned e = 0; e < shadow->count; e++) {
+        rad_vec3 p0 = shadow->vertex[e], p1 = shadow->vertex[(e + 1) % shadow->count];
+        edges->inward[e] = v3_cross(N, v3_sub(p1, p0));
+        edges->offset[e] = v3_dot(edges->inward[e], p0);
+    }
+}
+
+static inline bool no_line(rad_vec3 inward)
+{
+    return inward.x == 0 && inward.y == 0 && inward.z == 0;
+}
+
+/* True when the convex pieces a and b cannot overlap: an edge line of either has the
+ * other wholly outside (both counter-clockwise about N; b's edge lines given). */
+static bool separated(const piece *a, const piece *b, const shadow_edges *b_edges, rad_vec3 N)
+{
+    for (unsigned k = 0; k < a->count; k++) {
+        rad_vec3 p0 = a->vertex[k], p1 = a->vertex[(k + 1) % a->count];
+        rad_vec3 inward = v3_cross(N, v3_sub(p1, p0));
+        if (no_line(inward))
+            continue; /* a repeated corner: no edge, no side */
+        double offset = v3_dot(inward, p0);
+        bool outside = true;
+        for (unsigned m = 0; m < b->count && outside; m++)
+            outside = v3_dot(inward, b->vertex[m]) - offset <= 0;
+        if (outside)
+            return true;
+    }
+    for (unsigned k = 0; k < b->count; k++) {
+        if (no_line(b_edges->inward[k]))
+            continue;
+        bool outside = true;
+        for (unsigned m = 0; m < a->count && outside; m++)
+            outside = v3_dot(b_edges->inward[k], a->vertex[m]) - b_edges->offset[k] <= 0;
+        if (outside)
+            return true;
     }
     return false;
+}
+
+/* Splits `in` along the line inward . v = offset into the part on its inner side (>= 0)
+ * and the part outside (<= 0), as two clip_half_space calls would, in one pass; false
+ * when either would have more than PIECE_MAX_VERTICES corners. */
+static bool split_by_line(const piece *in, rad_vec3 inward, double offset, piece *inside,
+                          piece *outside)
+{
+    double d[PIECE_MAX_VERTICES];
+    for (unsigned k = 0; k < in->count; k++)
+        d[k] = v3_dot(inward, in->vertex[k]) - offset;
+    inside->count = outside->count = 0;
+    for (unsigned k = 0; k < in->count; k++) {
+        unsigned next = k + 1 == in->count ? 0 : k + 1;
+        rad_vec3 a = in->vertex[k];
+        double da = d[k], db = d[next];
+        bool crosses = (da > 0 && db < 0) || (da < 0 && db > 0);
+        if (inside->count + (da >= 0) + crosses > PIECE_MAX_VERTICES ||
+            outside->count + (da <= 0) + crosses > PIECE_MAX_VERTICES)
+            return false;
+        if (da >= 0)
+            inside->vertex[inside->count++] = a;
+        if (da <= 0)
+            outside->vertex[outside->count++] = a;
+        if (crosses) {
+            /* the same point either side: -da / (-da + db) is da / (da - db) bit for bit */
+            rad_vec3 x = v3_lerp(a, in->vertex[next], da / (da - db));
+            inside->vertex[inside->count++] = x;
+            outside->vertex[outside->count++] = x;
+        }
+    }
+    drop_repeated_corners(inside);
+    drop_repeated_corners(outside);
+    return true;
 }
 
 /* Subtracts the convex `shadow` (counter-clockwise about N) from the `count` pieces, into
@@ -130,29 +191,31 @@ static bool separated(const piece *a, const piece *b, rad_vec3 N)
 static int subtract_shadow(const piece *pieces, unsigned count, const piece *shadow, rad_vec3 N,
                            double tiny, piece *next)
 {
+    shadow_edges edges;
+    edge_lines(shadow, N, &edges);
     int made = 0;
     for (unsigned k = 0; k < count; k++) {
-        if (separated(&pieces[k], shadow, N)) {
+        if (separated(&pieces[k], shadow, &edges, N)) {
             if (made == SHADOW_MAX_PIECES)
                 return -1;
             next[made++] = pieces[k];
             continue;
         }
-        piece remaining = pieces[k];
-        for (unsigned e = 0; e < shadow->count && remaining.count >= 3; e++) {
-            rad_vec3 p0 = shadow->vertex[e], p1 = shadow->vertex[(e + 1) % shadow->count];
-            rad_vec3 inward = v3_cross(N, v3_sub(p1, p0));
-            if (inward.x == 0 && inward.y == 0 && inward.z == 0)
+        piece buffer[3];
+        const piece *remaining = &pieces[k];
+        for (unsigned e = 0; e < shadow->count && remaining->count >= 3; e++) {
+            if (no_line(edges.inward[e]))
                 continue;
-            double edge_offset = v3_dot(inward, p0);
-            piece outside, inside;
-            if (!clip_half_space(&remaining, v3_scale(inward, -1), -edge_offset, &outside) ||
-                !clip_half_space(&remaining, inward, edge_offset, &inside))
+            /* the part outside goes straight to `next` (a full `next` fails only when it
+             * would be kept); what is inside goes on */
+            piece *inside = remaining == &buffer[0] ? &buffer[1] : &buffer[0];
+            piece *outside = made < SHADOW_MAX_PIECES ? &next[made] : &buffer[2];
+            if (!split_by_line(remaining, edges.inward[e], edges.offset[e], inside, outside))
                 return -1;
-            if (outside.count >= 3 && piece_area(&outside, N) > tiny) {
+            if (outside->count >= 3 && piece_area(outside, N) > tiny) {
                 if (made == SHADOW_MAX_PIECES)
                     return -1;
-                next[made++] = outside;
+                made++;
             }
             remaining = inside;
         }
@@ -241,17 +304,6 @@ double shadow_visible_factor_subset(rad_vec3 x, rad_vec3 n, const vf_polygon *re
  * corners; false, a unchanged, otherwise. */
 static bool join_occluders(shadow_polygon *a, const shadow_polygon *b)
 {
-    rad_vec3 na = {0, 0, 0}, nb = {0, 0, 0};
-    for (unsigned k = 0; k < a->count; k++)
-        na = v3_add(na, v3_cross(a->vertex[k], a->vertex[(k + 1) % a->count]));
-    for (unsigned k = 0; k < b->count; k++)
-        nb = v3_add(nb, v3_cross(b->vertex[k], b->vertex[(k + 1) % b->count]));
-    double la = v3_length(na), lb = v3_length(nb);
-    if (!(la > 0) || !(lb > 0))
-        return false;
-    rad_vec3 normal = v3_scale(na, 1 / la);
-    if (v3_dot(normal, v3_scale(nb, 1 / lb)) < 1 - JOIN_STRAIGHT)
-        return false;
     for (unsigned i = 0; i < a->count; i++) {
         rad_vec3 u = a->vertex[i], v = a->vertex[(i + 1) % a->count];
         for (unsigned j = 0; j < b->count; j++) {
@@ -259,6 +311,19 @@ static bool join_occluders(shadow_polygon *a, const shadow_polygon *b)
             if (!(bj.x == v.x && bj.y == v.y && bj.z == v.z && bn.x == u.x && bn.y == u.y &&
                   bn.z == u.z))
                 continue;
+            /* the first shared edge decides; most pairs share none, so the planes are
+             * compared only now */
+            rad_vec3 na = {0, 0, 0}, nb = {0, 0, 0};
+            for (unsigned k = 0; k < a->count; k++)
+                na = v3_add(na, v3_cross(a->vertex[k], a->vertex[(k + 1) % a->count]));
+            for (unsigned k = 0; k < b->count; k++)
+                nb = v3_add(nb, v3_cross(b->vertex[k], b->vertex[(k + 1) % b->count]));
+            double la = v3_length(na), lb = v3_length(nb);
+            if (!(la > 0) || !(lb > 0))
+                return false;
+            rad_vec3 normal = v3_scale(na, 1 / la);
+            if (v3_dot(normal, v3_scale(nb, 1 / lb)) < 1 - JOIN_STRAIGHT)
+                return false;
             rad_vec3 joined[2 * VF_MAX_VERTICES];
             unsigned n = 0;
             for (unsigned k = 0; k <= i; k++)
@@ -303,15 +368,31 @@ uint32_t shadow_join_occluders(const shadow_occluder *triangles, uint32_t count,
         out[k].count = 3;
         memcpy(out[k].vertex, triangles[k].corner, 3 * sizeof(rad_vec3));
     }
-    bool joined = true;
-    while (joined) {
-        joined = false;
-        for (uint32_t a = 0; a < count && !joined; a++)
-            for (uint32_t b = a + 1; b < count && !joined; b++)
-                if (join_occluders(&out[a], &out[b])) {
-                    out[b] = out[--count];
-                    joined = true;
-                }
+    /* Joins, each time, the first pair (a, b) in order that joins, until none does; the
+     * scan does not start again from (0, 1) after each join. Before row a every pair is
+     * known not to join. A join into a changes only a (b takes the last polygon, which
+     * already failed with every row before a), so the next pair in order is the first
+     * (x, a), x < a, that joins, if any (x is then the changed one: the same again), else
+     * in row a itself. */
+    uint32_t a = 0;
+    while (a < count) {
+        uint32_t b = a + 1;
+        while (b < count && !join_occluders(&out[a], &out[b]))
+            b++;
+        if (b == count) {
+            a++;
+            continue;
+        }
+        out[b] = out[--count];
+        for (uint32_t x = 0; x < a;) {
+            if (join_occluders(&out[x], &out[a])) {
+                out[a] = out[--count];
+                a = x;
+                x = 0;
+            } else {
+                x++;
+            }
+        }
     }
     return count;
 }
