@@ -8,20 +8,20 @@
 
 #include "core/vec3.h"
 #include "geometry/contour.h"
+#include "geometry/flat_pieces.h"
 
 #define PIECE_MAX_VERTICES SHADOW_PIECE_MAX_VERTICES
 
 _Static_assert(SHADOW_PIECE_MAX_VERTICES <= CONTOUR_MAX_VERTICES - 1,
                "a piece is a polygon the contour integral takes");
+_Static_assert(FLAT_PIECE_MAX_VERTICES == SHADOW_PIECE_MAX_VERTICES,
+               "a piece in 3-D holds what it held in its plane");
 
 typedef shadow_piece piece;
 
-/* Corners within 1e-12 of the piece's extent of the corner before them dropped. A clip
- * through a corner makes its crossing point again, a hair away: the zero-length edge
- * between them has no direction, so `separated` took every shadow to lie outside it and
- * the piece survived shadows that covered it (a pair 0.005 % visible came out 5.8 %). The
- * receiver itself may come with repeated corners (the part of a polygon in front of a
- * plane through one of its corners, vf_polygon_clip_front). */
+/* Corners within 1e-12 of the piece's extent of the corner before them dropped: a clip
+ * through a corner makes its crossing point again, a hair away (flat_piece_drop_repeated
+ * says why that matters). */
 static void drop_repeated_corners(piece *p)
 {
     p->count = v3_drop_repeated(p->vertex, p->count, 1e-12);
@@ -48,179 +48,59 @@ static bool clip_half_space(const piece *in, rad_vec3 normal, double offset, pie
     return true;
 }
 
-static double piece_area(const piece *p, rad_vec3 normal)
-{
-    rad_vec3 sum = {0, 0, 0};
-    for (unsigned k = 0; k < p->count; k++)
-        sum = v3_add(sum, v3_cross(p->vertex[k], p->vertex[(k + 1) % p->count]));
-    return 0.5 * v3_dot(sum, normal);
-}
-
 /* The shadow of one convex occluder (`corners`, `count` of them, flat) on the receiver's
- * plane (normal N . v = offset), seen from x at height H above it; false when it casts
- * none. Counter-clockwise about N. */
-static bool project_shadow(rad_vec3 x, double H, rad_vec3 N, double offset,
-                           const rad_vec3 *corners, unsigned count, double epsilon,
-                           piece *shadow)
+ * plane (frame; its normal N, N . v = offset there), seen from the point at height H above
+ * x_flat (in the plane's coordinates); false when it casts none. Counter-clockwise. */
+static bool project_shadow(flat_point x_flat, double H, const plane_frame *frame,
+                           double offset, const rad_vec3 *corners, unsigned count,
+                           double epsilon, flat_piece *shadow)
 {
+    rad_vec3 N = frame->normal;
     piece occluder, low, slab;
     occluder.count = count;
     double top = H * (1 - 1e-9);
-    bool behind = true, above = true, between = true;
+    bool behind = true, above = true, some_low = false, some_high = false;
     for (unsigned k = 0; k < count; k++) {
         occluder.vertex[k] = corners[k];
         double h = v3_dot(N, corners[k]) - offset;
         behind = behind && h <= epsilon;
         above = above && h >= top;
-        between = between && h > epsilon && h < top;
+        some_low = some_low || !(h > epsilon);
+        some_high = some_high || !(h < top);
     }
     if (behind || above)
         return false; /* wholly behind the receiver's plane, or not below the point */
-    if (between) {
-        slab = occluder; /* the common case: wholly in between */
-    } else {
-        /* between the plane and the point: epsilon < h < H (1 - 1e-9) */
-        if (!clip_half_space(&occluder, N, offset + epsilon, &low) || low.count < 3)
+    /* the part between the plane and the point: epsilon < h < H (1 - 1e-9); most
+     * occluders are wholly in between, a wall standing on the receiver crosses only its
+     * plane */
+    const piece *cut = &occluder;
+    if (some_low) {
+        if (!clip_half_space(cut, N, offset + epsilon, &low) || low.count < 3)
             return false;
-        if (!clip_half_space(&low, v3_scale(N, -1), -(offset + top), &slab) || slab.count < 3)
+        cut = &low;
+    }
+    if (some_high) {
+        if (!clip_half_space(cut, v3_scale(N, -1), -(offset + top), &slab) || slab.count < 3)
             return false;
+        cut = &slab;
     }
-    shadow->count = slab.count;
-    for (unsigned k = 0; k < slab.count; k++) {
-        rad_vec3 P = slab.vertex[k];
-        double h = v3_dot(N, P) - offset;
-        shadow->vertex[k] = v3_add(x, v3_scale(v3_sub(P, x), H / (H - h)));
+    shadow->count = cut->count;
+    for (unsigned k = 0; k < cut->count; k++) {
+        rad_vec3 P = cut->vertex[k];
+        double t = H / (H - (v3_dot(N, P) - offset));
+        flat_point q = plane_frame_flat(frame, P);
+        shadow->vertex[k] = (flat_point){x_flat.u + (q.u - x_flat.u) * t,
+                                         x_flat.v + (q.v - x_flat.v) * t};
     }
-    double area = piece_area(shadow, N);
+    double area = flat_piece_area(shadow);
     if (area < 0) {
         for (unsigned k = 0; k < shadow->count / 2; k++) {
-            rad_vec3 swap = shadow->vertex[k];
+            flat_point swap = shadow->vertex[k];
             shadow->vertex[k] = shadow->vertex[shadow->count - 1 - k];
             shadow->vertex[shadow->count - 1 - k] = swap;
         }
     }
     return area != 0;
-}
-
-/* A convex shadow's edges as lines: inward[e] . v - offset[e] > 0 on its inner side;
- * an edge of no length (a repeated corner) has none (inward 0). */
-typedef struct shadow_edges {
-    rad_vec3 inward[PIECE_MAX_VERTICES];
-    double offset[PIECE_MAX_VERTICES];
-} shadow_edges;
-
-static void edge_lines(const piece *shadow, rad_vec3 N, shadow_edges *edges)
-{
-    for (unsigned e = 0; e < shadow->count; e++) {
-        rad_vec3 p0 = shadow->vertex[e], p1 = shadow->vertex[(e + 1) % shadow->count];
-        edges->inward[e] = v3_cross(N, v3_sub(p1, p0));
-        edges->offset[e] = v3_dot(edges->inward[e], p0);
-    }
-}
-
-static inline bool no_line(rad_vec3 inward)
-{
-    return inward.x == 0 && inward.y == 0 && inward.z == 0;
-}
-
-/* True when the convex pieces a and b cannot overlap: an edge line of either has the
- * other wholly outside (both counter-clockwise about N; b's edge lines given). */
-static bool separated(const piece *a, const piece *b, const shadow_edges *b_edges, rad_vec3 N)
-{
-    for (unsigned k = 0; k < a->count; k++) {
-        rad_vec3 p0 = a->vertex[k], p1 = a->vertex[(k + 1) % a->count];
-        rad_vec3 inward = v3_cross(N, v3_sub(p1, p0));
-        if (no_line(inward))
-            continue; /* a repeated corner: no edge, no side */
-        double offset = v3_dot(inward, p0);
-        bool outside = true;
-        for (unsigned m = 0; m < b->count && outside; m++)
-            outside = v3_dot(inward, b->vertex[m]) - offset <= 0;
-        if (outside)
-            return true;
-    }
-    for (unsigned k = 0; k < b->count; k++) {
-        if (no_line(b_edges->inward[k]))
-            continue;
-        bool outside = true;
-        for (unsigned m = 0; m < a->count && outside; m++)
-            outside = v3_dot(b_edges->inward[k], a->vertex[m]) - b_edges->offset[k] <= 0;
-        if (outside)
-            return true;
-    }
-    return false;
-}
-
-/* Splits `in` along the line inward . v = offset into the part on its inner side (>= 0)
- * and the part outside (<= 0), as two clip_half_space calls would, in one pass; false
- * when either would have more than PIECE_MAX_VERTICES corners. */
-static bool split_by_line(const piece *in, rad_vec3 inward, double offset, piece *inside,
-                          piece *outside)
-{
-    double d[PIECE_MAX_VERTICES];
-    for (unsigned k = 0; k < in->count; k++)
-        d[k] = v3_dot(inward, in->vertex[k]) - offset;
-    inside->count = outside->count = 0;
-    for (unsigned k = 0; k < in->count; k++) {
-        unsigned next = k + 1 == in->count ? 0 : k + 1;
-        rad_vec3 a = in->vertex[k];
-        double da = d[k], db = d[next];
-        bool crosses = (da > 0 && db < 0) || (da < 0 && db > 0);
-        if (inside->count + (da >= 0) + crosses > PIECE_MAX_VERTICES ||
-            outside->count + (da <= 0) + crosses > PIECE_MAX_VERTICES)
-            return false;
-        if (da >= 0)
-            inside->vertex[inside->count++] = a;
-        if (da <= 0)
-            outside->vertex[outside->count++] = a;
-        if (crosses) {
-            /* the same point either side: -da / (-da + db) is da / (da - db) bit for bit */
-            rad_vec3 x = v3_lerp(a, in->vertex[next], da / (da - db));
-            inside->vertex[inside->count++] = x;
-            outside->vertex[outside->count++] = x;
-        }
-    }
-    drop_repeated_corners(inside);
-    drop_repeated_corners(outside);
-    return true;
-}
-
-/* Subtracts the convex `shadow` (counter-clockwise about N) from the `count` pieces, into
- * `next`: the parts of each piece outside each shadow edge in turn, pieces of area at most
- * `tiny` dropped. Returns how many, or -1 past SHADOW_MAX_PIECES. */
-static int subtract_shadow(const piece *pieces, unsigned count, const piece *shadow, rad_vec3 N,
-                           double tiny, piece *next)
-{
-    shadow_edges edges;
-    edge_lines(shadow, N, &edges);
-    int made = 0;
-    for (unsigned k = 0; k < count; k++) {
-        if (separated(&pieces[k], shadow, &edges, N)) {
-            if (made == SHADOW_MAX_PIECES)
-                return -1;
-            next[made++] = pieces[k];
-            continue;
-        }
-        piece buffer[3];
-        const piece *remaining = &pieces[k];
-        for (unsigned e = 0; e < shadow->count && remaining->count >= 3; e++) {
-            if (no_line(edges.inward[e]))
-                continue;
-            /* the part outside goes straight to `next` (a full `next` fails only when it
-             * would be kept); what is inside goes on */
-            piece *inside = remaining == &buffer[0] ? &buffer[1] : &buffer[0];
-            piece *outside = made < SHADOW_MAX_PIECES ? &next[made] : &buffer[2];
-            if (!split_by_line(remaining, edges.inward[e], edges.offset[e], inside, outside))
-                return -1;
-            if (outside->count >= 3 && piece_area(outside, N) > tiny) {
-                if (made == SHADOW_MAX_PIECES)
-                    return -1;
-                made++;
-            }
-            remaining = inside;
-        }
-    }
-    return made;
 }
 
 /* The factor from x past occluders given as corner lists: occluder o has count(o) corners
@@ -240,33 +120,41 @@ static double visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
     double H = v3_dot(N, x) - offset;
     if (H <= plane_epsilon)
         return 0;
+    /* the shadows are cut from the receiver in its plane's own coordinates */
+    plane_frame frame = plane_frame_make(receiver->vertex[0], N);
+    flat_point x_flat = plane_frame_flat(&frame, x);
     double tiny = 1e-12 * receiver->area;
-    piece buffers[2][SHADOW_MAX_PIECES];
-    piece *pieces = buffers[0], *next = buffers[1];
+    flat_piece buffers[2][SHADOW_MAX_PIECES];
+    flat_piece *pieces = buffers[0], *next = buffers[1];
     unsigned count = 1;
     pieces[0].count = receiver->count;
-    memcpy(pieces[0].vertex, receiver->vertex, receiver->count * sizeof(rad_vec3));
-    drop_repeated_corners(&pieces[0]);
+    for (unsigned k = 0; k < receiver->count; k++)
+        pieces[0].vertex[k] = plane_frame_flat(&frame, receiver->vertex[k]);
+    flat_piece_drop_repeated(&pieces[0]);
     for (uint32_t k = 0; k < occluders->count && count > 0; k++) {
         uint32_t o = occluders->index ? occluders->index[k] : k;
-        piece shadow;
+        flat_piece shadow;
         const rad_vec3 *corners = occluders->triangles ? occluders->triangles[o].corner
                                                        : occluders->polygons[o].vertex;
         unsigned corner_count = occluders->triangles ? 3 : occluders->polygons[o].count;
-        if (!project_shadow(x, H, N, offset, corners, corner_count, plane_epsilon, &shadow))
+        if (!project_shadow(x_flat, H, &frame, offset, corners, corner_count, plane_epsilon,
+                            &shadow))
             continue;
-        int made = subtract_shadow(pieces, count, &shadow, N, tiny, next);
+        int made = flat_subtract(pieces, count, &shadow, tiny, next, SHADOW_MAX_PIECES);
         if (made < 0)
             return -1;
-        piece *swap = pieces;
+        flat_piece *swap = pieces;
         pieces = next;
         next = swap;
         count = (unsigned)made;
     }
     double factor = 0;
-    for (unsigned k = 0; k < count; k++)
-        factor += contour_point_to_polygon(x, n, pieces[k].vertex, pieces[k].count, N,
-                                           plane_epsilon);
+    for (unsigned k = 0; k < count; k++) {
+        rad_vec3 corner[FLAT_PIECE_MAX_VERTICES];
+        for (unsigned m = 0; m < pieces[k].count; m++)
+            corner[m] = plane_frame_point(&frame, pieces[k].vertex[m]);
+        factor += contour_point_to_polygon(x, n, corner, pieces[k].count, N, plane_epsilon);
+    }
     return factor;
 }
 
@@ -403,31 +291,37 @@ int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_v
 {
     if (window_count < 3 || window_count > PIECE_MAX_VERTICES)
         return -1;
-    piece buffer[SHADOW_MAX_PIECES];
-    piece *pieces = left, *next = buffer;
+    plane_frame frame = plane_frame_make(window[0], normal);
+    flat_piece buffers[2][SHADOW_MAX_PIECES];
+    flat_piece *pieces = buffers[0], *next = buffers[1];
     unsigned count = 1;
     pieces[0].count = window_count;
-    memcpy(pieces[0].vertex, window, window_count * sizeof(rad_vec3));
-    double tiny = 1e-12 * fabs(piece_area(&pieces[0], normal));
+    for (unsigned k = 0; k < window_count; k++)
+        pieces[0].vertex[k] = plane_frame_flat(&frame, window[k]);
+    double tiny = 1e-12 * fabs(flat_piece_area(&pieces[0]));
     for (uint32_t t = 0; t < polygon_count && count > 0; t++) {
         const shadow_polygon *polygon = &polygons[t];
-        piece shape = {.count = polygon->count};
-        memcpy(shape.vertex, polygon->vertex, polygon->count * sizeof(rad_vec3));
-        double area = piece_area(&shape, normal);
+        flat_piece shape = {.count = polygon->count};
+        for (unsigned k = 0; k < polygon->count; k++)
+            shape.vertex[k] = plane_frame_flat(&frame, polygon->vertex[k]);
+        double area = flat_piece_area(&shape);
         if (area == 0)
             continue;
         if (area < 0)
             for (unsigned k = 0; k < polygon->count; k++)
-                shape.vertex[k] = polygon->vertex[polygon->count - 1 - k];
-        int made = subtract_shadow(pieces, count, &shape, normal, tiny, next);
+                shape.vertex[k] = plane_frame_flat(&frame, polygon->vertex[polygon->count - 1 - k]);
+        int made = flat_subtract(pieces, count, &shape, tiny, next, SHADOW_MAX_PIECES);
         if (made < 0)
             return -1;
-        piece *swap = pieces;
+        flat_piece *swap = pieces;
         pieces = next;
         next = swap;
         count = (unsigned)made;
     }
-    if (pieces != left)
-        memcpy(left, pieces, count * sizeof(piece));
+    for (unsigned k = 0; k < count; k++) {
+        left[k].count = pieces[k].count;
+        for (unsigned m = 0; m < pieces[k].count; m++)
+            left[k].vertex[m] = plane_frame_point(&frame, pieces[k].vertex[m]);
+    }
     return (int)count;
 }

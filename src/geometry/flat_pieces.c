@@ -1,0 +1,168 @@
+/*
+ * flat_pieces.c - convex pieces of a plane and their subtraction, see flat_pieces.h.
+ */
+#include "geometry/flat_pieces.h"
+
+#include <math.h>
+
+#include "core/hemisphere.h"
+#include "core/minmax.h"
+
+plane_frame plane_frame_make(rad_vec3 origin, rad_vec3 n)
+{
+    plane_frame frame = {.origin = origin, .normal = n};
+    hemisphere_frame(n, &frame.u, &frame.v);
+    return frame;
+}
+
+double flat_piece_area(const flat_piece *p)
+{
+    double sum = 0;
+    for (unsigned k = 0; k < p->count; k++) {
+        flat_point a = p->vertex[k], b = p->vertex[k + 1 == p->count ? 0 : k + 1];
+        sum += a.u * b.v - a.v * b.u;
+    }
+    return 0.5 * sum;
+}
+
+static inline double extent_of(flat_point a, flat_point b)
+{
+    return max_d(fabs(a.u - b.u), fabs(a.v - b.v));
+}
+
+void flat_piece_drop_repeated(flat_piece *p)
+{
+    if (p->count < 2)
+        return;
+    double extent = 0;
+    for (unsigned k = 1; k < p->count; k++)
+        extent = max_d(extent, extent_of(p->vertex[k], p->vertex[0]));
+    double tiny = 1e-12 * extent;
+    unsigned kept = 1;
+    for (unsigned k = 1; k < p->count; k++)
+        if (extent_of(p->vertex[k], p->vertex[kept - 1]) > tiny)
+            p->vertex[kept++] = p->vertex[k];
+    while (kept > 1 && !(extent_of(p->vertex[kept - 1], p->vertex[0]) > tiny))
+        kept--;
+    p->count = kept;
+}
+
+/* An edge's line: inward . q - offset > 0 on the inner side of a counter-clockwise
+ * polygon's edge from p0 to p1 (inward is the edge turned a quarter left). */
+typedef struct flat_line {
+    double nu, nv, offset;
+} flat_line;
+
+static inline flat_line edge_line(flat_point p0, flat_point p1)
+{
+    flat_line line = {-(p1.v - p0.v), p1.u - p0.u, 0};
+    line.offset = line.nu * p0.u + line.nv * p0.v;
+    return line;
+}
+
+static inline double side_of(flat_line line, flat_point q)
+{
+    return line.nu * q.u + line.nv * q.v - line.offset;
+}
+
+static inline bool no_line(flat_line line) { return line.nu == 0 && line.nv == 0; }
+
+/* Whether `points` lie wholly on the outer side of the line (or on it). */
+static bool all_outside(flat_line line, const flat_piece *points)
+{
+    for (unsigned m = 0; m < points->count; m++)
+        if (side_of(line, points->vertex[m]) > 0)
+            return false;
+    return true;
+}
+
+/* True when the convex pieces a and b cannot overlap: an edge line of either has the
+ * other wholly outside (b's lines given). */
+static bool separated(const flat_piece *a, const flat_piece *b, const flat_line *b_lines)
+{
+    for (unsigned k = 0; k < a->count; k++) {
+        flat_line line = edge_line(a->vertex[k], a->vertex[k + 1 == a->count ? 0 : k + 1]);
+        if (!no_line(line) && all_outside(line, b))
+            return true;
+    }
+    for (unsigned k = 0; k < b->count; k++)
+        if (!no_line(b_lines[k]) && all_outside(b_lines[k], a))
+            return true;
+    return false;
+}
+
+/* Splits `in` (no repeated corners) along the line into the part on its inner side and
+ * the part outside, each with its repeated corners dropped; false when either would have more than
+ * FLAT_PIECE_MAX_VERTICES corners. */
+static bool split_by_line(const flat_piece *in, flat_line line, flat_piece *inside,
+                          flat_piece *outside)
+{
+    double d[FLAT_PIECE_MAX_VERTICES];
+    for (unsigned k = 0; k < in->count; k++)
+        d[k] = side_of(line, in->vertex[k]);
+    inside->count = outside->count = 0;
+    bool crossed = false;
+    for (unsigned k = 0; k < in->count; k++) {
+        unsigned next = k + 1 == in->count ? 0 : k + 1;
+        flat_point a = in->vertex[k], b = in->vertex[next];
+        double da = d[k], db = d[next];
+        bool crosses = (da > 0 && db < 0) || (da < 0 && db > 0);
+        if (inside->count + (da >= 0) + crosses > FLAT_PIECE_MAX_VERTICES ||
+            outside->count + (da <= 0) + crosses > FLAT_PIECE_MAX_VERTICES)
+            return false;
+        if (da >= 0)
+            inside->vertex[inside->count++] = a;
+        if (da <= 0)
+            outside->vertex[outside->count++] = a;
+        if (crosses) {
+            double t = da / (da - db);
+            flat_point x = {a.u + (b.u - a.u) * t, a.v + (b.v - a.v) * t};
+            inside->vertex[inside->count++] = x;
+            outside->vertex[outside->count++] = x;
+            crossed = true;
+        }
+    }
+    /* only a crossing point can repeat a corner: without one, each side keeps corners of
+     * the piece in order */
+    if (crossed) {
+        flat_piece_drop_repeated(inside);
+        flat_piece_drop_repeated(outside);
+    }
+    return true;
+}
+
+int flat_subtract(const flat_piece *pieces, unsigned count, const flat_piece *shape, double tiny,
+                  flat_piece *next, unsigned max_pieces)
+{
+    flat_line lines[FLAT_PIECE_MAX_VERTICES];
+    for (unsigned e = 0; e < shape->count; e++)
+        lines[e] = edge_line(shape->vertex[e], shape->vertex[e + 1 == shape->count ? 0 : e + 1]);
+    unsigned made = 0;
+    for (unsigned k = 0; k < count; k++) {
+        if (separated(&pieces[k], shape, lines)) {
+            if (made == max_pieces)
+                return -1;
+            next[made++] = pieces[k];
+            continue;
+        }
+        flat_piece buffer[3];
+        const flat_piece *remaining = &pieces[k];
+        for (unsigned e = 0; e < shape->count && remaining->count >= 3; e++) {
+            if (no_line(lines[e]))
+                continue;
+            /* the part outside goes straight to `next` (a full `next` fails only when it
+             * would be kept); what is inside goes on */
+            flat_piece *inside = remaining == &buffer[0] ? &buffer[1] : &buffer[0];
+            flat_piece *outside = made < max_pieces ? &next[made] : &buffer[2];
+            if (!split_by_line(remaining, lines[e], inside, outside))
+                return -1;
+            if (outside->count >= 3 && flat_piece_area(outside) > tiny) {
+                if (made == max_pieces)
+                    return -1;
+                made++;
+            }
+            remaining = inside;
+        }
+    }
+    return (int)made;
+}
