@@ -131,15 +131,41 @@ static bool split_by_line(const flat_piece *in, flat_line line, flat_piece *insi
     return true;
 }
 
+/* The box of a piece's corners. */
+typedef struct flat_box {
+    double u0, u1, v0, v1;
+} flat_box;
+
+static flat_box box_of(const flat_piece *p)
+{
+    flat_box box = {p->vertex[0].u, p->vertex[0].u, p->vertex[0].v, p->vertex[0].v};
+    for (unsigned k = 1; k < p->count; k++) {
+        box.u0 = min_d(box.u0, p->vertex[k].u);
+        box.u1 = max_d(box.u1, p->vertex[k].u);
+        box.v0 = min_d(box.v0, p->vertex[k].v);
+        box.v1 = max_d(box.v1, p->vertex[k].v);
+    }
+    return box;
+}
+
+/* Boxes apart, or touching: the pieces are separated (by a line along the frame's axes),
+ * as `separated` would find; most pieces and shadows are told apart so, cheaply. */
+static inline bool boxes_apart(flat_box a, flat_box b)
+{
+    return a.u1 <= b.u0 || b.u1 <= a.u0 || a.v1 <= b.v0 || b.v1 <= a.v0;
+}
+
 int flat_subtract(const flat_piece *pieces, unsigned count, const flat_piece *shape, double tiny,
                   flat_piece *next, unsigned max_pieces)
 {
     flat_line lines[FLAT_PIECE_MAX_VERTICES];
     for (unsigned e = 0; e < shape->count; e++)
         lines[e] = edge_line(shape->vertex[e], shape->vertex[e + 1 == shape->count ? 0 : e + 1]);
+    flat_box shape_box = box_of(shape);
     unsigned made = 0;
     for (unsigned k = 0; k < count; k++) {
-        if (separated(&pieces[k], shape, lines)) {
+        if (pieces[k].count == 0 || boxes_apart(box_of(&pieces[k]), shape_box) ||
+            separated(&pieces[k], shape, lines)) {
             if (made == max_pieces)
                 return -1;
             next[made++] = pieces[k];
