@@ -41,6 +41,8 @@ typedef struct outer_context {
     const shadow_occluder *occluders; /* what may stand in between (none: unobstructed) */
     const shadow_polygon *joined;     /* or the same joined into polygons */
     uint32_t occluder_count;
+    const shadow_receiver *receiver;  /* inner, made ready for the points */
+    const shadow_caster *casters;     /* the occluders made ready for it */
     int max_depth;
     int min_depth;           /* polygon_integral.min_depth */
     uint64_t work_left;      /* occluder clippings this pair may still spend */
@@ -184,8 +186,8 @@ static inline double point_factor(outer_context *c, rad_vec3 x)
         return 0;
     }
     c->work_left -= count;
-    double factor = shadow_visible_factor_subset(x, c->normal, c->inner, c->occluders,
-                                                 c->joined, index, count, c->plane_epsilon);
+    double factor = shadow_receiver_factor(c->receiver, x, c->normal, c->casters, index, count,
+                                           c->plane_epsilon);
     if (factor < 0) {
         c->failed = true;
         return 0;
@@ -212,8 +214,10 @@ double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accura
                          double plane_epsilon, double *bound)
 {
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
-    outer_context c = {outer->normal, inner,     plane_epsilon, NULL, NULL, 0,
-                       MAX_DEPTH,     0,         0,             false, NULL};
+    outer_context c = {.normal = outer->normal,
+                       .inner = inner,
+                       .plane_epsilon = plane_epsilon,
+                       .max_depth = MAX_DEPTH};
     return integrate_outer(&c, outer, accuracy, 0, bound);
 }
 
@@ -226,6 +230,16 @@ static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                              double *value, double *bound)
 {
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
+    if (count > PAIR_EXACT_MAX_OCCLUDERS)
+        return false; /* more than the exact path takes: sample instead */
+    shadow_receiver receiver;
+    shadow_receiver_prepare(inner, &receiver);
+    shadow_caster casters[PAIR_EXACT_MAX_OCCLUDERS];
+    for (uint32_t k = 0; k < count; k++) {
+        const rad_vec3 *corners = joined ? joined[k].vertex : occluders[k].corner;
+        shadow_caster_prepare(&receiver, corners, joined ? joined[k].count : 3, plane_epsilon,
+                              &casters[k]);
+    }
     cull_levels levels;
     outer_context c = {.normal = outer->normal,
                        .inner = inner,
@@ -233,10 +247,12 @@ static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                        .occluders = occluders,
                        .joined = joined,
                        .occluder_count = count,
+                       .receiver = &receiver,
+                       .casters = casters,
                        .max_depth = OBSTRUCTED_MAX_DEPTH,
                        .min_depth = min_depth,
                        .work_left = work_budget,
-                       .cull = count <= PAIR_EXACT_MAX_OCCLUDERS ? &levels : NULL};
+                       .cull = &levels};
     *value = integrate_outer(&c, outer, accuracy, absolute, bound);
     return !c.failed;
 }
@@ -248,8 +264,7 @@ bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
 {
     shadow_polygon joined[PAIR_EXACT_MAX_OCCLUDERS];
     if (occluder_count > PAIR_EXACT_MAX_OCCLUDERS)
-        return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, absolute,
-                                plane_epsilon, work_budget, OBSTRUCTED_MIN_DEPTH, value, bound);
+        return false;
     uint32_t count = shadow_join_occluders(occluders, occluder_count, joined);
     return obstructed_exact(p, q, NULL, joined, count, accuracy, absolute, plane_epsilon,
                             work_budget, OBSTRUCTED_MIN_DEPTH, value, bound);

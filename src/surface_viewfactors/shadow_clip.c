@@ -48,49 +48,94 @@ static bool clip_half_space(const piece *in, rad_vec3 normal, double offset, pie
     return true;
 }
 
-/* The shadow of one convex occluder (`corners`, `count` of them, flat) on the receiver's
- * plane (frame; its normal N, N . v = offset there), seen from the point at height H above
- * x_flat (in the plane's coordinates); false when it casts none. Counter-clockwise. */
-static bool project_shadow(flat_point x_flat, double H, const plane_frame *frame,
-                           double offset, const rad_vec3 *corners, unsigned count,
-                           double epsilon, flat_piece *shadow)
+void shadow_receiver_prepare(const vf_polygon *receiver, shadow_receiver *out)
 {
-    rad_vec3 N = frame->normal;
-    piece occluder, low, slab;
+    out->frame = plane_frame_make(receiver->vertex[0], receiver->normal);
+    out->offset = v3_dot(receiver->normal, receiver->vertex[0]);
+    out->tiny = 1e-12 * receiver->area;
+    out->whole.count = receiver->count;
+    for (unsigned k = 0; k < receiver->count; k++)
+        out->whole.vertex[k] = plane_frame_flat(&out->frame, receiver->vertex[k]);
+    flat_piece_drop_repeated(&out->whole);
+}
+
+void shadow_caster_prepare(const shadow_receiver *r, const rad_vec3 *corners, unsigned count,
+                           double plane_epsilon, shadow_caster *out)
+{
+    rad_vec3 N = r->frame.normal;
+    piece occluder, above;
     occluder.count = count;
-    double top = H * (1 - 1e-9);
-    bool behind = true, above = true, some_low = false, some_high = false;
+    bool some_low = false;
     for (unsigned k = 0; k < count; k++) {
         occluder.vertex[k] = corners[k];
-        double h = v3_dot(N, corners[k]) - offset;
-        behind = behind && h <= epsilon;
-        above = above && h >= top;
-        some_low = some_low || !(h > epsilon);
-        some_high = some_high || !(h < top);
+        some_low = some_low || !(v3_dot(N, corners[k]) - r->offset > plane_epsilon);
     }
-    if (behind || above)
-        return false; /* wholly behind the receiver's plane, or not below the point */
-    /* the part between the plane and the point: epsilon < h < H (1 - 1e-9); most
-     * occluders are wholly in between, a wall standing on the receiver crosses only its
-     * plane */
+    /* most occluders lie wholly above; a wall standing on the receiver crosses its plane */
     const piece *cut = &occluder;
     if (some_low) {
-        if (!clip_half_space(cut, N, offset + epsilon, &low) || low.count < 3)
-            return false;
-        cut = &low;
+        out->count = 0;
+        if (!clip_half_space(&occluder, N, r->offset + plane_epsilon, &above) ||
+            above.count < 3 || above.count > SHADOW_CASTER_MAX_VERTICES)
+            return;
+        cut = &above;
+    }
+    out->count = cut->count;
+    for (unsigned k = 0; k < cut->count; k++) {
+        out->at[k] = plane_frame_flat(&r->frame, cut->vertex[k]);
+        out->height[k] = v3_dot(N, cut->vertex[k]) - r->offset;
+    }
+}
+
+/* The caster's shadow on the receiver's plane seen from the point at height H above x_flat
+ * (its part below the point, heights < H (1 - 1e-9), projected from the point);
+ * false when it casts none. Counter-clockwise. */
+static bool project_shadow(flat_point x_flat, double H, const shadow_caster *caster,
+                           flat_piece *shadow)
+{
+    double top = H * (1 - 1e-9);
+    bool above = true, some_high = false;
+    for (unsigned k = 0; k < caster->count; k++) {
+        above = above && caster->height[k] >= top;
+        some_high = some_high || !(caster->height[k] < top);
+    }
+    if (caster->count < 3 || above)
+        return false; /* nothing above the receiver's plane, or nothing below the point */
+    flat_point at[SHADOW_CASTER_MAX_VERTICES + 1];
+    double height[SHADOW_CASTER_MAX_VERTICES + 1];
+    unsigned count = 0;
+    if (some_high) {
+        /* the part at heights <= top: corners and crossings in order */
+        for (unsigned k = 0; k < caster->count; k++) {
+            unsigned next = k + 1 == caster->count ? 0 : k + 1;
+            double da = top - caster->height[k], db = top - caster->height[next];
+            if (da >= 0) {
+                at[count] = caster->at[k];
+                height[count++] = caster->height[k];
+            }
+            if ((da > 0 && db < 0) || (da < 0 && db > 0)) {
+                double t = da / (da - db);
+                flat_point a = caster->at[k], b = caster->at[next];
+                at[count] = (flat_point){a.u + (b.u - a.u) * t, a.v + (b.v - a.v) * t};
+                height[count++] = caster->height[k] + (caster->height[next] - caster->height[k]) * t;
+            }
+        }
+    } else {
+        count = caster->count;
+        for (unsigned k = 0; k < count; k++) {
+            at[k] = caster->at[k];
+            height[k] = caster->height[k];
+        }
+    }
+    shadow->count = count;
+    for (unsigned k = 0; k < count; k++) {
+        double t = H / (H - height[k]);
+        shadow->vertex[k] = (flat_point){x_flat.u + (at[k].u - x_flat.u) * t,
+                                         x_flat.v + (at[k].v - x_flat.v) * t};
     }
     if (some_high) {
-        if (!clip_half_space(cut, v3_scale(N, -1), -(offset + top), &slab) || slab.count < 3)
+        flat_piece_drop_repeated(shadow);
+        if (shadow->count < 3)
             return false;
-        cut = &slab;
-    }
-    shadow->count = cut->count;
-    for (unsigned k = 0; k < cut->count; k++) {
-        rad_vec3 P = cut->vertex[k];
-        double t = H / (H - (v3_dot(N, P) - offset));
-        flat_point q = plane_frame_flat(frame, P);
-        shadow->vertex[k] = (flat_point){x_flat.u + (q.u - x_flat.u) * t,
-                                         x_flat.v + (q.v - x_flat.v) * t};
     }
     double area = flat_piece_area(shadow);
     if (area < 0) {
@@ -103,44 +148,51 @@ static bool project_shadow(flat_point x_flat, double H, const plane_frame *frame
     return area != 0;
 }
 
-/* The factor from x past occluders given as corner lists: occluder o has count(o) corners
- * at corners(o). */
+/* Where the occluders come from: casters prepared for the receiver, or corner lists
+ * (occluder o has count(o) corners at corners(o)) prepared as they are needed. */
 typedef struct occluder_list {
-    const shadow_occluder *triangles; /* either triangles */
+    const shadow_caster *casters;     /* either casters */
+    const shadow_occluder *triangles; /* or triangles */
     const shadow_polygon *polygons;   /* or convex polygons */
     const uint32_t *index;            /* NULL: 0 .. count - 1; else index[0 .. count) */
     uint32_t count;
 } occluder_list;
 
-static double visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
+static const shadow_caster *caster_of(const occluder_list *list, uint32_t k,
+                                      const shadow_receiver *r, double plane_epsilon,
+                                      shadow_caster *scratch)
+{
+    uint32_t o = list->index ? list->index[k] : k;
+    if (list->casters)
+        return &list->casters[o];
+    if (list->triangles)
+        shadow_caster_prepare(r, list->triangles[o].corner, 3, plane_epsilon, scratch);
+    else
+        shadow_caster_prepare(r, list->polygons[o].vertex, list->polygons[o].count,
+                              plane_epsilon, scratch);
+    return scratch;
+}
+
+static double visible_factor(const shadow_receiver *r, rad_vec3 x, rad_vec3 n,
                              const occluder_list *occluders, double plane_epsilon)
 {
-    rad_vec3 N = receiver->normal;
-    double offset = v3_dot(N, receiver->vertex[0]);
-    double H = v3_dot(N, x) - offset;
+    rad_vec3 N = r->frame.normal;
+    double H = v3_dot(N, x) - r->offset;
     if (H <= plane_epsilon)
         return 0;
     /* the shadows are cut from the receiver in its plane's own coordinates */
-    plane_frame frame = plane_frame_make(receiver->vertex[0], N);
-    flat_point x_flat = plane_frame_flat(&frame, x);
-    double tiny = 1e-12 * receiver->area;
+    flat_point x_flat = plane_frame_flat(&r->frame, x);
     flat_piece buffers[2][SHADOW_MAX_PIECES];
     flat_piece *pieces = buffers[0], *next = buffers[1];
     unsigned count = 1;
-    pieces[0].count = receiver->count;
-    for (unsigned k = 0; k < receiver->count; k++)
-        pieces[0].vertex[k] = plane_frame_flat(&frame, receiver->vertex[k]);
-    flat_piece_drop_repeated(&pieces[0]);
+    pieces[0] = r->whole;
     for (uint32_t k = 0; k < occluders->count && count > 0; k++) {
-        uint32_t o = occluders->index ? occluders->index[k] : k;
+        shadow_caster scratch;
         flat_piece shadow;
-        const rad_vec3 *corners = occluders->triangles ? occluders->triangles[o].corner
-                                                       : occluders->polygons[o].vertex;
-        unsigned corner_count = occluders->triangles ? 3 : occluders->polygons[o].count;
-        if (!project_shadow(x_flat, H, &frame, offset, corners, corner_count, plane_epsilon,
+        if (!project_shadow(x_flat, H, caster_of(occluders, k, r, plane_epsilon, &scratch),
                             &shadow))
             continue;
-        int made = flat_subtract(pieces, count, &shadow, tiny, next, SHADOW_MAX_PIECES);
+        int made = flat_subtract(pieces, count, &shadow, r->tiny, next, SHADOW_MAX_PIECES);
         if (made < 0)
             return -1;
         flat_piece *swap = pieces;
@@ -152,7 +204,7 @@ static double visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
     for (unsigned k = 0; k < count; k++) {
         rad_vec3 corner[FLAT_PIECE_MAX_VERTICES];
         for (unsigned m = 0; m < pieces[k].count; m++)
-            corner[m] = plane_frame_point(&frame, pieces[k].vertex[m]);
+            corner[m] = plane_frame_point(&r->frame, pieces[k].vertex[m]);
         factor += contour_point_to_polygon(x, n, corner, pieces[k].count, N, plane_epsilon);
     }
     return factor;
@@ -162,25 +214,28 @@ double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
                              const shadow_occluder *occluders, uint32_t occluder_count,
                              double plane_epsilon)
 {
-    occluder_list list = {occluders, NULL, NULL, occluder_count};
-    return visible_factor(x, n, receiver, &list, plane_epsilon);
+    shadow_receiver r;
+    shadow_receiver_prepare(receiver, &r);
+    occluder_list list = {NULL, occluders, NULL, NULL, occluder_count};
+    return visible_factor(&r, x, n, &list, plane_epsilon);
 }
 
 double shadow_visible_factor_polygons(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
                                       const shadow_polygon *occluders, uint32_t occluder_count,
                                       double plane_epsilon)
 {
-    occluder_list list = {NULL, occluders, NULL, occluder_count};
-    return visible_factor(x, n, receiver, &list, plane_epsilon);
+    shadow_receiver r;
+    shadow_receiver_prepare(receiver, &r);
+    occluder_list list = {NULL, NULL, occluders, NULL, occluder_count};
+    return visible_factor(&r, x, n, &list, plane_epsilon);
 }
 
-double shadow_visible_factor_subset(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
-                                    const shadow_occluder *triangles,
-                                    const shadow_polygon *polygons, const uint32_t *index,
-                                    uint32_t count, double plane_epsilon)
+double shadow_receiver_factor(const shadow_receiver *receiver, rad_vec3 x, rad_vec3 n,
+                              const shadow_caster *casters, const uint32_t *index,
+                              uint32_t count, double plane_epsilon)
 {
-    occluder_list list = {triangles, polygons, index, count};
-    return visible_factor(x, n, receiver, &list, plane_epsilon);
+    occluder_list list = {casters, NULL, NULL, index, count};
+    return visible_factor(receiver, x, n, &list, plane_epsilon);
 }
 
 /* Sine of the turn below which a corner of a joined occluder counts as straight (dropped)

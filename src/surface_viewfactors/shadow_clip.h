@@ -11,6 +11,7 @@
 #define RAD_VIEWFACTOR_SHADOW_CLIP_H
 
 #include "radiosity.h"
+#include "geometry/flat_pieces.h"
 #include "surface_viewfactors/vf_geometry.h"
 
 /* Most convex pieces the visible part may break into before the caller falls back to
@@ -40,12 +41,38 @@ double shadow_visible_factor_polygons(rad_vec3 x, rad_vec3 n, const vf_polygon *
                                       const shadow_polygon *occluders, uint32_t occluder_count,
                                       double plane_epsilon);
 
-/* The same behind the occluders index[0 .. count) of either `triangles` or `polygons` (the
- * other NULL): the ones that can shade x, of those that can shade the pair. */
-double shadow_visible_factor_subset(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
-                                    const shadow_occluder *triangles,
-                                    const shadow_polygon *polygons, const uint32_t *index,
-                                    uint32_t count, double plane_epsilon);
+/* A receiving polygon made ready for the factor from many points: its plane's frame and
+ * its corners in it. */
+typedef struct shadow_receiver {
+    plane_frame frame;
+    double offset; /* normal . v on its plane */
+    double tiny;   /* visible pieces of at most this area are dropped */
+    flat_piece whole;
+} shadow_receiver;
+
+void shadow_receiver_prepare(const vf_polygon *receiver, shadow_receiver *out);
+
+/* An occluder made ready for a receiver: its part above the receiver's plane (beyond
+ * plane_epsilon: what lies at or behind it shades nothing there), each corner's
+ * coordinates in the plane's frame and height above it; count 0 when nothing is above. */
+#define SHADOW_CASTER_MAX_VERTICES (VF_MAX_VERTICES + 1)
+
+typedef struct shadow_caster {
+    flat_point at[SHADOW_CASTER_MAX_VERTICES];
+    double height[SHADOW_CASTER_MAX_VERTICES];
+    unsigned count;
+} shadow_caster;
+
+/* corners: a flat convex polygon, at most VF_MAX_VERTICES of them. */
+void shadow_caster_prepare(const shadow_receiver *receiver, const rad_vec3 *corners,
+                           unsigned count, double plane_epsilon, shadow_caster *out);
+
+/* The factor from x to what of the receiver the casters index[0 .. count) (NULL: the first
+ * count) leave visible; the same as shadow_visible_factor behind the occluders they were
+ * made from. */
+double shadow_receiver_factor(const shadow_receiver *receiver, rad_vec3 x, rad_vec3 n,
+                              const shadow_caster *casters, const uint32_t *index,
+                              uint32_t count, double plane_epsilon);
 
 /* The occluding triangles joined where they can be, into `out` (room for `count`): two
  * join when they share an edge (the same corners, bit for bit), lie in one plane and their
