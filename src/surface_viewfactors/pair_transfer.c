@@ -47,7 +47,7 @@ typedef struct outer_context {
     int min_depth;           /* polygon_integral.min_depth */
     uint64_t work_left;      /* occluder clippings this pair may still spend */
     bool failed;             /* too many pieces somewhere, or the work budget ran out */
-    struct cull_levels *cull; /* NULL: every occluder at every point */
+    struct cull_levels *cull; /* NULL: unobstructed, no occluders */
 } outer_context;
 
 /* The occluders that can shade the triangle of the outer polygon the integral is at, for

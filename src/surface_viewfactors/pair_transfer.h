@@ -56,8 +56,8 @@ double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accura
  * (shadow_clip.h), with the occluders that can shade the part of the outer polygon the
  * point is in (the hull of that triangle of its splitting and the inner polygon), to
  * relative tolerance `accuracy`; false when the visible part broke into
- * too many pieces or more than about a millisecond of clipping was needed (sample
- * instead). */
+ * too many pieces, more than about a millisecond of clipping was needed or there are more
+ * than PAIR_EXACT_MAX_OCCLUDERS occluders (sample instead). */
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            const shadow_occluder *occluders, uint32_t occluder_count,
                            double accuracy, double plane_epsilon, double *value, double *bound);

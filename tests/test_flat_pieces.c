@@ -1,0 +1,101 @@
+/*
+ * test_flat_pieces.c - convex pieces of a plane and their subtraction
+ * (src/geometry/flat_pieces.c), against areas worked out by hand: a plane's frame maps its
+ * points to (u, v) and back and keeps counter-clockwise counter-clockwise; a square less
+ * a square over one of its corners leaves 3/4 of it in 2 pieces, less one in its middle a
+ * frame of 4 pieces, less a covering one nothing; a shape whose box is apart, or that only
+ * touches along an edge, leaves the piece as it was; of 2 triangles that cover it
+ * together, the first leaves the corner the second then covers; more pieces than there is room for fail (-1);
+ * corners repeated a hair apart are dropped, distinct ones kept. Not here: the shadows
+ * cut with it (test_shadow_clip, test_shadow_join).
+ */
+#include <math.h>
+#include <stdio.h>
+
+#include "core/vec3.h"
+#include "geometry/flat_pieces.h"
+#include "testlib.h"
+
+static flat_piece square(double u0, double u1, double v0, double v1)
+{
+    return (flat_piece){{{u0, v0}, {u1, v0}, {u1, v1}, {u0, v1}}, 4};
+}
+
+static double total_area(const flat_piece *pieces, int count)
+{
+    double sum = 0;
+    for (int k = 0; k < count; k++) {
+        double area = flat_piece_area(&pieces[k]);
+        CHECK(area > 0); /* counter-clockwise, not degenerate */
+        sum += area;
+    }
+    return sum;
+}
+
+int main(void)
+{
+    /* the frame of a tilted plane: axes unit and orthogonal, u x v = n, points back */
+    rad_vec3 n = v3_normalize(v3(0.3, -0.5, 0.8));
+    plane_frame frame = plane_frame_make(v3(1, 2, 3), n);
+    CHECK_NEAR(v3_length(frame.u), 1, 1e-15);
+    CHECK_NEAR(v3_length(frame.v), 1, 1e-15);
+    CHECK(fabs(v3_dot(frame.u, frame.v)) < 1e-15);
+    CHECK(v3_length(v3_sub(v3_cross(frame.u, frame.v), n)) < 1e-15);
+    rad_vec3 p = v3_add(v3(1, 2, 3), v3_add(v3_scale(frame.u, 0.7), v3_scale(frame.v, -1.3)));
+    flat_point q = plane_frame_flat(&frame, p);
+    CHECK_NEAR(q.u, 0.7, 1e-14);
+    CHECK_NEAR(q.v, -1.3, 1e-14);
+    CHECK(v3_length(v3_sub(plane_frame_point(&frame, q), p)) < 1e-14);
+
+    flat_piece unit = square(0, 1, 0, 1), next[8];
+    CHECK_NEAR(flat_piece_area(&unit), 1, 1e-15);
+
+    /* a square over the corner (1, 1): the L left is 3/4, in 2 convex pieces */
+    flat_piece corner = square(0.5, 1.5, 0.5, 1.5);
+    int made = flat_subtract(&unit, 1, &corner, 1e-12, next, 8);
+    printf("unit square less the square over its corner: %d pieces, area %.17g\n", made,
+           made > 0 ? total_area(next, made) : -1.0);
+    CHECK(made == 2);
+    CHECK_NEAR(total_area(next, made), 0.75, 1e-15);
+
+    /* a square in its middle: a frame of 4 pieces, 1 - 0.25 */
+    flat_piece middle = square(0.25, 0.75, 0.25, 0.75);
+    made = flat_subtract(&unit, 1, &middle, 1e-12, next, 8);
+    CHECK(made == 4);
+    CHECK_NEAR(total_area(next, made), 0.75, 1e-15);
+    /* ... with room for 3 only: fails */
+    CHECK(flat_subtract(&unit, 1, &middle, 1e-12, next, 3) == -1);
+
+    /* a covering square: nothing left */
+    flat_piece cover = square(-1, 2, -1, 2);
+    CHECK(flat_subtract(&unit, 1, &cover, 1e-12, next, 8) == 0);
+
+    /* apart, and touching along an edge: the piece as it was */
+    flat_piece apart = square(2, 3, 0, 1), touching = square(1, 2, 0.2, 0.8);
+    made = flat_subtract(&unit, 1, &apart, 1e-12, next, 8);
+    CHECK(made == 1 && next[0].count == 4);
+    CHECK_NEAR(total_area(next, made), 1, 0);
+    made = flat_subtract(&unit, 1, &touching, 1e-12, next, 8);
+    CHECK(made == 1 && next[0].count == 4);
+    CHECK_NEAR(total_area(next, made), 1, 0);
+
+    /* a triangle over the square's part below y = x + 0.1, then one over its part above
+     * y = x - 0.1: 0.9^2 / 2 left after the first, nothing after both */
+    flat_piece lower = {{{-0.3, -0.2}, {1.2, -0.2}, {1.2, 1.3}}, 3};
+    flat_piece upper = {{{-0.2, -0.3}, {1.3, 1.2}, {-0.2, 1.2}}, 3};
+    flat_piece after[8];
+    made = flat_subtract(&unit, 1, &lower, 1e-12, next, 8);
+    CHECK(made >= 1);
+    CHECK_NEAR(total_area(next, made), 0.405, 1e-14);
+    made = flat_subtract(next, (unsigned)(made > 0 ? made : 0), &upper, 1e-12, after, 8);
+    CHECK(made == 0);
+
+    /* corners repeated 1e-15 apart dropped, 1e-6 apart kept */
+    flat_piece repeated = {{{0, 0}, {1, 0}, {1, 1e-15}, {1, 1}, {0, 1}, {1e-16, 1}}, 6};
+    flat_piece_drop_repeated(&repeated);
+    CHECK(repeated.count == 4);
+    flat_piece distinct = {{{0, 0}, {1, 0}, {1, 1e-6}, {1, 1}}, 4};
+    flat_piece_drop_repeated(&distinct);
+    CHECK(distinct.count == 4);
+    return test_finish("test_flat_pieces");
+}
