@@ -24,9 +24,10 @@ static inline bool stopped(const polygon_integral *c) { return c->failed && *c->
 
 /* Whether f is smooth on the triangle, whose points come next (polygon_integral.cell). */
 static inline bool enter(const polygon_integral *c, rad_vec3 a, rad_vec3 b, rad_vec3 d,
-                         int level)
+                         int level, int slot, int parent_slot)
 {
-    return c->cell ? c->cell(c->context, a, b, d, level) : c->min_depth == 0;
+    return c->cell ? c->cell(c->context, a, b, d, level, slot, parent_slot)
+                   : c->min_depth == 0;
 }
 
 /* The 7-point rule times the area; *centre receives the 1-point (centroid) rule. */
@@ -44,23 +45,20 @@ static double rule7(const polygon_integral *c, rad_vec3 a, rad_vec3 b, rad_vec3 
     return (rule_w0 * f0 + rule_w1 * s1 + rule_w2 * s2) * area;
 }
 
-/* Integral over triangle (a, b, d) whose rule7 value is `whole`; *error accumulates the
- * estimated error of what is returned. */
+/* Integral over triangle (a, b, d), child `slot` at level depth - 1, whose rule7 value
+ * is `whole`; *error accumulates the estimated error of what is returned. */
 static double adapt(const polygon_integral *c, rad_vec3 a, rad_vec3 b, rad_vec3 d,
-                    double area, double whole, double tolerance, int depth, bool smooth,
-                    double *error)
+                    double area, double whole, double tolerance, int depth, int slot,
+                    bool smooth, double *error)
 {
     rad_vec3 ab = v3_scale(v3_add(a, b), 0.5), bd = v3_scale(v3_add(b, d), 0.5),
              da = v3_scale(v3_add(d, a), 0.5);
     double quarter = 0.25 * area, unused;
-    /* this triangle's own cell again (its siblings' came after it) */
-    if (depth > 1)
-        enter(c, a, b, d, depth - 1);
     rad_vec3 child[4][3] = {{a, ab, da}, {ab, b, bd}, {da, bd, d}, {ab, bd, da}};
     double part[4];
     bool part_smooth[4];
     for (int k = 0; k < 4; k++) {
-        part_smooth[k] = enter(c, child[k][0], child[k][1], child[k][2], depth);
+        part_smooth[k] = enter(c, child[k][0], child[k][1], child[k][2], depth, k, slot);
         part[k] = rule7(c, child[k][0], child[k][1], child[k][2], quarter, &unused);
     }
     double sum = part[0] + part[1] + part[2] + part[3];
@@ -71,10 +69,10 @@ static double adapt(const polygon_integral *c, rad_vec3 a, rad_vec3 b, rad_vec3 
         return sum;
     }
     double t = 0.5 * tolerance;
-    return adapt(c, a, ab, da, quarter, part[0], t, depth + 1, part_smooth[0], error) +
-           adapt(c, ab, b, bd, quarter, part[1], t, depth + 1, part_smooth[1], error) +
-           adapt(c, da, bd, d, quarter, part[2], t, depth + 1, part_smooth[2], error) +
-           adapt(c, ab, bd, da, quarter, part[3], t, depth + 1, part_smooth[3], error);
+    return adapt(c, a, ab, da, quarter, part[0], t, depth + 1, 0, part_smooth[0], error) +
+           adapt(c, ab, b, bd, quarter, part[1], t, depth + 1, 1, part_smooth[1], error) +
+           adapt(c, da, bd, d, quarter, part[2], t, depth + 1, 2, part_smooth[2], error) +
+           adapt(c, ab, bd, da, quarter, part[3], t, depth + 1, 3, part_smooth[3], error);
 }
 
 static double triangle_area(rad_vec3 a, rad_vec3 b, rad_vec3 d)
@@ -89,7 +87,7 @@ static double integrate_triangle(const polygon_integral *c, rad_vec3 a, rad_vec3
 {
     double area = triangle_area(a, b, d);
     double centre;
-    bool smooth = enter(c, a, b, d, 0);
+    bool smooth = enter(c, a, b, d, 0, 0, 0);
     double whole = rule7(c, a, b, d, area, &centre);
     /* the floor keeps a pair that transfers (almost) nothing from refining forever */
     double tolerance = fmax(fmax(accuracy * fabs(whole), absolute), 1e-15 * area);
@@ -98,7 +96,7 @@ static double integrate_triangle(const polygon_integral *c, rad_vec3 a, rad_vec3
         *error += fabs(whole - centre);
         return whole;
     }
-    return adapt(c, a, b, d, area, whole, tolerance, 1, smooth, error);
+    return adapt(c, a, b, d, area, whole, tolerance, 1, 0, smooth, error);
 }
 
 double polygon_integrate(const polygon_integral *integral, const rad_vec3 *polygon,

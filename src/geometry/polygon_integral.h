@@ -23,12 +23,16 @@ typedef struct polygon_integral {
     const bool *failed; /* when it becomes true (set by f), the integral stops refining */
     /* NULL, or told which triangle (a, b, d) at which level of splitting (0 = a fan
      * triangle) the next points of f belong to, before them: f may drop what does not
-     * matter there (the occluders that cannot shade it). Level k follows level k - 1's
-     * call for the triangle containing it. Returns whether f is smooth there (nothing
-     * shades it): a triangle where it is not is split to at least min_depth levels before
-     * its rules' agreement is believed (a shadow's edge can pass between all 7 points of a
-     * large triangle, and between its children's, which then agree on a wrong value). */
-    bool (*cell)(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int level);
+     * matter there (the occluders that cannot shade it). The triangle is child `slot`
+     * (0 to 3; 0 at level 0) of the one told last at level - 1 with slot `parent_slot`,
+     * and that one's call is still the last at its (level - 1, parent_slot): what f keeps
+     * per level and slot stays valid for the children. Returns whether f is smooth there
+     * (nothing shades it): a triangle where it is not is split to at least min_depth
+     * levels before its rules' agreement is believed (a shadow's edge can pass between
+     * all 7 points of a large triangle, and between its children's, which then agree on a
+     * wrong value). */
+    bool (*cell)(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int level, int slot,
+                 int parent_slot);
     int min_depth;
 } polygon_integral;
 

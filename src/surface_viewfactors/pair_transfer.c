@@ -53,11 +53,15 @@ typedef struct outer_context {
 /* The occluders that can shade the triangle of the outer polygon the integral is at, for
  * each level of its splitting (cull_cell), and the level the points now come from. Set by
  * cull_cell before any point: not initialised. */
+typedef struct cull_list {
+    bool blocked; /* one occluder hides all of q from the triangle */
+    uint32_t count;
+    uint32_t index[PAIR_EXACT_MAX_OCCLUDERS];
+} cull_list;
+
 typedef struct cull_levels {
-    int level;
-    bool blocked[OBSTRUCTED_MAX_DEPTH + 1]; /* one occluder hides all of q from the triangle */
-    uint32_t count[OBSTRUCTED_MAX_DEPTH + 1];
-    uint32_t index[OBSTRUCTED_MAX_DEPTH + 1][PAIR_EXACT_MAX_OCCLUDERS];
+    const cull_list *now; /* the points' triangle's */
+    cull_list list[OBSTRUCTED_MAX_DEPTH + 1][4]; /* per level and child slot */
 } cull_levels;
 
 /* Occluder o's corners. */
@@ -121,20 +125,21 @@ static bool blocks_all(const rad_vec3 *corner, unsigned count, const rad_vec3 *c
  * that cut the hull of it and the inner polygon (every segment between them lies in it),
  * that is, are not wholly outside one of the hull's side planes (its other faces are the
  * two polygons' planes, which the pair's occluders already cut). */
-static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int level)
+static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int level, int slot,
+                      int parent_slot)
 {
     outer_context *c = context;
-    cull_levels *cull = c->cull;
-    const uint32_t *from = level > 0 ? cull->index[level - 1] : NULL;
-    uint32_t from_count = level > 0 ? cull->count[level - 1] : c->occluder_count;
-    uint32_t *to = cull->index[level];
+    const cull_list *parent = level > 0 ? &c->cull->list[level - 1][parent_slot] : NULL;
+    cull_list *list = &c->cull->list[level][slot];
+    const uint32_t *from = parent ? parent->index : NULL;
+    uint32_t from_count = parent ? parent->count : c->occluder_count;
+    uint32_t *to = list->index;
     uint32_t kept = 0;
-    cull->level = level;
-    if (level > 0 && cull->blocked[level - 1]) {
-        cull->blocked[level] = true;
-        cull->count[level] = 0;
+    c->cull->now = list;
+    list->blocked = true;
+    list->count = 0;
+    if (parent && parent->blocked)
         return true; /* 0 all over */
-    }
     vf_polygon cell;
     cell.vertex[0] = a;
     cell.vertex[1] = b;
@@ -156,15 +161,12 @@ static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int lev
         }
         if (outside)
             continue;
-        if (blocks_all(corner, corners, cell.vertex, c->inner, c->plane_epsilon)) {
-            cull->blocked[level] = true;
-            cull->count[level] = 0;
-            return true;
-        }
+        if (blocks_all(corner, corners, cell.vertex, c->inner, c->plane_epsilon))
+            return true; /* blocked */
         to[kept++] = o;
     }
-    cull->blocked[level] = false;
-    cull->count[level] = kept;
+    list->blocked = false;
+    list->count = kept;
     return kept == 0;
 }
 
@@ -173,10 +175,10 @@ static inline double point_factor(outer_context *c, rad_vec3 x)
     uint32_t count = c->occluder_count;
     const uint32_t *index = NULL; /* all of them */
     if (c->cull && count) {
-        if (c->cull->blocked[c->cull->level])
+        if (c->cull->now->blocked)
             return 0;
-        count = c->cull->count[c->cull->level];
-        index = c->cull->index[c->cull->level];
+        count = c->cull->now->count;
+        index = c->cull->now->index;
     }
     if (count == 0)
         return contour_point_to_polygon(x, c->normal, c->inner->vertex, c->inner->count,
