@@ -6,6 +6,8 @@
  * triangle (0, k, k + 1) of P gets the 7-point degree-5 rule (Radon; Strang and Fix),
  * compared with the same rule on its 4 children, and is split further where the two
  * disagree, to a relative tolerance; what is left at the depth limit is the error bound.
+ * Where f is not smooth (shadows), its values at the corners and edge midpoints, which no
+ * rule point is near, are checked too (edge_check).
  */
 #ifndef RAD_GEOMETRY_POLYGON_INTEGRAL_H
 #define RAD_GEOMETRY_POLYGON_INTEGRAL_H
@@ -34,6 +36,9 @@ typedef struct polygon_integral {
     bool (*cell)(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int level, int slot,
                  int parent_slot);
     int min_depth;
+    /* where f is not smooth, f at each triangle's corners and edge midpoints must also
+     * agree with what its rule points predict (polygon_integral.c) */
+    bool edge_check;
 } polygon_integral;
 
 /* int over the convex polygon (count corners, counter-clockwise) of f, to the relative

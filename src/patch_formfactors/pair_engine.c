@@ -219,7 +219,8 @@ static double touching_transfer(const engine *e, uint32_t a, uint32_t b)
     const patch_geometry *ga = &e->geometry[a], *gb = &e->geometry[b];
     touching_context c = {ga->area <= gb->area ? ga : gb, ga->area <= gb->area ? gb : ga,
                           e->plane_epsilon};
-    polygon_integral integral = {touching_point_factor, &c, TOUCHING_MAX_DEPTH, NULL, NULL, 0};
+    polygon_integral integral = {touching_point_factor, &c, TOUCHING_MAX_DEPTH, NULL, NULL, 0,
+                                 false};
     double bound;
     return polygon_integrate(&integral, c.outer->corner, c.outer->corner_count,
                              TOUCHING_ACCURACY, &bound);

@@ -23,7 +23,11 @@
 #define OBSTRUCTED_MAX_DEPTH 8
 
 /* A triangle of the outer polygon that something may shade is split at least this many
- * times before the quadrature believes its rules' agreement. */
+ * times before the quadrature believes its rules' agreement, and f at its corners and edge
+ * midpoints must agree with what its rule points predict (polygon_integral's edge check:
+ * light through a gap can reach only a sliver along an edge, as below a tube's rim), in
+ * pair_obstructed_exact_within. pair_obstructed_exact (the patches' form factors, on a
+ * budget of a millisecond) has neither. */
 #define OBSTRUCTED_MIN_DEPTH 2
 
 /* Exact shadow clipping may spend this many (point, occluder) clippings on one pair, about
@@ -45,6 +49,7 @@ typedef struct outer_context {
     const shadow_caster *casters;     /* the occluders made ready for it */
     int max_depth;
     int min_depth;           /* polygon_integral.min_depth */
+    bool edge_check;         /* polygon_integral.edge_check */
     uint64_t work_left;      /* occluder clippings this pair may still spend */
     bool failed;             /* too many pieces somewhere, or the work budget ran out */
     struct cull_levels *cull; /* NULL: unobstructed, no occluders */
@@ -207,7 +212,7 @@ static double integrate_outer(outer_context *c, const vf_polygon *outer, double 
                               double absolute, double *bound)
 {
     polygon_integral integral = {point_factor_callback, c, c->max_depth, &c->failed,
-                                 c->cull ? cull_cell : NULL, c->min_depth};
+                                 c->cull ? cull_cell : NULL, c->min_depth, c->edge_check};
     return polygon_integrate_within(&integral, outer->vertex, outer->count, accuracy, absolute,
                                     bound);
 }
@@ -229,7 +234,7 @@ static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                              const shadow_occluder *occluders, const shadow_polygon *joined,
                              uint32_t count, double accuracy, double absolute,
                              double plane_epsilon, uint64_t work_budget, int min_depth,
-                             double *value, double *bound)
+                             bool edge_check, double *value, double *bound)
 {
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
     if (count > PAIR_EXACT_MAX_OCCLUDERS)
@@ -253,6 +258,7 @@ static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                        .casters = casters,
                        .max_depth = OBSTRUCTED_MAX_DEPTH,
                        .min_depth = min_depth,
+                       .edge_check = edge_check,
                        .work_left = work_budget,
                        .cull = &levels};
     *value = integrate_outer(&c, outer, accuracy, absolute, bound);
@@ -269,7 +275,7 @@ bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
         return false;
     uint32_t count = shadow_join_occluders(occluders, occluder_count, joined);
     return obstructed_exact(p, q, NULL, joined, count, accuracy, absolute, plane_epsilon,
-                            work_budget, OBSTRUCTED_MIN_DEPTH, value, bound);
+                            work_budget, OBSTRUCTED_MIN_DEPTH, true, value, bound);
 }
 
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
@@ -277,7 +283,7 @@ bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            double accuracy, double plane_epsilon, double *value, double *bound)
 {
     return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, 0, plane_epsilon,
-                            EXACT_WORK_BUDGET, 0, value, bound);
+                            EXACT_WORK_BUDGET, 0, false, value, bound);
 }
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)

@@ -452,7 +452,7 @@ static double sky_polygon(const sky_context *c, const vf_polygon *p, uint32_t pi
         for (unsigned s = 0; s < strip_count && !integrand.failed; s++) {
             integrand.work_left = SKY_WORK_BUDGET;
             polygon_integral integral = {sky_point, &integrand, SKY_MAX_DEPTH,
-                                         &integrand.failed, NULL, 0};
+                                         &integrand.failed, NULL, 0, false};
             double error;
             value += polygon_integrate(&integral, strips[s].vertex, strips[s].count,
                                        0.25 * c->accuracy, &error) -

@@ -247,9 +247,24 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
     double target = e->accuracy * sqrt(f0) * smaller;
     if (occluders <= e->exact_occluders) {
         double visible, error;
-        if (pair_obstructed_exact_within(p, q, w->occluders, occluders, 0.25 * e->accuracy,
-                                         0.5 * target, eps, PAIR_EXACT_WORK_BUDGET, &visible,
-                                         &error)) {
+        /* Each triangle of the splitting meets its share of the tolerance, halved a level
+         * down: the estimates add up to more than it where many triangles are split deep
+         * (a pair behind a grid of small occluders), and then the pair is done again to an
+         * eighth of the target, with 4 times the work budget (kept when it fits that and
+         * its bound is smaller). */
+        bool exact = pair_obstructed_exact_within(p, q, w->occluders, occluders,
+                                                  0.25 * e->accuracy, 0.5 * target, eps,
+                                                  PAIR_EXACT_WORK_BUDGET, &visible, &error);
+        double finer, finer_error;
+        if (exact && error > target &&
+            pair_obstructed_exact_within(p, q, w->occluders, occluders, 0.25 * e->accuracy,
+                                         0.125 * target, eps, 4 * PAIR_EXACT_WORK_BUDGET, &finer,
+                                         &finer_error) &&
+            finer_error < error) {
+            visible = finer;
+            error = finer_error;
+        }
+        if (exact) {
             counts->exact_pairs++;
             *bound = error;
             return fmax(fmin(visible, unobstructed), 0);
