@@ -51,8 +51,8 @@ static const int child_corner[4][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {3, 4, 5
  * 0.049 at a midpoint. Measured on the 1k city behind 256 occluders against brute force:
  * a factor 11 % low (within its bound, which is sized by the unobstructed factor) stays so
  * with 2 or 6 times and comes to 1.4 % with 16 times (about the degree-3 rule's weights),
- * but 16 times takes 1.7 times as long; 6 is the least that brings the tube's rim (test
- * _viewfactor_obstructed) within its bound. */
+ * but 16 times takes 1.7 times as long. 2 times already brings the tube's rim (test
+ * _viewfactor_obstructed) within its bound; 6 is for a margin, at about 10 % more time. */
 static double edge_point_share[6];
 #define EDGE_SHARE_LATTICE 120
 #define EDGE_SHARE_MARGIN 6.0
