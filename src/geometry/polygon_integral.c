@@ -174,7 +174,10 @@ static double rule7(const polygon_integral *c, rad_vec3 a, rad_vec3 b, rad_vec3 
 
 /* Integral over triangle (a, b, d), child `slot` at level depth - 1, whose rule7 value
  * is `whole`; *error accumulates the estimated error of what is returned. corner[3]: f at
- * a, b and d when the edge check is on there. */
+ * a, b and d when the edge check is on there. It is on in a triangle only where it was in
+ * the triangle's parent: f is smooth in the children of a triangle where it is (the cell
+ * callback's lists of what may shade only shrink a level down; without the callback,
+ * smoothness is the same everywhere), so the parent always hands its corners down. */
 static double adapt(const polygon_integral *c, rad_vec3 a, rad_vec3 b, rad_vec3 d,
                     double area, double whole, double tolerance, int depth, int slot,
                     bool smooth, const double *corner, double *error)
