@@ -65,6 +65,12 @@
  * test_contact_shadow's profile, the largest difference from the exact one: 2.29 % of the
  * open floor with 32 (past its 2 %), 1.94 % with 64. */
 #define PENUMBRA_DIRECT_SAMPLES 64u
+/* How the default render takes the emitters' light at the hits on a display triangle:
+ * interpolated from its corners (none of them sees the light), computed at the hit with
+ * shadow rays (a penumbra), or, where every corner sees all of the light and its
+ * unshadowed value is exact (emitter_unshadowed_exact), that value at the hit: linear
+ * interpolation of the open light, concave where it peaks, fell short there. */
+enum { DISPLAY_INTERPOLATED, DISPLAY_PENUMBRA, DISPLAY_OPEN_LIGHT };
 #define EMITTER_STREAM 0x5EEDE3177ull /* the per-pixel shifts of the emitters' samples */
 
 /* One thread's rays of one image row, compacted bounce by bounce. */
@@ -365,9 +371,13 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
             patch_index = twin - 1;
         }
         const uint32_t *v = sh->triangles[triangle];
-        /* the emitters' light here: at every hit, or at a penumbra's */
-        const bool emitter_light = sh->emitters && (!sh->penumbral || sh->penumbral[triangle]);
-        const rad_rgb *L = emitter_light && sh->penumbral ? sh->without_emitters : sh->radiance;
+        /* the emitters' light here: at every hit, or at a penumbra's (shadow rays), or,
+         * in the open light, its exact unshadowed value */
+        const uint8_t region = sh->penumbral ? sh->penumbral[triangle] : DISPLAY_PENUMBRA;
+        const bool emitter_light = sh->emitters && region == DISPLAY_PENUMBRA;
+        const bool open_light = sh->emitters && region == DISPLAY_OPEN_LIGHT;
+        const rad_rgb *L =
+            (emitter_light || open_light) && sh->penumbral ? sh->without_emitters : sh->radiance;
         rad_rgb weight = w->weight[r];
         rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit_u - hit_v),
                                        rgb_add(rgb_scale(L[v[1]], hit_u), rgb_scale(L[v[2]], hit_v)));
@@ -380,6 +390,16 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
             interpolated =
                 textured_radiance(sh, &w->rays[r], hit, patch_index, interpolated, &albedo);
         rgb_add_to(&w->sum[w->sample[r]], rgb_mul(weight, interpolated));
+        if (open_light && !rgb_is_zero(albedo)) {
+            const rad_ray *ray = &w->rays[r];
+            rad_vec3 point = v3(ray->origin[0] + (double)hit->t * ray->direction[0],
+                                ray->origin[1] + (double)hit->t * ray->direction[1],
+                                ray->origin[2] + (double)hit->t * ray->direction[2]);
+            rad_rgb open = emitter_unshadowed_irradiance(sh->emitters, sh->scene, point,
+                                                         sh->mesh->patches[patch_index].normal);
+            rgb_add_to(&w->sum[w->sample[r]],
+                       rgb_mul(rgb_scale(rgb_mul(weight, albedo), 1.0 / RAD_PI), open));
+        }
         if (((sh->lights && sh->lights->sharp_count > 0) || emitter_light) &&
             !rgb_is_zero(albedo)) {
             const rad_ray *ray = &w->rays[r];
@@ -426,7 +446,8 @@ static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work 
         if (first && depth == 0 && w->first_penumbral)
             for (uint32_t r = 0; r < count; r++)
                 w->first_penumbral[w->sample[r]] =
-                    w->hits[r].triangle != RAD_NO_HIT && sh->penumbral[w->hits[r].triangle];
+                    w->hits[r].triangle != RAD_NO_HIT &&
+                    sh->penumbral[w->hits[r].triangle] == DISPLAY_PENUMBRA;
         count = shade_hits(sh, w, count, depth < max_depth);
         flush_lights(sh, w);
     }
@@ -663,6 +684,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
         status = vertex_radiance(&job, radiance, NULL, error);
         if (status != RAD_OK)
             goto done;
+        const bool open_exact = emitter_unshadowed_exact(&emitters, options->scene);
         for (uint32_t t = 0; penumbral && t < display.triangle_count; t++) {
             /* corners that disagree, or one that sees a part (a point the display mesh
              * added on an edge: unknown, so a part) */
@@ -673,7 +695,9 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                 least = seen < least ? seen : least;
                 most = seen > most ? seen : most;
             }
-            penumbral[t] = least != most || least == VERTEX_SEES_PART;
+            penumbral[t] = least != most || least == VERTEX_SEES_PART ? DISPLAY_PENUMBRA
+                           : least == VERTEX_SEES_ALL && open_exact        ? DISPLAY_OPEN_LIGHT
+                                                                           : DISPLAY_INTERPOLATED;
         }
     } else if (!display_mesh_radiance_weighted(mesh, &display, shaded ? shaded : B, hidden,
                                                radiance))
