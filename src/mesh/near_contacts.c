@@ -67,17 +67,21 @@ rad_status near_contacts_build(const rad_mesh *mesh, double reach, double plane_
     out->start = rad_alloc_array((size_t)n + 1, sizeof(*out->start));
     out->offset = rad_alloc_array(n, sizeof(*out->offset));
     out->radius = rad_alloc_array(n, sizeof(*out->radius));
+    out->flatness = rad_alloc_array(n, sizeof(*out->flatness));
     uint32_t *pairs = NULL; /* (i, k) in pairs, two per entry */
     size_t pair_count = 0, pair_capacity = 0;
-    if (!boxes || !count || !out->start || !out->offset || !out->radius)
+    if (!boxes || !count || !out->start || !out->offset || !out->radius || !out->flatness)
         goto nomem;
     for (uint32_t i = 0; i < n; i++) {
         const rad_patch *p = &mesh->patches[i];
         out->offset[i] = v3_dot(p->normal, mesh->vertices[p->vertex[0]]);
-        out->radius[i] = 0;
-        for (unsigned c = 0; c < p->vertex_count; c++)
-            out->radius[i] =
-                fmax(out->radius[i], v3_length(v3_sub(mesh->vertices[p->vertex[c]], p->centroid)));
+        out->radius[i] = out->flatness[i] = 0;
+        for (unsigned c = 0; c < p->vertex_count; c++) {
+            rad_vec3 corner = mesh->vertices[p->vertex[c]];
+            out->radius[i] = fmax(out->radius[i], v3_length(v3_sub(corner, p->centroid)));
+            out->flatness[i] =
+                fmax(out->flatness[i], fabs(v3_dot(p->normal, corner) - out->offset[i]));
+        }
     }
     rad_vec3 scene_lo, scene_hi;
     v3_bounds(mesh->vertices, mesh->vertex_count, &scene_lo, &scene_hi);
@@ -162,9 +166,10 @@ void near_contacts_free(near_contacts *contacts)
     free(contacts->contact);
     free(contacts->offset);
     free(contacts->radius);
+    free(contacts->flatness);
     free(contacts->side);
     contacts->start = contacts->contact = NULL;
-    contacts->offset = contacts->radius = NULL;
+    contacts->offset = contacts->radius = contacts->flatness = NULL;
     contacts->side = NULL;
 }
 
@@ -226,6 +231,33 @@ bool near_contacts_pair_may_block(const near_contacts *contacts, uint32_t from, 
     return may_cross(contacts, from, to) || may_cross(contacts, to, from);
 }
 
+/* Can the segment a + t d, t in (t_low, zone), meet contact k? Not when the stretch where
+ * it runs within k's flatness of k's plane lies outside that range, nor when k's bounding
+ * sphere is farther from a than the stretch is long. Both tests are exact (k's triangles
+ * lie within its flatness of its plane and inside its sphere); they spare the triangle
+ * tests for the cells around a point of a folded wall, which lie within a hair of it and
+ * which a segment leaving the wall moves away from. */
+static bool may_meet(const near_contacts *contacts, uint32_t k, rad_vec3 a, rad_vec3 d,
+                     double length, double t_low, double zone)
+{
+    const rad_patch *patch = &contacts->mesh->patches[k];
+    /* the zone is zone x length long: a plane farther from a than that is not reached */
+    double reach = zone * length;
+    double distance = v3_dot(patch->normal, a) - contacts->offset[k];
+    if (fabs(distance) > reach)
+        return false;
+    rad_vec3 to_centre = v3_sub(patch->centroid, a);
+    double sphere = contacts->radius[k] + reach;
+    if (v3_dot(to_centre, to_centre) > sphere * sphere)
+        return false;
+    double slack = contacts->flatness[k] + 1e-3 * contacts->plane_epsilon; /* and rounding */
+    double speed = v3_dot(patch->normal, d);
+    if (speed == 0)
+        return fabs(distance) <= slack;
+    double t0 = (-distance - slack) / speed, t1 = (-distance + slack) / speed;
+    return fmax(t0, t1) > t_low && fmin(t0, t1) < zone;
+}
+
 /* The end `a` of a segment a + t d, t in [0, 1], of the given length: does it cross one
  * of patch `end`'s contacts (other than `other`) within t in (t_low, zone]? */
 static bool blocked_near(const near_contacts *contacts, uint32_t end, uint32_t other,
@@ -234,9 +266,7 @@ static bool blocked_near(const near_contacts *contacts, uint32_t end, uint32_t o
     const rad_mesh *mesh = contacts->mesh;
     for (uint32_t c = contacts->start[end]; c < contacts->start[end + 1]; c++) {
         uint32_t k = contacts->contact[c];
-        /* the zone is zone x length long: a plane farther from a than that is not reached */
-        double distance = v3_dot(mesh->patches[k].normal, a) - contacts->offset[k];
-        if (k != other && fabs(distance) <= zone * length &&
+        if (k != other && may_meet(contacts, k, a, d, length, t_low, zone) &&
             crosses_patch(mesh, k, a, d, t_low, zone))
             return true;
     }

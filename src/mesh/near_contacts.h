@@ -28,6 +28,8 @@ typedef struct near_contacts {
     const rad_mesh *mesh;
     double *offset;       /* patch_count: each patch's plane, normal . x = offset */
     double *radius;       /* patch_count: largest distance from the centroid to a corner */
+    double *flatness;     /* patch_count: largest distance of a corner from that plane (a
+                             cell of a folded quad is not flat) */
     int8_t *side;         /* per contact: the side of the contact's plane the listing patch
                              lies on (+1, -1), or 0 when the plane cuts it */
     double plane_epsilon; /* a crossing must lie this far along the segment from an end */
