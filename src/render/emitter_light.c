@@ -196,10 +196,14 @@ rad_rgb emitter_unshadowed_irradiance(const emitter_set *set, const rad_scene *s
 void emitter_to_unshadowed(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
                            rad_vec3 n, rad_rgb *irradiance, uint32_t count)
 {
+    emitter_scale_to(emitter_unshadowed_irradiance(set, scene, x, n), irradiance, count);
+}
+
+void emitter_scale_to(rad_rgb open, rad_rgb *irradiance, uint32_t count)
+{
     rad_rgb all = {0, 0, 0};
     for (uint32_t k = 0; k < count; k++)
         rgb_add_to(&all, irradiance[k]);
-    rad_rgb open = emitter_unshadowed_irradiance(set, scene, x, n);
     rad_rgb scale = {all.r > 0 ? open.r / all.r : 0, all.g > 0 ? open.g / all.g : 0,
                      all.b > 0 ? open.b / all.b : 0};
     for (uint32_t k = 0; k < count; k++)

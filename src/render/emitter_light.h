@@ -97,5 +97,8 @@ rad_rgb emitter_unshadowed_irradiance(const emitter_set *set, const rad_scene *s
 void emitter_to_unshadowed(const emitter_set *set, const rad_scene *scene, rad_vec3 x,
                            rad_vec3 n, rad_rgb *irradiance, uint32_t count);
 
+/* The same with the unshadowed irradiance `open` already at hand. */
+void emitter_scale_to(rad_rgb open, rad_rgb *irradiance, uint32_t count);
+
 
 #endif

@@ -320,13 +320,17 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
         rad_rgb *values = &w->light_value[w->light_count + count];
         if (sh->emitters_exact) {
             /* the unshadowed light exactly, shared out over the samples: those that get
-             * through bring their share */
-            uint32_t made = emitter_light_rays_alone(sh->emitters, sh->scene, point,
-                                                     patch->normal, leave, sh->emitter_samples,
-                                                     turn, index * sh->emitter_samples, shift1,
-                                                     shift2, rays, values);
-            emitter_to_unshadowed(sh->emitters, sh->scene, point, patch->normal, values, made);
-            count += made;
+             * through bring their share (none to trace where it is 0: a ceiling around a
+             * lamp that hangs below it) */
+            rad_rgb open = emitter_unshadowed_irradiance(sh->emitters, sh->scene, point,
+                                                         patch->normal);
+            if (!rgb_is_zero(open)) {
+                uint32_t made = emitter_light_rays_alone(
+                    sh->emitters, sh->scene, point, patch->normal, leave, sh->emitter_samples,
+                    turn, index * sh->emitter_samples, shift1, shift2, rays, values);
+                emitter_scale_to(open, values, made);
+                count += made;
+            }
         } else
             count += emitter_light_rays_mis(sh->emitters, sh->scene, point, patch->normal, leave,
                                             sh->emitter_samples, turn,
