@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/bytes.h"
+#include "core/hash.h"
 #include "testlib.h"
 
 /* 4 x 4 boxes of 2 x 2 x (2..5) on a 4-unit grid, each side its own OBJ object, and one
@@ -132,6 +134,21 @@ int main(void)
             fclose(f);
     }
     free(bytes);
+    /* a whole checkpoint of format version 3 (before the exact quadrature's edge check):
+     * refused, saying why */
+    bytes = test_read_bytes(test_path("ck.bin"), &size);
+    if (bytes && size > 100) {
+        bytes_put_u32(bytes + 8, 3);
+        bytes_put_u64(bytes + size - 8, hash_bytes(RAD_HASH_START, bytes, size - 8));
+        FILE *f = fopen(test_path("version3.bin"), "wb");
+        CHECK(f && fwrite(bytes, 1, size, f) == size);
+        if (f)
+            fclose(f);
+    }
+    free(bytes);
+    CHECK(test_run_tool("viewfactors blocks.obj -o other.mtx --resume version3.bin") == 1);
+    check_refusal("an earlier build (format version 3), whose exact clipping could miss light",
+                  "version3.bin");
     CHECK(test_run_tool("viewfactors blocks.obj -o other.mtx --resume damaged.bin") == 1);
     check_refusal("corrupted", "damaged.bin");
     CHECK(test_run_tool("viewfactors blocks.obj -o other.mtx --resume short.bin") == 1);

@@ -24,8 +24,12 @@
 static const uint8_t checkpoint_magic[8] = {0x89, 'R', 'A', 'D', 'V', 'F', 'C', '\n'};
 
 enum {
-    CHECKPOINT_VERSION = 3, /* 2: rows of pairs some sight ray met (seen_pairs.h); 3: exact
-                               occluders, obstructed pairs to an absolute target */
+    CHECKPOINT_VERSION = 4, /* 2: rows of pairs some sight ray met (seen_pairs.h); 3: exact
+                               occluders, obstructed pairs to an absolute target; 4: the
+                               same layout, rows from the exact quadrature with the edge
+                               check (polygon_integral.h), not to be mixed with rows of
+                               version 3, which could miss light along an edge */
+    CHECKPOINT_BEFORE_EDGE_CHECK = 3,
     HEADER_BYTES = 56,  /* magic, version, rows, fingerprint, accuracy, rays, seed, count,
                            sight rays, exact occluders */
     ROW_BYTES = 8,      /* row, entry count */
@@ -192,6 +196,16 @@ rad_status vf_checkpoint_read(const char *path, const vf_checkpoint_job *job,
     size_t size = 0;
     rad_status status = checkpoint_file_read(path, checkpoint_magic, CHECKPOINT_VERSION,
                                              "view-factor checkpoint", &bytes, &size, error);
+    if (status == RAD_ERR_PARSE) { /* a whole file of the version before: say why not */
+        rad_error ignored;
+        if (checkpoint_file_read(path, checkpoint_magic, CHECKPOINT_BEFORE_EDGE_CHECK,
+                                 "view-factor checkpoint", &bytes, &size, &ignored) == RAD_OK)
+            status = rad_fail(error, RAD_ERR_PARSE,
+                              "%s: a checkpoint of an earlier build (format version %d), "
+                              "whose exact clipping could miss light along an edge: its rows "
+                              "are not mixed with this build's; run again without --resume",
+                              path, CHECKPOINT_BEFORE_EDGE_CHECK);
+    }
     if (status == RAD_OK)
         status = parse_checkpoint(path, bytes, size, job, rows, done, count, error);
     if (status != RAD_OK)
