@@ -547,8 +547,12 @@ typedef struct rad_patch {
     rad_vec3 centroid;
     double bulge;         /* 0 for a planar patch; for a cell of a slightly folded quad
                              (real data: the Cornell box's left wall folds by 0.47 degrees),
-                             how far it may lie behind the input triangles, which are what
-                             blocks rays: visibility rays leave from twice this in front */
+                             how far the quad's cells may stray from its input triangles,
+                             either way: a quarter of the fold's lift */
+    double behind;        /* how far this cell lies behind the input triangles, which are
+                             what blocks rays (0 for a planar patch, and for a cell of a
+                             folded quad that lies in front of them): rays leaving its front
+                             start twice this in front */
     uint32_t twin;        /* 0 for a one-sided patch; on a two-sided surface
                              (RAD_SURFACE_TWO_SIDED), 1 + the index of the patch on the
                              other side: the same cell, corners in reverse order (so its

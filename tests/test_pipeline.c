@@ -46,20 +46,24 @@ static void check_mesh(const rad_scene *scene, const rad_mesh *mesh)
      * left wall's cells record their bulge (under a millimetre), the others none */
     CHECK(left_wall_patches > 0 && left_wall_triangles == 0);
     CHECK(quads == mesh->patch_count);
-    double bulge_left = 0, bulge_elsewhere = 0;
+    double bulge_left = 0, bulge_elsewhere = 0, behind_left = 0, behind_elsewhere = 0;
     for (uint32_t p = 0; p < mesh->patch_count; p++) {
         const rad_patch *patch = &mesh->patches[p];
-        if (patch->surface == left_wall)
+        if (patch->surface == left_wall) {
             bulge_left = fmax(bulge_left, patch->bulge);
-        else
+            behind_left = fmax(behind_left, patch->behind);
+        } else {
             bulge_elsewhere = fmax(bulge_elsewhere, patch->bulge);
+            behind_elsewhere = fmax(behind_elsewhere, patch->behind);
+        }
     }
     /* the fourth corner of the left wall lies 3.2 mm off the first triangle's plane; the
-     * bilinear surface strays up to a quarter of that, toward the room: no cell lies
-     * behind the triangles (which block rays), yet each is marked folded */
-    printf("left wall bulge %.3g mm\n", bulge_left);
-    CHECK(bulge_left > 0 && bulge_left < 1e-3);
-    CHECK(bulge_elsewhere == 0);
+     * bilinear surface strays a quarter of that at most, toward the room: every cell is
+     * marked folded, none lies behind the triangles (which block rays) */
+    printf("left wall bulge %.4f mm, behind %.3g mm\n", bulge_left, behind_left);
+    CHECK(bulge_left > 0.5 && bulge_left < 2);
+    CHECK(behind_left < 1e-9);
+    CHECK(bulge_elsewhere == 0 && behind_elsewhere == 0);
     /* a grid shares vertices: far fewer than 4 per patch */
     CHECK(mesh->vertex_count < 2 * mesh->patch_count);
     /* but not across regions: no vertex is used by both the light and the ceiling */
@@ -178,10 +182,12 @@ static void check_solvers(const rad_scene *scene, const rad_mesh *mesh, const ra
 
 /* A unit square folded along its diagonal from (0,0) to (1,1): the corner (1,0) lifted by
  * `lift` along the normal (+z; negative: behind). Meshed in cells of 0.1, each cell's
- * bulge is how far it lies behind the two triangles: the bilinear surface strays from them
- * by |lift| min(x (1 - y), y (1 - x)) toward the lift, so behind when the lift is, by the
- * largest of that over the cell (found here on a 21 x 21 grid), and nowhere in front. */
-static void check_folded_quad(double lift)
+ * `behind` is how far it lies behind the two triangles: the bilinear surface strays from
+ * them by |lift| min(x (1 - y), y (1 - x)) toward the lift, so behind when the lift is, by
+ * the largest of that over the cell (found here on a 21 x 21 grid), and nowhere in front;
+ * two-sided, each cell's twin faces -z and lies behind when the lift is toward +z. Every
+ * cell keeps the quad's bulge, a quarter of the lift either way. */
+static void check_folded_quad(double lift, bool two_sided)
 {
     char text[512];
     snprintf(text, sizeof(text),
@@ -189,40 +195,56 @@ static void check_folded_quad(double lift)
     rad_scene *scene = NULL;
     rad_mesh *mesh = NULL;
     rad_error error;
-    CHECK(rad_scene_load(test_write_file("folded.obj", text), NULL, &scene, &error) == RAD_OK);
+    rad_load_options options = {0};
+    CHECK(rad_scene_load(test_write_file("folded.obj", text), &options, &scene, &error) ==
+          RAD_OK);
     if (!scene)
         return;
+    if (two_sided)
+        CHECK(rad_scene_set_surface_flags(scene, "folded", RAD_SURFACE_TWO_SIDED, &error) ==
+              RAD_OK);
     CHECK(rad_mesh_build(scene, 0.1, &mesh, &error) == RAD_OK);
     double largest = 0, worst = 0, edge_cells = 0;
+    uint32_t cells = 0;
     for (uint32_t p = 0; mesh && p < mesh->patch_count; p++) {
         const rad_patch *patch = &mesh->patches[p];
+        /* a twin faces the other way: it lies behind where the lift is toward +z */
+        double toward_front = patch->normal.z > 0 ? lift : -lift;
+        cells++;
+        CHECK_NEAR(patch->bulge, fabs(lift) / 4, 1e-3); /* relative */
         double x0 = 1, x1 = 0, y0 = 1, y1 = 0;
         for (uint32_t k = 0; k < patch->vertex_count; k++) {
             rad_vec3 v = mesh->vertices[patch->vertex[k]];
             x0 = fmin(x0, v.x), x1 = fmax(x1, v.x), y0 = fmin(y0, v.y), y1 = fmax(y1, v.y);
         }
         double expected = 0;
-        for (int i = 0; lift < 0 && i <= 20; i++)
+        for (int i = 0; toward_front < 0 && i <= 20; i++)
             for (int j = 0; j <= 20; j++) {
                 double x = x0 + (x1 - x0) * i / 20, y = y0 + (y1 - y0) * j / 20;
-                expected = fmax(expected, -lift * fmin(x * (1 - y), y * (1 - x)));
+                expected = fmax(expected, -toward_front * fmin(x * (1 - y), y * (1 - x)));
             }
-        CHECK(patch->bulge > 0);
-        worst = fmax(worst, fabs(patch->bulge - expected));
-        largest = fmax(largest, patch->bulge);
-        if (x0 == 0 && y1 == 1)
-            edge_cells = fmax(edge_cells, patch->bulge);
+        worst = fmax(worst, fabs(patch->behind - expected));
+        if (toward_front < 0)
+            largest = fmax(largest, patch->behind);
+        if (toward_front < 0 && x0 == 0 && y1 == 1)
+            edge_cells = fmax(edge_cells, patch->behind);
     }
-    printf("folded quad, lift %+g: %u cells, largest bulge %.4g, worst error %.2g, the "
+    printf("folded quad, lift %+g%s: %u cells, largest behind %.4g, worst error %.2g, the "
            "corner cell at (0, 1) %.3g\n",
-           lift, mesh ? mesh->patch_count : 0, largest, worst, edge_cells);
-    CHECK(mesh && mesh->patch_count >= 100);
+           lift, two_sided ? ", two-sided" : "", cells, largest, worst, edge_cells);
+    CHECK(cells == (two_sided ? 2 : 1) * (mesh ? mesh->patch_count / (two_sided ? 2 : 1) : 0));
+    CHECK(mesh && mesh->patch_count >= (two_sided ? 200u : 100u));
     /* before, every cell took the quad's largest, a quarter of the lift. The mesh's
      * estimate (11 points a cell; the midpoints of a cell's diagonals lie on its flat
      * display triangles, not on the bilinear surface) is within 2e-3 of the lift of the
      * grid's here */
     CHECK(worst < 5e-3 * fabs(lift));
-    CHECK(lift > 0 ? largest < 1e-5 * lift : fabs(largest + lift / 4) < 5e-3 * fabs(lift));
+    /* the cells that lie behind: the centre's a quarter of the lift, the corner (0, 1)'s a
+     * hundredth (1e-4 of the lift at its inner corner) */
+    if (lift < 0 || two_sided) {
+        CHECK(fabs(largest - fabs(lift) / 4) < 5e-3 * fabs(lift));
+        CHECK(edge_cells > 0.005 * fabs(lift) && edge_cells < 0.015 * fabs(lift));
+    }
     rad_mesh_destroy(mesh);
     rad_scene_destroy(scene);
 }
@@ -242,8 +264,9 @@ int main(void)
     CHECK(rad_mesh_build(scene, 60.0, &mesh, &error) == RAD_OK);
     printf("%u patches, %u vertices\n", mesh->patch_count, mesh->vertex_count);
     check_mesh(scene, mesh);
-    check_folded_quad(0.01);
-    check_folded_quad(-0.01);
+    check_folded_quad(0.01, false);
+    check_folded_quad(-0.01, false);
+    check_folded_quad(0.01, true);
 
     rad_formfactors *embree = formfactors(scene, mesh, RAD_TRACER_EMBREE, 2);
     rad_formfactors *embree1 = formfactors(scene, mesh, RAD_TRACER_EMBREE, 1);

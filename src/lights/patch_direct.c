@@ -65,7 +65,7 @@ rad_status patch_direct_light(const rad_scene *scene, const rad_mesh *mesh, rad_
         for (int64_t p = 0; p < (int64_t)n; p++) {
             thread_buffers *b = &buffers[omp_get_thread_num()];
             const rad_patch *patch = &mesh->patches[p];
-            double leave = 2 * patch->bulge + set.leave;
+            double leave = 2 * patch->behind + set.leave;
             uint32_t count = 0;
             for (uint32_t q = 0; q < points; q++) {
                 rad_rng rng = rad_rng_seed(PATCH_LIGHT_STREAM, (uint64_t)p, q);

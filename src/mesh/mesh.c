@@ -137,20 +137,22 @@ static rad_vec3 edge_point(const rad_scene *scene, uint32_t a, uint32_t b, uint3
 }
 
 /* How far a cell of a folded quad (corners p on the quad's bilinear surface) lies behind
- * the quad's two input triangles, which are what blocks rays: the bilinear surface strays
- * from them by lift x min(s (1 - t), t (1 - s)), nothing on the quad's edges and a quarter
- * of the lift at its centre, so a cell's own distance, not the quad's largest, is what
- * rays leaving it must clear. Taken at the cell's corners, the midpoints of its edges and
- * diagonals, and its centre (on a small cell the distance is nearly linear). Shadow rays
- * that left every cell of the Cornell box's left wall (folded by 3.2 mm) a quarter of the
- * lift off it, 1.6 mm, moved the tall block's penumbra there: 5-7 % too dark against the
- * path tracer and a brute-force sum over the light. Never 0: a cell of a folded quad is
- * not flat (exact_pairs.c leaves such cells out of exact clipping). */
-static double cell_bulge(const mesh_output *out, const polygon *poly, const rad_vec3 *p,
-                         uint32_t count)
+ * the quad's two input triangles (*behind) and in front of them (*ahead), along the
+ * triangles' front normal: the bilinear surface strays from them by
+ * lift x min(s (1 - t), t (1 - s)) toward the lifted corner, nothing on the quad's edges
+ * and a quarter of the lift at its centre, so a cell's own distance, not the quad's
+ * largest, is what rays leaving it must clear (its twin on a two-sided surface, facing
+ * the other way, clears *ahead). Taken at the cell's corners, the midpoints of its edges
+ * and diagonals, and its centre (on a small cell the distance is nearly linear). Shadow
+ * rays that left every cell of the Cornell box's left wall (folded by 3.2 mm) a quarter
+ * of the lift off it, 1.6 mm, moved the tall block's penumbra there: 5-7 % too dark
+ * against the path tracer and a brute-force sum over the light. */
+static void cell_offsets(const mesh_output *out, const polygon *poly, const rad_vec3 *p,
+                         uint32_t count, double *behind, double *ahead)
 {
+    *behind = *ahead = 0;
     if (!(poly->bulge > 0) || poly->count != 4)
-        return poly->bulge;
+        return;
     const rad_vec3 *positions = out->in->scene->positions;
     rad_vec3 c[4];
     for (int k = 0; k < 4; k++)
@@ -174,13 +176,13 @@ static double cell_bulge(const mesh_output *out, const polygon *poly, const rad_
         q[points++] = v3_scale(v3_add(p[0], p[2]), 0.5);
         q[points++] = v3_scale(v3_add(p[1], p[3]), 0.5);
     }
-    double behind = 0;
     for (uint32_t k = 0; k < points; k++) {
         double side = v3_dot(v3_cross(diagonal, v3_sub(q[k], c[0])), up);
         rad_vec3 n = side * side_a >= 0 ? n_a : n_b;
-        behind = fmax(behind, v3_dot(n, v3_sub(c[0], q[k])));
+        double below = v3_dot(n, v3_sub(c[0], q[k]));
+        *behind = fmax(*behind, below);
+        *ahead = fmax(*ahead, -below);
     }
-    return fmax(behind, 1e-6 * poly->bulge);
 }
 
 static int add_patch(mesh_output *out, const polygon *poly, const rad_vec3 *p, uint32_t count)
@@ -192,7 +194,9 @@ static int add_patch(mesh_output *out, const polygon *poly, const rad_vec3 *p, u
     memset(patch, 0, sizeof(*patch));
     const rad_triangle *source = &out->in->scene->triangles[poly->triangle];
     patch->vertex_count = count;
-    patch->bulge = cell_bulge(out, poly, p, count);
+    patch->bulge = poly->bulge;
+    double ahead;
+    cell_offsets(out, poly, p, count, &patch->behind, &ahead);
     patch->surface = source->surface;
     patch->material = source->material;
     for (uint32_t k = 0; k < count; k++) {
@@ -517,8 +521,8 @@ static double plan_patch_count(const mesh_plan *plan, double patch_size)
 /* The back side of patches [first, end) of one polygon (region `region`): a twin per
  * patch, corners reversed (0, n-1, ..., 1: the same triangles for the renderer's split,
  * the opposite normal), its vertices in region `region` + the plan's region count. */
-static int add_twins(mesh_output *out, const mesh_plan *plan, uint32_t region, size_t first,
-                     size_t end)
+static int add_twins(mesh_output *out, const mesh_plan *plan, const polygon *poly,
+                     uint32_t region, size_t first, size_t end)
 {
     for (size_t k = first; k < end; k++) {
         if (!rad_grow_array((void **)&out->patches, &out->patch_capacity, out->patch_count + 1,
@@ -535,6 +539,13 @@ static int add_twins(mesh_output *out, const mesh_plan *plan, uint32_t region, s
                 return 0;
         }
         back->normal = v3_scale(front->normal, -1);
+        /* the same cell seen from the other side: what lies in front of the triangles
+         * for the front lies behind them for the back */
+        rad_vec3 corner[4];
+        for (uint32_t c = 0; c < front->vertex_count; c++)
+            corner[c] = out->weld.positions[front->vertex[c]];
+        double behind;
+        cell_offsets(out, poly, corner, front->vertex_count, &behind, &back->behind);
         back->twin = (uint32_t)k + 1;
         out->patches[k].twin = (uint32_t)out->patch_count + 1;
         out->patch_count++;
@@ -670,7 +681,7 @@ rad_status rad_mesh_build_with(const rad_scene *scene, const rad_mesh_options *o
     /* the back sides, after every front */
     for (size_t p = 0; p < plan.polygon_count; p++)
         if (polygon_two_sided(scene, &plan.polygons[p]) &&
-            !add_twins(&result, &plan, plan.polygons[p].region, first_patch[p],
+            !add_twins(&result, &plan, &plan.polygons[p], plan.polygons[p].region, first_patch[p],
                        first_patch[p + 1])) {
             free(first_patch);
             goto nomem;

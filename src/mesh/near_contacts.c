@@ -241,16 +241,17 @@ static bool may_meet(const near_contacts *contacts, uint32_t k, rad_vec3 a, rad_
                      double length, double t_low, double zone)
 {
     const rad_patch *patch = &contacts->mesh->patches[k];
-    /* the zone is zone x length long: a plane farther from a than that is not reached */
+    /* the zone is zone x length long: k's triangles, within `slack` of its plane, are not
+     * reached from farther than that */
     double reach = zone * length;
+    double slack = contacts->flatness[k] + 1e-3 * contacts->plane_epsilon; /* and rounding */
     double distance = v3_dot(patch->normal, a) - contacts->offset[k];
-    if (fabs(distance) > reach)
+    if (fabs(distance) > reach + slack)
         return false;
     rad_vec3 to_centre = v3_sub(patch->centroid, a);
     double sphere = contacts->radius[k] + reach;
     if (v3_dot(to_centre, to_centre) > sphere * sphere)
         return false;
-    double slack = contacts->flatness[k] + 1e-3 * contacts->plane_epsilon; /* and rounding */
     double speed = v3_dot(patch->normal, d);
     if (speed == 0)
         return fabs(distance) <= slack;

@@ -73,7 +73,7 @@ typedef struct patch_geometry {
     /* the map from the unit square: quads P = o + s u + t v + s t w (bilinear);
      * triangles P = o + sqrt(s) (u + t w), which is uniform in area */
     rad_vec3 o, u, v, w;
-    rad_vec3 lift; /* added to sample points: 2 x bulge along the normal (folded quads) */
+    rad_vec3 lift; /* added to sample points: 2 x behind along the normal (folded quads) */
 } patch_geometry;
 
 typedef struct pending_pair {
@@ -540,7 +540,7 @@ static rad_status run(const rad_mesh *mesh, const rad_tracer *occluders,
         g->normal = patch->normal;
         g->area = patch->area;
         patch_map(g);
-        g->lift = v3_scale(patch->normal, 2 * patch->bulge);
+        g->lift = v3_scale(patch->normal, 2 * patch->behind);
         g->centroid = patch->centroid;
         g->radius = 0;
         for (unsigned k = 0; k < patch->vertex_count; k++)

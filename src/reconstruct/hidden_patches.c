@@ -31,7 +31,7 @@ void display_hidden_patches(const rad_mesh *mesh, const rad_tracer *tracer, doub
         rad_vec3 n = patch->normal;
         rad_vec3 a, b;
         hemisphere_frame(n, &a, &b);
-        rad_vec3 origin = v3_add(patch->centroid, v3_scale(n, 2 * patch->bulge + leave));
+        rad_vec3 origin = v3_add(patch->centroid, v3_scale(n, 2 * patch->behind + leave));
         rad_rng rng = rad_rng_seed(HIDDEN_STREAM, (uint64_t)p, 0);
         rad_ray rays[HIDDEN_RAYS];
         rad_hit hits[HIDDEN_RAYS];

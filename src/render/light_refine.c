@@ -70,7 +70,7 @@ static bool measure_shares(const refine_state *st, const rad_mesh *mesh, uint32_
             double open = 1;
             if (st->reach > 0) {
                 rad_rng rng = rad_rng_seed(OPENNESS_STREAM, (uint64_t)v, 0);
-                emitter_cosine_rays(x, nv, 2 * f->bulge + st->leave, LIGHT_REFINE_PROBES, &rng,
+                emitter_cosine_rays(x, nv, 2 * f->behind + st->leave, LIGHT_REFINE_PROBES, &rng,
                                     &rays[base], &cosines[base]);
                 rad_tracer_intersect(st->occluders, &rays[base], LIGHT_REFINE_PROBES, &hits[base]);
                 double sum = 0;
@@ -82,7 +82,7 @@ static bool measure_shares(const refine_state *st, const rad_mesh *mesh, uint32_
             }
             share[v].open = open;
             uint32_t count = emitter_light_rays_by_triangle(
-                st->set, st->scene, x, nv, 2 * f->bulge + st->leave, LIGHT_REFINE_PROBES, 0.5,
+                st->set, st->scene, x, nv, 2 * f->behind + st->leave, LIGHT_REFINE_PROBES, 0.5,
                 0.5, 0.5, 0, &rays[base], &values[base]);
             rad_tracer_occluded(st->occluders, &rays[base], count, &blocked[base]);
             double all = 0, through = 0;

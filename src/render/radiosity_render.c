@@ -74,11 +74,16 @@
  * 0.703 %; seed 2 0.403 / 0.707 -> 0.403 / 0.706); the render at 256 x 256 0.2 s shorter. */
 #define EXTRA_SHADOW_SHARE 16u
 /* How the default render takes the emitters' light at the hits on a display triangle:
- * interpolated from its corners (none of them sees the light), computed at the hit with
- * shadow rays (a penumbra), or, where every corner sees all of the light and its
- * unshadowed value is exact (emitter_unshadowed_exact), that value at the hit: linear
- * interpolation of the open light, concave where it peaks, fell short there. */
+ * interpolated from its corners (none of them sees the light, or all see all of it and
+ * its exact value is not at hand), computed at the hit with shadow rays (a penumbra), or,
+ * where every corner sees all of the light and its unshadowed value is exact
+ * (emitter_unshadowed_exact) with at most OPEN_LIGHT_MAX_TRIANGLES emitting triangles,
+ * that value at the hit: linear interpolation of the open light, concave where it peaks,
+ * fell short there (the Cornell box's back wall 0.6-0.9 % dark). Each hit then costs a
+ * contour integral per emitting triangle: a lamp of 64 triangles doubled a render's time,
+ * so more keep the interpolation. */
 enum { DISPLAY_INTERPOLATED, DISPLAY_PENUMBRA, DISPLAY_OPEN_LIGHT };
+#define OPEN_LIGHT_MAX_TRIANGLES 8u
 #define EMITTER_STREAM 0x5EEDE3177ull
 /* A pixel on an emitter's rim (its corners and first samples meet an emitting surface and
  * another) gets RIM_PASSES x RIM_SIDE^2 / RIM_PASSES more samples besides its edge samples,
@@ -89,7 +94,7 @@ enum { DISPLAY_INTERPOLATED, DISPLAY_PENUMBRA, DISPLAY_OPEN_LIGHT };
  * (test_render_accuracy). There are few such pixels. */
 #define RIM_SIDE 32u
 #define RIM_PASSES 4u
-#define RIM_STREAM 0x5EED0121Bull /* the per-pixel shifts of the emitters' samples */
+#define RIM_STREAM 0x5EED0121Bull /* the rim samples' jitter, and their light's streams */ /* the per-pixel shifts of the emitters' samples */
 
 /* One thread's rays of one image row, compacted bounce by bounce. */
 typedef struct row_work {
@@ -97,7 +102,8 @@ typedef struct row_work {
     rad_hit *hits;
     rad_rgb *weight;  /* product of the Ks met so far */
     uint32_t *sample; /* the sample (pixel x, stratum) a ray belongs to */
-    rad_rgb *sum;     /* radiance gathered per sample: first samples, then edge samples */
+    rad_rgb *sum;     /* radiance gathered per sample: first samples, then edge samples
+                         (or, after those are summed, a pass of rim samples) */
     uint8_t *edge;    /* per pixel of the row: gets edge samples */
     double *level;    /* per pixel of the row: mean luminance of its first samples */
     uint32_t row;     /* the image row being rendered (random numbers) */
@@ -156,8 +162,9 @@ typedef struct shading {
     uint32_t edge_strata;           /* edge samples of an edge pixel */
     const rad_tracer *scene_tracer; /* the scene's own triangles: the emitters hit */
     const uint8_t *penumbral;       /* NULL: `emitters` light every hit; else per display
-                                       triangle, whether they light its hits (the others
-                                       show the emitters' light from the vertices) */
+                                       triangle, how its hits take the emitters' light
+                                       (DISPLAY_*: from the vertices, shadow rays at the
+                                       hit, or the exact open light at the hit) */
     const rad_rgb *without_emitters; /* per display vertex: the radiance without the
                                         emitters' light, shown where a hit adds its own */
 } shading;
@@ -303,7 +310,7 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
          w->cosine_count + sh->emitter_samples > w->cosine_capacity))
         flush_lights(sh, w);
     rad_rng rng = rad_rng_seed(sh->seed ^ LIGHT_STREAM ^ (w->rim_pass * RIM_STREAM), w->row, slot);
-    double leave = 2 * patch->bulge + sh->leave;
+    double leave = 2 * patch->behind + sh->leave;
     uint32_t count = 0, index;
     uint32_t pixel;
     if (slot < sh->per_row) {
@@ -345,6 +352,11 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
                 uint32_t made = emitter_light_rays_alone(
                     sh->emitters, sh->scene, point, patch->normal, leave, samples, turn, first,
                     shift1, shift2, rays, values);
+                if (made == 0 && extra) /* all of its few behind the horizon: the full set */
+                    made = emitter_light_rays_alone(sh->emitters, sh->scene, point,
+                                                    patch->normal, leave, sh->emitter_samples,
+                                                    turn, index * sh->emitter_samples, shift1,
+                                                    shift2, rays, values);
                 emitter_scale_to(open, values, made);
                 count += made;
             }
@@ -721,7 +733,8 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
         status = vertex_radiance(&job, radiance, NULL, error);
         if (status != RAD_OK)
             goto done;
-        const bool open_exact = emitter_unshadowed_exact(&emitters, options->scene);
+        const bool open_exact = emitter_unshadowed_exact(&emitters, options->scene) &&
+                                emitters.count <= OPEN_LIGHT_MAX_TRIANGLES;
         for (uint32_t t = 0; penumbral && t < display.triangle_count; t++) {
             /* corners that disagree, or one that sees a part (a point the display mesh
              * added on an edge: unknown, so a part) */

@@ -113,7 +113,7 @@ void vertex_frames(const rad_mesh *mesh, const uint8_t *hidden, vertex_frame *fr
             f->inward = v3_add(f->inward, v3_scale(v3_sub(patch->centroid,
                                                           mesh->vertices[patch->vertex[k]]),
                                                    patch->area));
-            f->bulge = fmax(f->bulge, patch->bulge);
+            f->behind = fmax(f->behind, patch->behind);
             f->weight += patch->area;
         }
     }
@@ -253,7 +253,7 @@ rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *s
             /* inside the vertex's patches (toward their mean centre): at a contact or a
              * crease the point is on the open side, as the patches are */
             rad_vec3 x = v3_add(mesh->vertices[v], v3_scale(f->inward, VERTEX_INWARD / f->weight));
-            double off = 2 * f->bulge + job->leave;
+            double off = 2 * f->behind + job->leave;
             rad_rgb sum = {0, 0, 0};
             if (exact) {
                 /* the unshadowed light exactly, times the share of the samples' that gets

@@ -36,7 +36,7 @@
  * patches alone). */
 typedef struct vertex_frame {
     rad_vec3 normal, inward;
-    double bulge, weight;
+    double behind, weight;
 } vertex_frame;
 
 /* frame[v] for the mesh's vertices, patches marked in `hidden` (NULL: none) left out. */

@@ -23,7 +23,10 @@
 static const uint8_t solve_checkpoint_magic[8] = {0x89, 'R', 'A', 'D', 'S', 'C', 'K', '\n'};
 
 enum {
-    SOLVE_CHECKPOINT_VERSION = 1,
+    SOLVE_CHECKPOINT_VERSION = 2, /* 2: form-factor rows whose folded cells' segments leave
+                                     from their own distance behind the input triangles
+                                     (rad_patch.behind), not the quad's largest: not mixed
+                                     with rows of version 1 */
     JOB_BYTES = 64, /* kind and the job */
 };
 

@@ -35,7 +35,7 @@ typedef struct hnode {
 } hnode;
 
 /* A patch for sampling, compact and in leaf order (a node's patches are contiguous): the
- * corner a (lifted off a folded quad by twice its bulge), the edges to the other corners
+ * corner a (lifted off a folded quad by twice its `behind`), the edges to the other corners
  * (ad zero for a triangle), the normal, and the share of the area in triangle (a, b, c). */
 typedef struct leaf_shape {
     float a[3], ab[3], ac[3], ad[3];

@@ -189,10 +189,10 @@ rad_rgb hier_leaf_gather(const rad_mesh *mesh, const hier_tree *tree, const rad_
     const rad_patch *patch = &mesh->patches[p->patch];
     double gap = v3_length(v3_sub(q->centroid, p->centroid)) - q->radius;
     rad_vec3 points[16];
-    unsigned count = patch_points(mesh, patch, cells_for(gap, p->radius), 2 * patch->bulge,
+    unsigned count = patch_points(mesh, patch, cells_for(gap, p->radius), 2 * patch->behind,
                                   points);
     if (count == 1)
-        points[0] = v3_add(patch->centroid, v3_scale(patch->normal, 2 * patch->bulge));
+        points[0] = v3_add(patch->centroid, v3_scale(patch->normal, 2 * patch->behind));
     rad_rgb sum = {0, 0, 0};
     for (unsigned k = 0; k < count; k++) {
         int budget = MAX_SOURCE_OPENINGS;

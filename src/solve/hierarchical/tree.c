@@ -178,7 +178,7 @@ static void describe_leaf(const rad_mesh *mesh, uint32_t patch, leaf_shape *shap
         double a0 = v3_length(v3_cross(ab, ac)), a1 = v3_length(v3_cross(ac, ad));
         shape->first_share = a0 + a1 > 0 ? (float)(a0 / (a0 + a1)) : 0.5f;
     }
-    put3(shape->a, v3_add(a, v3_scale(p->normal, 2 * p->bulge)));
+    put3(shape->a, v3_add(a, v3_scale(p->normal, 2 * p->behind)));
     put3(shape->ab, ab);
     put3(shape->ac, ac);
     put3(shape->ad, ad);
