@@ -234,14 +234,23 @@ static void whitted_texel_ratio(void)
 
 /* The light [0,2] x [0,2] at y = 1 facing down, u = x / 2 (black for u < 1/2, white for
  * u > 1/2 with the 8-texel texture), Kd 0, Ke 2 x texel; nothing else. */
-static void emission_seen_directly(void)
+/* `fold`: the corner (2, 1, 0) moved that far toward the camera, folding the quad along
+ * its diagonal: its cells then lie in front of its two triangles, and each hit's texel is
+ * looked up on the triangles a quarter of the fold away at most (rad_patch.bulge); when
+ * that reach was the cells' one-sided distance behind the triangles (0 here), the texels
+ * were lost and the render showed the material's mean, Ke x 1/2. */
+static void emission_seen_directly(double fold)
 {
     write_stripes("black_white.png", 8, 4, 0, 255);
     test_write_file("glow.mtl", "newmtl glow\nKd 0 0 0\nKe 2 2 2\nmap_Ke black_white.png\n");
-    test_write_file("glow.obj", "mtllib glow.mtl\no light\nusemtl glow\n"
-                                "v 0 1 0\nv 2 1 0\nv 2 1 2\nv 0 1 2\n"
-                                "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
-                                "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
+    char obj[256];
+    snprintf(obj, sizeof(obj),
+             "mtllib glow.mtl\no light\nusemtl glow\n"
+             "v 0 1 0\nv 2 %.17g 0\nv 2 1 2\nv 0 1 2\n"
+             "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+             "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+             1 - fold);
+    test_write_file("glow.obj", obj);
     rad_scene *scene = load("glow.obj");
     if (!scene)
         return;
@@ -296,9 +305,9 @@ static void emission_seen_directly(void)
                     nw++;
                 }
             }
-        printf("emission texture seen directly, %s: black half at most %.3g, white half mean "
-               "%.6f (Ke = 2), %u and %u pixels\n",
-               names[k], black, white / nw, nb, nw);
+        printf("emission texture seen directly%s, %s: black half at most %.3g, white half "
+               "mean %.6f (Ke = 2), %u and %u pixels\n",
+               fold > 0 ? " (quad folded)" : "", names[k], black, white / nw, nb, nw);
         CHECK(nb > 100 && nw > 100);
         CHECK(black <= 1e-6);
         CHECK_NEAR(white / nw, 2, 1e-5);
@@ -602,7 +611,8 @@ int main(void)
     test_tmpdir();
     textured_furnace();
     whitted_texel_ratio();
-    emission_seen_directly();
+    emission_seen_directly(0);
+    emission_seen_directly(0.01);
     floor_under_half_light(true);
     floor_under_half_light(false);
     solve_exitance();
