@@ -84,7 +84,7 @@
  * so more keep the interpolation. */
 enum { DISPLAY_INTERPOLATED, DISPLAY_PENUMBRA, DISPLAY_OPEN_LIGHT };
 #define OPEN_LIGHT_MAX_TRIANGLES 8u
-#define EMITTER_STREAM 0x5EEDE3177ull
+#define EMITTER_STREAM 0x5EEDE3177ull /* the per-pixel shifts of the emitters' samples */
 /* A pixel on an emitter's rim (its corners and first samples meet an emitting surface and
  * another) gets RIM_PASSES x RIM_SIDE^2 / RIM_PASSES more samples besides its edge samples,
  * RIM_SIDE x RIM_SIDE strata taken a band of rows per pass: the light is a hundred times
@@ -94,7 +94,7 @@ enum { DISPLAY_INTERPOLATED, DISPLAY_PENUMBRA, DISPLAY_OPEN_LIGHT };
  * (test_render_accuracy). There are few such pixels. */
 #define RIM_SIDE 32u
 #define RIM_PASSES 4u
-#define RIM_STREAM 0x5EED0121Bull /* the rim samples' jitter, and their light's streams */ /* the per-pixel shifts of the emitters' samples */
+#define RIM_STREAM 0x5EED0121Bull /* the rim samples' jitter, and their light's streams */
 
 /* One thread's rays of one image row, compacted bounce by bounce. */
 typedef struct row_work {
