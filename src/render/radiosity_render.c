@@ -161,7 +161,7 @@ typedef struct shading {
     size_t per_row;                 /* first samples of a row: W k^2 */
     uint32_t edge_strata;           /* edge samples of an edge pixel */
     const rad_tracer *scene_tracer; /* the scene's own triangles: the emitters hit */
-    const uint8_t *penumbral;       /* NULL: `emitters` light every hit; else per display
+    const uint8_t *emitter_way;     /* NULL: `emitters` light every hit; else per display
                                        triangle, how its hits take the emitters' light
                                        (DISPLAY_*: from the vertices, shadow rays at the
                                        hit, or the exact open light at the hit) */
@@ -342,7 +342,7 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
                  * hundreds in its pixel, takes a sixteenth: its pixel's first samples have
                  * the full number, and together they follow on from those along the same
                  * Halton points (with --direct pixel every hit has only a few) */
-                const bool extra = slot >= sh->per_row && sh->penumbral;
+                const bool extra = slot >= sh->per_row && sh->emitter_way;
                 uint32_t samples = extra ? (sh->emitter_samples + EXTRA_SHADOW_SHARE - 1) /
                                                EXTRA_SHADOW_SHARE
                                          : sh->emitter_samples;
@@ -422,11 +422,11 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
         const uint32_t *v = sh->triangles[triangle];
         /* the emitters' light here: at every hit, or at a penumbra's (shadow rays), or,
          * in the open light, its exact unshadowed value */
-        const uint8_t region = sh->penumbral ? sh->penumbral[triangle] : DISPLAY_PENUMBRA;
+        const uint8_t region = sh->emitter_way ? sh->emitter_way[triangle] : DISPLAY_PENUMBRA;
         const bool emitter_light = sh->emitters && region == DISPLAY_PENUMBRA;
         const bool open_light = sh->emitters && region == DISPLAY_OPEN_LIGHT;
         const rad_rgb *L =
-            (emitter_light || open_light) && sh->penumbral ? sh->without_emitters : sh->radiance;
+            (emitter_light || open_light) && sh->emitter_way ? sh->without_emitters : sh->radiance;
         rad_rgb weight = w->weight[r];
         rad_rgb interpolated = rgb_add(rgb_scale(L[v[0]], 1.0 - hit_u - hit_v),
                                        rgb_add(rgb_scale(L[v[1]], hit_u), rgb_scale(L[v[2]], hit_v)));
@@ -439,24 +439,22 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
             interpolated =
                 textured_radiance(sh, &w->rays[r], hit, patch_index, interpolated, &albedo);
         rgb_add_to(&w->sum[w->sample[r]], rgb_mul(weight, interpolated));
-        if (open_light && !rgb_is_zero(albedo)) {
+        const bool sharp = sh->lights && sh->lights->sharp_count > 0;
+        if ((open_light || sharp || emitter_light) && !rgb_is_zero(albedo)) {
+            /* the light this hit takes itself: the open light's exact value, or shadow
+             * rays toward the sharp sources and the emitters */
             const rad_ray *ray = &w->rays[r];
             rad_vec3 point = v3(ray->origin[0] + (double)hit->t * ray->direction[0],
                                 ray->origin[1] + (double)hit->t * ray->direction[1],
                                 ray->origin[2] + (double)hit->t * ray->direction[2]);
-            rad_rgb open = emitter_unshadowed_irradiance(sh->emitters, sh->scene, point,
-                                                         sh->mesh->patches[patch_index].normal);
-            rgb_add_to(&w->sum[w->sample[r]],
-                       rgb_mul(rgb_scale(rgb_mul(weight, albedo), 1.0 / RAD_PI), open));
-        }
-        if (((sh->lights && sh->lights->sharp_count > 0) || emitter_light) &&
-            !rgb_is_zero(albedo)) {
-            const rad_ray *ray = &w->rays[r];
-            rad_vec3 point = v3(ray->origin[0] + (double)hit->t * ray->direction[0],
-                                ray->origin[1] + (double)hit->t * ray->direction[1],
-                                ray->origin[2] + (double)hit->t * ray->direction[2]);
-            queue_lights(sh, w, w->sample[r], point, &sh->mesh->patches[patch_index],
-                         rgb_scale(rgb_mul(weight, albedo), 1.0 / RAD_PI), emitter_light);
+            const rad_patch *hit_patch = &sh->mesh->patches[patch_index];
+            rad_rgb factor = rgb_scale(rgb_mul(weight, albedo), 1.0 / RAD_PI);
+            if (open_light)
+                rgb_add_to(&w->sum[w->sample[r]],
+                           rgb_mul(factor, emitter_unshadowed_irradiance(
+                                               sh->emitters, sh->scene, point, hit_patch->normal)));
+            if (sharp || emitter_light)
+                queue_lights(sh, w, w->sample[r], point, hit_patch, factor, emitter_light);
         }
         if (!mirrors || !sh->materials || sh->irradiance)
             continue;
@@ -496,7 +494,7 @@ static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work 
             for (uint32_t r = 0; r < count; r++)
                 w->first_penumbral[w->sample[r]] =
                     w->hits[r].triangle != RAD_NO_HIT &&
-                    sh->penumbral[w->hits[r].triangle] == DISPLAY_PENUMBRA;
+                    sh->emitter_way[w->hits[r].triangle] == DISPLAY_PENUMBRA;
         count = shade_hits(sh, w, count, depth < max_depth);
         flush_lights(sh, w);
     }
@@ -569,6 +567,27 @@ static rad_status inputs_begin(const rad_render_options *options, const rad_mesh
     return RAD_OK;
 }
 
+/* Camera ray `ray` of a row through the image point (px, py), for sample `slot` (its sum
+ * starts at 0): first samples, edge samples and rim samples alike. */
+static void start_sample(row_work *w, const camera_frame *frame, uint32_t ray, size_t slot,
+                         double px, double py, uint32_t W, uint32_t H, float t_near)
+{
+    rad_vec3 d = v3_normalize(camera_direction(frame, px, py, W, H));
+    ray_set(&w->rays[ray], frame->eye, d, t_near, INFINITY);
+    w->weight[ray] = (rad_rgb){1, 1, 1};
+    w->sample[ray] = (uint32_t)slot;
+    w->sum[slot] = (rad_rgb){0, 0, 0};
+}
+
+/* Pixel (x, y) holds the mean of `count` samples summing to `sum`. */
+static void write_pixel(rad_image *image, uint32_t x, uint32_t y, rad_rgb sum, double count)
+{
+    float *pixel = &image->rgb[((size_t)y * image->width + x) * 3];
+    pixel[0] = (float)(sum.r / count);
+    pixel[1] = (float)(sum.g / count);
+    pixel[2] = (float)(sum.b / count);
+}
+
 static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                               const vertex_parents *parents, const rad_camera *camera,
                               const rad_render_options *options, rad_image *image,
@@ -608,7 +627,8 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
     rad_tracer *scene_tracer = NULL;
     uint8_t *hidden = NULL;
     rad_rgb *reflected = NULL;
-    uint8_t *sees = NULL, *penumbral = NULL; /* the default render's penumbrae */
+    uint8_t *sees = NULL, *emitter_way = NULL; /* the default render: how each display
+                                                  triangle takes the emitters' light */
     rad_rgb *without_emitters = NULL;
     const emitter_set *pixel_emitters = NULL; /* those whose light some pixels compute */
     bool agreed = false; /* every rank has passed ranks_agree (collective over MPI ranks) */
@@ -695,9 +715,9 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
         if (direct_light == RAD_DIRECT_VERTEX && emitters.count > 0) {
             /* the emitters' light at the penumbrae's pixels, the rest from the vertices */
             sees = rad_alloc_array(mesh->vertex_count ? mesh->vertex_count : 1, 1);
-            penumbral = rad_alloc_array(display.triangle_count ? display.triangle_count : 1, 1);
+            emitter_way = rad_alloc_array(display.triangle_count ? display.triangle_count : 1, 1);
             without_emitters = rad_alloc_array(display.vertex_count, sizeof(*without_emitters));
-            if (!sees || !penumbral || !without_emitters)
+            if (!sees || !emitter_way || !without_emitters)
                 goto nomem;
             pixel_emitters = &emitters;
             emitter_samples = PENUMBRA_DIRECT_SAMPLES;
@@ -735,7 +755,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
             goto done;
         const bool open_exact = emitter_unshadowed_exact(&emitters, options->scene) &&
                                 emitters.count <= OPEN_LIGHT_MAX_TRIANGLES;
-        for (uint32_t t = 0; penumbral && t < display.triangle_count; t++) {
+        for (uint32_t t = 0; emitter_way && t < display.triangle_count; t++) {
             /* corners that disagree, or one that sees a part (a point the display mesh
              * added on an edge: unknown, so a part) */
             uint8_t least = VERTEX_SEES_ALL, most = VERTEX_SEES_NONE;
@@ -745,7 +765,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                 least = seen < least ? seen : least;
                 most = seen > most ? seen : most;
             }
-            penumbral[t] = least != most || least == VERTEX_SEES_PART ? DISPLAY_PENUMBRA
+            emitter_way[t] = least != most || least == VERTEX_SEES_PART ? DISPLAY_PENUMBRA
                            : least == VERTEX_SEES_ALL && open_exact        ? DISPLAY_OPEN_LIGHT
                                                                            : DISPLAY_INTERPOLATED;
         }
@@ -810,7 +830,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
             if (!w->first_surface || !w->corner_surface)
                 goto nomem;
         }
-        if (penumbral && w->first_surface) {
+        if (emitter_way && w->first_surface) {
             w->first_penumbral = rad_alloc_array(per_row, 1);
             if (!w->first_penumbral)
                 goto nomem;
@@ -850,7 +870,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                      emitters_exact,
                      emitter_samples, per_row,
                      edge_k * edge_k, scene_tracer,
-                     penumbral, without_emitters};
+                     emitter_way, without_emitters};
 
     /* over several MPI ranks the rows are dealt out in turn (every pixel's random numbers
      * are its own, so each row comes out as in a serial run), then summed: every pixel is
@@ -889,12 +909,8 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
             for (unsigned s = 0; s < k * k; s++) {
                 double px = x + ((s % k) + rad_rng_uniform(&rng)) / k;
                 double py = y + ((s / k) + rad_rng_uniform(&rng)) / k;
-                rad_vec3 d = v3_normalize(camera_direction(&frame, px, py, W, H));
                 size_t index = (size_t)x * k * k + s;
-                ray_set(&w->rays[index], frame.eye, d, t_near, INFINITY);
-                w->weight[index] = (rad_rgb){1, 1, 1};
-                w->sample[index] = (uint32_t)index;
-                w->sum[index] = (rad_rgb){0, 0, 0};
+                start_sample(w, &frame, (uint32_t)index, index, px, py, W, H, t_near);
             }
         }
         trace_samples(&shade, tracer, w, (uint32_t)per_row, max_depth, true);
@@ -936,12 +952,8 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
             for (unsigned s = 0; s < edge_k * edge_k; s++) {
                 double px = x + ((s % edge_k) + rad_rng_uniform(&rng)) / edge_k;
                 double py = y + ((s / edge_k) + rad_rng_uniform(&rng)) / edge_k;
-                rad_vec3 d = v3_normalize(camera_direction(&frame, px, py, W, H));
-                size_t index = per_row + extra++;
-                ray_set(&w->rays[index - per_row], frame.eye, d, t_near, INFINITY);
-                w->weight[index - per_row] = (rad_rgb){1, 1, 1};
-                w->sample[index - per_row] = (uint32_t)index;
-                w->sum[index] = (rad_rgb){0, 0, 0};
+                start_sample(w, &frame, extra, per_row + extra, px, py, W, H, t_near);
+                extra++;
             }
         }
         if (extra)
@@ -958,14 +970,10 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                     rgb_add_to(&sum, w->sum[per_row + next_extra++]);
                 count += edge_k * edge_k;
             }
-            if (w->rim[x]) { /* written after its rim samples, below */
+            if (w->rim[x]) /* written after its rim samples, below */
                 w->rim_sum[x] = sum;
-                continue;
-            }
-            float *pixel = &image->rgb[((size_t)y * W + x) * 3];
-            pixel[0] = (float)(sum.r / count);
-            pixel[1] = (float)(sum.g / count);
-            pixel[2] = (float)(sum.b / count);
+            else
+                write_pixel(image, x, y, sum, count);
         }
         bool rims = false;
         for (uint32_t x = 0; x < W && !rims; x++)
@@ -984,11 +992,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                 for (unsigned s = 0; s < per_pass; s++, n++) {
                     double px = x + ((s % RIM_SIDE) + rad_rng_uniform(&rng)) / RIM_SIDE;
                     double py = y + (pass * band + s / RIM_SIDE + rad_rng_uniform(&rng)) / RIM_SIDE;
-                    rad_vec3 d = v3_normalize(camera_direction(&frame, px, py, W, H));
-                    ray_set(&w->rays[n], frame.eye, d, t_near, INFINITY);
-                    w->weight[n] = (rad_rgb){1, 1, 1};
-                    w->sample[n] = (uint32_t)(per_row + n);
-                    w->sum[per_row + n] = (rad_rgb){0, 0, 0};
+                    start_sample(w, &frame, n, per_row + n, px, py, W, H, t_near);
                 }
             }
             w->rim_pass = pass + 1;
@@ -1001,11 +1005,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
         for (uint32_t x = 0; rims && x < W; x++) {
             if (!w->rim[x])
                 continue;
-            double count = k * k + edge_k * edge_k + RIM_SIDE * RIM_SIDE;
-            float *pixel = &image->rgb[((size_t)y * W + x) * 3];
-            pixel[0] = (float)(w->rim_sum[x].r / count);
-            pixel[1] = (float)(w->rim_sum[x].g / count);
-            pixel[2] = (float)(w->rim_sum[x].b / count);
+            write_pixel(image, x, y, w->rim_sum[x], k * k + edge_k * edge_k + RIM_SIDE * RIM_SIDE);
         }
         render_progress_step(&progress);
     }
@@ -1051,7 +1051,7 @@ done:
     free(hidden);
     free(reflected);
     free(sees);
-    free(penumbral);
+    free(emitter_way);
     free(without_emitters);
     display_mesh_free(&display);
     free(radiance);
