@@ -6,6 +6,8 @@
  * frame of 4 pieces, less a covering one nothing; a shape whose box is apart, or that only
  * touches along an edge, leaves the piece as it was; of 2 triangles that cover it
  * together, the first leaves the corner the second then covers; more pieces than there is room for fail (-1);
+ * in place, a piece the shape misses stays as it was, one it covers vanishes and the
+ * next piece's parts may take its slot;
  * corners repeated a hair apart are dropped, distinct ones kept. Not here: the shadows
  * cut with it (test_shadow_clip, test_shadow_join).
  */
@@ -32,6 +34,14 @@ static double total_area(const flat_piece *pieces, int count)
     return sum;
 }
 
+/* The pieces `start` less `shape`, into `pieces` (room for max). */
+static int subtract_from(const flat_piece *start, const flat_piece *shape, flat_piece *pieces,
+                         unsigned max)
+{
+    pieces[0] = *start;
+    return flat_subtract(pieces, 1, shape, 1e-12, max);
+}
+
 int main(void)
 {
     /* the frame of a tilted plane: axes unit and orthogonal, u x v = n, points back */
@@ -52,7 +62,7 @@ int main(void)
 
     /* a square over the corner (1, 1): the L left is 3/4, in 2 convex pieces */
     flat_piece corner = square(0.5, 1.5, 0.5, 1.5);
-    int made = flat_subtract(&unit, 1, &corner, 1e-12, next, 8);
+    int made = subtract_from(&unit, &corner, next, 8);
     printf("unit square less the square over its corner: %d pieces, area %.17g\n", made,
            made > 0 ? total_area(next, made) : -1.0);
     CHECK(made == 2);
@@ -60,22 +70,22 @@ int main(void)
 
     /* a square in its middle: a frame of 4 pieces, 1 - 0.25 */
     flat_piece middle = square(0.25, 0.75, 0.25, 0.75);
-    made = flat_subtract(&unit, 1, &middle, 1e-12, next, 8);
+    made = subtract_from(&unit, &middle, next, 8);
     CHECK(made == 4);
     CHECK_NEAR(total_area(next, made), 0.75, 1e-15);
     /* ... with room for 3 only: fails */
-    CHECK(flat_subtract(&unit, 1, &middle, 1e-12, next, 3) == -1);
+    CHECK(subtract_from(&unit, &middle, next, 3) == -1);
 
     /* a covering square: nothing left */
     flat_piece cover = square(-1, 2, -1, 2);
-    CHECK(flat_subtract(&unit, 1, &cover, 1e-12, next, 8) == 0);
+    CHECK(subtract_from(&unit, &cover, next, 8) == 0);
 
     /* apart, and touching along an edge: the piece as it was */
     flat_piece apart = square(2, 3, 0, 1), touching = square(1, 2, 0.2, 0.8);
-    made = flat_subtract(&unit, 1, &apart, 1e-12, next, 8);
+    made = subtract_from(&unit, &apart, next, 8);
     CHECK(made == 1 && next[0].count == 4);
     CHECK_NEAR(total_area(next, made), 1, 0);
-    made = flat_subtract(&unit, 1, &touching, 1e-12, next, 8);
+    made = subtract_from(&unit, &touching, next, 8);
     CHECK(made == 1 && next[0].count == 4);
     CHECK_NEAR(total_area(next, made), 1, 0);
 
@@ -84,11 +94,31 @@ int main(void)
     flat_piece lower = {{{-0.3, -0.2}, {1.2, -0.2}, {1.2, 1.3}}, 3};
     flat_piece upper = {{{-0.2, -0.3}, {1.3, 1.2}, {-0.2, 1.2}}, 3};
     flat_piece after[8];
-    made = flat_subtract(&unit, 1, &lower, 1e-12, next, 8);
+    made = subtract_from(&unit, &lower, next, 8);
     CHECK(made >= 1);
     CHECK_NEAR(total_area(next, made), 0.405, 1e-14);
-    made = flat_subtract(next, (unsigned)(made > 0 ? made : 0), &upper, 1e-12, after, 8);
+    for (int k = 0; k < made; k++)
+        after[k] = next[k];
+    made = flat_subtract(after, (unsigned)(made > 0 ? made : 0), &upper, 1e-12, 8);
     CHECK(made == 0);
+
+    /* in place: a piece the shape misses stays where it was; one it covers vanishes and
+     * its slot is taken by the next piece's parts when the list is full. The wedge covers
+     * the unit square and pokes into [2, 3] x [0, 1] to (2.5, 0.5) from its left side:
+     * 1 - 1/3 of that square is left, in 2 pieces, in a list of room for 2. */
+    flat_piece wedge = {{{-1, -1}, {1.5, -1}, {2.5, 0.5}, {1.5, 2}, {-1, 2}}, 5};
+    flat_piece list[3] = {unit, square(2, 3, 0, 1), square(5, 6, 0, 1)};
+    made = flat_subtract(list, 2, &wedge, 1e-12, 2);
+    CHECK(made == 2);
+    CHECK_NEAR(total_area(list, made), 2.0 / 3, 1e-14);
+    list[0] = unit, list[1] = square(5, 6, 0, 1), list[2] = square(2, 3, 0, 1);
+    made = flat_subtract(list, 3, &wedge, 1e-12, 4);
+    CHECK(made == 3);
+    CHECK(made == 3 && list[0].count == 4 && list[0].vertex[0].u == 5); /* moved up, whole */
+    CHECK_NEAR(total_area(list, made), 1 + 2.0 / 3, 1e-14);
+    /* the square cut first, before the covered one vanishes: no room yet (-1) */
+    list[0] = square(2, 3, 0, 1), list[1] = unit;
+    CHECK(flat_subtract(list, 2, &wedge, 1e-12, 2) == -1);
 
     /* corners repeated 1e-15 apart dropped, 1e-6 apart kept */
     flat_piece repeated = {{{0, 0}, {1, 0}, {1, 1e-15}, {1, 1}, {0, 1}, {1e-16, 1}}, 6};

@@ -155,40 +155,92 @@ static inline bool boxes_apart(flat_box a, flat_box b)
     return a.u1 <= b.u0 || b.u1 <= a.u0 || a.v1 <= b.v0 || b.v1 <= a.v0;
 }
 
-int flat_subtract(const flat_piece *pieces, unsigned count, const flat_piece *shape, double tiny,
-                  flat_piece *next, unsigned max_pieces)
+/* Copies a piece's corners only (a piece holds room for many more than it uses). */
+static inline void piece_copy(flat_piece *to, const flat_piece *from)
+{
+    to->count = from->count;
+    for (unsigned k = 0; k < from->count; k++)
+        to->vertex[k] = from->vertex[k];
+}
+
+/* A slot for one more piece: past the last while there is room, else a hole (a piece that
+ * vanished) before `before`; -1 when there is neither. */
+static int free_slot(flat_piece *pieces, unsigned *made, unsigned max_pieces, unsigned *holes,
+                     unsigned *hole_from, unsigned before)
+{
+    if (*made < max_pieces)
+        return (int)(*made)++;
+    for (; *holes > 0 && *hole_from < before; (*hole_from)++)
+        if (pieces[*hole_from].count == 0) {
+            (*holes)--;
+            return (int)(*hole_from)++;
+        }
+    return -1;
+}
+
+int flat_subtract(flat_piece *pieces, unsigned count, const flat_piece *shape, double tiny,
+                  unsigned max_pieces)
 {
     flat_line lines[FLAT_PIECE_MAX_VERTICES];
     for (unsigned e = 0; e < shape->count; e++)
         lines[e] = edge_line(shape->vertex[e], shape->vertex[e + 1 == shape->count ? 0 : e + 1]);
     flat_box shape_box = box_of(shape);
-    unsigned made = 0;
+    unsigned made = count, holes = 0, hole_from = 0;
     for (unsigned k = 0; k < count; k++) {
-        if (pieces[k].count == 0 || boxes_apart(box_of(&pieces[k]), shape_box) ||
-            separated(&pieces[k], shape, lines)) {
-            if (made == max_pieces)
-                return -1;
-            next[made++] = pieces[k];
+        if (pieces[k].count == 0) {
+            holes++;
             continue;
         }
-        flat_piece buffer[3];
+        if (boxes_apart(box_of(&pieces[k]), shape_box) || separated(&pieces[k], shape, lines))
+            continue; /* stays as it is, where it is */
+        /* the parts outside the shape's edges in turn: the first takes the piece's own
+         * slot (free once the first cut has read it), the others go past the last */
+        flat_piece buffer[2], outside;
         const flat_piece *remaining = &pieces[k];
+        bool placed = false;
         for (unsigned e = 0; e < shape->count && remaining->count >= 3; e++) {
             if (no_line(lines[e]))
                 continue;
-            /* the part outside goes straight to `next` (a full `next` fails only when it
-             * would be kept); what is inside goes on */
+            /* most lines leave the rest wholly on one side: nothing to cut */
+            bool some_in = false, some_out = false;
+            for (unsigned m = 0; m < remaining->count; m++) {
+                double d = side_of(lines[e], remaining->vertex[m]);
+                some_in = some_in || d > 0;
+                some_out = some_out || d < 0;
+            }
+            if (!some_out)
+                continue; /* inside this edge: all of it goes on to the next */
             flat_piece *inside = remaining == &buffer[0] ? &buffer[1] : &buffer[0];
-            flat_piece *outside = made < max_pieces ? &next[made] : &buffer[2];
-            if (!split_by_line(remaining, lines[e], inside, outside))
+            if (!some_in) { /* wholly outside: all of it is left, nothing goes on */
+                piece_copy(&outside, remaining);
+                inside->count = 0;
+            } else if (!split_by_line(remaining, lines[e], inside, &outside)) {
                 return -1;
-            if (outside->count >= 3 && flat_piece_area(outside) > tiny) {
-                if (made == max_pieces)
-                    return -1;
-                made++;
             }
             remaining = inside;
+            if (outside.count < 3 || !(flat_piece_area(&outside) > tiny))
+                continue;
+            if (placed) {
+                int slot = free_slot(pieces, &made, max_pieces, &holes, &hole_from, k);
+                if (slot < 0)
+                    return -1;
+                piece_copy(&pieces[slot], &outside);
+            } else {
+                piece_copy(&pieces[k], &outside);
+                placed = true;
+            }
+        }
+        if (!placed) {
+            pieces[k].count = 0;
+            holes++;
         }
     }
-    return (int)made;
+    unsigned kept = 0; /* the holes closed up */
+    for (unsigned k = 0; k < made; k++)
+        if (pieces[k].count > 0) {
+            if (kept != k)
+                piece_copy(&pieces[kept], &pieces[k]);
+            kept++;
+        }
+    return (int)kept;
 }

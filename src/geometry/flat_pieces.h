@@ -61,11 +61,13 @@ double flat_piece_area(const flat_piece *p);
  * corners, vf_polygon_clip_front). */
 void flat_piece_drop_repeated(flat_piece *p);
 
-/* Subtracts the convex `shape` (counter-clockwise) from the `count` pieces, into `next`
- * (room for max_pieces): the parts of each piece outside each edge of the shape in turn,
- * pieces of area at most `tiny` dropped. Returns how many, or -1 when they would be more
+/* Subtracts the convex `shape` (counter-clockwise) from the `count` pieces, in place
+ * (room for max_pieces): each piece the shape overlaps gives way to its parts outside each
+ * edge of the shape in turn, pieces of area at most `tiny` dropped; the others stay where
+ * they are (the order of the pieces is otherwise not kept; a piece of no corners counts
+ * as none). Returns how many, or -1 (the pieces then undefined) when they would be more
  * than max_pieces or a cut piece more than FLAT_PIECE_MAX_VERTICES corners. */
-int flat_subtract(const flat_piece *pieces, unsigned count, const flat_piece *shape, double tiny,
-                  flat_piece *next, unsigned max_pieces);
+int flat_subtract(flat_piece *pieces, unsigned count, const flat_piece *shape, double tiny,
+                  unsigned max_pieces);
 
 #endif

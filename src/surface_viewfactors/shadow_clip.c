@@ -182,8 +182,7 @@ static double visible_factor(const shadow_receiver *r, rad_vec3 x, rad_vec3 n,
         return 0;
     /* the shadows are cut from the receiver in its plane's own coordinates */
     flat_point x_flat = plane_frame_flat(&r->frame, x);
-    flat_piece buffers[2][SHADOW_MAX_PIECES];
-    flat_piece *pieces = buffers[0], *next = buffers[1];
+    flat_piece pieces[SHADOW_MAX_PIECES];
     unsigned count = 1;
     pieces[0] = r->whole;
     for (uint32_t k = 0; k < occluders->count && count > 0; k++) {
@@ -192,12 +191,9 @@ static double visible_factor(const shadow_receiver *r, rad_vec3 x, rad_vec3 n,
         if (!project_shadow(x_flat, H, caster_of(occluders, k, r, plane_epsilon, &scratch),
                             &shadow))
             continue;
-        int made = flat_subtract(pieces, count, &shadow, r->tiny, next, SHADOW_MAX_PIECES);
+        int made = flat_subtract(pieces, count, &shadow, r->tiny, SHADOW_MAX_PIECES);
         if (made < 0)
             return -1;
-        flat_piece *swap = pieces;
-        pieces = next;
-        next = swap;
         count = (unsigned)made;
     }
     double factor = 0;
@@ -347,8 +343,7 @@ int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_v
     if (window_count < 3 || window_count > PIECE_MAX_VERTICES)
         return -1;
     plane_frame frame = plane_frame_make(window[0], normal);
-    flat_piece buffers[2][SHADOW_MAX_PIECES];
-    flat_piece *pieces = buffers[0], *next = buffers[1];
+    flat_piece pieces[SHADOW_MAX_PIECES];
     unsigned count = 1;
     pieces[0].count = window_count;
     for (unsigned k = 0; k < window_count; k++)
@@ -365,12 +360,9 @@ int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_v
         if (area < 0)
             for (unsigned k = 0; k < polygon->count; k++)
                 shape.vertex[k] = plane_frame_flat(&frame, polygon->vertex[polygon->count - 1 - k]);
-        int made = flat_subtract(pieces, count, &shape, tiny, next, SHADOW_MAX_PIECES);
+        int made = flat_subtract(pieces, count, &shape, tiny, SHADOW_MAX_PIECES);
         if (made < 0)
             return -1;
-        flat_piece *swap = pieces;
-        pieces = next;
-        next = swap;
         count = (unsigned)made;
     }
     for (unsigned k = 0; k < count; k++) {
