@@ -17,6 +17,7 @@
 #include "core/vec3.h"
 #include "lights/emitters.h"
 #include "render/emitter_light.h"
+#include "render/reflector_planes.h"
 #include "render/vertex_light.h"
 #include "render/vertex_radiance.h"
 #include "solve/patch_inputs.h"
@@ -25,6 +26,11 @@
 #define OPENNESS_STREAM 0x6F70656Eull /* the openness rays' random numbers, their own */
 
 enum { SEES_NONE, SEES_PART, SEES_ALL };
+
+/* Why a patch is split (split_patches): not, for the emitters' light, for the light the
+ * surfaces around reflect (its new vertices gather theirs); a crease waiting for the
+ * budget the shadows leave, a reflector's plane for its own. */
+enum { SPLIT_NOT, SPLIT_EMITTERS, SPLIT_CREASE, SPLIT_REFLECTED, SPLIT_PLANE };
 
 /* What a mesh being refined knows of each vertex: the share of the emitters' light that
  * reaches it (its point, as vertex_light takes it) and how that share reads. */
@@ -104,6 +110,16 @@ static bool measure_shares(const refine_state *st, const rad_mesh *mesh, uint32_
     free(hits);
     free(cosines);
     return ok;
+}
+
+/* Patch q's irradiance in solution B, (B - E) / rho in luminance (0 for a black one). */
+static double patch_irradiance(const rad_rgb *B, const rad_patch_inputs *inputs, uint32_t q)
+{
+    double albedo = rgb_luminance(inputs->albedo[q]);
+    return albedo > 0
+               ? rgb_luminance(rgb_max0(rgb_add(B[q], rgb_scale(inputs->exitance[q], -1)))) /
+                     albedo
+               : 0;
 }
 
 /* The patch's longest edge. */
@@ -250,7 +266,7 @@ static rad_status split_patches(const rad_mesh *mesh, const uint8_t *split, uint
             continue;
         }
         const uint32_t *v = patch->vertex;
-        const bool gathers = reflected_bends(patch, share);
+        const bool gathers = split[p] == SPLIT_REFLECTED || reflected_bends(patch, share);
         uint32_t m[4];
         for (uint32_t k = 0; k < patch->vertex_count; k++) {
             m[k] = midpoint(&table, next, grown, v[k], v[(k + 1) % patch->vertex_count]);
@@ -329,20 +345,25 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
 {
     *out = (light_refined){0};
     /* at most as many patches again for the emitters' light, and half as many for the
-     * creases (or what the shadows left); under a memory budget no more than lets the
-     * whole finer mesh and the light at its vertices (which comes after) fit three
-     * quarters of what is left: the finer mesh is an extra, given up before the light */
+     * creases (or what the shadows left), and an eighth for the reflectors' planes; under
+     * a memory budget no more than lets the whole finer mesh and the light at its vertices
+     * (which comes after) fit three quarters of what is left: the finer mesh is an extra,
+     * given up before the light, the planes' share first */
     size_t budget = (size_t)mesh->patch_count + mesh->patch_count / LIGHT_REFINE_CREASE_PART;
+    size_t plane_budget = mesh->patch_count / LIGHT_REFINE_PLANE_PART;
     uint64_t left = rad_memory_budget_left();
     if (left != UINT64_MAX) {
         uint64_t fit = left / 4 * 3 / (LIGHT_REFINE_BYTES_PER_PATCH + VERTEX_LIGHT_BYTES_PER_PATCH);
         uint64_t room = fit > mesh->patch_count ? fit - mesh->patch_count : 0;
         if (room < budget)
             budget = (size_t)room;
+        if (room - budget < plane_budget)
+            plane_budget = (size_t)(room - budget);
     }
     if (!scene || !rad_scene_has_emitter(scene) || mesh->patch_count == 0 || budget < 3)
         return RAD_OK;
     emitter_set set = {0};
+    reflector_set reflectors = {0};
     rad_tracer *occluders = NULL;
     rad_patch_inputs *built = NULL;
     rad_mesh *current = NULL;
@@ -358,6 +379,8 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
         status = rad_patch_inputs_build(scene, mesh, &built, error);
         inputs = built;
     }
+    if (status == RAD_OK)
+        status = reflectors_build(mesh, B, inputs, &reflectors, error);
     if (status != RAD_OK)
         goto done;
     if (!parent || !parents) {
@@ -384,7 +407,7 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
     }
     const rad_mesh *at = mesh;
     uint32_t measured = 0;
-    for (uint32_t level = 0; level < LIGHT_REFINE_LEVELS && budget >= 3; level++) {
+    for (uint32_t level = 0; level < LIGHT_REFINE_LEVELS && budget + plane_budget >= 3; level++) {
         vertex_share *grown =
             rad_resize_array(share, at->vertex_count ? at->vertex_count : 1, sizeof(*share));
         uint8_t *marks = rad_resize_array(split, at->patch_count ? at->patch_count : 1, 1);
@@ -397,27 +420,55 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
             goto done;
         }
         measured = at->vertex_count;
-        uint32_t splits = 0;
-        /* the patches the emitters' light bends in first, then those at creases */
+        uint32_t splits = 0, candidates = 0;
+        for (uint32_t p = 0; p < at->patch_count; p++)
+            candidates += at->patches[p].twin == 0 &&
+                          longest_edge(&at->patches[p], at->vertices) >= 2 * smallest;
+        /* (a patch with next to no light of its own, as in the gap above a lamp, is not
+         * split for a kink: a hundredth of the mean irradiance at least) */
+        double dark = 0, area = 0;
+        for (uint32_t q = 0; q < mesh->patch_count; q++) {
+            dark += mesh->patches[q].area * patch_irradiance(B, inputs, q);
+            area += mesh->patches[q].area;
+        }
+        dark = area > 0 ? 0.01 * dark / area : 0;
+        const uint32_t planes_tested =
+            candidates ? (uint32_t)(REFLECTOR_TESTS / candidates) : 0;
+        /* the patches the emitters' light bends in first, then those at creases and
+         * where a reflecting region's plane crosses */
         for (uint32_t p = 0; p < at->patch_count; p++) {
             const rad_patch *patch = &at->patches[p];
-            int reason = patch->twin == 0 && longest_edge(patch, at->vertices) >= 2 * smallest
-                             ? bends(patch, share)
-                             : 0;
-            split[p] = reason == 1 && shadow_budget >= 3 && budget >= 3 ? 1 : reason ? 2 : 0;
-            if (split[p] == 1) {
+            bool candidate =
+                patch->twin == 0 && longest_edge(patch, at->vertices) >= 2 * smallest;
+            int reason = candidate ? bends(patch, share) : 0;
+            if (candidate && reason == 0) {
+                double H = patch_irradiance(B, inputs, parent[p]);
+                if (H > dark && reflector_kink(&reflectors, planes_tested, patch, at->vertices,
+                                            H) > LIGHT_REFINE_KINK)
+                    reason = 3;
+            }
+            split[p] = reason == 1 && shadow_budget >= 3 && budget >= 3 ? SPLIT_EMITTERS
+                       : reason == 1 || reason == 2                     ? SPLIT_CREASE
+                       : reason == 3                                    ? SPLIT_PLANE
+                                                                        : SPLIT_NOT;
+            if (split[p] == SPLIT_EMITTERS) {
                 splits++;
                 budget -= 3;
                 shadow_budget -= 3;
             }
         }
         for (uint32_t p = 0; p < at->patch_count; p++) {
-            if (split[p] == 2 && budget >= 3) {
-                split[p] = 1;
+            if (split[p] == SPLIT_CREASE && budget >= 3) {
+                split[p] = SPLIT_EMITTERS;
                 splits++;
                 budget -= 3;
-            } else if (split[p] == 2)
-                split[p] = 0;
+            } else if (split[p] == SPLIT_PLANE && plane_budget >= 3) {
+                split[p] = SPLIT_REFLECTED;
+                splits++;
+                plane_budget -= 3;
+            } else if (split[p] == SPLIT_CREASE || split[p] == SPLIT_PLANE) {
+                split[p] = SPLIT_NOT;
+            }
         }
         if (splits == 0)
             break;
@@ -445,6 +496,7 @@ done:
     rad_patch_inputs_destroy(built);
     rad_tracer_destroy(occluders);
     emitters_free(&set);
+    reflectors_free(&reflectors);
     free(parent);
     free(parents);
     free(share);
