@@ -29,7 +29,7 @@
 
 /* Regions a patch is tested against, at most: the brightest (A L) first. The test is a few
  * dozen flops; a mesh of n candidate patches tests at most REFLECTOR_TESTS / n regions. */
-#define REFLECTOR_TESTS 50000000u
+#define REFLECTOR_TESTS 20000000u
 
 typedef struct reflector {
     rad_vec3 normal, centre; /* unit normal of the region's first patch; area centroid */
