@@ -107,7 +107,7 @@ int main(void)
      * the unit square and pokes into [2, 3] x [0, 1] to (2.5, 0.5) from its left side:
      * 1 - 1/3 of that square is left, in 2 pieces, in a list of room for 2. */
     flat_piece wedge = {{{-1, -1}, {1.5, -1}, {2.5, 0.5}, {1.5, 2}, {-1, 2}}, 5};
-    flat_piece list[3] = {unit, square(2, 3, 0, 1), square(5, 6, 0, 1)};
+    flat_piece list[4] = {unit, square(2, 3, 0, 1), square(5, 6, 0, 1)};
     made = flat_subtract(list, 2, &wedge, 1e-12, 2);
     CHECK(made == 2);
     CHECK_NEAR(total_area(list, made), 2.0 / 3, 1e-14);
