@@ -185,16 +185,18 @@ int flat_subtract(flat_piece *pieces, unsigned count, const flat_piece *shape, d
     for (unsigned e = 0; e < shape->count; e++)
         lines[e] = edge_line(shape->vertex[e], shape->vertex[e + 1 == shape->count ? 0 : e + 1]);
     flat_box shape_box = box_of(shape);
-    unsigned made = count, holes = 0, hole_from = 0;
+    unsigned made = count, holes = 0, hole_from = 0, waiting = 0;
+    flat_piece wait[FLAT_SUBTRACT_WAITING]; /* parts with no room yet */
     for (unsigned k = 0; k < count; k++) {
         if (pieces[k].count == 0) {
             holes++;
             continue;
         }
         if (boxes_apart(box_of(&pieces[k]), shape_box) || separated(&pieces[k], shape, lines))
-            continue; /* stays as it is, where it is */
+            continue; /* stays as it is */
         /* the parts outside the shape's edges in turn: the first takes the piece's own
-         * slot (free once the first cut has read it), the others go past the last */
+         * slot (free once the first cut has read it), the others go past the last, or
+         * into a hole an earlier piece left, or else wait for one a later piece leaves */
         flat_piece buffer[2], outside;
         const flat_piece *remaining = &pieces[k];
         bool placed = false;
@@ -222,9 +224,12 @@ int flat_subtract(flat_piece *pieces, unsigned count, const flat_piece *shape, d
                 continue;
             if (placed) {
                 int slot = free_slot(pieces, &made, max_pieces, &holes, &hole_from, k);
-                if (slot < 0)
+                if (slot >= 0)
+                    piece_copy(&pieces[slot], &outside);
+                else if (waiting < FLAT_SUBTRACT_WAITING)
+                    piece_copy(&wait[waiting++], &outside);
+                else
                     return -1;
-                piece_copy(&pieces[slot], &outside);
             } else {
                 piece_copy(&pieces[k], &outside);
                 placed = true;
@@ -242,5 +247,9 @@ int flat_subtract(flat_piece *pieces, unsigned count, const flat_piece *shape, d
                 piece_copy(&pieces[kept], &pieces[k]);
             kept++;
         }
+    if (kept + waiting > max_pieces)
+        return -1;
+    for (unsigned k = 0; k < waiting; k++)
+        piece_copy(&pieces[kept++], &wait[k]);
     return (int)kept;
 }

@@ -61,12 +61,17 @@ double flat_piece_area(const flat_piece *p);
  * corners, vf_polygon_clip_front). */
 void flat_piece_drop_repeated(flat_piece *p);
 
+/* Parts of one subtraction that may wait for the room a piece vanishing later leaves. */
+#define FLAT_SUBTRACT_WAITING 8u
+
 /* Subtracts the convex `shape` (counter-clockwise) from the `count` pieces, in place
  * (room for max_pieces): each piece the shape overlaps gives way to its parts outside each
- * edge of the shape in turn, pieces of area at most `tiny` dropped; the others stay where
- * they are (the order of the pieces is otherwise not kept; a piece of no corners counts
- * as none). Returns how many, or -1 (the pieces then undefined) when they would be more
- * than max_pieces or a cut piece more than FLAT_PIECE_MAX_VERTICES corners. */
+ * edge of the shape in turn, pieces of area at most `tiny` dropped; a piece the shape
+ * misses is kept as it is (it may move down to close the slot of one that vanished; the
+ * order of the pieces is not kept; a piece of no corners counts as none). Returns how
+ * many, or -1 (the pieces then undefined) when they would be more than max_pieces, when
+ * more than FLAT_SUBTRACT_WAITING parts wait at once for room that later pieces leave, or
+ * when a cut piece would have more than FLAT_PIECE_MAX_VERTICES corners. */
 int flat_subtract(flat_piece *pieces, unsigned count, const flat_piece *shape, double tiny,
                   unsigned max_pieces);
 

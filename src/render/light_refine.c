@@ -27,9 +27,10 @@
 
 enum { SEES_NONE, SEES_PART, SEES_ALL };
 
-/* Why a patch is split (split_patches): not, for the emitters' light, for the light the
- * surfaces around reflect (its new vertices gather theirs); a crease waiting for the
- * budget the shadows leave, a reflector's plane for its own. */
+/* Why a patch is split (split_patches): not; for the emitters' light or at a crease (its
+ * new vertices take their gathered light from its corners unless its corners' openness
+ * differs); for the light a region reflects (its new vertices gather theirs); a crease
+ * waiting for the budget the shadows leave, a reflector's plane for its own. */
 enum { SPLIT_NOT, SPLIT_EMITTERS, SPLIT_CREASE, SPLIT_REFLECTED, SPLIT_PLANE };
 
 /* What a mesh being refined knows of each vertex: the share of the emitters' light that
@@ -379,10 +380,12 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
         status = rad_patch_inputs_build(scene, mesh, &built, error);
         inputs = built;
     }
-    if (status == RAD_OK)
-        status = reflectors_build(mesh, B, inputs, &reflectors, error);
     if (status != RAD_OK)
         goto done;
+    /* the planes are an extra: without room for their regions, none is split for them */
+    rad_error ignored;
+    if (plane_budget >= 3 && reflectors_build(mesh, B, inputs, &reflectors, &ignored) != RAD_OK)
+        plane_budget = 0;
     if (!parent || !parents) {
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light's finer mesh");
         goto done;
@@ -407,7 +410,8 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
     }
     const rad_mesh *at = mesh;
     uint32_t measured = 0;
-    for (uint32_t level = 0; level < LIGHT_REFINE_LEVELS && budget + plane_budget >= 3; level++) {
+    for (uint32_t level = 0; level < LIGHT_REFINE_LEVELS && (budget >= 3 || plane_budget >= 3);
+         level++) {
         vertex_share *grown =
             rad_resize_array(share, at->vertex_count ? at->vertex_count : 1, sizeof(*share));
         uint8_t *marks = rad_resize_array(split, at->patch_count ? at->patch_count : 1, 1);
@@ -441,7 +445,7 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
             bool candidate =
                 patch->twin == 0 && longest_edge(patch, at->vertices) >= 2 * smallest;
             int reason = candidate ? bends(patch, share) : 0;
-            if (candidate && reason == 0) {
+            if (candidate && reason == 0 && plane_budget >= 3) {
                 double H = patch_irradiance(B, inputs, parent[p]);
                 if (H > dark && reflector_kink(&reflectors, planes_tested, patch, at->vertices,
                                             H) > LIGHT_REFINE_KINK)

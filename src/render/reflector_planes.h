@@ -12,12 +12,16 @@
  * block's top is bright, the face beside it dim). light_refine splits such patches.
  *
  * For a region R (area A, reflected radiosity L, its centre a distance d from the patch's)
- * the factor's slope across its plane is at most A / (pi d^3) (the point beside R, at
- * height h: F ~ A cos / (pi d^2) x h / d), so the irradiance's slope changes by up to
- * L A / (pi d^3) there, and interpolation across a patch of size s misses the kink by
- * up to a quarter of that times s. Relative to the patch's own irradiance H:
+ * far from the patch, the factor's slope across its plane is about A / (pi d^3) (the point
+ * beside R at height h: F ~ A cos / (pi d^2) x h / d), so the irradiance's slope changes
+ * by about L A / (pi d^3) there, and interpolation across a patch of size s (its longest
+ * edge; a plane along a quad's diagonal crosses up to sqrt 2 s) misses the kink by about
+ * a quarter of that times s. Relative to the patch's own irradiance H:
  *
- *     kink = L A s / (4 pi d^3 H),   d at least R's radius (a bound near a large R).
+ *     kink = L A s / (4 pi d^3 H),   d at least R's radius.
+ *
+ * An estimate, not a bound: beside a large R, at a distance rho from its edge, the slope
+ * is about 1 / (2 rho), which d floored at the radius (1 / R there) understates.
  *
  * reflector_kink gives the largest over the regions whose plane crosses the patch (its
  * corners strictly on both sides) and that lie at least partly in front of it.

@@ -23,7 +23,8 @@ typedef struct shadow_occluder {
 } shadow_occluder;
 
 /* F from the point x (unit normal n) to what of `receiver` the occluders leave visible.
- * Returns -1 when the visible part breaks into more than SHADOW_MAX_PIECES pieces. */
+ * Returns -1 when the visible part breaks into more than SHADOW_MAX_PIECES pieces (or a
+ * subtraction's parts wait for room beyond FLAT_SUBTRACT_WAITING, flat_pieces.h). */
 double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
                              const shadow_occluder *occluders, uint32_t occluder_count,
                              double plane_epsilon);
@@ -95,7 +96,8 @@ typedef struct shadow_piece {
  * about the unit `normal`, 3 to SHADOW_PIECE_MAX_VERTICES corners; the polygons either
  * way round), leave of it: its convex pieces go to `left` (room for SHADOW_MAX_PIECES),
  * slivers of at most 1e-12 of the window's area dropped. Returns how many (0: the polygons
- * cover the window), or -1 when it breaks into more than SHADOW_MAX_PIECES pieces. */
+ * cover the window), or -1 when it breaks into more than SHADOW_MAX_PIECES pieces (or a
+ * subtraction's parts wait for room beyond FLAT_SUBTRACT_WAITING, flat_pieces.h). */
 int shadow_window_remainder(const rad_vec3 *window, unsigned window_count, rad_vec3 normal,
                             const shadow_polygon *polygons, uint32_t polygon_count,
                             shadow_piece *left);
