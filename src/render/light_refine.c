@@ -380,12 +380,10 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
         status = rad_patch_inputs_build(scene, mesh, &built, error);
         inputs = built;
     }
+    if (status == RAD_OK && plane_budget >= 3)
+        status = reflectors_build(mesh, B, inputs, &reflectors, error);
     if (status != RAD_OK)
         goto done;
-    /* the planes are an extra: without room for their regions, none is split for them */
-    rad_error ignored;
-    if (plane_budget >= 3 && reflectors_build(mesh, B, inputs, &reflectors, &ignored) != RAD_OK)
-        plane_budget = 0;
     if (!parent || !parents) {
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light's finer mesh");
         goto done;
