@@ -61,27 +61,27 @@ int main(void)
     rad_patch wall = quad(w, 0, 1, 2, 3);
     CHECK(wall.normal.x > 0.999);
     double H = 0.25, expected = 1.5 * 0.2 / (4 * RAD_PI * 27 * H);
-    double kink = reflector_kink(&set, 1, &wall, w, H);
+    double kink = reflector_kink(&set, 1, &wall, w, 0.2, H);
     printf("kink across the square's plane 3 away: %.6g (by hand %.6g)\n", kink, expected);
     CHECK_NEAR(kink, expected, 1e-12);
     /* both regions tested: the dim one lies on the same plane, farther: the square's
      * bound is the largest */
-    CHECK_NEAR(reflector_kink(&set, 2, &wall, w, H), expected, 1e-12);
+    CHECK_NEAR(reflector_kink(&set, 2, &wall, w, 0.2, H), expected, 1e-12);
     /* none tested: none */
-    CHECK(reflector_kink(&set, 0, &wall, w, H) == 0);
+    CHECK(reflector_kink(&set, 0, &wall, w, 0.2, H) == 0);
 
     /* the same patch lifted wholly above the plane: not crossed */
     rad_vec3 above[4];
     for (int k = 0; k < 4; k++)
         above[k] = v3_add(w[k], v3(0, 0.2, 0));
-    CHECK(reflector_kink(&set, 2, &wall, above, H) == 0);
+    CHECK(reflector_kink(&set, 2, &wall, above, 0.2, H) == 0);
     /* turned away from the square (facing -x) and beyond its reach: behind it */
     rad_vec3 back[4] = {w[3], w[2], w[1], w[0]};
     rad_patch away = quad(back, 0, 1, 2, 3);
     CHECK(away.normal.x < -0.999);
-    CHECK(reflector_kink(&set, 2, &away, back, H) == 0);
+    CHECK(reflector_kink(&set, 2, &away, back, 0.2, H) == 0);
     /* a patch in the square's own plane: its corners all on it */
-    CHECK(reflector_kink(&set, 2, &patches[0], v, H) == 0);
+    CHECK(reflector_kink(&set, 2, &patches[0], v, 0.5, H) == 0);
 
     /* a black square reflects nothing: only the dim region is left */
     reflectors_free(&set);

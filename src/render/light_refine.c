@@ -406,6 +406,14 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
         status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light's finer mesh");
         goto done;
     }
+    /* (a patch with next to no light of its own, as in the gap above a lamp, is not split
+     * for a kink: a hundredth of the mean irradiance at least) */
+    double dark = 0, area = 0;
+    for (uint32_t q = 0; q < mesh->patch_count; q++) {
+        dark += mesh->patches[q].area * patch_irradiance(B, inputs, q);
+        area += mesh->patches[q].area;
+    }
+    dark = area > 0 ? 0.01 * dark / area : 0;
     const rad_mesh *at = mesh;
     uint32_t measured = 0;
     for (uint32_t level = 0; level < LIGHT_REFINE_LEVELS && (budget >= 3 || plane_budget >= 3);
@@ -422,31 +430,27 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
             goto done;
         }
         measured = at->vertex_count;
+        /* the patches that may split (one-sided, not yet at the finest), marked first:
+         * how many there are sets how many regions each is tested against */
         uint32_t splits = 0, candidates = 0;
-        for (uint32_t p = 0; p < at->patch_count; p++)
-            candidates += at->patches[p].twin == 0 &&
-                          longest_edge(&at->patches[p], at->vertices) >= 2 * smallest;
-        /* (a patch with next to no light of its own, as in the gap above a lamp, is not
-         * split for a kink: a hundredth of the mean irradiance at least) */
-        double dark = 0, area = 0;
-        for (uint32_t q = 0; q < mesh->patch_count; q++) {
-            dark += mesh->patches[q].area * patch_irradiance(B, inputs, q);
-            area += mesh->patches[q].area;
+        for (uint32_t p = 0; p < at->patch_count; p++) {
+            split[p] = at->patches[p].twin == 0 &&
+                       longest_edge(&at->patches[p], at->vertices) >= 2 * smallest;
+            candidates += split[p];
         }
-        dark = area > 0 ? 0.01 * dark / area : 0;
         const uint32_t planes_tested =
             candidates ? (uint32_t)(REFLECTOR_TESTS / candidates) : 0;
         /* the patches the emitters' light bends in first, then those at creases and
          * where a reflecting region's plane crosses */
         for (uint32_t p = 0; p < at->patch_count; p++) {
             const rad_patch *patch = &at->patches[p];
-            bool candidate =
-                patch->twin == 0 && longest_edge(patch, at->vertices) >= 2 * smallest;
+            const bool candidate = split[p];
             int reason = candidate ? bends(patch, share) : 0;
             if (candidate && reason == 0 && plane_budget >= 3) {
                 double H = patch_irradiance(B, inputs, parent[p]);
-                if (H > dark && reflector_kink(&reflectors, planes_tested, patch, at->vertices,
-                                            H) > LIGHT_REFINE_KINK)
+                if (H > dark &&
+                    reflector_kink(&reflectors, planes_tested, patch, at->vertices,
+                                   longest_edge(patch, at->vertices), H) > LIGHT_REFINE_KINK)
                     reason = 3;
             }
             split[p] = reason == 1 && shadow_budget >= 3 && budget >= 3 ? SPLIT_EMITTERS

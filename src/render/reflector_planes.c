@@ -113,12 +113,8 @@ void reflectors_free(reflector_set *set)
 }
 
 double reflector_kink(const reflector_set *set, uint32_t limit, const rad_patch *patch,
-                      const rad_vec3 *vertices, double irradiance)
+                      const rad_vec3 *vertices, double size, double irradiance)
 {
-    double size = 0;
-    for (uint32_t k = 0; k < patch->vertex_count; k++)
-        size = fmax(size, v3_length(v3_sub(vertices[patch->vertex[(k + 1) % patch->vertex_count]],
-                                           vertices[patch->vertex[k]])));
     double largest = 0;
     uint32_t count = limit < set->count ? limit : set->count;
     for (uint32_t i = 0; i < count; i++) {

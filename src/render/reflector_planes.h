@@ -55,10 +55,10 @@ rad_status reflectors_build(const rad_mesh *mesh, const rad_rgb *B,
 
 void reflectors_free(reflector_set *set);
 
-/* The largest kink (above) a region's plane makes in the patch (corners from vertices),
- * whose own irradiance is `irradiance` (radiosity units, > 0), testing the first `limit`
- * regions; 0 when no region's plane crosses it. */
+/* The largest kink (above) a region's plane makes in the patch (corners from vertices,
+ * longest edge `size`), whose own irradiance is `irradiance` (radiosity units, > 0),
+ * testing the first `limit` regions; 0 when no region's plane crosses it. */
 double reflector_kink(const reflector_set *set, uint32_t limit, const rad_patch *patch,
-                      const rad_vec3 *vertices, double irradiance);
+                      const rad_vec3 *vertices, double size, double irradiance);
 
 #endif
