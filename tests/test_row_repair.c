@@ -298,7 +298,9 @@ static void check_command_line(void)
     char command[512];
     for (int s = 1; s <= 40 && !seed; s++) {
         snprintf(command, sizeof(command),
-                 "viewfactors noisy.obj -o before.mtx --max-rays 64 --seed %d", s);
+                 "viewfactors noisy.obj -o before.mtx --max-rays 64 --exact-occluders 4 "
+                 "--seed %d",
+                 s);
         if (test_run_tool(command) != 0 || !read_mtx(test_path("before.mtx"), &before))
             break;
         for (uint32_t I = 0; I < before.n; I++) {
@@ -315,7 +317,8 @@ static void check_command_line(void)
     if (!seed)
         return;
     snprintf(command, sizeof(command),
-             "viewfactors noisy.obj -o after.mtx --max-rays 64 --seed %d --repair-rows "
+             "viewfactors noisy.obj -o after.mtx --max-rays 64 --exact-occluders 4 "
+             "--seed %d --repair-rows "
              "--stats repair.json",
              seed);
     CHECK(test_run_tool(command) == 0);
@@ -352,14 +355,16 @@ static void check_command_line(void)
 
     /* past the limit: exit 1, a message naming the option, no file */
     snprintf(command, sizeof(command),
-             "viewfactors noisy.obj -o refused.mtx --max-rays 64 --seed %d --repair-rows "
+             "viewfactors noisy.obj -o refused.mtx --max-rays 64 --exact-occluders 4 "
+             "--seed %d --repair-rows "
              "--repair-max-change %.6g",
              seed, 0.5 * relative);
     CHECK(test_run_tool(command) == 1);
     CHECK(strstr(test_read_text(test_path("stderr.txt")), "--repair-max-change") != NULL);
     CHECK(!test_file_exists(test_path("refused.mtx")));
     snprintf(command, sizeof(command),
-             "viewfactors noisy.obj -o refused.mtx --max-rays 64 --seed %d --repair-rows "
+             "viewfactors noisy.obj -o refused.mtx --max-rays 64 --exact-occluders 4 "
+             "--seed %d --repair-rows "
              "--repair-max-removed %.6g",
              seed, 0.5 * removed / exchange);
     CHECK(test_run_tool(command) == 1);

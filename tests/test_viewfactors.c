@@ -255,7 +255,8 @@ static double stats_value(const char *path, const char *key)
  * The reference is the test's own Monte-Carlo run: cosine-distributed rays from uniform
  * points of the bottom square, counted when they reach the top square past the blocker.
  * The blocker is one quad (two triangles: shadows clipped exactly) or split n x n (2 n^2
- * triangles, too many to clip: visibility sampled, with its error bound). */
+ * triangles, more than --exact-occluders 4 clips: visibility sampled, with its error
+ * bound; the default clips them all, checked by test_viewfactor_obstructed). */
 static void check_obstruction_monte_carlo(int split)
 {
     const double bottom[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
@@ -279,9 +280,18 @@ static void check_obstruction_monte_carlo(int split)
             v += 4;
         }
     (void)blocker;
-    const char *csv = run_viewfactors("obstructed", "--stats obstructed.json");
+    const char *csv = run_viewfactors("obstructed", "--exact-occluders 4 --stats obstructed.json");
     double F = csv_value(csv, "one", "two");
     double bound = stats_value(test_path("obstructed.json"), "largest_error_bound");
+    /* the sampled pair's bound is above its target: said, and counted in --stats (the
+     * text last, as test_read_text's buffer is the CSV's) */
+    CHECK(stats_value(test_path("obstructed.json"), "short_pairs") == (split == 1 ? 0 : 1));
+    const char *said = test_read_text(test_path("stderr.txt"));
+    const char *expected = split == 1 ? "every factor within --accuracy"
+                                      : "1 of 5 polygon pairs short of --accuracy";
+    CHECK(strstr(said, expected) != NULL);
+    if (!strstr(said, expected))
+        fprintf(stderr, "expected '%s' in: %s", expected, said);
 
     uint64_t state = 0x9E3779B97F4A7C15ull, hits = 0, samples = 4000000;
     for (uint64_t k = 0; k < samples; k++) {

@@ -54,7 +54,7 @@
 
 typedef struct pair_counts {
     uint64_t surface_pairs, polygon_pairs, unobstructed_pairs, hidden_pairs, obstructed_pairs,
-        exact_pairs, sampled_pairs, unseen_pairs, capped_pairs, rays, unmet_pairs;
+        exact_pairs, sampled_pairs, unseen_pairs, capped_pairs, short_pairs, rays, unmet_pairs;
 } pair_counts;
 
 /* Progress by polygon pairs, the unit of work (a row's cost is its polygons times the
@@ -232,6 +232,7 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
         counts->unobstructed_pairs++;
         unobstructed = pair_unobstructed(p, q, 0.25 * e->accuracy, eps, &quadrature_error);
         *bound = quadrature_error;
+        counts->short_pairs += quadrature_error > e->accuracy * fabs(unobstructed);
         return fmax(unobstructed, 0);
     }
     counts->obstructed_pairs++;
@@ -266,6 +267,7 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
         }
         if (exact) {
             counts->exact_pairs++;
+            counts->short_pairs += error > target;
             *bound = error;
             return fmax(fmin(visible, unobstructed), 0);
         }
@@ -278,6 +280,7 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
     counts->capped_pairs += visibility.capped;
     counts->unseen_pairs += visibility.unseen;
     *bound = quadrature_error + visibility.bound * unobstructed;
+    counts->short_pairs += *bound > target;
     return unobstructed * visibility.fraction;
 }
 
@@ -890,6 +893,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
             totals.sampled_pairs += counts.sampled_pairs;
             totals.unseen_pairs += counts.unseen_pairs;
             totals.capped_pairs += counts.capped_pairs;
+            totals.short_pairs += counts.short_pairs;
             totals.rays += counts.rays;
             totals.unmet_pairs += counts.unmet_pairs;
         }
@@ -922,16 +926,17 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
                                                   : "another rank ran out of memory")
                      : cp.interrupted ? RAD_OK
                                       : gather_rows(rows, state, n, error);
-        uint64_t sums[12] = {totals.surface_pairs,      totals.polygon_pairs,
+        uint64_t sums[13] = {totals.surface_pairs,      totals.polygon_pairs,
                              totals.unobstructed_pairs, totals.hidden_pairs,
                              totals.obstructed_pairs,   totals.exact_pairs,
                              totals.sampled_pairs,      totals.unseen_pairs,
-                             totals.capped_pairs,       totals.rays,
-                             totals.unmet_pairs,        seen.rays_cast};
-        ranks_sum(sums, 12);
-        totals = (pair_counts){sums[0], sums[1], sums[2], sums[3], sums[4],  sums[5],
-                               sums[6], sums[7], sums[8], sums[9], sums[10]};
-        seen.rays_cast = sums[11];
+                             totals.capped_pairs,       totals.short_pairs,
+                             totals.rays,               totals.unmet_pairs,
+                             seen.rays_cast};
+        ranks_sum(sums, 13);
+        totals = (pair_counts){sums[0], sums[1], sums[2], sums[3],  sums[4],  sums[5],
+                               sums[6], sums[7], sums[8], sums[9], sums[10], sums[11]};
+        seen.rays_cast = sums[12];
         free(owner);
         if (status == RAD_OK && rank == 0 && !cp.interrupted)
             matrix = assemble(&geometry, rows, n);
@@ -964,6 +969,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
         report->sampled_pairs = totals.sampled_pairs;
         report->unseen_pairs = totals.unseen_pairs;
         report->capped_pairs = totals.capped_pairs;
+        report->short_pairs = totals.short_pairs;
         report->rays = totals.rays;
         report->unmet_pairs = totals.unmet_pairs;
         report->sight_rays = sight_rays;

@@ -12,6 +12,10 @@
 
 #include "mpi_run.h"
 
+/* the command's start: behind at most 4 occluders exactly, the rest sampled (the sampled
+ * pairs' random numbers are what ranks must share; the default clips them all) */
+#define VIEWFACTORS "viewfactors city.obj --exact-occluders 4"
+
 /* The K of "FILE holds K of N rows" in the last run's stderr; -1 when missing. */
 static long rows_held(const char *file)
 {
@@ -32,7 +36,7 @@ static int count_lines_with(const char *text, const char *what)
 int main(void)
 {
     test_write_city(300, "city.obj"); /* 384 surfaces */
-    CHECK(test_run_tool("viewfactors city.obj -o serial.mtx --threads 2") == 0);
+    CHECK(test_run_tool(VIEWFACTORS " -o serial.mtx --threads 2") == 0);
 
     for (int ranks = 1; ranks <= 3; ranks += 2) {
         char arguments[256], name[32], checkpoint[32];
@@ -40,7 +44,7 @@ int main(void)
         snprintf(checkpoint, sizeof(checkpoint), "ck%d.bin", ranks);
         setenv("RADIOSITY_STOP_AFTER_CHECKPOINTS", "4", 1);
         snprintf(arguments, sizeof(arguments),
-                 "viewfactors city.obj -o %s --threads 1 --checkpoint %s "
+                 VIEWFACTORS " -o %s --threads 1 --checkpoint %s "
                  "--checkpoint-interval 0",
                  name, checkpoint);
         CHECK(test_run_mpi(ranks, arguments, 0, NULL) != 0);
@@ -48,7 +52,7 @@ int main(void)
         CHECK(!test_file_exists(test_path(name)));
         long held = rows_held(checkpoint);
         CHECK(held > 0 && held < 384);
-        snprintf(arguments, sizeof(arguments), "viewfactors city.obj -o %s --threads 1 --resume %s",
+        snprintf(arguments, sizeof(arguments), VIEWFACTORS " -o %s --threads 1 --resume %s",
                  name, checkpoint);
         CHECK(test_run_mpi(ranks, arguments, 0, NULL) == 0);
         CHECK(test_same_bytes(test_path("serial.mtx"), test_path(name)));
@@ -56,18 +60,18 @@ int main(void)
 
     /* a 3-rank checkpoint, continued by 2 ranks (stopped again further on), then serially */
     setenv("RADIOSITY_STOP_AFTER_CHECKPOINTS", "2", 1);
-    CHECK(test_run_mpi(3, "viewfactors city.obj -o mixed.mtx --threads 1 --checkpoint mixed.bin "
+    CHECK(test_run_mpi(3, VIEWFACTORS " -o mixed.mtx --threads 1 --checkpoint mixed.bin "
                           "--checkpoint-interval 0",
                        0, NULL) != 0);
     long first = rows_held("mixed.bin");
-    CHECK(test_run_mpi(2, "viewfactors city.obj -o mixed.mtx --threads 1 --resume mixed.bin "
+    CHECK(test_run_mpi(2, VIEWFACTORS " -o mixed.mtx --threads 1 --resume mixed.bin "
                           "--checkpoint-interval 0",
                        0, NULL) != 0);
     unsetenv("RADIOSITY_STOP_AFTER_CHECKPOINTS");
     long second = rows_held("mixed.bin");
     CHECK(first > 0 && second > first && second < 384);
     CHECK(!test_file_exists(test_path("mixed.mtx")));
-    CHECK(test_run_tool("viewfactors city.obj -o mixed.mtx --threads 2 --resume mixed.bin") == 0);
+    CHECK(test_run_tool(VIEWFACTORS " -o mixed.mtx --threads 2 --resume mixed.bin") == 0);
     CHECK(test_same_bytes(test_path("serial.mtx"), test_path("mixed.mtx")));
 
     /* a real SIGTERM once the first checkpoint exists (a 64th of the rows done; the run
@@ -78,7 +82,7 @@ int main(void)
         char command[8000];
         snprintf(command, sizeof(command),
                  "cd '%s' && RADIOSITY_WAIT_AFTER_CHECKPOINTS=1 sh -c \"%s%s%s '%s' viewfactors "
-                 "city.obj -o term.mtx --threads %d "
+                 "city.obj --exact-occluders 4 -o term.mtx --threads %d "
                  "--checkpoint term.bin --checkpoint-interval 0 & pid=\\$!; "
                  "while [ ! -e term.bin ]; do sleep 0.01; done; kill -TERM \\$pid; "
                  "wait \\$pid\" >'%s' 2>'%s' </dev/null",
@@ -90,7 +94,7 @@ int main(void)
         long held = rows_held("term.bin");
         CHECK(held > 0 && held < 384);
         CHECK(!test_file_exists(test_path("term.mtx")));
-        CHECK(test_run_tool("viewfactors city.obj -o term.mtx --threads 2 --resume term.bin") ==
+        CHECK(test_run_tool(VIEWFACTORS " -o term.mtx --threads 2 --resume term.bin") ==
               0);
         CHECK(test_same_bytes(test_path("serial.mtx"), test_path("term.mtx")));
         remove(test_path("term.mtx"));
@@ -98,7 +102,7 @@ int main(void)
     }
 
     /* another job's checkpoint: refused by every rank, said once, nothing written */
-    CHECK(test_run_mpi(3, "viewfactors city.obj -o refused.mtx --resume ck3.bin --accuracy 3e-4",
+    CHECK(test_run_mpi(3, VIEWFACTORS " -o refused.mtx --resume ck3.bin --accuracy 3e-4",
                        0, NULL) == 1);
     const char *err = test_read_text(test_path("stderr.txt"));
     CHECK(count_lines_with(err, "ck3.bin: a checkpoint made with other options") == 1);
