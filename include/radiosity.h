@@ -110,8 +110,8 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 #define RAD_DEFAULT_ACCURACY 1e-4       /* rad_viewfactor_options.accuracy */
 #define RAD_DEFAULT_MAX_RAYS 1024       /* rad_viewfactor_options.max_rays */
 #define RAD_SIGHT_RAYS_NONE UINT32_MAX  /* rad_viewfactor_options.sight_rays: none */
-#define RAD_DEFAULT_EXACT_OCCLUDERS 256 /* rad_viewfactor_options.exact_occluders */
-#define RAD_MAX_EXACT_OCCLUDERS 256     /* its largest value */
+#define RAD_DEFAULT_EXACT_OCCLUDERS 1024 /* rad_viewfactor_options.exact_occluders */
+#define RAD_MAX_EXACT_OCCLUDERS 1024     /* its largest value */
 #define RAD_DEFAULT_EMISSIVITY 0.9      /* rad_surface.emissivity when the file gives none */
 #define RAD_DEFAULT_RENDER_SPP 16       /* rad_render_options.samples_per_pixel */
 #define RAD_DEFAULT_DIRECT_SAMPLES 8    /* rad_render_options.direct_samples */
@@ -825,7 +825,7 @@ typedef struct rad_viewfactor_options {
                             F of accuracy x sqrt(F unobstructed); pairs with more are
                             sampled. 0 = RAD_DEFAULT_EXACT_OCCLUDERS (=
                             RAD_MAX_EXACT_OCCLUDERS, the most). Fewer: more sampled pairs,
-                            whose bounds stop at max_rays far above the accuracy (4: 7-10
+                            whose bounds stop at max_rays far above the accuracy (4: 8-10
                             times faster on generated cities, 73 % of the 1k city's pairs
                             short of it), and less time */
     uint32_t sight_rays; /* cosine-distributed rays from each surface that find which pairs

@@ -585,7 +585,7 @@ static bool between_squares(double x, double y)
 /* Plates 1 x 1 at z = 0 (up) and z = 1 (down) behind a grid of 50 small squares at
  * z = 0.5 (10 x 5, 0.06 x 0.12 each, 100 triangles), against the test's own count of
  * cosine rays from the lower plate that pass between the squares and land on the upper
- * one. Behind the default 4 exact occluders the pair is sampled; with all 256 it is clipped
+ * one. Behind 4 exact occluders the pair is sampled; by default (all of them) it is clipped
  * exactly, to its bound, and the bound to accuracy x sqrt(F unobstructed) (0.19982). */
 static void check_occluder_grid(uint32_t exact_occluders)
 {

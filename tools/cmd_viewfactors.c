@@ -49,8 +49,8 @@ static const char usage[] =
     "                       (default " CLI_STR(RAD_DEFAULT_MAX_RAYS) ")\n"
     "  --exact-occluders N  pairs behind at most N triangles are clipped exactly, not\n"
     "                       sampled (default and most " CLI_STR(RAD_MAX_EXACT_OCCLUDERS) ",\n"
-    "                       the accuracy for every pair behind that many; 4 is some\n"
-    "                       7-10x faster on cities, with sampled bounds far above it)\n"
+    "                       the accuracy for every pair behind that many; 4 is 8-10x\n"
+    "                       faster on cities, with sampled bounds far above it)\n"
     CLI_BASE_HELP("counts, times, invariants and error bounds");
 
 /* The rest of the help (one string may hold 4095 characters in C17), after the scene's. */
