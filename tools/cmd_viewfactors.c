@@ -416,18 +416,21 @@ int command_viewfactors(int argc, char **argv)
     cli_summary("largest error bound of a factor %.3g (absolute)%s", report.largest_error_bound,
                 capped);
     const double accuracy_asked = vf.accuracy > 0 ? vf.accuracy : RAD_DEFAULT_ACCURACY;
+    /* the counts are those of the rows this run computed, not of rows read from a
+     * checkpoint */
+    const char *rows_counted = report.resumed_rows ? " in the rows computed by this run" : "";
     if (report.short_pairs)
-        cli_summary("%llu of %llu polygon pairs short of --accuracy %g (their bound above "
+        cli_summary("%llu of %llu polygon pairs%s short of --accuracy %g (their bound above "
                     "accuracy x sqrt(F unobstructed)): %s",
                     (unsigned long long)report.short_pairs,
-                    (unsigned long long)report.polygon_pairs, accuracy_asked,
+                    (unsigned long long)report.polygon_pairs, rows_counted, accuracy_asked,
                     report.exact_occluders < RAD_MAX_EXACT_OCCLUDERS
                         ? "a larger --exact-occluders clips more of them exactly"
                         : "they are sampled behind more occluders than --exact-occluders");
     else
-        cli_summary("every factor within --accuracy %g (obstructed: accuracy x sqrt(F "
+        cli_summary("every factor%s within --accuracy %g (obstructed: accuracy x sqrt(F "
                     "unobstructed), absolute)",
-                    accuracy_asked);
+                    rows_counted, accuracy_asked);
     if (report.sight_rays)
         cli_summary("pairs no sight ray met (%u a surface): F = 0, each within %.1e (95 %%); "
                     "what they hold of a row, estimated: %.2g on average, %.2g at most",
