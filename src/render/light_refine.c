@@ -371,6 +371,7 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
     uint32_t *parent = rad_alloc_array(mesh->patch_count, sizeof(*parent));
     vertex_share *share = NULL;
     uint8_t *split = NULL;
+    double *edge = NULL; /* per patch of the level: its longest edge */
     vertex_parents *parents = rad_alloc_array(mesh->vertex_count ? mesh->vertex_count : 1,
                                               sizeof(*parents));
     rad_status status = emitters_build(scene, &set, error);
@@ -421,11 +422,15 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
         vertex_share *grown =
             rad_resize_array(share, at->vertex_count ? at->vertex_count : 1, sizeof(*share));
         uint8_t *marks = rad_resize_array(split, at->patch_count ? at->patch_count : 1, 1);
+        double *edges =
+            rad_resize_array(edge, at->patch_count ? at->patch_count : 1, sizeof(*edge));
         if (grown)
             share = grown;
         if (marks)
             split = marks;
-        if (!grown || !marks || !measure_shares(&st, at, measured, share)) {
+        if (edges)
+            edge = edges;
+        if (!grown || !marks || !edges || !measure_shares(&st, at, measured, share)) {
             status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the light's finer mesh");
             goto done;
         }
@@ -434,8 +439,8 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
          * how many there are sets how many regions each is tested against */
         uint32_t splits = 0, candidates = 0;
         for (uint32_t p = 0; p < at->patch_count; p++) {
-            split[p] = at->patches[p].twin == 0 &&
-                       longest_edge(&at->patches[p], at->vertices) >= 2 * smallest;
+            edge[p] = longest_edge(&at->patches[p], at->vertices);
+            split[p] = at->patches[p].twin == 0 && edge[p] >= 2 * smallest;
             candidates += split[p];
         }
         const uint32_t planes_tested =
@@ -449,8 +454,8 @@ rad_status light_refine(const rad_scene *scene, const rad_mesh *mesh, const rad_
             if (candidate && reason == 0 && plane_budget >= 3) {
                 double H = patch_irradiance(B, inputs, parent[p]);
                 if (H > dark &&
-                    reflector_kink(&reflectors, planes_tested, patch, at->vertices,
-                                   longest_edge(patch, at->vertices), H) > LIGHT_REFINE_KINK)
+                    reflector_kink(&reflectors, planes_tested, patch, at->vertices, edge[p], H) >
+                        LIGHT_REFINE_KINK)
                     reason = 3;
             }
             split[p] = reason == 1 && shadow_budget >= 3 && budget >= 3 ? SPLIT_EMITTERS
@@ -507,6 +512,7 @@ done:
     free(parents);
     free(share);
     free(split);
+    free(edge);
     return status;
 }
 

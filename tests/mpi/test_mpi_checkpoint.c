@@ -81,8 +81,8 @@ int main(void)
     for (int ranks = 0; ranks <= 3; ranks += 3) {
         char command[8000];
         snprintf(command, sizeof(command),
-                 "cd '%s' && RADIOSITY_WAIT_AFTER_CHECKPOINTS=1 sh -c \"%s%s%s '%s' viewfactors "
-                 "city.obj --exact-occluders 4 -o term.mtx --threads %d "
+                 "cd '%s' && RADIOSITY_WAIT_AFTER_CHECKPOINTS=1 sh -c \"%s%s%s '%s' " VIEWFACTORS
+                 " -o term.mtx --threads %d "
                  "--checkpoint term.bin --checkpoint-interval 0 & pid=\\$!; "
                  "while [ ! -e term.bin ]; do sleep 0.01; done; kill -TERM \\$pid; "
                  "wait \\$pid\" >'%s' 2>'%s' </dev/null",

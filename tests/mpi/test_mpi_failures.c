@@ -11,8 +11,8 @@
 
 #include "mpi_run.h"
 
-/* the city behind at most 4 occluders exactly (the default clips every pair: minutes on
- * one thread a rank) */
+/* the city behind at most 4 occluders exactly (the default clips every pair: about 8 times
+ * longer) */
 #define VIEWFACTORS "viewfactors city.obj --exact-occluders 4"
 
 int main(void)
