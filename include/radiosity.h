@@ -1036,6 +1036,11 @@ typedef struct rad_sky_report {
     uint64_t capped_pairs;     /* polygons whose rays reached 16 x max_rays first */
     uint64_t rays;             /* rays that reached a sampled tile's direction, traced */
     double largest_error_bound; /* max_I of SVF_I's bound (absolute) */
+    uint32_t surfaces;         /* surfaces given a sky view factor (not obstructions, area > 0) */
+    uint32_t short_surfaces;   /* of those, surfaces whose SVF bound is above the accuracy
+                                  (absolute: the sky's unobstructed share is 1, so this is
+                                  accuracy x sqrt(F unobstructed), the matrix's target for
+                                  an obstructed pair) */
     double seconds;
     int threads;
 } rad_sky_report;

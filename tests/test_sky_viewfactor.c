@@ -145,6 +145,8 @@ static void check_canyon(double W, double H, double L)
     double deviation = stderr_value("largest |row sum + SVF - 1| ");
     printf("  printed largest |row sum + SVF - 1| %.3g\n", deviation);
     CHECK(deviation >= 0 && deviation <= 1e-4);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")),
+                 "sky view factors: every one within --accuracy 0.0001 (absolute)") != NULL);
 }
 
 /* Möller-Trumbore: does the ray (o, d) hit triangle (a, b, c) at t > 1e-9? */
@@ -221,6 +223,41 @@ static void check_canyon_with_beam(void)
     CHECK(fabs(svf - reference) <= 4 * sigma + bound);
     CHECK_NEAR(row_sum(test_read_text(test_path("beam.csv")), "floor") + svf, 1,
                1e-4 + bound);
+}
+
+/* A floor under a grid of 7 x 7 small squares (98 triangles, one surface facing up): the
+ * sky behind more than 16 triangles is sampled, so the floor's SVF is short of the
+ * accuracy and the run says so (the grid's own, open above, is exact); the floor's value
+ * against the test's own count. */
+static void check_sampled_sky(void)
+{
+    quad_count = 0;
+    add_quad("floor", 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0);
+    for (int i = 0; i < 7; i++)
+        for (int j = 0; j < 7; j++) {
+            double x = (i + 0.25) / 7, y = (j + 0.25) / 7, h = 0.5 / 7, z = 0.15;
+            add_quad(i + j ? NULL : "grid", x, y, z, x + h, y, z, x + h, y + h, z, x, y + h, z);
+        }
+    write_obj("grid.obj");
+    CHECK(run("viewfactors grid.obj -o grid.csv --sky-view-factor grid-sky.csv --stats "
+              "grid.json"));
+    const char *text = test_read_text(test_path("stderr.txt"));
+    printf("%s", text);
+    CHECK(strstr(text, "sky view factors: 1 of 2 short of --accuracy 0.0001 (their bound above "
+                       "it, absolute)") != NULL);
+    CHECK(strstr(test_read_text(test_path("grid.json")), "\"sky_short_surfaces\": 1") != NULL);
+    const char *sky = test_read_text(test_path("grid-sky.csv"));
+    int index;
+    double svf = NAN, bound = NAN, sigma;
+    CHECK(sky_row(sky, "grid", &index, &svf, &bound));
+    CHECK_NEAR(svf, 1, 1e-9);
+    CHECK(bound <= 1e-4);
+    CHECK(sky_row(sky, "floor", &index, &svf, &bound));
+    CHECK(bound > 1e-4);
+    double reference = monte_carlo_sky(1u << 18, &sigma);
+    printf("floor under a grid: SVF %.6f (bound %.2g), Monte Carlo %.6f +- %.2g\n", svf, bound,
+           reference, sigma);
+    CHECK(fabs(svf - reference) <= 4 * sigma + bound);
 }
 
 static void check_plate(void)
@@ -317,6 +354,7 @@ int main(void)
     check_canyon(1, 2, 20);
     check_canyon(1, 1, 100);
     check_canyon_with_beam();
+    check_sampled_sky();
     check_plate();
     check_closed_box();
     check_layouts();

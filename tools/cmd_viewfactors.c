@@ -201,6 +201,13 @@ static bool sky_view_factors(const rad_scene *scene, const rad_viewfactor_option
                 (unsigned long long)report->sampled_pairs,
                 (unsigned long long)report->capped_pairs, report->largest_error_bound,
                 report->seconds);
+    if (report->short_surfaces)
+        cli_summary("sky view factors: %u of %u short of --accuracy %g (their bound above it, "
+                    "absolute): the sky behind more than 16 triangles is sampled, and a "
+                    "sampled bound falls only as 1 / sqrt(--max-rays)",
+                    report->short_surfaces, report->surfaces, accuracy);
+    else if (report->surfaces)
+        cli_summary("sky view factors: every one within --accuracy %g (absolute)", accuracy);
     if (check->worst_surface != UINT32_MAX)
         cli_summary("sky view factors: largest |row sum + SVF - 1| %.3g (accuracy %.3g) at "
                     "'%s': row sum %.9f (bound %.3g), SVF %.9f (bound %.3g)",
@@ -539,6 +546,7 @@ int command_viewfactors(int argc, char **argv)
         stats_number(&stats, "sky_largest_error_bound", sky_report.largest_error_bound);
         stats_number(&stats, "sky_row_sum_deviation", sky_check.largest_deviation);
         stats_integer(&stats, "sky_sampled_pairs", sky_report.sampled_pairs);
+        stats_integer(&stats, "sky_short_surfaces", sky_report.short_surfaces);
     }
     if (args.value[OPT_REPAIR_ROWS]) {
         stats_number(&stats, "repair_largest_change", repair.largest_change);

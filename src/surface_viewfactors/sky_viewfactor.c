@@ -614,6 +614,15 @@ rad_status rad_sky_viewfactors_compute(const rad_scene *scene,
             totals.rays += counts.rays;
         }
     }
+    /* the surfaces given a factor, and those whose bound is above the accuracy */
+    uint32_t given = 0, short_of = 0;
+    for (uint32_t I = 0; I < n; I++) {
+        const vf_surface *s = &geometry.surfaces[I];
+        if (s->polygon_count == 0 || !(s->area > 0))
+            continue;
+        given++;
+        short_of += bound[I] > c.accuracy;
+    }
     rad_tracer_destroy(tracer);
     occluder_tree_destroy(tree);
     vf_geometry_free(&geometry);
@@ -626,6 +635,8 @@ rad_status rad_sky_viewfactors_compute(const rad_scene *scene,
         report->sampled_pairs = totals.sampled_pairs;
         report->capped_pairs = totals.capped_pairs;
         report->rays = totals.rays;
+        report->surfaces = given;
+        report->short_surfaces = short_of;
         for (uint32_t I = 0; I < n; I++)
             report->largest_error_bound = fmax(report->largest_error_bound, bound[I]);
         report->seconds = rad_clock_seconds() - start;
