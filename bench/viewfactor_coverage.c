@@ -5,7 +5,8 @@
  * triangle of the scene by this program's own ray-triangle test (no tracer, no polygons,
  * no occluder tree, no proofs). G_IJ = A_I A_J mean(kernel x visible); F_IJ = G_IJ / A_I.
  *
- * usage: viewfactor_coverage SCENE [RANDOM_PAIRS [LARGEST_BOUNDS [SEGMENTS]]]
+ * usage: viewfactor_coverage SCENE [RANDOM_PAIRS [LARGEST_BOUNDS [SEGMENTS [EXACT_OCCLUDERS
+ *        [SKY_RAYS [SKY_SURFACES [SKY_EXACT]]]]]]]
  *   RANDOM_PAIRS stored factors F_IJ (I < J) drawn at random (default 150), LARGEST_BOUNDS
  *   more with the largest error bounds (default 50), SEGMENTS per pair (default 40000);
  *   and as many pairs drawn at random among those not stored (F = 0: proven hidden,
@@ -14,7 +15,9 @@
  *   + 3 s.e.; and the sky
  *   view factors of RANDOM_PAIRS surfaces drawn at random (rad_sky_viewfactors_compute)
  *   against the share of cosine-distributed rays from uniform points that nothing stops
- *   (SEGMENTS / 2 rays).
+ *   (SEGMENTS / 2 rays). EXACT_OCCLUDERS: the library's --exact-occluders (0: its
+ *   default); SKY_RAYS and SKY_SURFACES: the sky's rays a surface and surfaces (default
+ *   SEGMENTS / 2 and RANDOM_PAIRS); SKY_EXACT 1: the sky as with --sky-exact.
  * Prints one line per pair whose brute-force value lies outside bound + 3 standard errors,
  * then a summary: how many lie within bound + 3 s.e., within 2 bound + 3 s.e., the largest
  * |F - reference| / (bound + 3 s.e.), and the median bound and standard error.
@@ -181,7 +184,7 @@ int main(int argc, char **argv)
 {
     if (argc < 2) {
         fputs("usage: viewfactor_coverage SCENE [RANDOM_PAIRS [LARGEST_BOUNDS [SEGMENTS "
-              "[EXACT_OCCLUDERS]]]]\n",
+              "[EXACT_OCCLUDERS [SKY_RAYS [SKY_SURFACES [SKY_EXACT]]]]]]]\n",
               stderr);
         return 2;
     }
@@ -189,6 +192,10 @@ int main(int argc, char **argv)
     uint32_t largest = argc > 3 ? (uint32_t)atoi(argv[3]) : 50;
     uint32_t segments = argc > 4 ? (uint32_t)atoi(argv[4]) : 40000;
     uint32_t exact_occluders = argc > 5 ? (uint32_t)atoi(argv[5]) : 0;
+    /* the sky view factors' brute force: rays a surface, and how many surfaces */
+    uint32_t sky_rays = argc > 6 ? (uint32_t)atoi(argv[6]) : segments / 2;
+    uint32_t sky_surfaces = argc > 7 ? (uint32_t)atoi(argv[7]) : random_pairs;
+    bool sky_exact = argc > 8 && atoi(argv[8]) != 0; /* --sky-exact */
     rad_scene *scene = NULL;
     rad_error error = {0};
     if (rad_scene_load(argv[1], NULL, &scene, &error) != RAD_OK) {
@@ -198,7 +205,8 @@ int main(int argc, char **argv)
     rad_viewfactor_matrix *m = NULL;
     rad_viewfactor_report report;
     /* the command line's defaults (seed 1), so that its figures are `radiosity viewfactors`' */
-    rad_viewfactor_options options = {.seed = 1, .exact_occluders = exact_occluders};
+    rad_viewfactor_options options = {.seed = 1, .exact_occluders = exact_occluders,
+                                      .sky_exact = sky_exact};
     if (rad_viewfactor_matrix_compute(scene, &options, &m, &report, &error) != RAD_OK) {
         fprintf(stderr, "viewfactor_coverage: %s\n", error.message);
         return 1;
@@ -296,7 +304,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "viewfactor_coverage: %s\n", error.message);
         return 1;
     }
-    uint32_t sky_count = random_pairs < scene->surface_count ? random_pairs : scene->surface_count;
+    uint32_t sky_count = sky_surfaces < scene->surface_count ? sky_surfaces : scene->surface_count;
     uint32_t *sky_pick = malloc((sky_count ? sky_count : 1) * sizeof(uint32_t));
     double *sky_reference = malloc((sky_count ? sky_count : 1) * sizeof(double));
     double *sky_error = malloc((sky_count ? sky_count : 1) * sizeof(double));
@@ -309,7 +317,7 @@ int main(int argc, char **argv)
     }
 #pragma omp parallel for schedule(dynamic, 1)
     for (uint32_t k = 0; k < sky_count; k++)
-        brute_force_sky(scene, sky_pick[k], cumulative[sky_pick[k]], segments / 2,
+        brute_force_sky(scene, sky_pick[k], cumulative[sky_pick[k]], sky_rays,
                         &sky_reference[k], &sky_error[k]);
     uint32_t sky_within = 0, sky_within_twice = 0;
     double sky_worst = 0;
@@ -339,7 +347,7 @@ int main(int argc, char **argv)
            argv[1], count, top, count - top,
            segments, within, within_twice, worst, count ? bounds[count / 2] : 0,
            count ? errors[count / 2] : 0, report.largest_error_bound, unstored_count,
-           report.unmet_bound, report.sight_rays, zero_seen, zero_outside, zero_largest, sky_count, segments / 2, sky_within, sky_within_twice, sky_worst,
+           report.unmet_bound, report.sight_rays, zero_seen, zero_outside, zero_largest, sky_count, sky_rays, sky_within, sky_within_twice, sky_worst,
            sky_report.largest_error_bound);
     return 0;
 }

@@ -839,6 +839,12 @@ typedef struct rad_viewfactor_options {
     int threads;         /* 0 = all cores */
     rad_progress_fn progress;
     void *progress_user;
+    bool sky_exact;      /* rad_sky_viewfactors_compute only. false: a tile of the sky that
+                            more than 16 triangles obstruct is sampled by rays (seconds; bounds
+                            about 1e-2 in a city, far above the accuracy); true: clipped
+                            exactly as a pair of the matrix is, behind up to exact_occluders
+                            triangles, so that every sky view factor meets the accuracy (some
+                            17 times the matrix's time on the 1k generated city) */
     /* Long runs (see rad_viewfactor_matrix_compute): */
     const char *checkpoint;     /* NULL: none. Restart file of the rows done so far, written
                                    atomically (rank 0 of an MPI job writes every rank's rows)

@@ -227,8 +227,9 @@ static void check_canyon_with_beam(void)
 
 /* A floor under a grid of 7 x 7 small squares (98 triangles, one surface facing up): the
  * sky behind more than 16 triangles is sampled, so the floor's SVF is short of the
- * accuracy and the run says so (the grid's own, open above, is exact); the floor's value
- * against the test's own count. */
+ * accuracy and the run says so (the grid's own, open above, is exact); with --sky-exact it
+ * is clipped, within the accuracy. Both against the test's own count (2^22 rays: s.e.
+ * about 2e-4). */
 static void check_sampled_sky(void)
 {
     quad_count = 0;
@@ -254,10 +255,28 @@ static void check_sampled_sky(void)
     CHECK(bound <= 1e-4);
     CHECK(sky_row(sky, "floor", &index, &svf, &bound));
     CHECK(bound > 1e-4);
-    double reference = monte_carlo_sky(1u << 18, &sigma);
+    double reference = monte_carlo_sky(1u << 22, &sigma);
     printf("floor under a grid: SVF %.6f (bound %.2g), Monte Carlo %.6f +- %.2g\n", svf, bound,
            reference, sigma);
     CHECK(fabs(svf - reference) <= 4 * sigma + bound);
+    /* --sky-exact: clipped, every one within */
+    CHECK(run("viewfactors grid.obj -o grid.csv --sky-view-factor grid-exact.csv --sky-exact "
+              "--stats grid.json"));
+    text = test_read_text(test_path("stderr.txt"));
+    printf("%s", text);
+    CHECK(strstr(text, "sky view factors: every one within --accuracy 0.0001 (absolute)") != NULL);
+    CHECK(strstr(test_read_text(test_path("grid.json")), "\"sky_short_surfaces\": 0") != NULL);
+    sky = test_read_text(test_path("grid-exact.csv"));
+    CHECK(sky_row(sky, "floor", &index, &svf, &bound));
+    printf("floor under a grid, --sky-exact: SVF %.6f (bound %.2g), Monte Carlo %.6f +- %.2g\n",
+           svf, bound, reference, sigma);
+    CHECK(bound <= 1e-4);
+    CHECK(fabs(svf - reference) <= 4 * sigma + bound);
+    /* it asks for the sky view factors */
+    CHECK(test_run_tool("viewfactors grid.obj -o grid2.csv --sky-exact") == 2);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")),
+                 "--sky-exact: applies to --sky-view-factor FILE only") != NULL);
+    CHECK(!test_file_exists(test_path("grid2.csv")));
 }
 
 static void check_plate(void)

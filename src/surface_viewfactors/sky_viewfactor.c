@@ -19,8 +19,12 @@
  * quadrature refine; a long polygon is cut into strips of aspect about 2 first. The
  * tiles with too many occluders at the last level (and a polygon's obstructed tiles when
  * its exact integral does not settle within its work budget) are counted by
- * cosine-distributed rays from the polygon (sample_sky). No shortcut drops anything as
- * hidden. Error bounds add in quadrature, as in the matrix's rows.
+ * cosine-distributed rays from the polygon (sample_sky). With sky_exact
+ * (rad_viewfactor_options, --sky-exact) a polygon with such a tile takes every tile of
+ * the last level as its own pair, clipped exactly behind up to exact_occluders triangles
+ * as the matrix's pairs are (pair_tile), and samples only those that do not settle. No
+ * shortcut drops anything as hidden. Error bounds add in quadrature, as in the matrix's
+ * rows.
  *
  * Not here: the matrix (viewfactor_matrix.c); the writer (sky_viewfactor_writer.c).
  */
@@ -52,6 +56,12 @@
  * quadrature (4^8 cells of each fan triangle). */
 #define SKY_WORK_BUDGET (1u << 16)
 #define SKY_MAX_DEPTH 8
+
+/* The clippings a TILE_PAIR tile may spend (pair_tile): four times a pair of the
+ * matrix's (with one, 1,129 tiles of the 486-surface generated city ran out and were
+ * sampled, leaving 201 of its sky view factors short of the accuracy; with four, none and
+ * 16). */
+#define SKY_PAIR_WORK_BUDGET (4u * PAIR_EXACT_WORK_BUDGET)
 
 /* Occluders are cut this far (times the polygon's size) above its plane (lift_occluders). */
 #define SKY_LIFT 1e-6
@@ -85,7 +95,10 @@ typedef struct sky_counts {
     uint64_t polygon_pairs, obstructed_pairs, exact_pairs, sampled_pairs, capped_pairs, rays;
 } sky_counts;
 
-enum { TILE_EXACT = 1, TILE_SAMPLED };
+/* TILE_EXACT: in the polygon's one integrand (sky_point); TILE_PAIR: a tile of the last
+ * level with more occluders, integrated as its own pair (pair_tile); TILE_SAMPLED: by rays
+ * (sample_sky). */
+enum { TILE_EXACT = 1, TILE_SAMPLED, TILE_PAIR };
 
 typedef struct sky_tile {
     vf_polygon polygon;
@@ -100,6 +113,9 @@ typedef struct sky_workspace {
     pair_workspace pair;
     sky_tile tiles[SKY_MAX_TILES];
     uint32_t tile_count;
+    /* a TILE_PAIR tile's occluders (pair_tile): as collected, then lifted */
+    shadow_occluder collected[RAD_MAX_EXACT_OCCLUDERS];
+    shadow_occluder lifted[2 * RAD_MAX_EXACT_OCCLUDERS];
 } sky_workspace;
 
 typedef struct sky_box {
@@ -145,6 +161,8 @@ typedef struct sky_context {
     double accuracy, eps;
     double ray_offset; /* sampled rays start this far above their point (scene units) */
     uint32_t max_rays;
+    uint32_t exact_occluders; /* a TILE_PAIR tile is clipped behind this many at most
+                                 (SKY_EXACT_MAX_OCCLUDERS: there is none; sky_exact) */
     uint64_t seed;
 } sky_context;
 
@@ -156,10 +174,10 @@ typedef struct sky_context {
  * rays that leave p at elevations below SKY_LIFT sqrt(A_p) / d from points at distance d
  * from it: about SKY_LIFT / 2 of the SVF (the cosine-weighted share (e^2 / 2) averaged over
  * p). */
-static uint32_t lift_occluders(const vf_polygon *p, shadow_occluder *occluders, uint32_t count)
+static uint32_t lift_occluders_to(const vf_polygon *p, const shadow_occluder *occluders,
+                                  uint32_t count, shadow_occluder *kept)
 {
     double offset = v3_dot(p->normal, p->vertex[0]) + SKY_LIFT * sqrt(p->area);
-    shadow_occluder kept[2 * SKY_EXACT_MAX_OCCLUDERS];
     uint32_t made = 0;
     for (uint32_t o = 0; o < count; o++) {
         rad_vec3 out[4];
@@ -177,14 +195,24 @@ static uint32_t lift_occluders(const vf_polygon *p, shadow_occluder *occluders, 
         if (n == 4)
             kept[made++] = (shadow_occluder){{out[0], out[2], out[3]}};
     }
+    return made;
+}
+
+/* lift_occluders_to in place, for at most SKY_EXACT_MAX_OCCLUDERS occluders. */
+static uint32_t lift_occluders(const vf_polygon *p, shadow_occluder *occluders, uint32_t count)
+{
+    shadow_occluder kept[2 * SKY_EXACT_MAX_OCCLUDERS];
+    uint32_t made = lift_occluders_to(p, occluders, count, kept);
     memcpy(occluders, kept, made * sizeof(*kept));
     return made;
 }
 
 /* The tiles of face `face` under (level, i, j) that p faces, split while they have too
- * many occluders; a tile whose children would all be sampled is sampled whole instead
- * (sampling cost grows with the pairs, not with their size). Returns false when the
- * subtree holds a tile to clip exactly. */
+ * many occluders for the polygon's integrand; at the last level such a tile is its own
+ * pair (TILE_PAIR) when the run clips more than SKY_EXACT_MAX_OCCLUDERS triangles
+ * (exact_occluders), else sampled, and a tile whose children would all be sampled is
+ * sampled whole instead (sampling cost grows with the pairs, not with their size).
+ * Returns false when the subtree holds a tile to clip exactly. */
 static bool add_tiles(const sky_context *c, const vf_polygon *p, sky_workspace *w,
                       unsigned face, unsigned level, unsigned i, unsigned j)
 {
@@ -219,8 +247,12 @@ static bool add_tiles(const sky_context *c, const vf_polygon *p, sky_workspace *
         tile->occluder_count = count;
         tile->id = (face << 24) | (level << 20) | (i << 10) | j;
     }
-    tile->state = TILE_SAMPLED;
     w->tile_count++;
+    if (level == SKY_MAX_LEVEL && c->exact_occluders > SKY_EXACT_MAX_OCCLUDERS) {
+        tile->state = TILE_PAIR;
+        return false;
+    }
+    tile->state = TILE_SAMPLED;
     return true;
 }
 
@@ -430,6 +462,32 @@ static double sample_sky(const sky_context *c, const vf_polygon *p, uint32_t pi,
     return fmin(mean, share);
 }
 
+/* The transfer from p to a TILE_PAIR tile as far as the triangles in their hull leave it
+ * visible, clipped exactly as a pair of the matrix is (pair_obstructed_exact_within:
+ * joined where they share an edge, culled per cell of p's splitting), to the looser of
+ * the relative accuracy and `absolute`; false when more than exact_occluders triangles
+ * (after lifting) stand in the hull, the visible part breaks into too many pieces or the
+ * clipping needs more than SKY_PAIR_WORK_BUDGET: the tile is then sampled. */
+static bool pair_tile(const sky_context *c, const vf_polygon *p, sky_workspace *w,
+                      const vf_polygon *tile, double absolute, uint32_t *collected,
+                      double *value, double *bound)
+{
+    uint32_t count = occluder_tree_collect(c->tree, p, tile, c->eps, w->collected,
+                                           c->exact_occluders);
+    *collected = count;
+    if (count > c->exact_occluders)
+        return false;
+    count = lift_occluders_to(p, w->collected, count, w->lifted);
+    if (count > c->exact_occluders)
+        return false;
+    if (count == 0) {
+        *value = pair_unobstructed(p, tile, 0.25 * c->accuracy, c->eps, bound);
+        return true;
+    }
+    return pair_obstructed_exact_within(p, tile, w->lifted, count, c->accuracy, absolute,
+                                        c->eps, SKY_PAIR_WORK_BUDGET, value, bound);
+}
+
 /* The transfer from polygon p (index pi) to the sky, with its error bound in *bound. */
 static double sky_polygon(const sky_context *c, const vf_polygon *p, uint32_t pi,
                           sky_workspace *w, vf_polygon *strips, sky_counts *counts,
@@ -438,12 +496,36 @@ static double sky_polygon(const sky_context *c, const vf_polygon *p, uint32_t pi
     w->tile_count = 0;
     for (unsigned face = 0; face < 6; face++)
         add_tiles(c, p, w, face, 0, 0, 0);
-    bool any_exact = false;
-    for (uint32_t k = 0; k < w->tile_count; k++) {
-        any_exact = any_exact || w->tiles[k].state == TILE_EXACT;
-        counts->polygon_pairs++;
-        counts->obstructed_pairs += w->tiles[k].occluder_count > 0;
+    /* a polygon with a tile of many occluders (in a city, most) takes every tile of the
+     * last level as its own pair: in the one integrand their shadows' kinks would refine
+     * it for all of them, and its clipping budget run out, mostly after spending it; and a
+     * large tile's shadows refine its pair to the deepest level, leaving their error in
+     * its bound */
+    bool busy = false;
+    for (uint32_t k = 0; k < w->tile_count; k++)
+        busy = busy || w->tiles[k].state == TILE_PAIR;
+    if (busy) {
+        w->tile_count = 0;
+        for (unsigned face = 0; face < 6; face++)
+            for (unsigned i = 0; i < 1u << SKY_MAX_LEVEL; i++)
+                for (unsigned j = 0; j < 1u << SKY_MAX_LEVEL; j++) {
+                    sky_tile *tile = &w->tiles[w->tile_count];
+                    make_tile(c->box, face, SKY_MAX_LEVEL, i, j, &tile->polygon);
+                    const vf_polygon *t = &tile->polygon;
+                    if (!vf_polygon_in_front(t, p->normal, v3_dot(p->normal, p->vertex[0]),
+                                             c->eps) ||
+                        !vf_polygon_in_front(p, t->normal, v3_dot(t->normal, t->vertex[0]),
+                                             c->eps))
+                        continue;
+                    tile->id = (face << 24) | (SKY_MAX_LEVEL << 20) | (i << 10) | j;
+                    tile->state = TILE_PAIR;
+                    tile->occluder_count = 0; /* pair_tile's count */
+                    w->tile_count++;
+                }
     }
+    bool any_exact = false;
+    for (uint32_t k = 0; k < w->tile_count; k++)
+        any_exact = any_exact || w->tiles[k].state == TILE_EXACT;
     double transfer = 0, variance = 0;
     unsigned strip_count = any_exact ? cut_strips(p, strips) : 0;
     while (any_exact) {
@@ -464,22 +546,44 @@ static double sky_polygon(const sky_context *c, const vf_polygon *p, uint32_t pi
             variance += error2;
             break;
         }
-        /* too many pieces behind one tile: sample that tile; out of work: sample every
-         * obstructed tile */
+        /* too many pieces behind one tile: that tile on its own; out of work: every
+         * obstructed tile (each its own pair when the run clips more occluders than the
+         * integrand takes, else sampled) */
         any_exact = false;
         for (uint32_t k = 0; k < w->tile_count; k++) {
             sky_tile *tile = &w->tiles[k];
             if (tile->state == TILE_EXACT &&
                 (k == integrand.failed_tile ||
                  (integrand.failed_tile == UINT32_MAX && tile->occluder_count)))
-                tile->state = TILE_SAMPLED;
+                tile->state = c->exact_occluders > SKY_EXACT_MAX_OCCLUDERS ? TILE_PAIR
+                                                                           : TILE_SAMPLED;
             any_exact = any_exact || tile->state == TILE_EXACT;
         }
+    }
+    /* the tiles with many occluders, each its own pair: their bounds add in quadrature to
+     * half the accuracy at most (of the transfer A_p SVF, absolute); those that do not
+     * settle are sampled */
+    uint32_t pairs = 0;
+    for (uint32_t k = 0; k < w->tile_count; k++)
+        pairs += w->tiles[k].state == TILE_PAIR;
+    for (uint32_t k = 0; pairs && k < w->tile_count; k++) {
+        sky_tile *tile = &w->tiles[k];
+        double value, b;
+        if (tile->state != TILE_PAIR)
+            continue;
+        if (pair_tile(c, p, w, &tile->polygon, 0.5 * c->accuracy * p->area / sqrt(pairs),
+                      &tile->occluder_count, &value, &b)) {
+            transfer += value;
+            variance += b * b;
+        } else
+            tile->state = TILE_SAMPLED;
     }
     double sampled_share = 0, share_error = 0; /* unobstructed F to the sampled tiles */
     for (uint32_t k = 0; k < w->tile_count; k++) {
         const sky_tile *tile = &w->tiles[k];
-        if (tile->state == TILE_EXACT) {
+        counts->polygon_pairs++;
+        counts->obstructed_pairs += tile->occluder_count > 0;
+        if (tile->state == TILE_EXACT || tile->state == TILE_PAIR) {
             counts->exact_pairs += tile->occluder_count > 0;
             continue;
         }
@@ -550,9 +654,17 @@ rad_status rad_sky_viewfactors_compute(const rad_scene *scene,
     uint32_t max_rays = options->max_rays ? options->max_rays : RAD_DEFAULT_MAX_RAYS;
     sky_box box;
     scene_box(scene, &box);
-    sky_context c = {&box, NULL, NULL,
-                     options->accuracy > 0 ? options->accuracy : RAD_DEFAULT_ACCURACY, 0, 0,
-                     max_rays < 64 ? 64 : max_rays, options->seed};
+    sky_context c = {&box,
+                     NULL,
+                     NULL,
+                     options->accuracy > 0 ? options->accuracy : RAD_DEFAULT_ACCURACY,
+                     0,
+                     0,
+                     max_rays < 64 ? 64 : max_rays,
+                     !options->sky_exact         ? SKY_EXACT_MAX_OCCLUDERS
+                     : options->exact_occluders ? options->exact_occluders
+                                                : RAD_DEFAULT_EXACT_OCCLUDERS,
+                     options->seed};
     vf_geometry geometry;
     occluder_tree *tree = NULL;
     rad_tracer *tracer = NULL;
