@@ -843,8 +843,9 @@ typedef struct rad_viewfactor_options {
                             more than 16 triangles obstruct is sampled by rays (seconds; bounds
                             about 1e-2 in a city, far above the accuracy); true: clipped
                             exactly as a pair of the matrix is, behind up to exact_occluders
-                            triangles, so that every sky view factor meets the accuracy (some
-                            17 times the matrix's time on the 1k generated city) */
+                            triangles: bounds at about the accuracy (up to 1.3 times it
+                            where many shadows cross a large polygon), at some 13 times the
+                            matrix's time on the 1k generated city */
     /* Long runs (see rad_viewfactor_matrix_compute): */
     const char *checkpoint;     /* NULL: none. Restart file of the rows done so far, written
                                    atomically (rank 0 of an MPI job writes every rank's rows)
