@@ -207,6 +207,13 @@ static uint32_t lift_occluders(const vf_polygon *p, shadow_occluder *occluders, 
     return made;
 }
 
+/* Whether p and tile t face each other (each in front of the other's plane). */
+static bool tile_faces(const sky_context *c, const vf_polygon *p, const vf_polygon *t)
+{
+    return vf_polygon_in_front(t, p->normal, v3_dot(p->normal, p->vertex[0]), c->eps) &&
+           vf_polygon_in_front(p, t->normal, v3_dot(t->normal, t->vertex[0]), c->eps);
+}
+
 /* The tiles of face `face` under (level, i, j) that p faces, split while they have too
  * many occluders for the polygon's integrand; at the last level such a tile is its own
  * pair (TILE_PAIR) when the run clips more than SKY_EXACT_MAX_OCCLUDERS triangles
@@ -220,8 +227,7 @@ static bool add_tiles(const sky_context *c, const vf_polygon *p, sky_workspace *
     sky_tile *tile = &w->tiles[first];
     make_tile(c->box, face, level, i, j, &tile->polygon);
     const vf_polygon *t = &tile->polygon;
-    if (!vf_polygon_in_front(t, p->normal, v3_dot(p->normal, p->vertex[0]), c->eps) ||
-        !vf_polygon_in_front(p, t->normal, v3_dot(t->normal, t->vertex[0]), c->eps))
+    if (!tile_faces(c, p, t))
         return true;
     uint32_t count = occluder_tree_collect(c->tree, p, t, c->eps, tile->occluders,
                                            SKY_EXACT_MAX_OCCLUDERS);
@@ -511,11 +517,7 @@ static double sky_polygon(const sky_context *c, const vf_polygon *p, uint32_t pi
                 for (unsigned j = 0; j < 1u << SKY_MAX_LEVEL; j++) {
                     sky_tile *tile = &w->tiles[w->tile_count];
                     make_tile(c->box, face, SKY_MAX_LEVEL, i, j, &tile->polygon);
-                    const vf_polygon *t = &tile->polygon;
-                    if (!vf_polygon_in_front(t, p->normal, v3_dot(p->normal, p->vertex[0]),
-                                             c->eps) ||
-                        !vf_polygon_in_front(p, t->normal, v3_dot(t->normal, t->vertex[0]),
-                                             c->eps))
+                    if (!tile_faces(c, p, &tile->polygon))
                         continue;
                     tile->id = (face << 24) | (SKY_MAX_LEVEL << 20) | (i << 10) | j;
                     tile->state = TILE_PAIR;
