@@ -708,6 +708,12 @@ void rad_tracer_occluded(const rad_tracer *tracer, const rad_ray *rays, uint32_t
 void rad_tracer_intersect(const rad_tracer *tracer, const rad_ray *rays, uint32_t count,
                           rad_hit *hits);
 
+/* The same, for rays given in coherent runs (one origin, directions that turn little from
+ * one ray to the next, as a hemisphere's strata in order): traced as packets, which is
+ * faster for such rays and slower for scattered ones. The same hits. */
+void rad_tracer_intersect_coherent(const rad_tracer *tracer, const rad_ray *rays,
+                                   uint32_t count, rad_hit *hits);
+
 /* ------------------------------------------------------------------------------------ */
 /* Form factors                                                                          */
 

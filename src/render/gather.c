@@ -6,6 +6,18 @@
 #include "core/rgb.h"
 #include "core/vec3.h"
 
+void gather_trace(const gather_view *view, const rad_ray *rays, uint32_t count, rad_hit *hits)
+{
+    if (!view->locator) {
+        rad_tracer_intersect_coherent(view->tracer, rays, count, hits);
+        return;
+    }
+    rad_tracer_intersect_coherent(view->scene_tracer, rays, count, hits);
+    for (uint32_t k = 0; k < count; k++)
+        if (!display_locate(view->locator, &hits[k]))
+            rad_tracer_intersect(view->tracer, &rays[k], 1, &hits[k]);
+}
+
 rad_rgb gather_seen(const gather_view *view, const rad_ray *ray, const rad_hit *hit)
 {
     if (hit->triangle == RAD_NO_HIT) {

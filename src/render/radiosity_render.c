@@ -42,6 +42,7 @@
 #include "parallel/ranks.h"
 #include "render/progress.h"
 #include "render/vertex_radiance.h"
+#include "reconstruct/display_locate.h"
 #include "reconstruct/display_mesh.h"
 #include "scene/patch_materials.h"
 #include "trace/ray.h"
@@ -483,7 +484,7 @@ static void trace_samples(const shading *sh, const rad_tracer *tracer, row_work 
                           uint32_t count, unsigned max_depth, bool first)
 {
     for (unsigned depth = 0; count > 0; depth++) {
-        rad_tracer_intersect(tracer, w->rays, count, w->hits);
+        rad_tracer_intersect_coherent(tracer, w->rays, count, w->hits);
         if (first && depth == 0 && w->first_surface)
             for (uint32_t r = 0; r < count; r++)
                 w->first_surface[w->sample[r]] =
@@ -625,6 +626,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
     emitter_set emitters = {0};
     const emitter_set *emitters_ptr = NULL;
     rad_tracer *scene_tracer = NULL;
+    display_locator *locator = NULL;
     uint8_t *hidden = NULL;
     rad_rgb *reflected = NULL;
     uint8_t *sees = NULL, *emitter_way = NULL; /* the default render: how each display
@@ -703,7 +705,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
     gather_view view = {mesh,   (const uint32_t(*)[3])display.triangles,
                         display.patch_of, NULL,
                         B,      inputs ? inputs->exitance : NULL,
-                        lights_ptr, tracer};
+                        lights_ptr, tracer, NULL, NULL};
     display_hidden_patches(mesh, tracer, leave, hidden, NULL, 0);
     if (direct_light != RAD_DIRECT_SOLUTION) {
         /* what gather rays meet: the reflected light (B - E) / pi at the vertices */
@@ -712,6 +714,15 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
             !vertex_radiance_reflected(mesh, &display, B, inputs->exitance, hidden, reflected))
             goto nomem;
         view.reflected = reflected;
+        /* the gather's rays against the scene's triangles, placed in the display mesh */
+        status = display_locator_build(options->scene, scene_tracer, mesh, &display, positions,
+                                       traced,
+                                       (uint64_t)VERTEX_LIGHT_BYTES_PER_PATCH * mesh->patch_count,
+                                       threads, &locator, error);
+        if (status != RAD_OK)
+            goto done;
+        view.scene_tracer = scene_tracer;
+        view.locator = locator;
         if (direct_light == RAD_DIRECT_VERTEX && emitters.count > 0) {
             /* the emitters' light at the penumbrae's pixels, the rest from the vertices */
             sees = rad_alloc_array(mesh->vertex_count ? mesh->vertex_count : 1, 1);
@@ -898,7 +909,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                 rad_vec3 d = v3_normalize(camera_direction(&frame, c % (W + 1), y + c / (W + 1), W, H));
                 ray_set(&w->rays[c], frame.eye, d, t_near, INFINITY);
             }
-            rad_tracer_intersect(tracer, w->rays, 2 * (W + 1), w->hits);
+            rad_tracer_intersect_coherent(tracer, w->rays, 2 * (W + 1), w->hits);
             for (uint32_t c = 0; c < 2 * (W + 1); c++)
                 w->corner_surface[c] = w->hits[c].triangle == RAD_NO_HIT
                                            ? UINT32_MAX
@@ -1047,6 +1058,7 @@ done:
     free(surface_emits);
     rad_tracer_destroy(tracer);
     rad_tracer_destroy(scene_tracer);
+    display_locator_destroy(locator);
     emitters_free(&emitters);
     free(hidden);
     free(reflected);

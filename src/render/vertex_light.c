@@ -315,7 +315,7 @@ rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *s
                 continue; /* its gathered light: its parents' mean, below */
             /* the gather: E = pi / N x the sum of the radiance met by N cosine rays */
             emitter_cosine_rays(x, nv, off, gather, &rng, cosine, cos_x);
-            rad_tracer_intersect(view->tracer, cosine, gather, hit);
+            gather_trace(view, cosine, gather, hit);
             rad_rgb seen = {0, 0, 0};
             uint32_t backs = 0; /* rays that met the back of a one-sided surface */
             for (uint32_t k = 0; k < gather; k++) {

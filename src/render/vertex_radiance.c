@@ -220,6 +220,7 @@ rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh 
     uint8_t *hidden = rad_alloc_array(n, sizeof(*hidden));
     rad_rgb *reflected = rad_alloc_array(vertices, sizeof(*reflected));
     rad_tracer *tracer = NULL, *scene_tracer = NULL;
+    display_locator *locator = NULL;
     emitter_set emitters = {0};
     light_set lights;
     rad_status status = RAD_OK;
@@ -247,10 +248,17 @@ rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh 
     }
     light_set_init(&lights, scene);
     bool any_lights = scene->light_count > 0;
+    /* the gather's rays against the scene's triangles, placed in the display mesh */
+    status = display_locator_build(scene, scene_tracer, mesh, display, positions,
+                                   display_mesh_front_triangles(mesh, display),
+                                   (uint64_t)VERTEX_LIGHT_BYTES_PER_PATCH * mesh->patch_count,
+                                   threads, &locator, error);
+    if (status != RAD_OK)
+        goto done;
     gather_view view = {mesh,      (const uint32_t(*)[3])display->triangles,
                         display->patch_of, reflected,
                         B,         inputs->exitance,
-                        any_lights ? &lights : NULL, tracer};
+                        any_lights ? &lights : NULL, tracer, scene_tracer, locator};
     vertex_radiance_job job = {
         .mesh = mesh,
         .display = display,
@@ -270,6 +278,7 @@ rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh 
 done:
     rad_tracer_destroy(tracer);
     rad_tracer_destroy(scene_tracer);
+    display_locator_destroy(locator);
     emitters_free(&emitters);
     free(positions);
     free(hidden);

@@ -133,7 +133,21 @@ void rad_tracer_intersect(const rad_tracer *tracer, const rad_ray *rays, uint32_
     switch (tracer->backend) {
     case RAD_TRACER_EMBREE:
     case RAD_TRACER_EMBREE_FAST:
-        rad_tracer_embree_intersect(tracer, rays, count, hits);
+        rad_tracer_embree_intersect(tracer, rays, count, false, hits);
+        break;
+    case RAD_TRACER_BRUTE_FORCE:
+        rad_tracer_brute_intersect(tracer, rays, count, hits);
+        break;
+    }
+}
+
+void rad_tracer_intersect_coherent(const rad_tracer *tracer, const rad_ray *rays,
+                                   uint32_t count, rad_hit *hits)
+{
+    switch (tracer->backend) {
+    case RAD_TRACER_EMBREE:
+    case RAD_TRACER_EMBREE_FAST:
+        rad_tracer_embree_intersect(tracer, rays, count, true, hits);
         break;
     case RAD_TRACER_BRUTE_FORCE:
         rad_tracer_brute_intersect(tracer, rays, count, hits);

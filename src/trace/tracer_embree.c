@@ -223,12 +223,14 @@ void rad_tracer_embree_occluded(const rad_tracer *tracer, const rad_ray *rays, u
 }
 
 void rad_tracer_embree_intersect(const rad_tracer *tracer, const rad_ray *rays,
-                                 uint32_t count, rad_hit *hits)
+                                 uint32_t count, bool coherent, rad_hit *hits)
 {
     unsigned int modes = fp_modes_enter();
     RTCScene scene = tracer->embree->scene;
     struct RTCIntersectContext context;
     rtcInitIntersectContext(&context);
+    if (coherent) /* a final gather's strata from one point: about 2x faster */
+        context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     struct RTCRayHit chunk[CHUNK];
     for (uint32_t done = 0; done < count;) {
         uint32_t n = count - done < CHUNK ? count - done : CHUNK;

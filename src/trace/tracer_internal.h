@@ -75,8 +75,9 @@ rad_status rad_tracer_embree_build(rad_tracer *tracer, rad_error *error);
 void rad_tracer_embree_release(rad_tracer *tracer);
 void rad_tracer_embree_occluded(const rad_tracer *tracer, const rad_ray *rays, uint32_t count,
                                 uint8_t *occluded);
+/* coherent: Embree's coherent-ray context (rad_tracer_intersect_coherent) */
 void rad_tracer_embree_intersect(const rad_tracer *tracer, const rad_ray *rays,
-                                 uint32_t count, rad_hit *hits);
+                                 uint32_t count, bool coherent, rad_hit *hits);
 
 /* Brute-force backend (tracer_brute.c): needs nothing beyond vertices/indices. */
 void rad_tracer_brute_occluded(const rad_tracer *tracer, const rad_ray *rays, uint32_t count,

@@ -1,0 +1,373 @@
+/*
+ * display_locate.c - where a hit on a scene triangle lies in the display mesh
+ * (display_locate.h).
+ */
+#include "reconstruct/display_locate.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+
+#include "core/alloc.h"
+#include "core/error.h"
+#include "core/vec3.h"
+#include "trace/ray.h"
+
+/* Probe points per display triangle: its centroid and a point 9/10 of the way to each
+ * corner; each may find a different scene triangle (a quad's cell across its diagonal). */
+#define PROBES 4u
+/* Display triangles probed per batch of rays (per thread). */
+#define PROBE_BATCH 256u
+/* A grid over a scene triangle has about this many display triangles a cell, and at most
+ * MAX_SIDE x MAX_SIDE cells. */
+#define PER_CELL 2.0
+#define MAX_SIDE 256u
+/* A point this far outside a display triangle, in its own barycentrics, still counts as
+ * on it (the scene hit's u, v are floats), its barycentrics clamped onto it. */
+#define ON_EDGE 1e-3
+/* Same side: the display triangle's normal and the scene triangle's within ~8 degrees. */
+#define SAME_SIDE 0.99
+
+/* One display triangle in one scene triangle's cell: (b1, b2) = m ((u, v) - q0). */
+typedef struct located {
+    float q0[2]; /* the display triangle's corner 0 in (u, v) */
+    float m[4];
+    uint32_t triangle;
+} located;
+
+/* A display triangle on a scene triangle: its map from the scene triangle's (u, v) and
+ * its box there. */
+typedef struct placement {
+    double m[4], q0[2];
+    double lo[2], hi[2];
+} placement;
+
+/* A display triangle found on a scene triangle, before the cells are made. */
+typedef struct found {
+    uint32_t scene_triangle, triangle;
+} found;
+
+struct display_locator {
+    uint32_t scene_triangles;
+    uint32_t *first_cell; /* per scene triangle, and one past the last */
+    uint32_t *side;       /* per scene triangle: its grid's side (0: no display triangle) */
+    uint32_t *cell_start; /* per cell, and one past the last: into items */
+    located *items;
+};
+
+/* The scene triangle's corner and edges, as (u, v) measure them. */
+typedef struct triangle_frame {
+    rad_vec3 p0, e1, e2;
+    double a, b, c, det; /* e1.e1, e1.e2, e2.e2 and the Gram determinant */
+} triangle_frame;
+
+static triangle_frame frame_of(const rad_scene *scene, uint32_t t)
+{
+    const uint32_t *v = scene->triangles[t].vertex;
+    triangle_frame f;
+    f.p0 = scene->positions[v[0]];
+    f.e1 = v3_sub(scene->positions[v[1]], f.p0);
+    f.e2 = v3_sub(scene->positions[v[2]], f.p0);
+    f.a = v3_dot(f.e1, f.e1);
+    f.b = v3_dot(f.e1, f.e2);
+    f.c = v3_dot(f.e2, f.e2);
+    f.det = f.a * f.c - f.b * f.b;
+    return f;
+}
+
+/* The point's (u, v) in the scene triangle, projected onto its plane. */
+static void uv_of(const triangle_frame *f, rad_vec3 x, double uv[2])
+{
+    rad_vec3 r = v3_sub(x, f->p0);
+    double s1 = v3_dot(f->e1, r), s2 = v3_dot(f->e2, r);
+    uv[0] = (f->c * s1 - f->b * s2) / f->det;
+    uv[1] = (f->a * s2 - f->b * s1) / f->det;
+}
+
+/* The display triangle d's map from the scene triangle's (u, v) to its barycentrics, and
+ * its box there; false when it is edge-on in that plane. */
+static bool map_onto(const triangle_frame *f, const rad_vec3 corner[3], placement *out)
+{
+    double q[3][2];
+    for (int k = 0; k < 3; k++)
+        uv_of(f, corner[k], q[k]);
+    double a00 = q[1][0] - q[0][0], a01 = q[2][0] - q[0][0];
+    double a10 = q[1][1] - q[0][1], a11 = q[2][1] - q[0][1];
+    double det = a00 * a11 - a01 * a10;
+    if (!(fabs(det) > 1e-14 * (fabs(a00 * a11) + fabs(a01 * a10))) || !isfinite(det))
+        return false;
+    out->m[0] = a11 / det;
+    out->m[1] = -a01 / det;
+    out->m[2] = -a10 / det;
+    out->m[3] = a00 / det;
+    out->q0[0] = q[0][0];
+    out->q0[1] = q[0][1];
+    for (int a = 0; a < 2; a++) {
+        out->lo[a] = fmin(q[0][a], fmin(q[1][a], q[2][a]));
+        out->hi[a] = fmax(q[0][a], fmax(q[1][a], q[2][a]));
+    }
+    return true;
+}
+
+static uint32_t cell_index(double x, uint32_t side)
+{
+    double at = floor(x * side);
+    return at < 0 ? 0 : at >= side ? side - 1 : (uint32_t)at;
+}
+
+/* The scene triangles under display triangle d (up to PROBES, UINT32_MAX for none), by
+ * short rays onto it from just in front, kept when the triangle hit is of d's patch's
+ * surface and material and faces the same way. */
+static void probe_rays(const rad_mesh *mesh, const display_mesh *display,
+                       const rad_vec3 *positions, uint32_t d, rad_ray *rays, bool *valid)
+{
+    const uint32_t *v = display->triangles[d];
+    rad_vec3 a = positions[v[0]], b = positions[v[1]], c = positions[v[2]];
+    rad_vec3 n = v3_cross(v3_sub(b, a), v3_sub(c, a));
+    double length = v3_length(n);
+    *valid = length > 0 && isfinite(length);
+    if (!*valid) { /* nothing to find: empty rays */
+        for (unsigned k = 0; k < PROBES; k++)
+            ray_set(&rays[k], a, v3(1, 0, 0), 1, 0);
+        return;
+    }
+    n = v3_scale(n, 1 / length);
+    const rad_patch *patch = &mesh->patches[display->patch_of[d]];
+    double edge = fmax(v3_length(v3_sub(b, a)), fmax(v3_length(v3_sub(c, b)),
+                                                     v3_length(v3_sub(a, c))));
+    double lift = 0.01 * edge + 2 * (patch->behind + patch->bulge);
+    rad_vec3 centre = v3_scale(v3_add(v3_add(a, b), c), 1.0 / 3.0);
+    rad_vec3 point[PROBES] = {centre, v3_lerp(centre, a, 0.9), v3_lerp(centre, b, 0.9),
+                              v3_lerp(centre, c, 0.9)};
+    for (unsigned k = 0; k < PROBES; k++)
+        ray_set(&rays[k], v3_add(point[k], v3_scale(n, lift)), v3_scale(n, -1), 0, 2 * lift);
+}
+
+rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene_tracer,
+                                 const rad_mesh *mesh, const display_mesh *display,
+                                 const rad_vec3 *positions, uint32_t front, uint64_t keep,
+                                 int threads, display_locator **out, rad_error *error)
+{
+    *out = NULL;
+    if (!scene || !scene_tracer || scene->triangle_count == 0 || front == 0)
+        return RAD_OK;
+    uint64_t left = rad_memory_budget_left();
+    if (left != UINT64_MAX && (left < keep || (left - keep) / DISPLAY_LOCATE_BYTES_PER_TRIANGLE <
+                                                  (uint64_t)front + PROBE_BATCH * threads))
+        return RAD_OK;
+    threads = threads < 1 ? 1 : threads;
+    const uint32_t T = scene->triangle_count;
+    display_locator *l = rad_alloc_array(1, sizeof(*l));
+    uint32_t (*under)[PROBES] = rad_alloc_array(front, sizeof(*under));
+    rad_ray *rays = rad_alloc_array((size_t)threads * PROBE_BATCH * PROBES, sizeof(*rays));
+    rad_hit *hits = rad_alloc_array((size_t)threads * PROBE_BATCH * PROBES, sizeof(*hits));
+    bool *valid = rad_alloc_array((size_t)threads * PROBE_BATCH, sizeof(*valid));
+    uint32_t *count = rad_alloc_array((size_t)T + 1, sizeof(*count));
+    found *pairs = NULL;
+    uint32_t *cursor = NULL;
+    if (!l || !under || !rays || !hits || !valid || !count)
+        goto fail;
+    l->scene_triangles = T;
+
+    /* 1. the scene triangles under each display triangle */
+    const uint32_t batches = (front + PROBE_BATCH - 1) / PROBE_BATCH;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int64_t batch = 0; batch < (int64_t)batches; batch++) {
+        const int thread = omp_get_thread_num();
+        rad_ray *r = &rays[(size_t)thread * PROBE_BATCH * PROBES];
+        rad_hit *h = &hits[(size_t)thread * PROBE_BATCH * PROBES];
+        bool *ok = &valid[(size_t)thread * PROBE_BATCH];
+        const uint32_t first = (uint32_t)batch * PROBE_BATCH;
+        const uint32_t n = front - first < PROBE_BATCH ? front - first : PROBE_BATCH;
+        for (uint32_t k = 0; k < n; k++)
+            probe_rays(mesh, display, positions, first + k, &r[k * PROBES], &ok[k]);
+        rad_tracer_intersect(scene_tracer, r, n * PROBES, h);
+        for (uint32_t k = 0; k < n; k++) {
+            const uint32_t d = first + k;
+            const rad_patch *patch = &mesh->patches[display->patch_of[d]];
+            unsigned kept = 0;
+            for (unsigned p = 0; p < PROBES; p++) {
+                uint32_t t = h[k * PROBES + p].triangle;
+                bool again = t == RAD_NO_HIT || !ok[k];
+                for (unsigned q = 0; !again && q < kept; q++)
+                    again = under[d][q] == t;
+                if (again || scene->triangles[t].surface != patch->surface ||
+                    scene->triangles[t].material != patch->material)
+                    continue;
+                const uint32_t *sv = scene->triangles[t].vertex;
+                rad_vec3 tn = v3_cross(v3_sub(scene->positions[sv[1]], scene->positions[sv[0]]),
+                                       v3_sub(scene->positions[sv[2]], scene->positions[sv[0]]));
+                double tl = v3_length(tn);
+                if (!(tl > 0) || v3_dot(tn, patch->normal) < SAME_SIDE * tl)
+                    continue;
+                under[d][kept++] = t;
+            }
+            for (unsigned p = kept; p < PROBES; p++)
+                under[d][p] = UINT32_MAX;
+        }
+    }
+    free(rays);
+    free(hits);
+    free(valid);
+    rays = NULL;
+    hits = NULL;
+    valid = NULL;
+
+    /* 2. each (scene triangle, display triangle) with its map, in scene-triangle order */
+    size_t pair_count = 0;
+    for (uint32_t d = 0; d < front; d++)
+        for (unsigned p = 0; p < PROBES && under[d][p] != UINT32_MAX; p++) {
+            count[under[d][p]]++;
+            pair_count++;
+        }
+    pairs = rad_alloc_array(pair_count ? pair_count : 1, sizeof(*pairs));
+    cursor = rad_alloc_array((size_t)T + 1, sizeof(*cursor));
+    l->first_cell = rad_alloc_array((size_t)T + 1, sizeof(*l->first_cell));
+    l->side = rad_alloc_array(T, sizeof(*l->side));
+    if (!pairs || !cursor || !l->first_cell || !l->side)
+        goto fail;
+    for (uint32_t t = 0, at = 0; t < T; t++) {
+        cursor[t] = at;
+        at += count[t];
+    }
+    size_t cells = 0;
+    for (uint32_t t = 0; t < T; t++) {
+        l->first_cell[t] = (uint32_t)cells;
+        uint32_t side = count[t] ? (uint32_t)ceil(sqrt(count[t] / PER_CELL)) : 0;
+        side = count[t] && side < 1 ? 1 : side > MAX_SIDE ? MAX_SIDE : side;
+        l->side[t] = side;
+        cells += (size_t)side * side;
+        if (cells > UINT32_MAX / 2)
+            goto fail;
+    }
+    l->first_cell[T] = (uint32_t)cells;
+    for (uint32_t d = 0; d < front; d++)
+        for (unsigned p = 0; p < PROBES && under[d][p] != UINT32_MAX; p++) {
+            uint32_t t = under[d][p];
+            pairs[cursor[t]++] = (found){t, d};
+        }
+    free(under);
+    under = NULL;
+
+    /* 3. the cells: each display triangle in every cell its (u, v) box meets */
+    l->cell_start = rad_alloc_array(cells + 1, sizeof(*l->cell_start));
+    if (!l->cell_start)
+        goto fail;
+    size_t items = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t k = 0; k < pair_count; k++) {
+            const uint32_t t = pairs[k].scene_triangle, *v = display->triangles[pairs[k].triangle];
+            const rad_vec3 corner[3] = {positions[v[0]], positions[v[1]], positions[v[2]]};
+            triangle_frame frame = frame_of(scene, t);
+            placement at, *f = &at;
+            if (!(frame.det > 0) || !map_onto(&frame, corner, f) || f->hi[0] < 0 ||
+                f->hi[1] < 0 || f->lo[0] > 1 || f->lo[1] > 1)
+                continue; /* edge-on or outside: never located there */
+            uint32_t side = l->side[t];
+            uint32_t u0 = cell_index(f->lo[0], side), u1 = cell_index(f->hi[0], side);
+            uint32_t v0 = cell_index(f->lo[1], side), v1 = cell_index(f->hi[1], side);
+            for (uint32_t cv = v0; cv <= v1; cv++)
+                for (uint32_t cu = u0; cu <= u1; cu++) {
+                    size_t cell = l->first_cell[t] + (size_t)cv * side + cu;
+                    if (pass == 0) {
+                        l->cell_start[cell + 1]++;
+                        items++;
+                    } else {
+                        located *item = &l->items[l->cell_start[cell]++];
+                        for (int m = 0; m < 4; m++)
+                            item->m[m] = (float)f->m[m];
+                        item->q0[0] = (float)f->q0[0];
+                        item->q0[1] = (float)f->q0[1];
+                        item->triangle = pairs[k].triangle;
+                    }
+                }
+        }
+        if (pass == 0) {
+            if (items > UINT32_MAX)
+                goto fail;
+            for (size_t c = 0; c < cells; c++) /* starts; pass 1 moves each to its end */
+                l->cell_start[c + 1] += l->cell_start[c];
+            l->items = rad_alloc_array(items ? items : 1, sizeof(*l->items));
+            if (!l->items)
+                goto fail;
+        }
+    }
+    for (size_t c = cells; c > 0; c--) /* each end back to its start */
+        l->cell_start[c] = l->cell_start[c - 1];
+    l->cell_start[0] = 0;
+    free(pairs);
+    free(cursor);
+    free(count);
+    *out = l;
+    return RAD_OK;
+fail:
+    free(under);
+    free(rays);
+    free(hits);
+    free(valid);
+    free(count);
+    free(pairs);
+    free(cursor);
+    display_locator_destroy(l);
+    return rad_fail(error, RAD_ERR_NOMEM, "out of memory for placing the gather's hits");
+}
+
+/* The barycentrics of (u, v) in the item's display triangle; the least of the three. */
+static double weights_in(const located *item, double u, double v, double *b1, double *b2)
+{
+    double du = u - item->q0[0], dv = v - item->q0[1];
+    *b1 = item->m[0] * du + item->m[1] * dv;
+    *b2 = item->m[2] * du + item->m[3] * dv;
+    double b0 = 1 - *b1 - *b2, least = *b1 < *b2 ? *b1 : *b2;
+    return b0 < least ? b0 : least;
+}
+
+bool display_locate(const display_locator *l, rad_hit *hit)
+{
+    if (hit->triangle == RAD_NO_HIT)
+        return true;
+    const uint32_t t = hit->triangle, side = l->side[t];
+    if (side == 0)
+        return false;
+    const double u = hit->u, v = hit->v;
+    double best = -INFINITY, b1 = 0, b2 = 0;
+    uint32_t chosen = RAD_NO_HIT;
+    const uint32_t cell = l->first_cell[t] + cell_index(v, side) * side + cell_index(u, side);
+    for (uint32_t k = l->cell_start[cell]; k < l->cell_start[cell + 1]; k++) {
+        double x1, x2, least = weights_in(&l->items[k], u, v, &x1, &x2);
+        if (least > best) {
+            best = least;
+            b1 = x1;
+            b2 = x2;
+            chosen = l->items[k].triangle;
+            if (least >= 0)
+                break;
+        }
+    }
+    if (!(best >= -ON_EDGE))
+        return false;
+    if (best < 0) { /* just outside: onto the triangle */
+        b1 = fmax(b1, 0);
+        b2 = fmax(b2, 0);
+        double sum = b1 + b2;
+        if (sum > 1) {
+            b1 /= sum;
+            b2 /= sum;
+        }
+    }
+    hit->triangle = chosen;
+    hit->u = (float)b1;
+    hit->v = (float)b2;
+    return true;
+}
+
+void display_locator_destroy(display_locator *l)
+{
+    if (!l)
+        return;
+    free(l->first_cell);
+    free(l->side);
+    free(l->cell_start);
+    free(l->items);
+    free(l);
+}
