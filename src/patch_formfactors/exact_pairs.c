@@ -11,6 +11,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 
 #include "core/alloc.h"
@@ -338,10 +339,187 @@ done:
     return status;
 }
 
+/* A group's cell is about this many mean patches wide. */
+#define GROUP_WIDTH 4.0
+
+/* Where a patch goes: its surface, its plane (normal and offset rounded), its cell. */
+typedef struct group_key {
+    uint32_t surface, patch;
+    int64_t normal[3], offset, cell[2];
+} group_key;
+
+static int compare_keys(const void *pa, const void *pb)
+{
+    const group_key *a = pa, *b = pb;
+    const int64_t ka[6] = {a->normal[0], a->normal[1], a->normal[2], a->offset, a->cell[0],
+                           a->cell[1]};
+    const int64_t kb[6] = {b->normal[0], b->normal[1], b->normal[2], b->offset, b->cell[0],
+                           b->cell[1]};
+    if (a->surface != b->surface)
+        return a->surface < b->surface ? -1 : 1;
+    for (int k = 0; k < 6; k++)
+        if (ka[k] != kb[k])
+            return ka[k] < kb[k] ? -1 : 1;
+    return a->patch < b->patch ? -1 : a->patch > b->patch;
+}
+
+static bool same_group(const group_key *a, const group_key *b)
+{
+    return a->surface == b->surface && a->normal[0] == b->normal[0] &&
+           a->normal[1] == b->normal[1] && a->normal[2] == b->normal[2] &&
+           a->offset == b->offset && a->cell[0] == b->cell[0] && a->cell[1] == b->cell[1];
+}
+
+/* The normal a key's rounding stands for: every patch of a group measures its cell with
+ * the same axes. */
+static rad_vec3 key_normal(const group_key *key)
+{
+    return v3_normalize(v3((double)key->normal[0], (double)key->normal[1],
+                           (double)key->normal[2]));
+}
+
+static void plane_axes(rad_vec3 n, rad_vec3 *a, rad_vec3 *b)
+{
+    *a = fabs(n.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
+    *a = v3_normalize(v3_sub(*a, v3_scale(n, v3_dot(n, *a))));
+    *b = v3_cross(n, *a); /* a x b = n: the rectangle's corners run counter-clockwise */
+}
+
+/* The rectangle in the first member's plane around the members' corners; members off that
+ * plane leave the group. False when fewer than two are left (no group). */
+static bool group_rectangle(exact_pairs *pairs, const group_key *member, uint32_t count,
+                            uint32_t group, vf_polygon *out)
+{
+    const vf_polygon *first = &pairs->polygons[member[0].patch];
+    rad_vec3 n = first->normal, a, b;
+    double offset = v3_dot(n, first->vertex[0]);
+    plane_axes(n, &a, &b);
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    uint32_t kept = 0;
+    for (uint32_t m = 0; m < count; m++) {
+        const vf_polygon *p = &pairs->polygons[member[m].patch];
+        bool on = v3_dot(p->normal, n) > 1 - 1e-9;
+        for (unsigned c = 0; on && c < p->count; c++)
+            on = fabs(v3_dot(n, p->vertex[c]) - offset) <= pairs->plane_epsilon;
+        pairs->group_of[member[m].patch] = on ? group : EXACT_NO_GROUP;
+        if (!on)
+            continue;
+        kept++;
+        for (unsigned c = 0; c < p->count; c++) {
+            double u = v3_dot(a, p->vertex[c]), v = v3_dot(b, p->vertex[c]);
+            lo[0] = fmin(lo[0], u);
+            hi[0] = fmax(hi[0], u);
+            lo[1] = fmin(lo[1], v);
+            hi[1] = fmax(hi[1], v);
+        }
+    }
+    if (kept < 2 || !(hi[0] > lo[0]) || !(hi[1] > lo[1])) {
+        for (uint32_t m = 0; m < count; m++)
+            pairs->group_of[member[m].patch] = EXACT_NO_GROUP;
+        return false;
+    }
+    *out = *first;
+    out->count = 4;
+    const double u[4] = {lo[0], hi[0], hi[0], lo[0]}, v[4] = {lo[1], lo[1], hi[1], hi[1]};
+    for (int c = 0; c < 4; c++)
+        out->vertex[c] = v3_add(v3_scale(n, offset), v3_add(v3_scale(a, u[c]), v3_scale(b, v[c])));
+    vf_polygon_finish(out);
+    out->normal = n;
+    return true;
+}
+
+rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threads,
+                             rad_error *error)
+{
+    const uint32_t n = mesh->patch_count;
+    double area = 0;
+    uint32_t flat = 0;
+    for (uint32_t p = 0; p < n; p++)
+        if (pairs->polygons[p].count) {
+            area += pairs->polygons[p].area;
+            flat++;
+        }
+    if (flat < 2 || !(area > 0) || pairs->screen_node_count == 0)
+        return RAD_OK; /* nothing to group, or nothing can block */
+    const double width = GROUP_WIDTH * sqrt(area / flat);
+    group_key *keys = rad_alloc_array(flat, sizeof(*keys));
+    pairs->group_of = rad_alloc_array(n, sizeof(*pairs->group_of));
+    vf_polygon *rectangles = NULL;
+    if (!keys || !pairs->group_of)
+        goto nomem;
+    uint32_t k = 0;
+    for (uint32_t p = 0; p < n; p++) {
+        pairs->group_of[p] = EXACT_NO_GROUP;
+        const vf_polygon *polygon = &pairs->polygons[p];
+        if (!polygon->count)
+            continue;
+        group_key *key = &keys[k++];
+        key->surface = polygon->surface;
+        key->patch = p;
+        key->normal[0] = llround(polygon->normal.x * 1e6);
+        key->normal[1] = llround(polygon->normal.y * 1e6);
+        key->normal[2] = llround(polygon->normal.z * 1e6);
+        rad_vec3 normal = key_normal(key), a, b;
+        plane_axes(normal, &a, &b);
+        key->offset = llround(v3_dot(normal, polygon->centroid) / width * 1e3);
+        key->cell[0] = (int64_t)floor(v3_dot(a, polygon->centroid) / width);
+        key->cell[1] = (int64_t)floor(v3_dot(b, polygon->centroid) / width);
+    }
+    qsort(keys, flat, sizeof(*keys), compare_keys);
+    uint32_t groups = 0;
+    for (uint32_t first = 0, last; first < flat; first = last) {
+        for (last = first + 1; last < flat && same_group(&keys[first], &keys[last]); last++)
+            ;
+        groups += last - first >= 2;
+    }
+    rectangles = rad_alloc_array(groups ? groups : 1, sizeof(*rectangles));
+    if (!rectangles)
+        goto nomem;
+    uint32_t made = 0;
+    for (uint32_t first = 0, last; first < flat; first = last) {
+        for (last = first + 1; last < flat && same_group(&keys[first], &keys[last]); last++)
+            ;
+        if (last - first >= 2 &&
+            group_rectangle(pairs, &keys[first], last - first, made, &rectangles[made]))
+            made++;
+    }
+    free(keys);
+    keys = NULL;
+    /* a row of words per group: each thread writes its rows' words alone, so each row is
+     * screened in full, (g, h) and (h, g) both */
+    pairs->group_count = made;
+    pairs->group_words = (made + 63) / 64;
+    pairs->group_clear =
+        rad_alloc_array((size_t)made * pairs->group_words + 1, sizeof(*pairs->group_clear));
+    if (!pairs->group_clear)
+        goto nomem;
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads > 0 ? threads : 1)
+    for (int64_t g = 0; g < (int64_t)made; g++)
+        for (uint32_t h = 0; h < made; h++)
+            if (h != (uint32_t)g && !screen_may_block(pairs, &rectangles[g], &rectangles[h]))
+                pairs->group_clear[(size_t)g * pairs->group_words + h / 64] |= UINT64_C(1)
+                                                                               << (h % 64);
+    free(rectangles);
+    return RAD_OK;
+nomem:
+    free(keys);
+    free(rectangles);
+    free(pairs->group_of);
+    free(pairs->group_clear);
+    pairs->group_of = NULL;
+    pairs->group_clear = NULL;
+    pairs->group_count = 0;
+    return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the groups of patches");
+}
+
 void exact_pairs_free(exact_pairs *pairs)
 {
     occluder_tree_destroy(pairs->tree);
     free(pairs->polygons);
+    free(pairs->group_of);
+    free(pairs->group_clear);
+    pairs->group_of = NULL;
+    pairs->group_clear = NULL;
     free(pairs->screen_nodes);
     free(pairs->screen_triangles);
     pairs->tree = NULL;

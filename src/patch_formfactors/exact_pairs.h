@@ -29,7 +29,14 @@ typedef struct exact_pairs {
     vf_polygon *polygons; /* per patch; count 0 for a folded (bulging) patch: never exact */
     double epsilon;       /* touching a pair's hull within this does not count */
     double plane_epsilon; /* in front of a plane means beyond this (scene units) */
+    /* groups of about 16 neighbouring coplanar patches (exact_pairs_group): two groups
+     * whose rectangles' hull no triangle cuts make every pair between them clear */
+    uint32_t *group_of;   /* per patch, or EXACT_NO_GROUP; NULL: no groups */
+    uint32_t group_count, group_words;
+    uint64_t *group_clear; /* per group, group_words words: bit h of the row of g */
 } exact_pairs;
+
+#define EXACT_NO_GROUP UINT32_MAX
 
 rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
                              double plane_epsilon, exact_pairs *out, rad_error *error);
@@ -41,6 +48,26 @@ typedef enum exact_outcome {
     EXACT_SAMPLE    /* too many occluders (or a folded patch, or the clipping gave up):
                        sample visibility */
 } exact_outcome;
+
+/* Groups the patches: neighbouring coplanar patches of one surface, in cells about four
+ * patches wide, each group standing for the rectangle in its plane around its patches;
+ * then screens every two groups' rectangles as a pair. The hull of two patches lies in the
+ * hull of their groups' rectangles, so a triangle that cuts the first cuts the second:
+ * two groups found clear make each pair between them clear, and screening the pair
+ * itself (which would say the same) is skipped. A folded patch has no group. */
+rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threads,
+                             rad_error *error);
+
+/* Whether the pair (i, j) is clear by its groups. */
+static inline bool exact_pairs_group_clear(const exact_pairs *pairs, uint32_t i, uint32_t j)
+{
+    if (!pairs->group_of)
+        return false;
+    uint32_t g = pairs->group_of[i], h = pairs->group_of[j];
+    if (g == EXACT_NO_GROUP || h == EXACT_NO_GROUP)
+        return false;
+    return pairs->group_clear[(size_t)g * pairs->group_words + h / 64] >> (h % 64) & 1u;
+}
 
 /* Classifies the pair (i, j); with `clip` (pairs close enough for their kernel to vary
  * fast across them) also settles a pair that few triangles obstruct, to relative

@@ -419,8 +419,11 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
             continue;
         w->pairs_facing++;
         double settled;
-        exact_outcome outcome = exact_pairs_transfer(
-            &e->exact, i, j, distance < EXACT_DISTANCE * radii, EXACT_ACCURACY, &settled);
+        exact_outcome outcome =
+            exact_pairs_group_clear(&e->exact, i, j)
+                ? EXACT_CLEAR
+                : exact_pairs_transfer(&e->exact, i, j, distance < EXACT_DISTANCE * radii,
+                                       EXACT_ACCURACY, &settled);
         if (outcome == EXACT_CLEAR) {
             w->pairs_clear++;
             e->sink(e->sink_data, thread, i, j, G);
@@ -555,6 +558,8 @@ static rad_status run(const rad_mesh *mesh, const rad_tracer *occluders,
                                  error);
     if (status == RAD_OK)
         status = exact_pairs_build(mesh, occluders, e.plane_epsilon, &e.exact, error);
+    if (status == RAD_OK)
+        status = exact_pairs_group(&e.exact, mesh, threads, error);
     if (status != RAD_OK)
         goto done;
     double start = rad_clock_seconds();
