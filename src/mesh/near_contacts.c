@@ -256,7 +256,7 @@ static bool may_meet(const near_contacts *contacts, uint32_t k, rad_vec3 a, rad_
     if (speed == 0)
         return fabs(distance) <= slack;
     double t0 = (-distance - slack) / speed, t1 = (-distance + slack) / speed;
-    return fmax(t0, t1) > t_low && fmin(t0, t1) < zone;
+    return max_d(t0, t1) > t_low && min_d(t0, t1) < zone;
 }
 
 /* The end `a` of a segment a + t d, t in [0, 1], of the given length: does it cross one

@@ -16,6 +16,7 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/minmax.h"
 #include "core/vec3.h"
 #include "surface_viewfactors/pair_transfer.h"
 #include "trace/tracer_internal.h"
@@ -207,8 +208,8 @@ static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, cons
         const vf_polygon *polygon = k ? q : p;
         for (unsigned c = 0; c < polygon->count; c++)
             for (int a = 0; a < 3; a++) {
-                s.lo[a] = fmin(s.lo[a], coordinate(polygon->vertex[c], a));
-                s.hi[a] = fmax(s.hi[a], coordinate(polygon->vertex[c], a));
+                s.lo[a] = min_d(s.lo[a], coordinate(polygon->vertex[c], a));
+                s.hi[a] = max_d(s.hi[a], coordinate(polygon->vertex[c], a));
             }
     }
     const screen_triangle *candidate[SCREEN_CANDIDATES];

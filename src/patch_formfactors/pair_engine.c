@@ -29,6 +29,7 @@
 #include "core/alloc.h"
 #include "core/clock.h"
 #include "core/error.h"
+#include "core/minmax.h"
 #include "core/random.h"
 #include "core/tolerance.h"
 #include "core/vec3.h"
@@ -308,7 +309,7 @@ static double weighted_visibility(const engine *e, const batch *b, const pending
                                   uint32_t i)
 {
     const patch_geometry *gi = &e->geometry[i], *gj = &e->geometry[pair->j];
-    double floor_r = 0.5 * fmin(gi->radius, gj->radius);
+    double floor_r = 0.5 * min_d(gi->radius, gj->radius);
     double floor_r2 = floor_r * floor_r;
     double total = 0, visible = 0;
     for (uint32_t r = 0; r < pair->ray_count; r++) {
@@ -317,7 +318,7 @@ static double weighted_visibility(const engine *e, const batch *b, const pending
         double r2 = v3_dot(d, d);
         double length = sqrt(r2);
         double ci = v3_dot(gi->normal, d) / length, cj = -v3_dot(gj->normal, d) / length;
-        double kernel = fmax(ci, 0) * fmax(cj, 0) / fmax(r2, floor_r2);
+        double kernel = max_d(ci, 0) * max_d(cj, 0) / max_d(r2, floor_r2);
         total += kernel;
         if (!b->occluded[pair->first_ray + r])
             visible += kernel;

@@ -213,7 +213,8 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
     hits = NULL;
     valid = NULL;
 
-    /* 2. each (scene triangle, display triangle) with its map, in scene-triangle order */
+    /* 2. the (scene triangle, display triangle) pairs in scene-triangle order, and each
+     * scene triangle's grid: about PER_CELL display triangles a cell */
     size_t pair_count = 0;
     for (uint32_t d = 0; d < front; d++)
         for (unsigned p = 0; p < PROBES && under[d][p] != UINT32_MAX; p++) {
