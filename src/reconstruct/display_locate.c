@@ -165,6 +165,7 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
     uint32_t *count = rad_alloc_array((size_t)T + 1, sizeof(*count));
     found *pairs = NULL;
     uint32_t *cursor = NULL;
+    float *cover = NULL; /* per listing while the cells are made */
     if (!l || !under || !rays || !hits || !valid || !count)
         goto fail;
     l->scene_triangles = T;
@@ -274,6 +275,10 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
                         l->cell_start[cell + 1]++;
                         items++;
                     } else {
+                        /* how much of the cell its box covers: the likelier first */
+                        double du = fmin(f->hi[0], (cu + 1.0) / side) - fmax(f->lo[0], (double)cu / side);
+                        double dv = fmin(f->hi[1], (cv + 1.0) / side) - fmax(f->lo[1], (double)cv / side);
+                        cover[l->cell_start[cell]] = (float)(fmax(du, 0) * fmax(dv, 0));
                         located *item = &l->items[l->cell_start[cell]++];
                         for (int m = 0; m < 4; m++)
                             item->m[m] = (float)f->m[m];
@@ -289,19 +294,36 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
             for (size_t c = 0; c < cells; c++) /* starts; pass 1 moves each to its end */
                 l->cell_start[c + 1] += l->cell_start[c];
             l->items = rad_alloc_array(items ? items : 1, sizeof(*l->items));
-            if (!l->items)
+            cover = rad_alloc_array(items ? items : 1, sizeof(*cover));
+            if (!l->items || !cover)
                 goto fail;
         }
     }
     for (size_t c = cells; c > 0; c--) /* each end back to its start */
         l->cell_start[c] = l->cell_start[c - 1];
     l->cell_start[0] = 0;
+    /* each cell's display triangles by how much of it they cover, most first: a hit is
+     * found after fewer tests (on the Cornell box 6.9 a hit in arrival order) */
+    for (size_t c = 0; c < cells; c++)
+        for (uint32_t k = l->cell_start[c] + 1; k < l->cell_start[c + 1]; k++) {
+            located item = l->items[k];
+            float key = cover[k];
+            uint32_t at = k;
+            for (; at > l->cell_start[c] && cover[at - 1] < key; at--) {
+                l->items[at] = l->items[at - 1];
+                cover[at] = cover[at - 1];
+            }
+            l->items[at] = item;
+            cover[at] = key;
+        }
+    free(cover);
     free(pairs);
     free(cursor);
     free(count);
     *out = l;
     return RAD_OK;
 fail:
+    free(cover);
     free(under);
     free(rays);
     free(hits);
