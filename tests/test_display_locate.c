@@ -9,7 +9,9 @@
  *     the folded wall's stray from its input triangles),
  *   - the located triangle is on the surface and side that the display tracer's hit is,
  *   - a miss is a miss for both,
- *   - at most 1 ray in 10^4 is not placed (the gather traces those on the display mesh).
+ *   - at most 1 ray in 10^4 is not placed (the gather traces those on the display mesh),
+ *   - the locator holds at most DISPLAY_LOCATE_BYTES_PER_TRIANGLE a display triangle, on
+ *     a long thin strip (20 x 0.4, two triangles) too.
  */
 #include <math.h>
 #include <stdio.h>
@@ -102,12 +104,14 @@ static void check_scene(const char *name, const rad_scene *scene, double patch_s
         other_surface += mine->surface != theirs->surface;
         other_side += got->front != want->front;
     }
+    double bytes = (double)display_locator_bytes(locator) / front;
     printf("%s: %u patches, %u display triangles, %u rays: %u hits, %u not placed, "
            "farthest %.3g (stray %.3g, diagonal %.3g), %u on another surface, %u on "
-           "another side, %u miss only one way\n",
+           "another side, %u miss only one way; %.0f bytes a display triangle\n",
            name, mesh->patch_count, front, RAYS, hits, unplaced, worst, stray, diagonal,
-           other_surface, other_side, miss_mismatch);
-    CHECK(hits > RAYS / 2);
+           other_surface, other_side, miss_mismatch, bytes);
+    CHECK(bytes <= DISPLAY_LOCATE_BYTES_PER_TRIANGLE);
+    CHECK(hits > RAYS / 4);
     CHECK(unplaced <= hits / 10000);
     CHECK(off_point == 0);
     CHECK(other_surface <= hits / 10000);
@@ -163,5 +167,22 @@ int main(void)
         check_scene("octahedron in a box", scene, 0.25);
     rad_scene_destroy(scene);
     free(obj.data);
+
+    /* a long thin strip, 20 x 0.4 under a ceiling as thin (two triangles each, 50 to 1):
+     * a grid over the (u, v) square would stretch each display triangle's box over many
+     * cells (the locator took 1 kB a display triangle on such a strip) */
+    test_obj strip = {0};
+    test_obj_add(&strip, "mtllib octahedron.mtl\n");
+    test_obj_object(&strip, "floor", "white");
+    test_obj_rectangle(&strip, 1, 0, 0, 0, 0.4, 20, 1);
+    test_obj_object(&strip, "ceiling", "light");
+    test_obj_rectangle(&strip, 1, 0.4, 0, 0, 0.4, 20, -1);
+    path = test_write_file("strip.obj", strip.data);
+    scene = NULL;
+    CHECK(rad_scene_load(path, NULL, &scene, &error) == RAD_OK);
+    if (scene)
+        check_scene("thin strip", scene, 0.05);
+    rad_scene_destroy(scene);
+    free(strip.data);
     return test_finish("test_display_locate");
 }

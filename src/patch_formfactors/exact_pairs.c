@@ -429,6 +429,17 @@ static bool group_rectangle(exact_pairs *pairs, const group_key *member, uint32_
     return true;
 }
 
+/* Whether some corner of each rectangle lies in front of the other's plane. */
+static bool rectangles_face(const vf_polygon *a, const vf_polygon *b, double epsilon)
+{
+    bool ab = false, ba = false;
+    for (unsigned k = 0; k < 4; k++) {
+        ab = ab || v3_dot(a->normal, v3_sub(b->vertex[k], a->vertex[0])) > epsilon;
+        ba = ba || v3_dot(b->normal, v3_sub(a->vertex[k], b->vertex[0])) > epsilon;
+    }
+    return ab && ba;
+}
+
 rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threads,
                              rad_error *error)
 {
@@ -454,7 +465,7 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
         const vf_polygon *polygon = &pairs->polygons[p];
         if (!polygon->count)
             continue;
-        group_key *key = &keys[k++];
+        group_key *key = &keys[k];
         key->surface = polygon->surface;
         key->patch = p;
         key->normal[0] = llround(polygon->normal.x * 1e6);
@@ -462,10 +473,17 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
         key->normal[2] = llround(polygon->normal.z * 1e6);
         rad_vec3 normal = key_normal(key), a, b;
         plane_axes(normal, &a, &b);
-        key->offset = llround(v3_dot(normal, polygon->centroid) / width * 1e3);
-        key->cell[0] = (int64_t)floor(v3_dot(a, polygon->centroid) / width);
-        key->cell[1] = (int64_t)floor(v3_dot(b, polygon->centroid) / width);
+        double offset = v3_dot(normal, polygon->centroid) / width * 1e3;
+        double cell[2] = {floor(v3_dot(a, polygon->centroid) / width),
+                          floor(v3_dot(b, polygon->centroid) / width)};
+        if (!(fabs(offset) < 1e15 && fabs(cell[0]) < 1e15 && fabs(cell[1]) < 1e15))
+            continue; /* patches far smaller than their distance from the origin: no group */
+        key->offset = llround(offset);
+        key->cell[0] = (int64_t)cell[0];
+        key->cell[1] = (int64_t)cell[1];
+        k++;
     }
+    flat = k;
     qsort(keys, flat, sizeof(*keys), compare_keys);
     uint32_t groups = 0;
     for (uint32_t first = 0, last; first < flat; first = last) {
@@ -486,8 +504,9 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
     }
     free(keys);
     keys = NULL;
-    /* a row of words per group: each thread writes its rows' words alone, so each row is
-     * screened in full, (g, h) and (h, g) both */
+    /* a row of words per group, the pair (g, h) in g's row for g < h: each thread writes
+     * its rows' words alone; rectangles that do not face each other are not screened (no
+     * pair between them faces either) */
     pairs->group_count = made;
     pairs->group_words = (made + 63) / 64;
     pairs->group_clear =
@@ -496,8 +515,9 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
         goto nomem;
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads > 0 ? threads : 1)
     for (int64_t g = 0; g < (int64_t)made; g++)
-        for (uint32_t h = 0; h < made; h++)
-            if (h != (uint32_t)g && !screen_may_block(pairs, &rectangles[g], &rectangles[h]))
+        for (uint32_t h = (uint32_t)g + 1; h < made; h++)
+            if (rectangles_face(&rectangles[g], &rectangles[h], pairs->plane_epsilon) &&
+                !screen_may_block(pairs, &rectangles[g], &rectangles[h]))
                 pairs->group_clear[(size_t)g * pairs->group_words + h / 64] |= UINT64_C(1)
                                                                                << (h % 64);
     free(rectangles);

@@ -33,7 +33,7 @@ typedef struct exact_pairs {
      * whose rectangles' hull no triangle cuts make every pair between them clear */
     uint32_t *group_of;   /* per patch, or EXACT_NO_GROUP; NULL: no groups */
     uint32_t group_count, group_words;
-    uint64_t *group_clear; /* per group, group_words words: bit h of the row of g */
+    uint64_t *group_clear; /* per group, group_words words: bit h of the row of g, g < h */
 } exact_pairs;
 
 #define EXACT_NO_GROUP UINT32_MAX
@@ -66,6 +66,11 @@ static inline bool exact_pairs_group_clear(const exact_pairs *pairs, uint32_t i,
     uint32_t g = pairs->group_of[i], h = pairs->group_of[j];
     if (g == EXACT_NO_GROUP || h == EXACT_NO_GROUP)
         return false;
+    if (g > h) { /* the pair is kept in the lower group's row */
+        uint32_t swap = g;
+        g = h;
+        h = swap;
+    }
     return pairs->group_clear[(size_t)g * pairs->group_words + h / 64] >> (h % 64) & 1u;
 }
 

@@ -19,9 +19,12 @@
 /* Display triangles probed per batch of rays (per thread). */
 #define PROBE_BATCH 256u
 /* A grid over a scene triangle has about this many display triangles a cell, and at most
- * MAX_SIDE x MAX_SIDE cells. */
+ * MAX_SIDE cells along either side. */
 #define PER_CELL 2.0
 #define MAX_SIDE 256u
+/* A display triangle whose box meets more cells than this is not listed (its hits are
+ * traced on the display mesh): the listings stay about PER_CELL a cell. */
+#define MAX_CELLS_PER_TRIANGLE 64u
 /* A point this far outside a display triangle, in its own barycentrics, still counts as
  * on it (the scene hit's u, v are floats), its barycentrics clamped onto it. */
 #define ON_EDGE 1e-3
@@ -36,7 +39,7 @@ typedef struct located {
 } located;
 
 /* A display triangle on a scene triangle: its map from the scene triangle's (u, v) and
- * its box there. */
+ * its box in the triangle's grid (grid_frame). */
 typedef struct placement {
     double m[4], q0[2];
     double lo[2], hi[2];
@@ -47,10 +50,19 @@ typedef struct found {
     uint32_t scene_triangle, triangle;
 } found;
 
+/* A scene triangle's grid: (x, y) = (f[0] + f[1] u + f[2] v, f[3] + f[4] u + f[5] v) is
+ * the point's place in the triangle's bounding rectangle, 0 to 1 along its longest edge
+ * and across it (square cells on a long thin triangle, where the (u, v) square would
+ * stretch each display triangle's box over many cells); nx x ny cells. */
+typedef struct grid_frame {
+    double f[6];
+    uint32_t nx, ny; /* 0: no display triangle */
+} grid_frame;
+
 struct display_locator {
     uint32_t scene_triangles;
     uint32_t *first_cell; /* per scene triangle, and one past the last */
-    uint32_t *side;       /* per scene triangle: its grid's side (0: no display triangle) */
+    grid_frame *grid;     /* per scene triangle: where its cells lie */
     uint32_t *cell_start; /* per cell, and one past the last: into items */
     located *items;
 };
@@ -84,13 +96,18 @@ static void uv_of(const triangle_frame *f, rad_vec3 x, double uv[2])
     uv[1] = (f->a * s2 - f->b * s1) / f->det;
 }
 
+static void grid_point(const grid_frame *g, double u, double v, double *x, double *y);
+
 /* The display triangle d's map from the scene triangle's (u, v) to its barycentrics, and
- * its box there; false when it is edge-on in that plane. */
-static bool map_onto(const triangle_frame *f, const rad_vec3 corner[3], placement *out)
+ * its box in the grid; false when it is edge-on in that plane. */
+static bool map_onto(const triangle_frame *f, const rad_vec3 corner[3], const grid_frame *g,
+                     placement *out)
 {
-    double q[3][2];
-    for (int k = 0; k < 3; k++)
+    double q[3][2], x[3][2];
+    for (int k = 0; k < 3; k++) {
         uv_of(f, corner[k], q[k]);
+        grid_point(g, q[k][0], q[k][1], &x[k][0], &x[k][1]);
+    }
     double a00 = q[1][0] - q[0][0], a01 = q[2][0] - q[0][0];
     double a10 = q[1][1] - q[0][1], a11 = q[2][1] - q[0][1];
     double det = a00 * a11 - a01 * a10;
@@ -103,8 +120,8 @@ static bool map_onto(const triangle_frame *f, const rad_vec3 corner[3], placemen
     out->q0[0] = q[0][0];
     out->q0[1] = q[0][1];
     for (int a = 0; a < 2; a++) {
-        out->lo[a] = fmin(q[0][a], fmin(q[1][a], q[2][a]));
-        out->hi[a] = fmax(q[0][a], fmax(q[1][a], q[2][a]));
+        out->lo[a] = fmin(x[0][a], fmin(x[1][a], x[2][a]));
+        out->hi[a] = fmax(x[0][a], fmax(x[1][a], x[2][a]));
     }
     return true;
 }
@@ -112,7 +129,69 @@ static bool map_onto(const triangle_frame *f, const rad_vec3 corner[3], placemen
 static uint32_t cell_index(double x, uint32_t side)
 {
     double at = floor(x * side);
-    return at < 0 ? 0 : at >= side ? side - 1 : (uint32_t)at;
+    return !(at >= 0) ? 0 : at >= side ? side - 1 : (uint32_t)at;
+}
+
+/* The frame of scene triangle t's grid, for `count` display triangles on it. */
+static grid_frame grid_of(const rad_scene *scene, uint32_t t, uint32_t count)
+{
+    grid_frame g = {{0, 0, 0, 0, 0, 0}, 0, 0};
+    if (count == 0)
+        return g;
+    const uint32_t *v = scene->triangles[t].vertex;
+    rad_vec3 p0 = scene->positions[v[0]];
+    rad_vec3 e1 = v3_sub(scene->positions[v[1]], p0), e2 = v3_sub(scene->positions[v[2]], p0);
+    rad_vec3 e3 = v3_sub(e2, e1);
+    rad_vec3 along = v3_dot(e1, e1) >= v3_dot(e2, e2) ? e1 : e2;
+    along = v3_dot(e3, e3) > v3_dot(along, along) ? e3 : along;
+    rad_vec3 n = v3_cross(e1, e2);
+    if (!(v3_length(n) > 0) || !(v3_length(along) > 0))
+        return g;
+    along = v3_normalize(along);
+    rad_vec3 across = v3_normalize(v3_cross(v3_normalize(n), along));
+    /* the corners in (along, across), from p0: (0, 0), e1's, e2's */
+    double x[3] = {0, v3_dot(along, e1), v3_dot(along, e2)};
+    double y[3] = {0, v3_dot(across, e1), v3_dot(across, e2)};
+    double x0 = fmin(x[0], fmin(x[1], x[2])), sx = fmax(x[0], fmax(x[1], x[2])) - x0;
+    double y0 = fmin(y[0], fmin(y[1], y[2])), sy = fmax(y[0], fmax(y[1], y[2])) - y0;
+    if (!(sx > 0) || !(sy > 0))
+        return g;
+    g.f[0] = -x0 / sx;
+    g.f[1] = x[1] / sx;
+    g.f[2] = x[2] / sx;
+    g.f[3] = -y0 / sy;
+    g.f[4] = y[1] / sy;
+    g.f[5] = y[2] / sy;
+    double cells = count / PER_CELL, nx = round(sqrt(cells * sx / sy));
+    nx = nx < 1 ? 1 : nx > MAX_SIDE ? MAX_SIDE : nx;
+    double ny = round(cells / nx);
+    ny = ny < 1 ? 1 : ny > MAX_SIDE ? MAX_SIDE : ny;
+    g.nx = (uint32_t)nx;
+    g.ny = (uint32_t)ny;
+    return g;
+}
+
+static void grid_point(const grid_frame *g, double u, double v, double *x, double *y)
+{
+    *x = g->f[0] + g->f[1] * u + g->f[2] * v;
+    *y = g->f[3] + g->f[4] * u + g->f[5] * v;
+}
+
+/* How far above display triangle d its probes start (a hundredth of its longest edge past
+ * a folded cell's stray), and in *slack how far from there the surface under it may lie:
+ * the stray, and a fifth of that hundredth (not a parallel layer of the same surface a
+ * little above or below). */
+static double probe_lift(const rad_mesh *mesh, const display_mesh *display,
+                         const rad_vec3 *positions, uint32_t d, double *slack)
+{
+    const uint32_t *v = display->triangles[d];
+    rad_vec3 a = positions[v[0]], b = positions[v[1]], c = positions[v[2]];
+    const rad_patch *patch = &mesh->patches[display->patch_of[d]];
+    double edge = fmax(v3_length(v3_sub(b, a)), fmax(v3_length(v3_sub(c, b)),
+                                                     v3_length(v3_sub(a, c))));
+    double stray = 2 * (patch->behind + patch->bulge);
+    *slack = stray + 0.002 * edge;
+    return 0.01 * edge + stray;
 }
 
 /* The scene triangles under display triangle d (up to PROBES, UINT32_MAX for none), by
@@ -132,10 +211,7 @@ static void probe_rays(const rad_mesh *mesh, const display_mesh *display,
         return;
     }
     n = v3_scale(n, 1 / length);
-    const rad_patch *patch = &mesh->patches[display->patch_of[d]];
-    double edge = fmax(v3_length(v3_sub(b, a)), fmax(v3_length(v3_sub(c, b)),
-                                                     v3_length(v3_sub(a, c))));
-    double lift = 0.01 * edge + 2 * (patch->behind + patch->bulge);
+    double slack, lift = probe_lift(mesh, display, positions, d, &slack);
     rad_vec3 centre = v3_scale(v3_add(v3_add(a, b), c), 1.0 / 3.0);
     rad_vec3 point[PROBES] = {centre, v3_lerp(centre, a, 0.9), v3_lerp(centre, b, 0.9),
                               v3_lerp(centre, c, 0.9)};
@@ -151,11 +227,11 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
     *out = NULL;
     if (!scene || !scene_tracer || scene->triangle_count == 0 || front == 0)
         return RAD_OK;
+    threads = threads < 1 ? 1 : threads;
     uint64_t left = rad_memory_budget_left();
     if (left != UINT64_MAX && (left < keep || (left - keep) / DISPLAY_LOCATE_BYTES_PER_TRIANGLE <
                                                   (uint64_t)front + PROBE_BATCH * threads))
         return RAD_OK;
-    threads = threads < 1 ? 1 : threads;
     const uint32_t T = scene->triangle_count;
     display_locator *l = rad_alloc_array(1, sizeof(*l));
     uint32_t (*under)[PROBES] = rad_alloc_array(front, sizeof(*under));
@@ -186,10 +262,12 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
         for (uint32_t k = 0; k < n; k++) {
             const uint32_t d = first + k;
             const rad_patch *patch = &mesh->patches[display->patch_of[d]];
+            double slack, lift = probe_lift(mesh, display, positions, d, &slack);
             unsigned kept = 0;
             for (unsigned p = 0; p < PROBES; p++) {
                 uint32_t t = h[k * PROBES + p].triangle;
-                bool again = t == RAD_NO_HIT || !ok[k];
+                bool again = t == RAD_NO_HIT || !ok[k] ||
+                             !(fabs(h[k * PROBES + p].t - lift) <= slack);
                 for (unsigned q = 0; !again && q < kept; q++)
                     again = under[d][q] == t;
                 if (again || scene->triangles[t].surface != patch->surface ||
@@ -225,8 +303,8 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
     pairs = rad_alloc_array(pair_count ? pair_count : 1, sizeof(*pairs));
     cursor = rad_alloc_array((size_t)T + 1, sizeof(*cursor));
     l->first_cell = rad_alloc_array((size_t)T + 1, sizeof(*l->first_cell));
-    l->side = rad_alloc_array(T, sizeof(*l->side));
-    if (!pairs || !cursor || !l->first_cell || !l->side)
+    l->grid = rad_alloc_array(T, sizeof(*l->grid));
+    if (!pairs || !cursor || !l->first_cell || !l->grid)
         goto fail;
     for (uint32_t t = 0, at = 0; t < T; t++) {
         cursor[t] = at;
@@ -235,12 +313,10 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
     size_t cells = 0;
     for (uint32_t t = 0; t < T; t++) {
         l->first_cell[t] = (uint32_t)cells;
-        uint32_t side = count[t] ? (uint32_t)ceil(sqrt(count[t] / PER_CELL)) : 0;
-        side = count[t] && side < 1 ? 1 : side > MAX_SIDE ? MAX_SIDE : side;
-        l->side[t] = side;
-        cells += (size_t)side * side;
+        l->grid[t] = grid_of(scene, t, count[t]);
+        cells += (size_t)l->grid[t].nx * l->grid[t].ny;
         if (cells > UINT32_MAX / 2)
-            goto fail;
+            goto decline;
     }
     l->first_cell[T] = (uint32_t)cells;
     for (uint32_t d = 0; d < front; d++)
@@ -262,22 +338,26 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
             const rad_vec3 corner[3] = {positions[v[0]], positions[v[1]], positions[v[2]]};
             triangle_frame frame = frame_of(scene, t);
             placement at, *f = &at;
-            if (!(frame.det > 0) || !map_onto(&frame, corner, f) || f->hi[0] < 0 ||
-                f->hi[1] < 0 || f->lo[0] > 1 || f->lo[1] > 1)
+            const grid_frame *g = &l->grid[t];
+            if (g->nx == 0 || !(frame.det > 0) || !map_onto(&frame, corner, g, f) ||
+                f->hi[0] < 0 || f->hi[1] < 0 || f->lo[0] > 1 || f->lo[1] > 1)
                 continue; /* edge-on or outside: never located there */
-            uint32_t side = l->side[t];
-            uint32_t u0 = cell_index(f->lo[0], side), u1 = cell_index(f->hi[0], side);
-            uint32_t v0 = cell_index(f->lo[1], side), v1 = cell_index(f->hi[1], side);
+            uint32_t u0 = cell_index(f->lo[0], g->nx), u1 = cell_index(f->hi[0], g->nx);
+            uint32_t v0 = cell_index(f->lo[1], g->ny), v1 = cell_index(f->hi[1], g->ny);
+            if ((uint64_t)(u1 - u0 + 1) * (v1 - v0 + 1) > MAX_CELLS_PER_TRIANGLE)
+                continue; /* larger than its cells: its hits are traced on the display */
             for (uint32_t cv = v0; cv <= v1; cv++)
                 for (uint32_t cu = u0; cu <= u1; cu++) {
-                    size_t cell = l->first_cell[t] + (size_t)cv * side + cu;
+                    size_t cell = l->first_cell[t] + (size_t)cv * g->nx + cu;
                     if (pass == 0) {
                         l->cell_start[cell + 1]++;
                         items++;
                     } else {
                         /* how much of the cell its box covers: the likelier first */
-                        double du = fmin(f->hi[0], (cu + 1.0) / side) - fmax(f->lo[0], (double)cu / side);
-                        double dv = fmin(f->hi[1], (cv + 1.0) / side) - fmax(f->lo[1], (double)cv / side);
+                        double du = fmin(f->hi[0], (cu + 1.0) / g->nx) -
+                                    fmax(f->lo[0], (double)cu / g->nx);
+                        double dv = fmin(f->hi[1], (cv + 1.0) / g->ny) -
+                                    fmax(f->lo[1], (double)cv / g->ny);
                         cover[l->cell_start[cell]] = (float)(fmax(du, 0) * fmax(dv, 0));
                         located *item = &l->items[l->cell_start[cell]++];
                         for (int m = 0; m < 4; m++)
@@ -289,8 +369,12 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
                 }
         }
         if (pass == 0) {
-            if (items > UINT32_MAX)
-                goto fail;
+            /* the listings counted: under a budget that cannot hold them beside `keep`, no
+             * locator (the estimate above was made before their number was known) */
+            uint64_t need = (uint64_t)items * (sizeof(located) + sizeof(float));
+            left = rad_memory_budget_left();
+            if (items > UINT32_MAX || (left != UINT64_MAX && (left < keep || left - keep < need)))
+                goto decline;
             for (size_t c = 0; c < cells; c++) /* starts; pass 1 moves each to its end */
                 l->cell_start[c + 1] += l->cell_start[c];
             l->items = rad_alloc_array(items ? items : 1, sizeof(*l->items));
@@ -333,6 +417,17 @@ fail:
     free(cursor);
     display_locator_destroy(l);
     return rad_fail(error, RAD_ERR_NOMEM, "out of memory for placing the gather's hits");
+decline:
+    free(cover);
+    free(under);
+    free(rays);
+    free(hits);
+    free(valid);
+    free(count);
+    free(pairs);
+    free(cursor);
+    display_locator_destroy(l);
+    return RAD_OK;
 }
 
 /* The barycentrics of (u, v) in the item's display triangle; the least of the three. */
@@ -349,13 +444,16 @@ bool display_locate(const display_locator *l, rad_hit *hit)
 {
     if (hit->triangle == RAD_NO_HIT)
         return true;
-    const uint32_t t = hit->triangle, side = l->side[t];
-    if (side == 0)
+    const uint32_t t = hit->triangle;
+    const grid_frame *g = &l->grid[t];
+    if (g->nx == 0)
         return false;
     const double u = hit->u, v = hit->v;
     double best = -INFINITY, b1 = 0, b2 = 0;
     uint32_t chosen = RAD_NO_HIT;
-    const uint32_t cell = l->first_cell[t] + cell_index(v, side) * side + cell_index(u, side);
+    double x, y;
+    grid_point(g, u, v, &x, &y);
+    const uint32_t cell = l->first_cell[t] + cell_index(y, g->ny) * g->nx + cell_index(x, g->nx);
     for (uint32_t k = l->cell_start[cell]; k < l->cell_start[cell + 1]; k++) {
         double x1, x2, least = weights_in(&l->items[k], u, v, &x1, &x2);
         if (least > best) {
@@ -384,12 +482,20 @@ bool display_locate(const display_locator *l, rad_hit *hit)
     return true;
 }
 
+uint64_t display_locator_bytes(const display_locator *l)
+{
+    const uint64_t cells = l->first_cell[l->scene_triangles];
+    const uint64_t items = l->cell_start[cells];
+    return sizeof(*l) + (uint64_t)l->scene_triangles * (sizeof(uint32_t) + sizeof(grid_frame)) +
+           (cells + 1) * sizeof(uint32_t) + items * sizeof(located);
+}
+
 void display_locator_destroy(display_locator *l)
 {
     if (!l)
         return;
     free(l->first_cell);
-    free(l->side);
+    free(l->grid);
     free(l->cell_start);
     free(l->items);
     free(l);

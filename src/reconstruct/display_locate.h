@@ -5,9 +5,9 @@
  * (every patch split into triangles) each ray walks a tree over tens of thousands of
  * triangles; traced against the scene's own triangles (a Cornell box has 32) it walks
  * almost none, and the display triangle under the hit is then found here: each scene
- * triangle holds a grid over its barycentric (u, v) square, each cell the display
- * triangles that overlap it, each with the affine map from (u, v) to its own
- * barycentrics. Which display triangles lie on which scene triangle is found by probing:
+ * triangle holds a grid over its bounding rectangle (along its longest edge and across),
+ * each cell the display triangles that overlap it, each with the affine map from the
+ * hit's (u, v) to its own barycentrics. Which display triangles lie on which scene triangle is found by probing:
  * short rays from just in front of points of each display triangle, back onto it, against
  * the scene, keeping the scene triangles of the same surface, material and side.
  *
@@ -16,7 +16,8 @@
  * Where no display triangle covers a hit (a sliver that no probe found, a folded quad's
  * cell that strays from its input triangles), display_locate says so and the caller
  * traces that ray against the display mesh instead: the answer never depends on the
- * probes having found everything, only the speed.
+ * probes having found everything, only the speed. A miss of the scene's triangles is a
+ * miss: the display mesh, made from those triangles, covers nothing else.
  */
 #ifndef RAD_RECONSTRUCT_DISPLAY_LOCATE_H
 #define RAD_RECONSTRUCT_DISPLAY_LOCATE_H
@@ -28,8 +29,10 @@
 
 typedef struct display_locator display_locator;
 
-/* At most this many bytes a display triangle while the locator is built and after (its
- * cells and their display triangles: about 95 on the Cornell box's finer mesh). */
+/* The bytes a display triangle that building the locator is expected to hold at its
+ * peak (about 95 on the Cornell box's finer mesh; test_display_locate holds every scene
+ * it builds, a long thin strip included, under this): under a budget, the first check.
+ * Once the listings are counted, what they need is checked against the budget again. */
 #define DISPLAY_LOCATE_BYTES_PER_TRIANGLE 192u
 
 /* Builds the locator for the first `front` display triangles (positions: every display
@@ -48,6 +51,9 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
  * weights of its corners 1 and 2); t and front stay. A miss stays a miss. False when no
  * display triangle covers the point (the hit is then unchanged). Thread-safe. */
 bool display_locate(const display_locator *locator, rad_hit *hit);
+
+/* The bytes the locator holds. */
+uint64_t display_locator_bytes(const display_locator *locator);
 
 void display_locator_destroy(display_locator *locator);
 
