@@ -16,6 +16,7 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/hemisphere.h"
 #include "core/minmax.h"
 #include "core/vec3.h"
 #include "surface_viewfactors/pair_transfer.h"
@@ -379,13 +380,6 @@ static rad_vec3 key_normal(const group_key *key)
                            (double)key->normal[2]));
 }
 
-static void plane_axes(rad_vec3 n, rad_vec3 *a, rad_vec3 *b)
-{
-    *a = fabs(n.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
-    *a = v3_normalize(v3_sub(*a, v3_scale(n, v3_dot(n, *a))));
-    *b = v3_cross(n, *a); /* a x b = n: the rectangle's corners run counter-clockwise */
-}
-
 /* The rectangle in the first member's plane around the members' corners; members off that
  * plane leave the group. False when fewer than two are left (no group). */
 static bool group_rectangle(exact_pairs *pairs, const group_key *member, uint32_t count,
@@ -394,7 +388,7 @@ static bool group_rectangle(exact_pairs *pairs, const group_key *member, uint32_
     const vf_polygon *first = &pairs->polygons[member[0].patch];
     rad_vec3 n = first->normal, a, b;
     double offset = v3_dot(n, first->vertex[0]);
-    plane_axes(n, &a, &b);
+    hemisphere_frame(n, &a, &b); /* a x b = n: the corners run counter-clockwise */
     double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
     uint32_t kept = 0;
     for (uint32_t m = 0; m < count; m++) {
@@ -472,7 +466,7 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
         key->normal[1] = llround(polygon->normal.y * 1e6);
         key->normal[2] = llround(polygon->normal.z * 1e6);
         rad_vec3 normal = key_normal(key), a, b;
-        plane_axes(normal, &a, &b);
+        hemisphere_frame(normal, &a, &b);
         double offset = v3_dot(normal, polygon->centroid) / width * 1e3;
         double cell[2] = {floor(v3_dot(a, polygon->centroid) / width),
                           floor(v3_dot(b, polygon->centroid) / width)};

@@ -242,6 +242,7 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
     found *pairs = NULL;
     uint32_t *cursor = NULL;
     float *cover = NULL; /* per listing while the cells are made */
+    rad_status status = RAD_OK;
     if (!l || !under || !rays || !hits || !valid || !count)
         goto fail;
     l->scene_triangles = T;
@@ -407,6 +408,8 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
     *out = l;
     return RAD_OK;
 fail:
+    status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for placing the gather's hits");
+decline: /* no locator: RAD_OK, or the failure above */
     free(cover);
     free(under);
     free(rays);
@@ -416,18 +419,7 @@ fail:
     free(pairs);
     free(cursor);
     display_locator_destroy(l);
-    return rad_fail(error, RAD_ERR_NOMEM, "out of memory for placing the gather's hits");
-decline:
-    free(cover);
-    free(under);
-    free(rays);
-    free(hits);
-    free(valid);
-    free(count);
-    free(pairs);
-    free(cursor);
-    display_locator_destroy(l);
-    return RAD_OK;
+    return status;
 }
 
 /* The barycentrics of (u, v) in the item's display triangle; the least of the three. */
