@@ -15,6 +15,7 @@
 #include "core/alloc.h"
 #include "core/error.h"
 #include "core/vec3.h"
+#include "surface_viewfactors/convex_solids.h"
 
 #define LEAF_SIZE 4u
 #define MAX_CORNERS (2u * VF_MAX_VERTICES)
@@ -31,6 +32,7 @@ typedef struct tree_triangle {
     rad_vec3 normal; /* unit */
     uint32_t source; /* the radiating polygon it belongs to (vf_polygon.source), or
                         UINT32_MAX */
+    uint32_t solid;  /* the convex solid it bounds (convex_solids.h), or UINT32_MAX */
 } tree_triangle;
 
 struct occluder_tree {
@@ -38,6 +40,8 @@ struct occluder_tree {
     uint32_t node_count;
     tree_triangle *triangles;
     uint32_t triangle_count;
+    convex_solids solids;
+    bool use_solids; /* leave out solids' faces turned away from the pair */
 };
 
 typedef struct hull {
@@ -121,8 +125,16 @@ rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_
         occluder_tree_destroy(tree);
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the occluder tree");
     }
+    rad_status status = convex_solids_find(scene, &tree->solids, error);
+    if (status != RAD_OK) {
+        free(centres);
+        occluder_tree_destroy(tree);
+        return status;
+    }
+    tree->use_solids = true;
     for (uint32_t t = 0; t < count; t++) {
         tree_triangle *tt = &tree->triangles[t];
+        tt->solid = tree->solids.of_triangle[t];
         for (int c = 0; c < 3; c++)
             tt->corner[c] = scene->positions[scene->triangles[t].vertex[c]];
         tt->normal = v3_normalize(v3_cross(v3_sub(tt->corner[1], tt->corner[0]),
@@ -148,6 +160,7 @@ void occluder_tree_destroy(occluder_tree *tree)
         return;
     free(tree->nodes);
     free(tree->triangles);
+    convex_solids_free(&tree->solids);
     free(tree);
 }
 
@@ -309,6 +322,8 @@ static bool triangle_cuts(const hull *h, const tree_triangle *t, double epsilon)
     return !(below || above);
 }
 
+void occluder_tree_use_solids(occluder_tree *tree, bool use) { tree->use_solids = use; }
+
 uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
                                const vf_polygon *q, double epsilon, shadow_occluder *out,
                                uint32_t max)
@@ -320,6 +335,11 @@ uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
     make_hull(&h, p, q, epsilon);
     h.exclude[0] = p->source;
     h.exclude[1] = q->source;
+    /* a convex solid's faces turned away from p (or, if p cannot see it so, from q) cast
+     * no shadow its other faces do not: the last solid met and the polygon it is seen
+     * from (NULL: all its faces) */
+    uint32_t last_solid = UINT32_MAX;
+    const vf_polygon *seen_from = NULL;
     uint32_t stack[2 * MAX_DEPTH + 2];
     unsigned top = 0;
     stack[top++] = 0;
@@ -329,11 +349,24 @@ uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
             continue;
         if (node->count) {
             for (uint32_t t = node->first; t < node->first + node->count; t++) {
-                if (!triangle_cuts(&h, &tree->triangles[t], epsilon))
+                const tree_triangle *tt = &tree->triangles[t];
+                if (!triangle_cuts(&h, tt, epsilon))
                     continue;
+                if (tt->solid != UINT32_MAX && tree->use_solids) {
+                    if (tt->solid != last_solid) {
+                        const convex_solid *solid = &tree->solids.solids[tt->solid];
+                        last_solid = tt->solid;
+                        seen_from = convex_solid_viewpoint(solid, p, epsilon)   ? p
+                                    : convex_solid_viewpoint(solid, q, epsilon) ? q
+                                                                                : NULL;
+                    }
+                    if (seen_from &&
+                        convex_solid_face_away(tt->normal, tt->corner[0], seen_from, epsilon))
+                        continue;
+                }
                 if (found == max)
                     return max + 1;
-                memcpy(out[found++].corner, tree->triangles[t].corner, sizeof(out->corner));
+                memcpy(out[found++].corner, tt->corner, sizeof(out->corner));
             }
         } else {
             stack[top++] = node->first;

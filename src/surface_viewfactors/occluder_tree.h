@@ -22,6 +22,10 @@ rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_
                                occluder_tree **out, rad_error *error);
 void occluder_tree_destroy(occluder_tree *tree);
 
+/* Whether occluder_tree_collect leaves out solids' faces turned away (true after build);
+ * false: every triangle that cuts the hull, for a test or a benchmark to compare. */
+void occluder_tree_use_solids(occluder_tree *tree, bool use);
+
 /* Room for the side planes of the hull of two polygons (at most two per edge). */
 #define OCCLUDER_HULL_MAX_SIDES (4u * VF_MAX_VERTICES)
 
@@ -40,8 +44,11 @@ unsigned occluder_hull_edge_sides(const vf_polygon *p, const vf_polygon *q, unsi
                                   double epsilon, rad_vec3 *normal, double *offset);
 
 /* The triangles other than the polygons' own that may cut the hull of p and q (touching
- * the hull's boundary within epsilon, scene units, does not count): their corners go to
- * `out` (room for `max`); returns how many, or max + 1 when there are more. */
+ * the hull's boundary within epsilon, scene units, does not count), save the faces of a
+ * convex solid (convex_solids.h) turned away from p, or from q when p lies inside it or
+ * beyond its missing face: their corners go to `out` (room for `max`); returns how many,
+ * or max + 1 when there are more. The segments between p and q that they block are the
+ * same as behind all the triangles. */
 uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
                                const vf_polygon *q, double epsilon, shadow_occluder *out,
                                uint32_t max);

@@ -1,0 +1,67 @@
+/*
+ * convex_solids.h - the scene's triangles that bound convex solids, and which of them a
+ * polygon's view can leave out (internal).
+ *
+ * A segment from a point outside a convex solid that passes through it enters it through
+ * a face turned toward the point. So behind a convex solid the faces turned away from the
+ * point cast no shadow that the faces turned toward it do not already cast: the view
+ * factors behind a city block's buildings need only the walls and roofs that face the
+ * polygon, about half of them.
+ *
+ * A solid here is a connected set of triangles (corners joined where their positions are
+ * equal bit for bit) that
+ *   - is convex: every corner of the set lies behind or on the plane of each triangle
+ *     (front = counter-clockwise, facing out), and not all in one plane;
+ *   - is closed: each edge a -> b of a triangle is the edge b -> a of exactly one other,
+ *     save at most the edges of one missing face, all of which lie in one plane (a
+ *     building standing on the ground has walls and a roof but no floor). Through a
+ *     missing face a segment can enter from that face's outer side only, so that solid's
+ *     faces are left out only for a polygon wholly on the face's inner side.
+ * Anything else (a T-junction along an edge, an edge three triangles share, a reflex
+ * edge, two open faces) is no solid: its triangles stay occluders as they are.
+ */
+#ifndef RAD_VIEWFACTOR_CONVEX_SOLIDS_H
+#define RAD_VIEWFACTOR_CONVEX_SOLIDS_H
+
+#include <stdbool.h>
+
+#include "radiosity.h"
+#include "surface_viewfactors/vf_geometry.h"
+
+/* Face planes kept per solid to tell a polygon outside it; a solid with more distinct face
+ * planes than this is not one here. */
+#define CONVEX_SOLID_MAX_PLANES 24u
+
+typedef struct convex_solid {
+    rad_vec3 normal[CONVEX_SOLID_MAX_PLANES]; /* outward unit normals of its face planes */
+    double offset[CONVEX_SOLID_MAX_PLANES];   /* normal . x on the plane */
+    unsigned plane_count;
+    bool open;               /* one face missing, in the plane: */
+    rad_vec3 open_normal;    /* outward unit normal */
+    double open_offset;
+} convex_solid;
+
+typedef struct convex_solids {
+    uint32_t *of_triangle; /* per scene triangle: its solid, or UINT32_MAX */
+    convex_solid *solids;
+    uint32_t count;
+} convex_solids;
+
+/* Finds the scene's convex solids. RAD_ERR_NOMEM, else RAD_OK (with none, it may be). */
+rad_status convex_solids_find(const rad_scene *scene, convex_solids *out, rad_error *error);
+
+void convex_solids_free(convex_solids *solids);
+
+/* Whether the faces of `solid` turned away from every point of the polygon may be left
+ * out of its view: the polygon lies outside the solid or on it (on the outer side of one
+ * of its face planes, within epsilon) and, for an open solid, on the inner side of the
+ * missing face's plane. */
+bool convex_solid_viewpoint(const convex_solid *solid, const vf_polygon *polygon,
+                            double epsilon);
+
+/* Whether the face with unit normal n through `corner` is turned away from every point of
+ * the polygon (each corner behind its plane or on it, within epsilon). */
+bool convex_solid_face_away(rad_vec3 n, rad_vec3 corner, const vf_polygon *polygon,
+                            double epsilon);
+
+#endif

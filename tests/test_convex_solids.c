@@ -1,0 +1,308 @@
+/*
+ * test_convex_solids.c - convex solids among a scene's triangles (convex_solids_find,
+ * src/surface_viewfactors/convex_solids.c) and the occluders a pair's view leaves out
+ * behind them (occluder_tree_collect).
+ *
+ * Found: a closed box; a building with walls of two storeys and a roof but no floor (open,
+ * the missing face's plane outward down); a tetrahedron. Not found: walls alone (two open
+ * faces), an L-shaped prism (not convex), a box turned inside out, a box whose wall is split
+ * where its neighbour's is not (a T-junction), a flat sheet, a box with a face given twice.
+ *
+ * The exact transfer between a floor and a ceiling square behind three boxes (closed; open
+ * below, its missing face turned to the floor; open above) is the same with the faces left
+ * out as with every triangle, and both match brute-force ray casting against every
+ * triangle (an independent code path): a wrong face left out lets light through a box.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "core/vec3.h"
+#include "surface_viewfactors/convex_solids.h"
+#include "surface_viewfactors/occluder_tree.h"
+#include "surface_viewfactors/pair_transfer.h"
+#include "surface_viewfactors/vf_geometry.h"
+#include "testlib.h"
+
+static char text[1 << 15];
+static size_t used;
+static int vertices;
+
+static void vertex(double x, double y, double z)
+{
+    used += (size_t)snprintf(text + used, sizeof(text) - used, "v %.17g %.17g %.17g\n", x, y, z);
+    vertices++;
+}
+
+/* A quad of four new vertices, counter-clockwise seen from its front. */
+static void quad(const double p[4][3])
+{
+    for (int k = 0; k < 4; k++)
+        vertex(p[k][0], p[k][1], p[k][2]);
+    used += (size_t)snprintf(text + used, sizeof(text) - used, "f %d %d %d %d\n", vertices - 3,
+                             vertices - 2, vertices - 1, vertices);
+}
+
+enum { WALLS = 1, ROOF = 2, FLOOR = 4, STOREYS = 8, INSIDE_OUT = 16, SPLIT_ONE_WALL = 32 };
+
+/* The box [x0, x1] x [y0, y1] x [z0, z1] facing out (in with INSIDE_OUT), of the parts
+ * `parts` names; each face of its own vertices. STOREYS: walls in two storeys;
+ * SPLIT_ONE_WALL: the first wall alone in two. */
+static void box(double x0, double x1, double y0, double y1, double z0, double z1, int parts)
+{
+    const double c[8][3] = {{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1},
+                            {x0, y1, z0}, {x1, y1, z0}, {x1, y1, z1}, {x0, y1, z1}};
+    /* -z, +x, +z, -x walls (bottom corners, then top), counter-clockwise from outside */
+    const int wall[4][2] = {{1, 0}, {2, 1}, {3, 2}, {0, 3}};
+    for (int w = 0; (parts & WALLS) && w < 4; w++) {
+        const double *a = c[wall[w][0]], *b = c[wall[w][1]];
+        int storeys = (parts & STOREYS) || ((parts & SPLIT_ONE_WALL) && w == 0) ? 2 : 1;
+        for (int s = 0; s < storeys; s++) {
+            double ya = y0 + (y1 - y0) * s / storeys, yb = y0 + (y1 - y0) * (s + 1) / storeys;
+            double q[4][3] = {{a[0], ya, a[2]}, {b[0], ya, b[2]}, {b[0], yb, b[2]}, {a[0], yb, a[2]}};
+            if (parts & INSIDE_OUT)
+                for (int k = 0; k < 2; k++)
+                    for (int d = 0; d < 3; d++) {
+                        double t = q[k][d];
+                        q[k][d] = q[3 - k][d];
+                        q[3 - k][d] = t;
+                    }
+            quad((const double(*)[3])q);
+        }
+    }
+    if (parts & ROOF) {
+        const int r[4] = {4, 7, 6, 5}, in[4] = {4, 5, 6, 7};
+        double q[4][3];
+        for (int k = 0; k < 4; k++)
+            memcpy(q[k], c[(parts & INSIDE_OUT) ? in[k] : r[k]], sizeof(q[k]));
+        quad((const double(*)[3])q);
+    }
+    if (parts & FLOOR) {
+        const int f[4] = {0, 1, 2, 3}, in[4] = {0, 3, 2, 1};
+        double q[4][3];
+        for (int k = 0; k < 4; k++)
+            memcpy(q[k], c[(parts & INSIDE_OUT) ? in[k] : f[k]], sizeof(q[k]));
+        quad((const double(*)[3])q);
+    }
+}
+
+static rad_scene *load(const char *name, uint32_t flags)
+{
+    rad_scene_file file = {test_write_file(name, text), flags, true};
+    rad_scene *scene = NULL;
+    rad_error error = {0};
+    CHECK(rad_scene_load_files(&file, 1, NULL, &scene, &error) == RAD_OK);
+    used = 0;
+    vertices = 0;
+    return scene;
+}
+
+/* The solids of the scene written so far: how many, and the first's openness. */
+static uint32_t solids_of(const char *name, convex_solids *out)
+{
+    rad_scene *scene = load(name, 0);
+    rad_error error = {0};
+    *out = (convex_solids){0};
+    if (scene)
+        CHECK(convex_solids_find(scene, out, &error) == RAD_OK);
+    rad_scene_destroy(scene);
+    return out->count;
+}
+
+static void check_found(void)
+{
+    convex_solids s;
+    box(0, 1, 0, 2, 0, 3, WALLS | ROOF | FLOOR);
+    CHECK(solids_of("closed.obj", &s) == 1);
+    CHECK(s.count == 1 && !s.solids[0].open && s.solids[0].plane_count == 6);
+    convex_solids_free(&s);
+
+    box(0, 10, 0, 22, 0, 10, WALLS | ROOF | STOREYS);
+    CHECK(solids_of("building.obj", &s) == 1);
+    if (s.count == 1) {
+        const convex_solid *b = &s.solids[0];
+        CHECK(b->open && b->plane_count == 5);
+        CHECK_ABS(b->open_normal.y, -1, 1e-12);
+        CHECK_ABS(b->open_offset, 0, 1e-12);
+    }
+    convex_solids_free(&s);
+
+    /* two buildings side by side, apart: two solids */
+    box(0, 10, 0, 22, 0, 10, WALLS | ROOF | STOREYS);
+    box(18, 28, 0, 9, 0, 10, WALLS | ROOF);
+    CHECK(solids_of("two.obj", &s) == 2);
+    convex_solids_free(&s);
+
+    vertex(0, 0, 0), vertex(1, 0, 0), vertex(0, 1, 0), vertex(0, 0, 1);
+    used += (size_t)snprintf(text + used, sizeof(text) - used, "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+    CHECK(solids_of("tetrahedron.obj", &s) == 1);
+    convex_solids_free(&s);
+
+    box(0, 1, 0, 2, 0, 3, WALLS);
+    CHECK(solids_of("walls.obj", &s) == 0);
+    convex_solids_free(&s);
+
+    box(0, 1, 0, 2, 0, 3, WALLS | ROOF | FLOOR | INSIDE_OUT);
+    CHECK(solids_of("inside_out.obj", &s) == 0);
+    convex_solids_free(&s);
+
+    box(0, 1, 0, 2, 0, 3, WALLS | ROOF | SPLIT_ONE_WALL);
+    CHECK(solids_of("t_junction.obj", &s) == 0);
+    convex_solids_free(&s);
+
+    const double sheet[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 0, -1}, {0, 0, -1}};
+    quad(sheet);
+    CHECK(solids_of("sheet.obj", &s) == 0);
+    convex_solids_free(&s);
+
+    box(0, 1, 0, 2, 0, 3, WALLS | ROOF | FLOOR);
+    box(0, 1, 0, 2, 0, 3, ROOF);
+    CHECK(solids_of("twice.obj", &s) == 0);
+    convex_solids_free(&s);
+
+    /* an L-shaped prism: an outline of six corners, extruded; its reflex edge breaks it */
+    const double L[6][2] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+    for (int k = 0; k < 6; k++)
+        vertex(L[k][0], 0, -L[k][1]);
+    for (int k = 0; k < 6; k++)
+        vertex(L[k][0], 1, -L[k][1]);
+    for (int k = 0; k < 6; k++) {
+        int a = k + 1, b = (k + 1) % 6 + 1;
+        used += (size_t)snprintf(text + used, sizeof(text) - used, "f %d %d %d %d\n", a, b,
+                                 b + 6, a + 6);
+    }
+    used += (size_t)snprintf(text + used, sizeof(text) - used,
+                             "f 7 8 9 10\nf 7 10 11 12\nf 1 4 3 2\nf 1 6 5 4\n");
+    CHECK(solids_of("ell.obj", &s) == 0);
+    convex_solids_free(&s);
+}
+
+static double uniform(uint64_t *state)
+{
+    *state = *state * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(*state >> 11) * 0x1.0p-53;
+}
+
+/* The share of cosine rays from uniform points of polygon `from` (a parallel-axis square
+ * facing -y) whose first hit is a triangle of surface `to`: brute-force ray casting. */
+static double monte_carlo(const rad_scene *scene, const vf_polygon *from, uint32_t to,
+                          uint32_t rays, double *standard_error)
+{
+    rad_error error = {0};
+    rad_tracer *tracer = NULL;
+    CHECK(rad_tracer_create_for_scene(RAD_TRACER_BRUTE_FORCE, scene, &tracer, &error) == RAD_OK);
+    if (!tracer)
+        return 0;
+    uint64_t state = 12345, reached = 0;
+    rad_ray batch[1024];
+    rad_hit hits[1024];
+    rad_vec3 lo = from->vertex[0], hi = from->vertex[0];
+    for (unsigned k = 1; k < from->count; k++) {
+        lo = v3(fmin(lo.x, from->vertex[k].x), lo.y, fmin(lo.z, from->vertex[k].z));
+        hi = v3(fmax(hi.x, from->vertex[k].x), hi.y, fmax(hi.z, from->vertex[k].z));
+    }
+    for (uint32_t done = 0; done < rays; done += 1024) {
+        for (int k = 0; k < 1024; k++) {
+            double x = lo.x + (hi.x - lo.x) * uniform(&state);
+            double z = lo.z + (hi.z - lo.z) * uniform(&state);
+            double q = uniform(&state), phi = 2 * 3.14159265358979323846 * uniform(&state);
+            double r = sqrt(q);
+            batch[k] = (rad_ray){{(float)x, (float)lo.y, (float)z},
+                                 1e-5f,
+                                 {(float)(r * cos(phi)), (float)-sqrt(1 - q),
+                                  (float)(r * sin(phi))},
+                                 INFINITY};
+        }
+        rad_tracer_intersect(tracer, batch, 1024, hits);
+        for (int k = 0; k < 1024; k++)
+            reached += hits[k].triangle != RAD_NO_HIT &&
+                       scene->triangles[hits[k].triangle].surface == to;
+    }
+    rad_tracer_destroy(tracer);
+    uint32_t n = (rays + 1023) / 1024 * 1024;
+    double share = (double)reached / n;
+    *standard_error = sqrt(share * (1 - share) / n);
+    return share;
+}
+
+static void check_exact_behind_solids(void)
+{
+    /* the floor [0, 4]^2 at y = 0 facing up; the ceiling [3, 7] x [0, 4] at y = 5 facing
+     * down; boxes between */
+    const double floor_q[4][3] = {{0, 0, 0}, {4, 0, 0}, {4, 0, -4}, {0, 0, -4}};
+    const double ceiling_q[4][3] = {{3, 5, 0}, {3, 5, -4}, {7, 5, -4}, {7, 5, 0}};
+    used += (size_t)snprintf(text + used, sizeof(text) - used, "o floor\n");
+    quad(floor_q);
+    used += (size_t)snprintf(text + used, sizeof(text) - used, "o ceiling\n");
+    quad(ceiling_q);
+    used += (size_t)snprintf(text + used, sizeof(text) - used, "o closed\n");
+    box(4.2, 5.2, 1.5, 2.5, -2, -1, WALLS | ROOF | FLOOR);
+    used += (size_t)snprintf(text + used, sizeof(text) - used, "o open_below\n");
+    box(4.2, 5.2, 3, 4, -3.5, -2.2, WALLS | ROOF);
+    used += (size_t)snprintf(text + used, sizeof(text) - used, "o open_above\n");
+    box(2.5, 3.5, 1.5, 2.5, -1.5, -0.5, WALLS | FLOOR);
+    rad_scene *scene = load("behind.obj", 0);
+    if (!scene)
+        return;
+    vf_geometry geometry;
+    rad_error error = {0};
+    occluder_tree *tree = NULL;
+    CHECK(vf_geometry_build(scene, &geometry, &error) == RAD_OK);
+    CHECK(occluder_tree_build(scene, geometry.triangle_source, &tree, &error) == RAD_OK);
+    convex_solids solids;
+    CHECK(convex_solids_find(scene, &solids, &error) == RAD_OK);
+    CHECK(solids.count == 3);
+    convex_solids_free(&solids);
+    const vf_polygon *floor_p = NULL, *ceiling_p = NULL;
+    for (uint32_t k = 0; k < geometry.polygon_count; k++) {
+        const vf_polygon *p = &geometry.polygons[k];
+        if (p->normal.y > 0.5 && p->centroid.y < 0.1)
+            floor_p = p;
+        if (p->normal.y < -0.5 && p->centroid.y > 4.9)
+            ceiling_p = p;
+    }
+    CHECK(floor_p && ceiling_p && tree);
+    if (floor_p && ceiling_p && tree) {
+        static shadow_occluder all[256], kept[256];
+        const double eps = geometry.plane_epsilon;
+        occluder_tree_use_solids(tree, false);
+        uint32_t n_all = occluder_tree_collect(tree, floor_p, ceiling_p, eps, all, 256);
+        occluder_tree_use_solids(tree, true);
+        uint32_t n_kept = occluder_tree_collect(tree, floor_p, ceiling_p, eps, kept, 256);
+        /* 32 of the boxes' 32 triangles cut the hull; the closed box's roof and +x wall
+         * face away from the whole floor (2 triangles each). The box open below cannot be
+         * seen from the floor so (its missing face is turned to it), and from the ceiling
+         * every face of it is turned toward or cut by the ceiling's plane; the box open
+         * above likewise from the floor */
+        printf("occluders between floor and ceiling: %u triangles, %u kept\n", n_all, n_kept);
+        CHECK(n_all == 32);
+        CHECK(n_kept == 28);
+        double g_all, b_all, g_kept, b_kept;
+        CHECK(pair_obstructed_exact_within(floor_p, ceiling_p, all, n_all, 1e-6, 0, eps,
+                                           UINT64_MAX, &g_all, &b_all));
+        CHECK(pair_obstructed_exact_within(floor_p, ceiling_p, kept, n_kept, 1e-6, 0, eps,
+                                           UINT64_MAX, &g_kept, &b_kept));
+        double F_all = g_all / ceiling_p->area, F_kept = g_kept / ceiling_p->area;
+        double se, reference = monte_carlo(scene, ceiling_p, floor_p->surface, 4u << 20, &se);
+        printf("F(ceiling -> floor): behind every triangle %.7f, faces left out %.7f, "
+               "brute force %.5f +- %.5f\n",
+               F_all, F_kept, reference, se);
+        CHECK_ABS(F_kept, F_all, 1e-6 * F_all + (b_all + b_kept) / ceiling_p->area);
+        CHECK_ABS(F_kept, reference, 3 * se);
+        /* the boxes block a good share: a box seen through would show */
+        double open;
+        CHECK(pair_obstructed_exact_within(floor_p, ceiling_p, all, 0, 1e-6, 0, eps, UINT64_MAX,
+                                           &open, &b_all));
+        CHECK(open / ceiling_p->area - F_kept > 20 * se);
+    }
+    occluder_tree_destroy(tree);
+    vf_geometry_free(&geometry);
+    rad_scene_destroy(scene);
+}
+
+int main(void)
+{
+    check_found();
+    check_exact_behind_solids();
+    return test_finish("test_convex_solids");
+}
