@@ -8,7 +8,6 @@
 
 #include "core/alloc.h"
 #include "core/edge_key.h"
-#include "core/error.h"
 #include "core/union_find.h"
 #include "core/vec3.h"
 #include "core/weld.h"
@@ -65,6 +64,18 @@ static rad_vec3 corner_of(const component_view *c, uint32_t t, int k)
     return c->scene->positions[c->scene->triangles[t].vertex[k]];
 }
 
+/* Whether edge k of triangle t (from corner k to the next) is matched by no edge the other
+ * way: an edge of the missing face; its ends go to *p and *q. */
+static bool open_edge(const component_view *c, uint32_t t, int k, rad_vec3 *p, rad_vec3 *q)
+{
+    uint32_t from = c->vid[3 * (size_t)t + k], to = c->vid[3 * (size_t)t + (k + 1) % 3];
+    if (edge_present(c->edges, directed(to, from)))
+        return false;
+    *p = corner_of(c, t, k);
+    *q = corner_of(c, t, (k + 1) % 3);
+    return true;
+}
+
 /* The set as a convex solid into *solid, or false. */
 static bool component_solid(const component_view *c, convex_solid *solid)
 {
@@ -104,7 +115,7 @@ static bool component_solid(const component_view *c, convex_solid *solid)
         }
     }
     /* convex: every corner behind or on every face plane; not flat: some corner behind
-     * the first */
+     * one of them */
     bool deep = false;
     for (unsigned k = 0; k < solid->plane_count; k++)
         for (uint32_t i = 0; i < c->count; i++)
@@ -117,63 +128,59 @@ static bool component_solid(const component_view *c, convex_solid *solid)
             }
     if (!deep)
         return false;
-    /* closed, or open along edges of one plane */
+    /* closed, or open along edges in one plane: the plane through the first open edge and
+     * the open edges' end farthest from its line, then every open edge checked against it */
     solid->open = false;
-    rad_vec3 a = {0, 0, 0}, b = {0, 0, 0}, n = {0, 0, 0};
+    rad_vec3 a = {0, 0, 0}, b = {0, 0, 0}, n = {0, 0, 0}, p, q;
     bool have_edge = false;
-    for (int pass = 0; pass < 2; pass++) /* the plane from the open edges, then the check */
-        for (uint32_t i = 0; i < c->count; i++) {
-            uint32_t t = c->triangles[i];
-            for (int k = 0; k < 3; k++) {
-                uint32_t from = c->vid[3 * (size_t)t + k], to = c->vid[3 * (size_t)t + (k + 1) % 3];
-                if (edge_present(c->edges, directed(to, from)))
-                    continue;
-                rad_vec3 p = corner_of(c, t, k), q = corner_of(c, t, (k + 1) % 3);
-                if (pass == 0) {
-                    if (!have_edge) {
-                        a = p, b = q;
-                        have_edge = true;
-                    }
-                    rad_vec3 across[2] = {p, q};
-                    for (int m = 0; m < 2; m++) {
-                        rad_vec3 candidate = v3_cross(v3_sub(b, a), v3_sub(across[m], a));
-                        if (v3_dot(candidate, candidate) > v3_dot(n, n))
-                            n = candidate;
-                    }
-                } else if (fabs(v3_dot(solid->open_normal, p) - solid->open_offset) > eps ||
-                           fabs(v3_dot(solid->open_normal, q) - solid->open_offset) > eps) {
-                    return false; /* open edges off the missing face's plane */
-                }
+    for (uint32_t i = 0; i < c->count; i++)
+        for (int k = 0; k < 3; k++) {
+            if (!open_edge(c, c->triangles[i], k, &p, &q))
+                continue;
+            if (!have_edge) {
+                a = p, b = q;
+                have_edge = true;
             }
-            if (pass == 0 && i + 1 == c->count && have_edge) {
-                double length = v3_length(n);
-                if (!(length > 0))
-                    return false;
-                solid->open = true;
-                solid->open_normal = v3_scale(n, 1 / length);
-                solid->open_offset = v3_dot(solid->open_normal, a);
+            rad_vec3 across[2] = {p, q};
+            for (int m = 0; m < 2; m++) {
+                rad_vec3 candidate = v3_cross(v3_sub(b, a), v3_sub(across[m], a));
+                if (v3_dot(candidate, candidate) > v3_dot(n, n))
+                    n = candidate;
             }
         }
-    if (solid->open) { /* outward: away from the corners, all on one side */
-        double least = INFINITY, most = -INFINITY;
-        for (uint32_t i = 0; i < c->count; i++)
-            for (int m = 0; m < 3; m++) {
-                double d = v3_dot(solid->open_normal, corner_of(c, c->triangles[i], m)) -
-                           solid->open_offset;
-                least = fmin(least, d);
-                most = fmax(most, d);
-            }
-        if (least >= -eps) {
-            solid->open_normal = v3_scale(solid->open_normal, -1);
-            solid->open_offset = -solid->open_offset;
-        } else if (most > eps) {
-            return false;
+    if (!have_edge)
+        return true;
+    double length = v3_length(n);
+    if (!(length > 0))
+        return false; /* open edges along one line: no face's outline */
+    solid->open = true;
+    solid->open_normal = v3_scale(n, 1 / length);
+    solid->open_offset = v3_dot(solid->open_normal, a);
+    for (uint32_t i = 0; i < c->count; i++)
+        for (int k = 0; k < 3; k++)
+            if (open_edge(c, c->triangles[i], k, &p, &q) &&
+                (fabs(v3_dot(solid->open_normal, p) - solid->open_offset) > eps ||
+                 fabs(v3_dot(solid->open_normal, q) - solid->open_offset) > eps))
+                return false; /* open edges off the missing face's plane */
+    /* outward: away from the corners, which must all lie on one side */
+    double least = INFINITY, most = -INFINITY;
+    for (uint32_t i = 0; i < c->count; i++)
+        for (int m = 0; m < 3; m++) {
+            double d = v3_dot(solid->open_normal, corner_of(c, c->triangles[i], m)) -
+                       solid->open_offset;
+            least = fmin(least, d);
+            most = fmax(most, d);
         }
+    if (least >= -eps) {
+        solid->open_normal = v3_scale(solid->open_normal, -1);
+        solid->open_offset = -solid->open_offset;
+    } else if (most > eps) {
+        return false;
     }
     return true;
 }
 
-rad_status convex_solids_find(const rad_scene *scene, convex_solids *out, rad_error *error)
+bool convex_solids_find(const rad_scene *scene, convex_solids *out)
 {
     *out = (convex_solids){0};
     const uint32_t n = scene->triangle_count;
@@ -190,7 +197,7 @@ rad_status convex_solids_find(const rad_scene *scene, convex_solids *out, rad_er
     convex_solid *solids = NULL;
     edge_set edges = {rad_alloc_array(capacity, sizeof(uint64_t)), capacity - 1};
     rad_weld weld;
-    bool welded = rad_weld_init(&weld, 3 * n + 1) != 0;
+    bool welded = rad_weld_init(&weld, n < UINT32_MAX / 3 ? 3 * n + 1 : UINT32_MAX) != 0;
     bool ok = vid && parent && bad && bad_set && start && order && of_triangle && edges.keys && welded;
     for (uint32_t t = 0; ok && t < n; t++)
         for (int k = 0; k < 3; k++) {
@@ -233,18 +240,31 @@ rad_status convex_solids_find(const rad_scene *scene, convex_solids *out, rad_er
         for (uint32_t v = vertices; v-- > 0;) /* back to the sets' first places */
             start[v + 1] = start[v];
         start[0] = 0;
-        solids = rad_alloc_array((size_t)n / 3 + 1, sizeof(*solids));
-        ok = solids != NULL;
+        uint32_t room = 0;
+        convex_solid found;
         for (uint32_t root = 0; ok && root < vertices; root++) {
             if (start[root + 1] == start[root] || bad_set[root])
                 continue; /* no set's root, or a bad set */
             component_view view = {scene, vid, &edges, &order[start[root]],
                                    start[root + 1] - start[root]};
-            if (!component_solid(&view, &solids[solid_count]))
+            if (!component_solid(&view, &found))
                 continue;
+            if (solid_count == room) {
+                room = room ? 2 * room : 16;
+                convex_solid *grown = rad_resize_array(solids, room, sizeof(*solids));
+                ok = grown != NULL;
+                if (!ok)
+                    break;
+                solids = grown;
+            }
+            solids[solid_count] = found;
             for (uint32_t i = 0; i < view.count; i++)
                 of_triangle[view.triangles[i]] = solid_count;
             solid_count++;
+        }
+        if (ok && solid_count) { /* the room left over given back */
+            convex_solid *fitted = rad_resize_array(solids, solid_count, sizeof(*solids));
+            solids = fitted ? fitted : solids;
         }
     }
     free(vid);
@@ -257,12 +277,12 @@ rad_status convex_solids_find(const rad_scene *scene, convex_solids *out, rad_er
     if (!ok) {
         free(of_triangle);
         free(solids);
-        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for finding convex solids");
+        return false;
     }
     out->of_triangle = of_triangle;
     out->solids = solids;
     out->count = solid_count;
-    return RAD_OK;
+    return true;
 }
 
 void convex_solids_free(convex_solids *solids)
@@ -272,13 +292,18 @@ void convex_solids_free(convex_solids *solids)
     *solids = (convex_solids){0};
 }
 
-bool convex_solid_viewpoint(const convex_solid *solid, const vf_polygon *polygon, double epsilon)
+bool convex_solid_seen_from(const convex_solid *solid, const vf_polygon *polygon, double epsilon)
 {
     bool outside = false;
     for (unsigned k = 0; k < solid->plane_count && !outside; k++) {
+        bool beyond = false;
         outside = true;
-        for (unsigned m = 0; m < polygon->count && outside; m++)
-            outside = v3_dot(solid->normal[k], polygon->vertex[m]) - solid->offset[k] >= -epsilon;
+        for (unsigned m = 0; m < polygon->count && outside; m++) {
+            double d = v3_dot(solid->normal[k], polygon->vertex[m]) - solid->offset[k];
+            outside = d >= -epsilon;
+            beyond = beyond || d > epsilon;
+        }
+        outside = outside && beyond;
     }
     if (!outside)
         return false;

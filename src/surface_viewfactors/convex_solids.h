@@ -17,8 +17,11 @@
  *     building standing on the ground has walls and a roof but no floor). Through a
  *     missing face a segment can enter from that face's outer side only, so that solid's
  *     faces are left out only for a polygon wholly on the face's inner side.
- * Anything else (a T-junction along an edge, an edge three triangles share, a reflex
- * edge, two open faces) is no solid: its triangles stay occluders as they are.
+ * Anything else (an edge three triangles share, a reflex edge, open edges in two planes)
+ * is no solid: its triangles stay occluders as they are. A T-junction leaves the edges
+ * along it unmatched: when they lie in one plane the solid counts as open there (a face
+ * taken for missing: only the faces seen from its inner side are left out, which is
+ * safe), else it is no solid.
  */
 #ifndef RAD_VIEWFACTOR_CONVEX_SOLIDS_H
 #define RAD_VIEWFACTOR_CONVEX_SOLIDS_H
@@ -47,16 +50,20 @@ typedef struct convex_solids {
     uint32_t count;
 } convex_solids;
 
-/* Finds the scene's convex solids. RAD_ERR_NOMEM, else RAD_OK (with none, it may be). */
-rad_status convex_solids_find(const rad_scene *scene, convex_solids *out, rad_error *error);
+/* Finds the scene's convex solids; false (and none) when out of memory. It holds about
+ * 150 bytes a triangle while it looks, and keeps 4 a triangle and 800 a solid. */
+bool convex_solids_find(const rad_scene *scene, convex_solids *out);
 
 void convex_solids_free(convex_solids *solids);
 
 /* Whether the faces of `solid` turned away from every point of the polygon may be left
- * out of its view: the polygon lies outside the solid or on it (on the outer side of one
- * of its face planes, within epsilon) and, for an open solid, on the inner side of the
- * missing face's plane. */
-bool convex_solid_viewpoint(const convex_solid *solid, const vf_polygon *polygon,
+ * out of its view: the polygon lies outside the solid, on the outer side of one of its
+ * face planes with a corner beyond it (a polygon lying in a face plane, as the ground
+ * under a building's floor does, may lie on the solid's surface, and a segment from
+ * there enters through no face), and, for an open solid, on the inner side of the missing
+ * face's plane or on it. Within epsilon: a polygon up to epsilon inside the solid passes,
+ * and a sliver of its view that thin may go through. */
+bool convex_solid_seen_from(const convex_solid *solid, const vf_polygon *polygon,
                             double epsilon);
 
 /* Whether the face with unit normal n through `corner` is turned away from every point of

@@ -125,16 +125,11 @@ rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_
         occluder_tree_destroy(tree);
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the occluder tree");
     }
-    rad_status status = convex_solids_find(scene, &tree->solids, error);
-    if (status != RAD_OK) {
-        free(centres);
-        occluder_tree_destroy(tree);
-        return status;
-    }
-    tree->use_solids = true;
+    /* the solids only speed the pairs up: without room for them every triangle stays */
+    tree->use_solids = convex_solids_find(scene, &tree->solids);
     for (uint32_t t = 0; t < count; t++) {
         tree_triangle *tt = &tree->triangles[t];
-        tt->solid = tree->solids.of_triangle[t];
+        tt->solid = tree->use_solids ? tree->solids.of_triangle[t] : UINT32_MAX;
         for (int c = 0; c < 3; c++)
             tt->corner[c] = scene->positions[scene->triangles[t].vertex[c]];
         tt->normal = v3_normalize(v3_cross(v3_sub(tt->corner[1], tt->corner[0]),
@@ -356,8 +351,8 @@ uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
                     if (tt->solid != last_solid) {
                         const convex_solid *solid = &tree->solids.solids[tt->solid];
                         last_solid = tt->solid;
-                        seen_from = convex_solid_viewpoint(solid, p, epsilon)   ? p
-                                    : convex_solid_viewpoint(solid, q, epsilon) ? q
+                        seen_from = convex_solid_seen_from(solid, p, epsilon)   ? p
+                                    : convex_solid_seen_from(solid, q, epsilon) ? q
                                                                                 : NULL;
                     }
                     if (seen_from &&
