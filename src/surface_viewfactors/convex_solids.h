@@ -16,7 +16,7 @@
  *     save at most the edges of one missing face, all of which lie in one plane (a
  *     building standing on the ground has walls and a roof but no floor). Through a
  *     missing face a segment can enter from that face's outer side only, so that solid's
- *     faces are left out only for a polygon wholly on the face's inner side.
+ *     faces are left out only for a polygon on the face's inner side or in its plane.
  * Anything else (an edge three triangles share, a reflex edge, open edges in two planes)
  * is no solid: its triangles stay occluders as they are. A T-junction leaves the edges
  * along it unmatched: when they lie in one plane the solid counts as open there (a face
@@ -50,8 +50,8 @@ typedef struct convex_solids {
     uint32_t count;
 } convex_solids;
 
-/* Finds the scene's convex solids; false (and none) when out of memory. It holds about
- * 150 bytes a triangle while it looks, and keeps 4 a triangle and 800 a solid. */
+/* Finds the scene's convex solids; false (and none) when out of memory. It holds up to
+ * about 250 bytes a triangle while it looks, and keeps 4 a triangle and 800 a solid. */
 bool convex_solids_find(const rad_scene *scene, convex_solids *out);
 
 void convex_solids_free(convex_solids *solids);
