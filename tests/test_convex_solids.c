@@ -103,8 +103,9 @@ static uint32_t solids_of(const char *name, convex_solids *out)
 {
     rad_scene *scene = load(name, 0);
     *out = (convex_solids){0};
+    rad_error error = {0};
     if (scene)
-        CHECK(convex_solids_find(scene, out));
+        CHECK(convex_solids_find(scene, out, &error) == RAD_OK);
     rad_scene_destroy(scene);
     return out->count;
 }
@@ -251,7 +252,7 @@ static void check_exact(const char *name, uint32_t solids_expected, uint32_t all
     CHECK(vf_geometry_build(scene, &geometry, &error) == RAD_OK);
     CHECK(occluder_tree_build(scene, geometry.triangle_source, &tree, &error) == RAD_OK);
     convex_solids solids;
-    CHECK(convex_solids_find(scene, &solids));
+    CHECK(convex_solids_find(scene, &solids, &error) == RAD_OK);
     CHECK(solids.count == solids_expected);
     convex_solids_free(&solids);
     const vf_polygon *floor_p = NULL, *ceiling_p = NULL;

@@ -8,6 +8,7 @@
 
 #include "core/alloc.h"
 #include "core/edge_key.h"
+#include "core/error.h"
 #include "core/union_find.h"
 #include "core/vec3.h"
 #include "core/weld.h"
@@ -180,7 +181,7 @@ static bool component_solid(const component_view *c, convex_solid *solid)
     return true;
 }
 
-bool convex_solids_find(const rad_scene *scene, convex_solids *out)
+rad_status convex_solids_find(const rad_scene *scene, convex_solids *out, rad_error *error)
 {
     *out = (convex_solids){0};
     const uint32_t n = scene->triangle_count;
@@ -262,10 +263,6 @@ bool convex_solids_find(const rad_scene *scene, convex_solids *out)
                 of_triangle[view.triangles[i]] = solid_count;
             solid_count++;
         }
-        if (ok && solid_count) { /* the room left over given back */
-            convex_solid *fitted = rad_resize_array(solids, solid_count, sizeof(*solids));
-            solids = fitted ? fitted : solids;
-        }
     }
     free(vid);
     free(parent);
@@ -277,12 +274,12 @@ bool convex_solids_find(const rad_scene *scene, convex_solids *out)
     if (!ok) {
         free(of_triangle);
         free(solids);
-        return false;
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for finding convex solids");
     }
     out->of_triangle = of_triangle;
     out->solids = solids;
     out->count = solid_count;
-    return true;
+    return RAD_OK;
 }
 
 void convex_solids_free(convex_solids *solids)

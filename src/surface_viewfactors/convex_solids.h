@@ -50,9 +50,13 @@ typedef struct convex_solids {
     uint32_t count;
 } convex_solids;
 
-/* Finds the scene's convex solids; false (and none) when out of memory. It holds up to
- * about 250 bytes a triangle while it looks, and keeps 4 a triangle and 800 a solid. */
-bool convex_solids_find(const rad_scene *scene, convex_solids *out);
+/* What the search holds at most while it looks, per triangle (it keeps 4 a triangle and
+ * about 800 a solid): a caller under a --max-memory budget without this much room left
+ * goes without the solids rather than fail. */
+#define CONVEX_SOLIDS_SEARCH_BYTES 256u
+
+/* Finds the scene's convex solids: RAD_ERR_NOMEM, else RAD_OK (with none, it may be). */
+rad_status convex_solids_find(const rad_scene *scene, convex_solids *out, rad_error *error);
 
 void convex_solids_free(convex_solids *solids);
 

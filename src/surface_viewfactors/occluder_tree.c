@@ -125,8 +125,18 @@ rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_
         occluder_tree_destroy(tree);
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the occluder tree");
     }
-    /* the solids only speed the pairs up: without room for them every triangle stays */
-    tree->use_solids = convex_solids_find(scene, &tree->solids);
+    /* the solids only speed the pairs up: under a budget without room for their search,
+     * every triangle stays */
+    uint64_t left = rad_memory_budget_left();
+    if (left == UINT64_MAX || left / CONVEX_SOLIDS_SEARCH_BYTES > count) {
+        rad_status status = convex_solids_find(scene, &tree->solids, error);
+        if (status != RAD_OK) {
+            free(centres);
+            occluder_tree_destroy(tree);
+            return status;
+        }
+        tree->use_solids = true;
+    }
     for (uint32_t t = 0; t < count; t++) {
         tree_triangle *tt = &tree->triangles[t];
         tt->solid = tree->use_solids ? tree->solids.of_triangle[t] : UINT32_MAX;

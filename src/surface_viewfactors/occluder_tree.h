@@ -23,8 +23,9 @@ rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_
 void occluder_tree_destroy(occluder_tree *tree);
 
 /* Whether occluder_tree_collect leaves out solids' faces turned away (true after build,
- * unless there was no memory to find them); false: every triangle that cuts the hull, for
- * a test or a benchmark to compare. Not while other threads collect from the tree. */
+ * unless a --max-memory budget had no room to find them); false: every triangle that cuts
+ * the hull, for a test or a benchmark to compare. Not while other threads collect from
+ * the tree. */
 void occluder_tree_use_solids(occluder_tree *tree, bool use);
 
 /* Room for the side planes of the hull of two polygons (at most two per edge). */
