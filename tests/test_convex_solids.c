@@ -4,17 +4,20 @@
  * behind them (occluder_tree_collect).
  *
  * Found: a closed box; a building with walls of two storeys and a roof but no floor (open,
- * the missing face's plane outward down); a tetrahedron. Not found: walls alone (two open
- * faces), an L-shaped prism (not convex), a box turned inside out, a box whose wall is split
- * where its neighbour's is not (a T-junction), a flat sheet, a box with a face given twice.
+ * the missing face's plane outward down); a tetrahedron; a closed box with one wall split
+ * where its neighbours are not (a T-junction: open along that wall). Not found: walls
+ * alone (two open faces), an L-shaped prism (not convex), a box turned inside out, the
+ * T-junction with the floor missing too, a flat sheet, a box with a face given twice.
  *
- * The exact transfer between a floor and a ceiling square behind three boxes (closed; open
- * below, its missing face turned to the floor; open above) is the same with the faces left
+ * The exact transfer between a floor and a ceiling square is the same with the faces left
  * out as with every triangle, and both match brute-force ray casting against every
- * triangle (an independent code path): a wrong face left out lets light through a box.
+ * triangle (an independent code path): behind three boxes (closed; open below, its missing
+ * face turned to the floor; open above), over a box standing on the floor (the floor lies
+ * on it) and from inside a closed box. A wrong face left out lets light through a box.
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/vec3.h"
@@ -24,77 +27,43 @@
 #include "surface_viewfactors/vf_geometry.h"
 #include "testlib.h"
 
-static char text[1 << 15];
-static size_t used;
-static int vertices;
-
-static void vertex(double x, double y, double z)
-{
-    used += (size_t)snprintf(text + used, sizeof(text) - used, "v %.17g %.17g %.17g\n", x, y, z);
-    vertices++;
-}
-
-/* A quad of four new vertices, counter-clockwise seen from its front. */
-static void quad(const double p[4][3])
-{
-    for (int k = 0; k < 4; k++)
-        vertex(p[k][0], p[k][1], p[k][2]);
-    used += (size_t)snprintf(text + used, sizeof(text) - used, "f %d %d %d %d\n", vertices - 3,
-                             vertices - 2, vertices - 1, vertices);
-}
+/* The scene being written (testlib's OBJ text), loaded and emptied by load(). */
+static test_obj obj;
 
 enum { WALLS = 1, ROOF = 2, FLOOR = 4, STOREYS = 8, INSIDE_OUT = 16, SPLIT_ONE_WALL = 32 };
 
 /* The box [x0, x1] x [y0, y1] x [z0, z1] facing out (in with INSIDE_OUT), of the parts
  * `parts` names; each face of its own vertices. STOREYS: walls in two storeys;
- * SPLIT_ONE_WALL: the first wall alone in two. */
+ * SPLIT_ONE_WALL: the -z wall alone in two. */
 static void box(double x0, double x1, double y0, double y1, double z0, double z1, int parts)
 {
-    const double c[8][3] = {{x0, y0, z0}, {x1, y0, z0}, {x1, y0, z1}, {x0, y0, z1},
-                            {x0, y1, z0}, {x1, y1, z0}, {x1, y1, z1}, {x0, y1, z1}};
-    /* -z, +x, +z, -x walls (bottom corners, then top), counter-clockwise from outside */
-    const int wall[4][2] = {{1, 0}, {2, 1}, {3, 2}, {0, 3}};
-    for (int w = 0; (parts & WALLS) && w < 4; w++) {
-        const double *a = c[wall[w][0]], *b = c[wall[w][1]];
+    const int out = (parts & INSIDE_OUT) ? -1 : 1;
+    for (int w = 0; (parts & WALLS) && w < 4; w++) { /* -z, +x, +z, -x */
         int storeys = (parts & STOREYS) || ((parts & SPLIT_ONE_WALL) && w == 0) ? 2 : 1;
-        for (int s = 0; s < storeys; s++) {
-            double ya = y0 + (y1 - y0) * s / storeys, yb = y0 + (y1 - y0) * (s + 1) / storeys;
-            double q[4][3] = {{a[0], ya, a[2]}, {b[0], ya, b[2]}, {b[0], yb, b[2]}, {a[0], yb, a[2]}};
-            if (parts & INSIDE_OUT)
-                for (int k = 0; k < 2; k++)
-                    for (int d = 0; d < 3; d++) {
-                        double t = q[k][d];
-                        q[k][d] = q[3 - k][d];
-                        q[3 - k][d] = t;
-                    }
-            quad((const double(*)[3])q);
+        for (int k = 0; k < storeys; k++) {
+            double ya = y0 + (y1 - y0) * k / storeys, yb = y0 + (y1 - y0) * (k + 1) / storeys;
+            if (w % 2 == 0) /* in a z plane: (x, y) */
+                test_obj_rectangle(&obj, 2, w == 0 ? z0 : z1, x0, ya, x1, yb, w == 0 ? -out : out);
+            else /* in an x plane: (y, z) */
+                test_obj_rectangle(&obj, 0, w == 1 ? x1 : x0, ya, z0, yb, z1, w == 1 ? out : -out);
         }
     }
-    if (parts & ROOF) {
-        const int r[4] = {4, 7, 6, 5}, in[4] = {4, 5, 6, 7};
-        double q[4][3];
-        for (int k = 0; k < 4; k++)
-            memcpy(q[k], c[(parts & INSIDE_OUT) ? in[k] : r[k]], sizeof(q[k]));
-        quad((const double(*)[3])q);
-    }
-    if (parts & FLOOR) {
-        const int f[4] = {0, 1, 2, 3}, in[4] = {0, 3, 2, 1};
-        double q[4][3];
-        for (int k = 0; k < 4; k++)
-            memcpy(q[k], c[(parts & INSIDE_OUT) ? in[k] : f[k]], sizeof(q[k]));
-        quad((const double(*)[3])q);
-    }
+    if (parts & ROOF) /* in a y plane: (z, x) */
+        test_obj_rectangle(&obj, 1, y1, z0, x0, z1, x1, out);
+    if (parts & FLOOR)
+        test_obj_rectangle(&obj, 1, y0, z0, x0, z1, x1, -out);
 }
 
 static rad_scene *load(const char *name, uint32_t flags)
 {
-    rad_scene_file file = {test_write_file(name, text), flags, true};
+    test_obj_add(&obj, "%s", ""); /* (an empty scene is text too) */
+    rad_scene_file file = {test_write_file(name, obj.data), flags, true};
     /* (the OBJ's objects are its surfaces) */
     rad_scene *scene = NULL;
     rad_error error = {0};
     CHECK(rad_scene_load_files(&file, 1, NULL, &scene, &error) == RAD_OK);
-    used = 0;
-    vertices = 0;
+    obj.length = 0;
+    obj.vertices = 0;
     return scene;
 }
 
@@ -134,8 +103,7 @@ static void check_found(void)
     CHECK(solids_of("two.obj", &s) == 2);
     convex_solids_free(&s);
 
-    vertex(0, 0, 0), vertex(1, 0, 0), vertex(0, 1, 0), vertex(0, 0, 1);
-    used += (size_t)snprintf(text + used, sizeof(text) - used, "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+    test_obj_add(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
     CHECK(solids_of("tetrahedron.obj", &s) == 1);
     convex_solids_free(&s);
 
@@ -161,8 +129,7 @@ static void check_found(void)
     CHECK(solids_of("t_junction_open.obj", &s) == 0);
     convex_solids_free(&s);
 
-    const double sheet[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 0, -1}, {0, 0, -1}};
-    quad(sheet);
+    test_obj_rectangle(&obj, 1, 0, -1, 0, 0, 1, 1);
     CHECK(solids_of("sheet.obj", &s) == 0);
     convex_solids_free(&s);
 
@@ -173,17 +140,14 @@ static void check_found(void)
 
     /* an L-shaped prism: an outline of six corners, extruded; its reflex edge breaks it */
     const double L[6][2] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
-    for (int k = 0; k < 6; k++)
-        vertex(L[k][0], 0, -L[k][1]);
-    for (int k = 0; k < 6; k++)
-        vertex(L[k][0], 1, -L[k][1]);
+    for (int y = 0; y < 2; y++)
+        for (int k = 0; k < 6; k++)
+            test_obj_add(&obj, "v %g %d %g\n", L[k][0], y, -L[k][1]);
     for (int k = 0; k < 6; k++) {
         int a = k + 1, b = (k + 1) % 6 + 1;
-        used += (size_t)snprintf(text + used, sizeof(text) - used, "f %d %d %d %d\n", a, b,
-                                 b + 6, a + 6);
+        test_obj_add(&obj, "f %d %d %d %d\n", a, b, b + 6, a + 6);
     }
-    used += (size_t)snprintf(text + used, sizeof(text) - used,
-                             "f 7 8 9 10\nf 7 10 11 12\nf 1 4 3 2\nf 1 6 5 4\n");
+    test_obj_add(&obj, "f 7 8 9 10\nf 7 10 11 12\nf 1 4 3 2\nf 1 6 5 4\n");
     CHECK(solids_of("ell.obj", &s) == 0);
     convex_solids_free(&s);
 }
@@ -250,7 +214,7 @@ static void check_exact(const char *name, uint32_t solids_expected, uint32_t all
     rad_error error = {0};
     occluder_tree *tree = NULL;
     CHECK(vf_geometry_build(scene, &geometry, &error) == RAD_OK);
-    CHECK(occluder_tree_build(scene, geometry.triangle_source, &tree, &error) == RAD_OK);
+    CHECK(occluder_tree_build(scene, geometry.triangle_source, true, &tree, &error) == RAD_OK);
     convex_solids solids;
     CHECK(convex_solids_find(scene, &solids, &error) == RAD_OK);
     CHECK(solids.count == solids_expected);
@@ -299,17 +263,16 @@ static void check_exact(const char *name, uint32_t solids_expected, uint32_t all
 
 /* The floor [x0, x1] x [z0, z1] at y = 0 facing up, the ceiling over it shifted by
  * `shift` along x at y = height facing down. */
+/* The floor [x0, x1] x [z0, z1] at y = 0 facing up, the ceiling over it shifted by
+ * `shift` along x at y = height facing down, then the boxes' object. */
 static void floor_and_ceiling(double x0, double x1, double z0, double z1, double shift,
                               double height)
 {
-    const double floor_q[4][3] = {{x0, 0, z1}, {x1, 0, z1}, {x1, 0, z0}, {x0, 0, z0}};
-    const double ceiling_q[4][3] = {{x0 + shift, height, z1}, {x0 + shift, height, z0},
-                                    {x1 + shift, height, z0}, {x1 + shift, height, z1}};
-    used += (size_t)snprintf(text + used, sizeof(text) - used, "o floor\n");
-    quad(floor_q);
-    used += (size_t)snprintf(text + used, sizeof(text) - used, "o ceiling\n");
-    quad(ceiling_q);
-    used += (size_t)snprintf(text + used, sizeof(text) - used, "o boxes\n");
+    test_obj_add(&obj, "o floor\n");
+    test_obj_rectangle(&obj, 1, 0, z0, x0, z1, x1, 1);
+    test_obj_add(&obj, "o ceiling\n");
+    test_obj_rectangle(&obj, 1, height, z0, x0 + shift, z1, x1 + shift, -1);
+    test_obj_add(&obj, "o boxes\n");
 }
 
 static void check_exact_behind_solids(void)
@@ -319,13 +282,7 @@ static void check_exact_behind_solids(void)
      * ceiling, which no face of it is turned away from); open above (seen from the floor,
      * which straddles every wall plane). 32 triangles cut the hull; the closed box's roof
      * and +x wall face away from the whole floor (2 triangles each) */
-    const double floor_q[4][3] = {{0, 0, 0}, {4, 0, 0}, {4, 0, -4}, {0, 0, -4}};
-    const double ceiling_q[4][3] = {{3, 5, 0}, {3, 5, -4}, {7, 5, -4}, {7, 5, 0}};
-    used += (size_t)snprintf(text + used, sizeof(text) - used, "o floor\n");
-    quad(floor_q);
-    used += (size_t)snprintf(text + used, sizeof(text) - used, "o ceiling\n");
-    quad(ceiling_q);
-    used += (size_t)snprintf(text + used, sizeof(text) - used, "o boxes\n");
+    floor_and_ceiling(0, 4, -4, 0, 3, 5);
     box(4.2, 5.2, 1.5, 2.5, -2, -1, WALLS | ROOF | FLOOR);
     box(4.2, 5.2, 3, 4, -3.5, -2.2, WALLS | ROOF);
     box(2.5, 3.5, 1.5, 2.5, -1.5, -0.5, WALLS | FLOOR);
@@ -350,5 +307,6 @@ int main(void)
 {
     check_found();
     check_exact_behind_solids();
+    free(obj.data);
     return test_finish("test_convex_solids");
 }

@@ -279,7 +279,7 @@ rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
     scene.position_count = vertex_count;
     scene.triangles = triangles;
     scene.triangle_count = triangle_count;
-    status = occluder_tree_build(&scene, source, &out->tree, error);
+    status = occluder_tree_build(&scene, source, true, &out->tree, error);
     if (status != RAD_OK)
         goto done;
     out->screen_triangles =

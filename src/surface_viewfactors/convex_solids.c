@@ -27,29 +27,26 @@ typedef struct edge_set {
 
 static inline uint64_t directed(uint32_t a, uint32_t b) { return ((uint64_t)a << 32) | b; }
 
+/* The slot holding the key, or the empty one where it would go. */
+static uint64_t *edge_slot(const edge_set *set, uint64_t key)
+{
+    uint64_t s = edge_key_hash(key) & set->mask;
+    while (set->keys[s] != EMPTY && set->keys[s] != key)
+        s = (s + 1) & set->mask;
+    return &set->keys[s];
+}
+
 /* Inserts the key; false when it was there already. */
 static bool edge_insert(edge_set *set, uint64_t key)
 {
-    uint64_t s = edge_key_hash(key) & set->mask;
-    while (set->keys[s] != EMPTY) {
-        if (set->keys[s] == key)
-            return false;
-        s = (s + 1) & set->mask;
-    }
-    set->keys[s] = key;
+    uint64_t *slot = edge_slot(set, key);
+    if (*slot == key)
+        return false;
+    *slot = key;
     return true;
 }
 
-static bool edge_present(const edge_set *set, uint64_t key)
-{
-    uint64_t s = edge_key_hash(key) & set->mask;
-    while (set->keys[s] != EMPTY) {
-        if (set->keys[s] == key)
-            return true;
-        s = (s + 1) & set->mask;
-    }
-    return false;
-}
+static bool edge_present(const edge_set *set, uint64_t key) { return *edge_slot(set, key) == key; }
 
 /* What the search holds while it looks at one connected set of triangles. */
 typedef struct component_view {

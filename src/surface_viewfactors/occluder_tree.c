@@ -110,7 +110,7 @@ static int build_node(occluder_tree *tree, uint32_t node, uint32_t first, uint32
 }
 
 rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_source,
-                               occluder_tree **out, rad_error *error)
+                               bool solids, occluder_tree **out, rad_error *error)
 {
     *out = NULL;
     occluder_tree *tree = rad_alloc_array(1, sizeof(*tree));
@@ -128,7 +128,7 @@ rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_
     /* the solids only speed the pairs up: under a budget without room for their search,
      * every triangle stays */
     uint64_t left = rad_memory_budget_left();
-    if (left == UINT64_MAX || left / CONVEX_SOLIDS_SEARCH_BYTES > count) {
+    if (solids && (left == UINT64_MAX || left / CONVEX_SOLIDS_SEARCH_BYTES > count)) {
         rad_status status = convex_solids_find(scene, &tree->solids, error);
         if (status != RAD_OK) {
             free(centres);

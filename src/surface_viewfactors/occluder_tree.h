@@ -17,15 +17,18 @@
 typedef struct occluder_tree occluder_tree;
 
 /* triangle_source: per scene triangle, the radiating polygon covering it (its own
- * triangles never block a polygon's view), or UINT32_MAX (vf_geometry.triangle_source). */
+ * triangles never block a polygon's view), or UINT32_MAX (vf_geometry.triangle_source).
+ * solids: find the scene's convex solids (convex_solids.h), whose faces turned away from a
+ * pair occluder_tree_collect leaves out (not under a --max-memory budget without room for
+ * their search); false for a caller that changes the occluders it collects, as the sky
+ * does, or wants every one. */
 rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_source,
-                               occluder_tree **out, rad_error *error);
+                               bool solids, occluder_tree **out, rad_error *error);
 void occluder_tree_destroy(occluder_tree *tree);
 
-/* Whether occluder_tree_collect leaves out solids' faces turned away (true after build,
- * unless a --max-memory budget had no room to find them); false: every triangle that cuts
- * the hull, for a test or a benchmark to compare. Not while other threads collect from
- * the tree. */
+/* Whether occluder_tree_collect leaves out the faces of the solids the build found (it
+ * does after a build that found them); false: every triangle that cuts the hull, for a
+ * test to compare. Not while other threads collect from the tree. */
 void occluder_tree_use_solids(occluder_tree *tree, bool use);
 
 /* Room for the side planes of the hull of two polygons (at most two per edge). */

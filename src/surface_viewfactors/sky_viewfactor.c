@@ -673,12 +673,10 @@ rad_status rad_sky_viewfactors_compute(const rad_scene *scene,
     rad_status status = vf_geometry_build(scene, &geometry, error);
     if (status != RAD_OK)
         return status;
-    status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
     /* every face of a convex solid stays: the sky lifts its occluders off p's plane
      * (lift_occluders_to), and where a ray enters a solid through the part cut away, a face
      * turned away from p is what stops it */
-    if (status == RAD_OK)
-        occluder_tree_use_solids(tree, false);
+    status = occluder_tree_build(scene, geometry.triangle_source, false, &tree, error);
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &tracer, error);
     if (status != RAD_OK) {

@@ -705,7 +705,7 @@ rad_status rad_viewfactor_matrix_compute(const rad_scene *scene,
     if (status == RAD_OK && rad_memory_budget() && options->sight_rays == RAD_SIGHT_RAYS_NONE)
         status = matrix_fits(&geometry, NULL, error);
     if (status == RAD_OK)
-        status = occluder_tree_build(scene, geometry.triangle_source, &tree, error);
+        status = occluder_tree_build(scene, geometry.triangle_source, true, &tree, error);
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE_FAST, scene, &occluders, error);
     if (status == RAD_OK)
