@@ -11,6 +11,7 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "geometry/contour.h"
+#include "geometry/parallelogram_integral.h"
 #include "geometry/polygon_integral.h"
 #include "surface_viewfactors/occluder_tree.h"
 #include "trace/ray.h"
@@ -50,6 +51,7 @@ typedef struct outer_context {
     int max_depth;
     int min_depth;           /* polygon_integral.min_depth */
     bool edge_check;         /* polygon_integral.edge_check */
+    bool strips;             /* a parallelogram outer polygon by parallelogram_integral.h */
     uint64_t work_left;      /* occluder clippings this pair may still spend */
     bool failed;             /* too many pieces somewhere, or the work budget ran out */
     struct cull_levels *cull; /* NULL: unobstructed, no occluders */
@@ -66,7 +68,7 @@ typedef struct cull_list {
 
 typedef struct cull_levels {
     const cull_list *now; /* the points' triangle's */
-    cull_list list[OBSTRUCTED_MAX_DEPTH + 1][4]; /* per level and child slot */
+    cull_list list[PARALLELOGRAM_MAX_LEVELS][4]; /* per level and child slot */
 } cull_levels;
 
 /* Occluder o's corners. */
@@ -85,7 +87,7 @@ static const rad_vec3 *occluder_corners(const outer_context *c, uint32_t o, unsi
  * epsilon), and it holds, by epsilon, every point where a segment between their corners
  * crosses the plane. These points span the hull's cross-section, which is then inside it. */
 static bool blocks_all(const rad_vec3 *corner, unsigned count, const rad_vec3 *cell,
-                       const vf_polygon *q, double epsilon)
+                       unsigned cell_count, const vf_polygon *q, double epsilon)
 {
     rad_vec3 normal = v3_cross(v3_sub(corner[1], corner[0]), v3_sub(corner[2], corner[0]));
     double length = v3_length(normal);
@@ -93,13 +95,13 @@ static bool blocks_all(const rad_vec3 *corner, unsigned count, const rad_vec3 *c
         return false;
     normal = v3_scale(normal, 1 / length);
     double offset = v3_dot(normal, corner[0]);
-    double s[3], t[VF_MAX_VERTICES];
-    for (unsigned k = 0; k < 3; k++)
+    double s[4] = {0, 0, 0, 0}, t[VF_MAX_VERTICES];
+    for (unsigned k = 0; k < cell_count; k++)
         s[k] = v3_dot(normal, cell[k]) - offset;
     for (unsigned k = 0; k < q->count; k++)
         t[k] = v3_dot(normal, q->vertex[k]) - offset;
     double sign = s[0] > 0 ? 1 : -1;
-    for (unsigned k = 0; k < 3; k++)
+    for (unsigned k = 0; k < cell_count; k++)
         if (!(sign * s[k] > epsilon))
             return false;
     for (unsigned k = 0; k < q->count; k++)
@@ -116,7 +118,7 @@ static bool blocks_all(const rad_vec3 *corner, unsigned count, const rad_vec3 *c
         inward[e] = v3_scale(inward[e], 1 / inward_length);
         inward_offset[e] = v3_dot(inward[e], corner[e]);
     }
-    for (unsigned i = 0; i < 3; i++)
+    for (unsigned i = 0; i < cell_count; i++)
         for (unsigned j = 0; j < q->count; j++) {
             rad_vec3 x = v3_lerp(cell[i], q->vertex[j], s[i] / (s[i] - t[j]));
             for (unsigned e = 0; e < count; e++)
@@ -130,10 +132,9 @@ static bool blocks_all(const rad_vec3 *corner, unsigned count, const rad_vec3 *c
  * that cut the hull of it and the inner polygon (every segment between them lies in it),
  * that is, are not wholly outside one of the hull's side planes (its other faces are the
  * two polygons' planes, which the pair's occluders already cut). */
-static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int level, int slot,
-                      int parent_slot)
+static bool cull_polygon(outer_context *c, const rad_vec3 *cell_corner, unsigned corner_count,
+                         int level, int slot, int parent_slot)
 {
-    outer_context *c = context;
     const cull_list *parent = level > 0 ? &c->cull->list[level - 1][parent_slot] : NULL;
     cull_list *list = &c->cull->list[level][slot];
     const uint32_t *from = parent ? parent->index : NULL;
@@ -146,11 +147,13 @@ static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int lev
     if (parent && parent->blocked)
         return true; /* 0 all over */
     vf_polygon cell;
-    cell.vertex[0] = a;
-    cell.vertex[1] = b;
-    cell.vertex[2] = d;
-    cell.count = 3;
-    cell.centroid = v3_scale(v3_add(v3_add(a, b), d), 1.0 / 3);
+    rad_vec3 centroid = {0, 0, 0};
+    for (unsigned k = 0; k < corner_count; k++) {
+        cell.vertex[k] = cell_corner[k];
+        centroid = v3_add(centroid, cell_corner[k]);
+    }
+    cell.count = corner_count;
+    cell.centroid = v3_scale(centroid, 1.0 / corner_count);
     rad_vec3 normal[2 * (3 + VF_MAX_VERTICES)];
     double offset[2 * (3 + VF_MAX_VERTICES)];
     unsigned planes = occluder_hull_sides(&cell, c->inner, c->plane_epsilon, normal, offset);
@@ -166,13 +169,26 @@ static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int lev
         }
         if (outside)
             continue;
-        if (blocks_all(corner, corners, cell.vertex, c->inner, c->plane_epsilon))
+        if (blocks_all(corner, corners, cell.vertex, cell.count, c->inner, c->plane_epsilon))
             return true; /* blocked */
         to[kept++] = o;
     }
     list->blocked = false;
     list->count = kept;
     return kept == 0;
+}
+
+static bool cull_cell(void *context, rad_vec3 a, rad_vec3 b, rad_vec3 d, int level, int slot,
+                      int parent_slot)
+{
+    const rad_vec3 corners[3] = {a, b, d};
+    return cull_polygon(context, corners, 3, level, slot, parent_slot);
+}
+
+static bool cull_parallelogram(void *context, const rad_vec3 corner[4], int level, int slot,
+                               int parent_slot)
+{
+    return cull_polygon(context, corner, 4, level, slot, parent_slot);
 }
 
 static inline double point_factor(outer_context *c, rad_vec3 x)
@@ -211,6 +227,12 @@ static double point_factor_callback(void *context, rad_vec3 x)
 static double integrate_outer(outer_context *c, const vf_polygon *outer, double accuracy,
                               double absolute, double *bound)
 {
+    rad_vec3 origin, a, b;
+    if (c->strips && parallelogram_of(outer->vertex, outer->count, &origin, &a, &b)) {
+        parallelogram_integral strips = {point_factor_callback, c, c->max_depth, &c->failed,
+                                         cull_parallelogram, c->min_depth, c->edge_check};
+        return parallelogram_integrate_within(&strips, origin, a, b, accuracy, absolute, bound);
+    }
     polygon_integral integral = {point_factor_callback, c, c->max_depth, &c->failed,
                                  c->cull ? cull_cell : NULL, c->min_depth, c->edge_check};
     return polygon_integrate_within(&integral, outer->vertex, outer->count, accuracy, absolute,
@@ -234,7 +256,7 @@ static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                              const shadow_occluder *occluders, const shadow_polygon *joined,
                              uint32_t count, double accuracy, double absolute,
                              double plane_epsilon, uint64_t work_budget, int min_depth,
-                             bool edge_check, double *value, double *bound)
+                             bool edge_check, bool strips, double *value, double *bound)
 {
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
     if (count > PAIR_EXACT_MAX_OCCLUDERS)
@@ -259,6 +281,7 @@ static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                        .max_depth = OBSTRUCTED_MAX_DEPTH,
                        .min_depth = min_depth,
                        .edge_check = edge_check,
+                       .strips = strips,
                        .work_left = work_budget,
                        .cull = &levels};
     *value = integrate_outer(&c, outer, accuracy, absolute, bound);
@@ -275,7 +298,7 @@ bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
         return false;
     uint32_t count = shadow_join_occluders(occluders, occluder_count, joined);
     return obstructed_exact(p, q, NULL, joined, count, accuracy, absolute, plane_epsilon,
-                            work_budget, OBSTRUCTED_MIN_DEPTH, true, value, bound);
+                            work_budget, OBSTRUCTED_MIN_DEPTH, true, true, value, bound);
 }
 
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
@@ -283,7 +306,7 @@ bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            double accuracy, double plane_epsilon, double *value, double *bound)
 {
     return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, 0, plane_epsilon,
-                            EXACT_WORK_BUDGET, 0, false, value, bound);
+                            EXACT_WORK_BUDGET, 0, false, false, value, bound);
 }
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)

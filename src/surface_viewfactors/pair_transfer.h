@@ -66,7 +66,9 @@ bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
  * on the transfer, with at most `work_budget` (point, occluder) clippings, and the occluders
  * (at most PAIR_EXACT_MAX_OCCLUDERS of them) first joined where they share an edge in one
  * plane (shadow_join_occluders: a wall's triangles cast one shadow, not one each; the same
- * visible part, in fewer pieces). */
+ * visible part, in fewer pieces). An outer polygon that is a parallelogram is integrated in
+ * cells split into strips where the shadows' kinks run along its edges
+ * (parallelogram_integral.h), any other by triangles. */
 bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
                                   const shadow_occluder *occluders, uint32_t occluder_count,
                                   double accuracy, double absolute, double plane_epsilon,
