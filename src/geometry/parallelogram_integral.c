@@ -90,14 +90,16 @@ static double fourth_difference(double e0, double g0, double m, double g1, doubl
  * smooth the prediction is good to h^5 and the check costs no split; a sliver of light or
  * shadow along an edge or at a corner, which no rule point sees, shows. A cell halved into
  * strips is checked along its centre line across the cut only (the midpoints of the two
- * edges that were cut, against the 6 positions on that line): its other check points would
- * be extrapolated from the 3 nodes along the direction not cut, a quadratic that misses
- * even a smooth cubic; a sliver along an edge that was not cut shows in the fourth
- * difference that chose the cut, which takes that edge's midpoint. A miss weighs
- * CHECK_SHARE_MARGIN times the part of the cell nearer that check point than any other
- * point (in the unit square of the cell's coordinates), as polygon_integral's edge check
- * does with 6: measured on the 1k city against a 1000-times finer run, 6 left the errors
- * of the worst pairs at 0.9 of their bounds, 12 at 0.8 (the triangles' 0.8).
+ * edges parallel to the cut and the centre, against the 6 positions on that line): its
+ * other check points would be extrapolated from the 3 nodes along the direction not cut,
+ * a quadratic that misses even a smooth cubic. A sliver along an edge that was not cut
+ * shows in the fourth difference that chose the cut, which takes that edge's midpoint; one
+ * at a corner, seen by a quartered cell's check above the child's tolerance and above
+ * what the rules disagree on, makes the child that holds that corner quarter too. A miss
+ * weighs CHECK_SHARE_MARGIN times the part of the cell nearer that check point than any
+ * other point (in the unit square of the cell's coordinates), as polygon_integral's edge
+ * check does with 6: on the 1k city, against runs 1000 times finer, 6 left the errors of
+ * the worst pairs at 0.9 of their bounds, 12 at 0.8 (the triangles' 0.8).
  */
 #define CHECK_SHARE_MARGIN 12.0
 #define CHECK_SHARE_LATTICE 120
@@ -199,7 +201,8 @@ static void check_compute(void)
 /* The miss of the children's prediction at the 3 x 3 check points (at[i][j]: f at s = i -
  * 1, t = j - 1 of the cell), as a share of the cell's integral's scale: sum of share times
  * |f - predicted|. */
-static double check_miss(int kind, const double *part_value, double at[3][3])
+static double check_miss(int kind, const double *part_value, double at[3][3],
+                         double miss_at[3][3])
 {
     bool halved_s = kind != SPLIT_T, halved_t = kind != SPLIT_S;
     int ns = halved_s ? 6 : 3, nt = halved_t ? 6 : 3;
@@ -218,6 +221,7 @@ static double check_miss(int kind, const double *part_value, double at[3][3])
     double miss = 0;
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++) {
+            miss_at[i][j] = 0;
             /* a strip checks its centre line across the cut only: f at the other check
              * points would be extrapolated from 3 nodes along the direction it was not cut
              * in, a quadratic that misses a smooth cubic there */
@@ -231,7 +235,8 @@ static double check_miss(int kind, const double *part_value, double at[3][3])
                     predicted += ws * wt * grid[a][b];
                 }
             }
-            miss += check_share[kind][i][j] * fabs(at[i][j] - predicted);
+            miss_at[i][j] = check_share[kind][i][j] * fabs(at[i][j] - predicted);
+            miss += miss_at[i][j];
         }
     return miss;
 }
@@ -253,7 +258,7 @@ static const int child_check[SPLIT_KINDS][4][4][2] = {
  * edge check is on there. */
 static double adapt(const frame *p, cell k, double whole, const double *value, double tolerance,
                     int level, int slot, int parent_slot, int splits_s, int splits_t,
-                    bool smooth, const double *corner, double *error)
+                    bool smooth, bool quarter, const double *corner, double *error)
 {
     const parallelogram_integral *c = p->c;
     bool check = c->edge_check && !smooth;
@@ -283,6 +288,9 @@ static double adapt(const frame *p, cell k, double whole, const double *value, d
     if (forced) {
         split_s = need_s || (can_s && !need_t);
         split_t = need_t || (can_t && !need_s);
+    } else if (quarter) {
+        split_s = can_s;
+        split_t = can_t;
     } else {
         double along_s = fourth_difference(at[0][1], value[1], value[4], value[7], at[2][1]);
         double along_t = fourth_difference(at[1][0], value[3], value[4], value[5], at[1][2]);
@@ -319,11 +327,10 @@ static double adapt(const frame *p, cell k, double whole, const double *value, d
     double sum = 0;
     for (int m = 0; m < children; m++)
         sum += part[m];
-    double difference = fabs(sum - whole);
-    if (check) {
-        double area = p->jacobian * (k.s1 - k.s0) * (k.t1 - k.t0);
-        difference = fmax(difference, check_miss(kind, &part_value[0][0], at) * area);
-    }
+    double rules = fabs(sum - whole), difference = rules, miss_at[3][3] = {{0}};
+    double area = p->jacobian * (k.s1 - k.s0) * (k.t1 - k.t0);
+    if (check)
+        difference = fmax(difference, check_miss(kind, &part_value[0][0], at, miss_at) * area);
     int child_s = splits_s + split_s, child_t = splits_t + split_t;
     /* split to the deepest in either direction: splitting the other way could not see
      * what is left unresolved across this one (halves along a kink agree on it) */
@@ -338,11 +345,19 @@ static double adapt(const frame *p, cell k, double whole, const double *value, d
     double t = tolerance * (children == 4 ? 0.5 : 0.70710678118654752), total = 0;
     for (int m = 0; m < children; m++) {
         double child_corner[4];
+        /* a miss at a corner of the child, above its tolerance and above what the rules
+         * disagree on, is something no rule point sees there (a kink the rules see misses
+         * at the points along it too, and strips follow it): the child is quartered, for a
+         * strip would check its centre line only and lose it */
+        bool missed = false;
         if (check)
-            for (int v = 0; v < 4; v++)
-                child_corner[v] = at[child_check[kind][m][v][0]][child_check[kind][m][v][1]];
+            for (int v = 0; v < 4; v++) {
+                int i = child_check[kind][m][v][0], j = child_check[kind][m][v][1];
+                child_corner[v] = at[i][j];
+                missed = missed || miss_at[i][j] * area > fmax(t, rules);
+            }
         total += adapt(p, child[m], part[m], part_value[m], t, level + 1, m, slot, child_s,
-                       child_t, part_smooth[m], check ? child_corner : NULL, error);
+                       child_t, part_smooth[m], missed, check ? child_corner : NULL, error);
     }
     return total;
 }
@@ -380,7 +395,7 @@ double parallelogram_integrate_within(const parallelogram_integral *integral, ra
         corner[3] = f_at(&p, 0, 1);
     }
     double result = adapt(&p, whole_cell, whole, value, tolerance, 1, 0, 0, 0, 0, smooth,
-                          check ? corner : NULL, &error);
+                          false, check ? corner : NULL, &error);
     *bound = error;
     return result;
 }

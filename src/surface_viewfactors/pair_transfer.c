@@ -132,6 +132,9 @@ static bool blocks_all(const rad_vec3 *corner, unsigned count, const rad_vec3 *c
  * that cut the hull of it and the inner polygon (every segment between them lies in it),
  * that is, are not wholly outside one of the hull's side planes (its other faces are the
  * two polygons' planes, which the pair's occluders already cut). */
+_Static_assert(2 * (4 + VF_MAX_VERTICES) <= OCCLUDER_HULL_MAX_SIDES,
+               "the hull of a 4-corner cell and the inner polygon has room for its sides");
+
 static bool cull_polygon(outer_context *c, const rad_vec3 *cell_corner, unsigned corner_count,
                          int level, int slot, int parent_slot)
 {
@@ -154,8 +157,8 @@ static bool cull_polygon(outer_context *c, const rad_vec3 *cell_corner, unsigned
     }
     cell.count = corner_count;
     cell.centroid = v3_scale(centroid, 1.0 / corner_count);
-    rad_vec3 normal[2 * (3 + VF_MAX_VERTICES)];
-    double offset[2 * (3 + VF_MAX_VERTICES)];
+    rad_vec3 normal[OCCLUDER_HULL_MAX_SIDES]; /* a 4-corner cell and a 6-corner q: 20 */
+    double offset[OCCLUDER_HULL_MAX_SIDES];
     unsigned planes = occluder_hull_sides(&cell, c->inner, c->plane_epsilon, normal, offset);
     for (uint32_t k = 0; k < from_count; k++) {
         uint32_t o = from ? from[k] : k;
@@ -229,8 +232,12 @@ static double integrate_outer(outer_context *c, const vf_polygon *outer, double 
 {
     rad_vec3 origin, a, b;
     if (c->strips && parallelogram_of(outer->vertex, outer->count, &origin, &a, &b)) {
+        /* one forced split more than the triangles: after 2 each way every point of the
+         * strips lies on one of some 21 lines across each direction, 0.1 apart, and a band
+         * of light through a slit parallel to them can fall between two (the triangles'
+         * points are scattered) */
         parallelogram_integral strips = {point_factor_callback, c, c->max_depth, &c->failed,
-                                         cull_parallelogram, c->min_depth, c->edge_check};
+                                         cull_parallelogram, c->min_depth + 1, c->edge_check};
         return parallelogram_integrate_within(&strips, origin, a, b, accuracy, absolute, bound);
     }
     polygon_integral integral = {point_factor_callback, c, c->max_depth, &c->failed,
