@@ -122,7 +122,7 @@ static void occluder_rectangle(double x0, double x1, double y0, double y1, doubl
 }
 
 /* The transfer from `floor` (a parallelogram: strips) to `ceiling` behind the 6 lid
- * triangles, checked against the same floor given with a fifth corner (triangles), 400
+ * triangles, checked against the same floor given with a fifth corner (triangles), 250
  * times finer; returns the reference. */
 static double floor_through_slit(const char *what, const vf_polygon *floor,
                                  const vf_polygon *floor_five, const vf_polygon *ceiling,
