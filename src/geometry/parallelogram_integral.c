@@ -317,7 +317,8 @@ static double adapt(const frame *p, cell k, double whole, const double *value, d
         kind = SPLIT_T;
     }
     if (children == 0)
-        return whole; /* split to the deepest both ways: its parent's disagreement is in *error */
+        return whole; /* max_splits 0: the first rule alone, with no estimate of its error
+                         (a cell split to the deepest either way stops below, with one) */
     double part[4], part_value[4][9];
     bool part_smooth[4];
     for (int m = 0; m < children; m++) {

@@ -39,7 +39,7 @@ typedef bool (*parallelogram_cell_fn)(void *context, const rad_vec3 corner[4], i
 typedef struct parallelogram_integral {
     polygon_point_fn f;
     void *context;
-    int max_splits;     /* in either direction, at most PARALLELOGRAM_MAX_SPLITS */
+    int max_splits;     /* in either direction, 1 to PARALLELOGRAM_MAX_SPLITS */
     const bool *failed; /* as polygon_integral.failed */
     parallelogram_cell_fn cell; /* NULL or as polygon_integral.cell */
     int min_splits;     /* where f is not smooth, splits in each direction before the
