@@ -8,8 +8,8 @@
  * at the first splits, is found by the edge check, and so is a sliver at a corner; a floor
  * seen through a slit parallel to its edge (the view factors' path) agrees with the same
  * floor by triangles; and the cell callback's protocol holds:
- * every point lies in the cell told last, and every cell in the one its level and parent
- * slot name.
+ * every point lies in the cell told last (or selected again), and every cell in the one
+ * its level and parent slot name.
  */
 #include <math.h>
 #include <stdio.h>
@@ -51,7 +51,7 @@ typedef struct protocol {
     rad_vec3 cell[PARALLELOGRAM_MAX_LEVELS][4][4];
     bool told[PARALLELOGRAM_MAX_LEVELS][4];
     rad_vec3 now[4];
-    unsigned long points, cells, outside_now, outside_parent;
+    unsigned long points, cells, selected, outside_now, outside_parent;
 } protocol;
 
 /* whether x lies in the rectangle cell (axis-aligned in x, y here), by 1e-12 */
@@ -82,6 +82,14 @@ static bool protocol_cell(void *context, const rad_vec3 corner[4], int level, in
         p->cell[level][slot][k] = p->now[k] = corner[k];
     p->told[level][slot] = true;
     return false; /* as where shadows may fall: split to min_splits, edge check on */
+}
+
+static void protocol_select(void *context, int level, int slot)
+{
+    protocol *p = context;
+    p->selected++;
+    for (int k = 0; k < 4; k++)
+        p->now[k] = p->cell[level][slot][k];
 }
 
 static double protocol_f(void *context, rad_vec3 x)
@@ -158,7 +166,7 @@ int main(void)
     for (int check = 0; check < 2; check++) {
         counted c = {quintic, NULL, 0};
         parallelogram_integral integral = {counted_f, &c, 8, NULL, NULL, check ? 2 : 0,
-                                           check == 1};
+                                           check == 1, NULL};
         value = parallelogram_integrate_within(&integral, v3(0, 0, 0), v3(2, 0, 0),
                                                       v3(0, 1, 0), 1e-12, 0, &bound);
         printf("quintic (edge check %s): %.17g, exact %.17g, bound %.2g, %lu points\n",
@@ -171,7 +179,7 @@ int main(void)
     double c_line = 0.7310585786;
     double kink_exact = 0.75 * (c_line * c_line + (2 - c_line) * (2 - c_line));
     counted strips_count = {kink, &c_line, 0}, triangles_count = {kink, &c_line, 0};
-    parallelogram_integral strips = {counted_f, &strips_count, 8, NULL, NULL, 2, true};
+    parallelogram_integral strips = {counted_f, &strips_count, 8, NULL, NULL, 2, true, NULL};
     polygon_integral triangles = {counted_f, &triangles_count, 8, NULL, NULL, 2, true};
     double strips_bound, triangles_bound;
     double by_strips = parallelogram_integrate_within(&strips, v3(0, 0, 0), v3(2, 0, 0),
@@ -195,7 +203,7 @@ int main(void)
     double w = 0.02, wedge_exact = w / 2;
     for (int check = 0; check < 2; check++) {
         counted c = {wedge, &w, 0};
-        parallelogram_integral integral = {counted_f, &c, 8, NULL, NULL, 2, check == 1};
+        parallelogram_integral integral = {counted_f, &c, 8, NULL, NULL, 2, check == 1, NULL};
         value = parallelogram_integrate_within(&integral, v3(0, 0, 0), v3(2, 0, 0),
                                                       v3(0, 1, 0), 1e-3, 1e-9, &bound);
         printf("wedge of width %g on an edge (edge check %s): %.9g, exact %.9g, bound %.2g\n",
@@ -215,7 +223,7 @@ int main(void)
      * a bound of 1e-16). */
     double sliver_w = 0.01, sliver_exact = 0.4 + sliver_w * sliver_w / 6;
     counted sliver = {corner_sliver, &sliver_w, 0};
-    parallelogram_integral at_corner = {counted_f, &sliver, 8, NULL, NULL, 2, true};
+    parallelogram_integral at_corner = {counted_f, &sliver, 8, NULL, NULL, 2, true, NULL};
     value = parallelogram_integrate_within(&at_corner, v3(0, 0, 0), v3(2, 0, 0), v3(0, 1, 0),
                                            1e-6, 0, &bound);
     printf("sliver of width %g at a corner: %.12g, exact %.12g, bound %.2g, %lu points\n",
@@ -258,17 +266,24 @@ int main(void)
                              lid) > 0);
 
     /* the protocol, on the wedge over a slope (so that cells split both ways and in
-     * strips) */
-    static protocol p;
-    parallelogram_integral told = {protocol_f, &p, 8, NULL, protocol_cell, 2, true};
-    value = parallelogram_integrate_within(&told, v3(0, 0, 0), v3(2, 0, 0), v3(0, 1, 0),
-                                                  1e-6, 0, &bound);
-    printf("protocol: %lu cells told, %lu points, %lu outside the cell told last, %lu cells "
-           "outside their parent; value %.9g, exact %.9g\n",
-           p.cells, p.points, p.outside_now, p.outside_parent, value, 0.01 + 0.25);
-    CHECK(p.cells > 16);
-    CHECK(p.outside_now == 0);
-    CHECK(p.outside_parent == 0);
-    CHECK(fabs(value - 0.26) <= bound);
+     * strips): with every cell told again before its own points come back, and with the
+     * one told last at its level and slot selected instead (as the view factors do) */
+    for (int selecting = 0; selecting < 2; selecting++) {
+        static protocol p;
+        p = (protocol){0};
+        parallelogram_integral told = {protocol_f, &p, 8, NULL, protocol_cell, 2, true,
+                                       selecting ? protocol_select : NULL};
+        value = parallelogram_integrate_within(&told, v3(0, 0, 0), v3(2, 0, 0), v3(0, 1, 0),
+                                               1e-6, 0, &bound);
+        printf("protocol (%s): %lu cells told, %lu selected, %lu points, %lu outside the "
+               "cell told last, %lu cells outside their parent; value %.9g, exact %.9g\n",
+               selecting ? "selected" : "told again", p.cells, p.selected, p.points,
+               p.outside_now, p.outside_parent, value, 0.01 + 0.25);
+        CHECK(p.cells > 16);
+        CHECK(selecting ? p.selected > 0 : p.selected == 0);
+        CHECK(p.outside_now == 0);
+        CHECK(p.outside_parent == 0);
+        CHECK(fabs(value - 0.26) <= bound);
+    }
     return test_finish("test_parallelogram_integral");
 }

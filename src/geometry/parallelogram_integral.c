@@ -270,7 +270,9 @@ static double adapt(const frame *p, cell k, double whole, const double *value, d
     if (check || !forced) {
         /* the cell's edge midpoints: its points are the next, and the callback last told
          * of a child of it */
-        if (c->cell)
+        if (c->select)
+            c->select(c->context, level - 1, slot);
+        else if (c->cell)
             enter(p, k, level - 1, slot, parent_slot);
         at[0][1] = f_at(p, k.s0, tm);
         at[2][1] = f_at(p, k.s1, tm);

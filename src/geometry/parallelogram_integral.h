@@ -36,6 +36,10 @@
 typedef bool (*parallelogram_cell_fn)(void *context, const rad_vec3 corner[4], int level,
                                       int slot, int parent_slot);
 
+/* Makes the cell told last at (level, slot) the one the next points belong to again, as
+ * its telling did (its children have been told since, at level + 1). */
+typedef void (*parallelogram_select_fn)(void *context, int level, int slot);
+
 typedef struct parallelogram_integral {
     polygon_point_fn f;
     void *context;
@@ -45,6 +49,8 @@ typedef struct parallelogram_integral {
     int min_splits;     /* where f is not smooth, splits in each direction before the
                            rules' agreement is believed */
     bool edge_check;
+    /* NULL: a cell whose own points come again after its children's is told again */
+    parallelogram_select_fn select;
 } parallelogram_integral;
 
 /* Whether the convex polygon (count corners) is a parallelogram: corner 0 at *origin, the

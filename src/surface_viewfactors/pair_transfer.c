@@ -66,6 +66,10 @@ typedef struct cull_list {
     uint32_t index[PAIR_EXACT_MAX_OCCLUDERS];
 } cull_list;
 
+_Static_assert(OBSTRUCTED_MAX_DEPTH + 1 <= PARALLELOGRAM_MAX_LEVELS &&
+                   OBSTRUCTED_MAX_DEPTH <= PARALLELOGRAM_MAX_SPLITS,
+               "the cull levels hold the triangles' depths and the strips' splits");
+
 typedef struct cull_levels {
     const cull_list *now; /* the points' triangle's */
     cull_list list[PARALLELOGRAM_MAX_LEVELS][4]; /* per level and child slot */
@@ -194,6 +198,14 @@ static bool cull_parallelogram(void *context, const rad_vec3 corner[4], int leve
     return cull_polygon(context, corner, 4, level, slot, parent_slot);
 }
 
+/* The cell told at (level, slot) is the points' again: its list is intact, since only its
+ * own telling and its children's (a level down) have run since. */
+static void select_parallelogram(void *context, int level, int slot)
+{
+    outer_context *c = context;
+    c->cull->now = &c->cull->list[level][slot];
+}
+
 static inline double point_factor(outer_context *c, rad_vec3 x)
 {
     uint32_t count = c->occluder_count;
@@ -237,7 +249,8 @@ static double integrate_outer(outer_context *c, const vf_polygon *outer, double 
          * of light through a slit parallel to them can fall between two (the triangles'
          * points are scattered) */
         parallelogram_integral strips = {point_factor_callback, c, c->max_depth, &c->failed,
-                                         cull_parallelogram, c->min_depth + 1, c->edge_check};
+                                         cull_parallelogram, c->min_depth + 1, c->edge_check,
+                                         select_parallelogram};
         return parallelogram_integrate_within(&strips, origin, a, b, accuracy, absolute, bound);
     }
     polygon_integral integral = {point_factor_callback, c, c->max_depth, &c->failed,
