@@ -8,6 +8,7 @@
 #include <pthread.h>
 
 #include "core/vec3.h"
+#include "geometry/least_squares.h"
 
 /* A cell is halved across one direction only when its fourth difference there is at least
  * this many times the other's. */
@@ -118,54 +119,21 @@ static double halved_position(int a)
     return (a < 3 ? -0.5 : 0.5) + 0.5 * gauss_node[a % 3];
 }
 
-/* weights of the least-squares polynomial of degree `degree` through `count` positions,
- * evaluated at -1, 0 and 1 */
-static void fit_weights(const double *position, int count, int degree, double out[3][6])
-{
-    int terms = degree + 1;
-    double normal[5][5] = {{0}}, rhs[5];
-    for (int i = 0; i < terms; i++)
-        for (int j = 0; j < terms; j++)
-            for (int k = 0; k < count; k++)
-                normal[i][j] += pow(position[k], i) * pow(position[k], j);
-    for (int m = 0; m < 3; m++) {
-        double x = m - 1.0;
-        double matrix[5][5];
-        for (int i = 0; i < terms; i++) {
-            rhs[i] = pow(x, i);
-            for (int j = 0; j < terms; j++)
-                matrix[i][j] = normal[i][j];
-        }
-        /* Gaussian elimination: the matrix is symmetric positive definite */
-        for (int i = 0; i < terms; i++)
-            for (int r = i + 1; r < terms; r++) {
-                double factor = matrix[r][i] / matrix[i][i];
-                for (int j = i; j < terms; j++)
-                    matrix[r][j] -= factor * matrix[i][j];
-                rhs[r] -= factor * rhs[i];
-            }
-        double y[5];
-        for (int i = terms - 1; i >= 0; i--) {
-            y[i] = rhs[i];
-            for (int j = i + 1; j < terms; j++)
-                y[i] -= matrix[i][j] * y[j];
-            y[i] /= matrix[i][i];
-        }
-        for (int k = 0; k < count; k++) {
-            out[m][k] = 0;
-            for (int i = 0; i < terms; i++)
-                out[m][k] += y[i] * pow(position[k], i);
-        }
-    }
-}
-
 static void check_compute(void)
 {
     double six[6];
     const double *three = gauss_node;
     for (int a = 0; a < 6; a++)
         six[a] = halved_position(a);
-    fit_weights(six, 6, 4, predict6);
+    /* the quartic nearest the 6 positions, at -1, 0 and 1 */
+    double design[6][5], at[3][5];
+    for (int a = 0; a < 6; a++)
+        for (int i = 0; i < 5; i++)
+            design[a][i] = pow(six[a], i);
+    for (int m = 0; m < 3; m++)
+        for (int i = 0; i < 5; i++)
+            at[m][i] = pow(m - 1.0, i);
+    least_squares_predictor(&design[0][0], 6, 5, &at[0][0], 3, &predict6[0][0]);
     for (int kind = 0; kind < SPLIT_KINDS; kind++) {
         bool halved_s = kind != SPLIT_T, halved_t = kind != SPLIT_S;
         int ns = halved_s ? 6 : 3, nt = halved_t ? 6 : 3;

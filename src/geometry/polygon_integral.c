@@ -7,6 +7,7 @@
 #include <pthread.h>
 
 #include "core/vec3.h"
+#include "geometry/least_squares.h"
 
 /* The 7-point degree-5 rule on a triangle (Radon; Strang and Fix): barycentric points. */
 static const double rule_a1 = 0.059715871789769820, rule_b1 = 0.470142064105115090;
@@ -40,6 +41,7 @@ static const double rule_point[7][3] = {
 #define EDGE_FIT_DEGREE 4
 #define EDGE_FIT_TERMS ((EDGE_FIT_DEGREE + 1) * (EDGE_FIT_DEGREE + 2) / 2)
 #define CHILD_POINTS 28
+_Static_assert(EDGE_FIT_TERMS <= LEAST_SQUARES_MAX_TERMS, "the fit's terms fit");
 
 static const double edge_point[6][3] = {{1, 0, 0},     {0, 1, 0},     {0, 0, 1},
                                         {0.5, 0.5, 0}, {0, 0.5, 0.5}, {0.5, 0, 0.5}};
@@ -108,44 +110,11 @@ static void edge_predict_compute(void)
         }
     for (int p = 0; p < 6; p++)
         edge_point_share[p] = EDGE_SHARE_MARGIN * nearest_count[p] / lattice;
-    /* the normal equations' matrix, factored L L^T (Cholesky) */
-    double normal[EDGE_FIT_TERMS][EDGE_FIT_TERMS];
-    for (int i = 0; i < EDGE_FIT_TERMS; i++)
-        for (int j = 0; j < EDGE_FIT_TERMS; j++) {
-            normal[i][j] = 0;
-            for (int r = 0; r < CHILD_POINTS; r++)
-                normal[i][j] += design[r][i] * design[r][j];
-        }
-    for (int j = 0; j < EDGE_FIT_TERMS; j++) {
-        for (int k = 0; k < j; k++)
-            normal[j][j] -= normal[j][k] * normal[j][k];
-        normal[j][j] = sqrt(normal[j][j]);
-        for (int i = j + 1; i < EDGE_FIT_TERMS; i++) {
-            for (int k = 0; k < j; k++)
-                normal[i][j] -= normal[i][k] * normal[j][k];
-            normal[i][j] /= normal[j][j];
-        }
-    }
-    for (int p = 0; p < 6; p++) {
-        /* x = (A^T A)^-1 terms(p); the prediction's weights are A x */
-        double x[EDGE_FIT_TERMS];
-        edge_fit_terms(edge_point[p][1], edge_point[p][2], x);
-        for (int i = 0; i < EDGE_FIT_TERMS; i++) {
-            for (int k = 0; k < i; k++)
-                x[i] -= normal[i][k] * x[k];
-            x[i] /= normal[i][i];
-        }
-        for (int i = EDGE_FIT_TERMS - 1; i >= 0; i--) {
-            for (int k = i + 1; k < EDGE_FIT_TERMS; k++)
-                x[i] -= normal[k][i] * x[k];
-            x[i] /= normal[i][i];
-        }
-        for (int r = 0; r < CHILD_POINTS; r++) {
-            edge_predict[p][r] = 0;
-            for (int i = 0; i < EDGE_FIT_TERMS; i++)
-                edge_predict[p][r] += design[r][i] * x[i];
-        }
-    }
+    double at[6][EDGE_FIT_TERMS];
+    for (int p = 0; p < 6; p++)
+        edge_fit_terms(edge_point[p][1], edge_point[p][2], at[p]);
+    least_squares_predictor(&design[0][0], CHILD_POINTS, EDGE_FIT_TERMS, &at[0][0], 6,
+                            &edge_predict[0][0]);
 }
 
 static inline bool stopped(const polygon_integral *c) { return c->failed && *c->failed; }
