@@ -5,9 +5,11 @@
  * kink along a line parallel to an edge (what a rectilinear scene's shadows make) reaches
  * its tolerance with a small part of the points the triangle splitting of
  * polygon_integral.c takes; a thin wedge of light along an edge, which no rule point sees
- * at the first splits, is found by the edge check, and so is a sliver at a corner; a floor
- * seen through a slit parallel to its edge (the view factors' path) agrees with the same
- * floor by triangles; and the cell callback's protocol holds:
+ * at the first splits, is found by the edge check, and so is a sliver at a corner; a ridge
+ * parallel to an edge, between the lines of every rule point, is missed with no forced
+ * splits and found whole by the probes; a floor seen through a slit parallel to its edge
+ * (the view factors' path, with probes and no forced splits) agrees with the same floor
+ * by triangles; and the cell callback's protocol holds, with and without the probes:
  * every point lies in the cell told last (or selected again), and every cell in the one
  * its level and parent slot name.
  */
@@ -101,6 +103,22 @@ static double protocol_f(void *context, rad_vec3 x)
     return wedge(x, &w) + 0.25 * x.y;
 }
 
+/* f = 1 + y + 10 max(0, 1 - |x - 0.36| / 0.02): a ridge 0.04 wide across x = 0.36 on a
+ * slope, int over [0, 2] x [0, 1] = 2 + 1 + 10 x 0.02 = 3.2 */
+static double ridge(rad_vec3 x, const double *parameter)
+{
+    (void)parameter;
+    return 1 + x.y + 10 * fmax(0, 1 - fabs(x.x - 0.36) / 0.02);
+}
+
+/* As where shadows may fall: f not smooth anywhere, so the probes look everywhere. */
+static bool rough_cell(void *context, const rad_vec3 corner[4], int level, int slot,
+                       int parent_slot)
+{
+    (void)context, (void)corner, (void)level, (void)slot, (void)parent_slot;
+    return false;
+}
+
 /* f = (x / 2)^4 + max(0, 1 - (x + y) / w): a sliver of light at the corner (0, 0) */
 static double corner_sliver(rad_vec3 x, const double *w)
 {
@@ -166,7 +184,7 @@ int main(void)
     for (int check = 0; check < 2; check++) {
         counted c = {quintic, NULL, 0};
         parallelogram_integral integral = {counted_f, &c, 8, NULL, NULL, check ? 2 : 0,
-                                           check == 1, NULL};
+                                           check == 1, NULL, false};
         value = parallelogram_integrate_within(&integral, v3(0, 0, 0), v3(2, 0, 0),
                                                       v3(0, 1, 0), 1e-12, 0, &bound);
         printf("quintic (edge check %s): %.17g, exact %.17g, bound %.2g, %lu points\n",
@@ -179,7 +197,8 @@ int main(void)
     double c_line = 0.7310585786;
     double kink_exact = 0.75 * (c_line * c_line + (2 - c_line) * (2 - c_line));
     counted strips_count = {kink, &c_line, 0}, triangles_count = {kink, &c_line, 0};
-    parallelogram_integral strips = {counted_f, &strips_count, 8, NULL, NULL, 2, true, NULL};
+    parallelogram_integral strips = {counted_f, &strips_count, 8, NULL, NULL, 2, true, NULL,
+                                     false};
     polygon_integral triangles = {counted_f, &triangles_count, 8, NULL, NULL, 2, true};
     double strips_bound, triangles_bound;
     double by_strips = parallelogram_integrate_within(&strips, v3(0, 0, 0), v3(2, 0, 0),
@@ -203,7 +222,8 @@ int main(void)
     double w = 0.02, wedge_exact = w / 2;
     for (int check = 0; check < 2; check++) {
         counted c = {wedge, &w, 0};
-        parallelogram_integral integral = {counted_f, &c, 8, NULL, NULL, 2, check == 1, NULL};
+        parallelogram_integral integral = {counted_f, &c,       8,   NULL, NULL, 2,
+                                           check == 1, NULL, false};
         value = parallelogram_integrate_within(&integral, v3(0, 0, 0), v3(2, 0, 0),
                                                       v3(0, 1, 0), 1e-3, 1e-9, &bound);
         printf("wedge of width %g on an edge (edge check %s): %.9g, exact %.9g, bound %.2g\n",
@@ -223,13 +243,36 @@ int main(void)
      * a bound of 1e-16). */
     double sliver_w = 0.01, sliver_exact = 0.4 + sliver_w * sliver_w / 6;
     counted sliver = {corner_sliver, &sliver_w, 0};
-    parallelogram_integral at_corner = {counted_f, &sliver, 8, NULL, NULL, 2, true, NULL};
+    parallelogram_integral at_corner = {counted_f, &sliver, 8, NULL, NULL, 2, true, NULL,
+                                        false};
     value = parallelogram_integrate_within(&at_corner, v3(0, 0, 0), v3(2, 0, 0), v3(0, 1, 0),
                                            1e-6, 0, &bound);
     printf("sliver of width %g at a corner: %.12g, exact %.12g, bound %.2g, %lu points\n",
            sliver_w, value, sliver_exact, bound, sliver.points);
     CHECK(fabs(value - sliver_exact) <= bound);
     CHECK(fabs(value - sliver_exact) <= 0.02 * sliver_w * sliver_w / 6);
+
+    /* A ridge parallel to an edge, between the lines of every rule point and edge-check
+     * point of the first splits (x = 0.225, 0.5, 0.775, ... of the unit square's 0.18):
+     * with no forced splits the rules agree on the slope and miss it, and the bound says
+     * nothing; the probes (one at x = 0.1727 of the square) find it. */
+    for (int probing = 0; probing < 2; probing++) {
+        counted c = {ridge, NULL, 0};
+        parallelogram_integral integral = {counted_f, &c, 8, NULL, rough_cell, 0, true, NULL,
+                                           probing == 1};
+        value = parallelogram_integrate_within(&integral, v3(0, 0, 0), v3(2, 0, 0),
+                                               v3(0, 1, 0), 1e-5, 0, &bound);
+        printf("ridge of width 0.04 across x = 0.36 (probes %s): %.9g, exact 3.2, bound %.2g, "
+               "%lu points\n",
+               probing ? "on" : "off", value, bound, c.points);
+        if (!probing) {
+            CHECK(fabs(value - 3) < 1e-12);
+            CHECK(bound < 1e-12);
+        } else {
+            CHECK(fabs(value - 3.2) <= bound);
+            CHECK(fabs(value - 3.2) <= 1e-4 * 3.2);
+        }
+    }
 
     /* A floor seen through a slit: the unit floor (up) under a 3 x 3 ceiling 1 above it
      * (down), with a lid 0.01 above the floor open only along x in [0.17, 0.19] and a gap
@@ -268,16 +311,19 @@ int main(void)
     /* the protocol, on the wedge over a slope (so that cells split both ways and in
      * strips): with every cell told again before its own points come back, and with the
      * one told last at its level and slot selected instead (as the view factors do) */
-    for (int selecting = 0; selecting < 2; selecting++) {
+    for (int variant = 0; variant < 4; variant++) {
+        bool selecting = variant % 2, probing = variant >= 2;
         static protocol p;
         p = (protocol){0};
-        parallelogram_integral told = {protocol_f, &p, 8, NULL, protocol_cell, 2, true,
-                                       selecting ? protocol_select : NULL};
+        /* with the probes, no forced splits (as the view factors take them) */
+        parallelogram_integral told = {
+            protocol_f,  &p, 8, NULL, protocol_cell, probing ? 0 : 2, true,
+            selecting ? protocol_select : NULL, probing};
         value = parallelogram_integrate_within(&told, v3(0, 0, 0), v3(2, 0, 0), v3(0, 1, 0),
                                                1e-6, 0, &bound);
-        printf("protocol (%s): %lu cells told, %lu selected, %lu points, %lu outside the "
+        printf("protocol (%s%s): %lu cells told, %lu selected, %lu points, %lu outside the "
                "cell told last, %lu cells outside their parent; value %.9g, exact %.9g\n",
-               selecting ? "selected" : "told again", p.cells, p.selected, p.points,
+               selecting ? "selected" : "told again", probing ? ", probes" : "", p.cells, p.selected, p.points,
                p.outside_now, p.outside_parent, value, 0.01 + 0.25);
         CHECK(p.cells > 16);
         CHECK(selecting ? p.selected > 0 : p.selected == 0);

@@ -16,6 +16,13 @@
  * cut, must also agree with what its children's rule points predict. A cell split to
  * max_splits either way is not split the other way: halves along a kink agree on what
  * neither resolves, so it stops there with its disagreement as its error.
+ * With `probes`, 55 points of a lattice over the whole parallelogram, with 55 distinct
+ * values along either direction, check each cell about to be accepted: f at the probes in
+ * it against its rule points' biquadratic, the misses counted as error. A probe far
+ * outside its cell's range marks a feature the rule points did not see (light through a
+ * slit), and the integral is made again with the cells along that probe's two lines cut
+ * narrow. This takes the place of forced splits (min_splits), which only narrowed the gaps
+ * between the lines all rule points lie on, at the price of every cell.
  */
 #ifndef RAD_GEOMETRY_PARALLELOGRAM_INTEGRAL_H
 #define RAD_GEOMETRY_PARALLELOGRAM_INTEGRAL_H
@@ -51,6 +58,9 @@ typedef struct parallelogram_integral {
     bool edge_check;
     /* NULL: a cell whose own points come again after its children's is told again */
     parallelogram_select_fn select;
+    /* where f is not smooth, cells are accepted only where f at the lattice probes inside
+     * them follows their rule points (above) */
+    bool probes;
 } parallelogram_integral;
 
 /* Whether the convex polygon (count corners) is a parallelogram: corner 0 at *origin, the

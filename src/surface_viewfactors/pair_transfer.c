@@ -244,13 +244,11 @@ static double integrate_outer(outer_context *c, const vf_polygon *outer, double 
 {
     rad_vec3 origin, a, b;
     if (c->strips && parallelogram_of(outer->vertex, outer->count, &origin, &a, &b)) {
-        /* one forced split more than the triangles: after 2 each way every point of the
-         * strips lies on one of some 21 lines across each direction, 0.1 apart, and a band
-         * of light through a slit parallel to them can fall between two (the triangles'
-         * points are scattered) */
+        /* no forced splits: the probes find what the rule points miss (a band of light
+         * through a slit parallel to an edge falls between the lines they lie on) */
         parallelogram_integral strips = {point_factor_callback, c, c->max_depth, &c->failed,
-                                         cull_parallelogram, c->min_depth + 1, c->edge_check,
-                                         select_parallelogram};
+                                         cull_parallelogram, 0, c->edge_check,
+                                         select_parallelogram, true};
         return parallelogram_integrate_within(&strips, origin, a, b, accuracy, absolute, bound);
     }
     polygon_integral integral = {point_factor_callback, c, c->max_depth, &c->failed,
