@@ -23,7 +23,7 @@ typedef struct frame {
     const parallelogram_integral *c;
     rad_vec3 origin, a, b;
     double jacobian;    /* |a x b| */
-    uint64_t cuts;      /* the probes whose lines are cut along (probe_outlier) */
+    uint64_t cuts;      /* the outliers whose lines cells are quartered along (needs_cut) */
     uint64_t *outliers; /* NULL, or the probes found outside their cells' range */
 } frame;
 
@@ -169,9 +169,6 @@ static void check_compute(void)
     }
 }
 
-/* The miss of the children's prediction at the 3 x 3 check points (at[i][j]: f at s = i -
- * 1, t = j - 1 of the cell), as a share of the cell's integral's scale: sum of share times
- * |f - predicted|. */
 /*
  * The probes. However a cell is split, its rule points lie on a few lines across each
  * direction, and a band of light through a slit parallel to them (or a shadow as thin)
@@ -283,6 +280,9 @@ static bool needs_cut(const frame *p, double lo, double hi, bool along_s)
     return false;
 }
 
+/* The miss of the children's prediction at the 3 x 3 check points (at[i][j]: f at s = i -
+ * 1, t = j - 1 of the cell), as a share of the cell's integral's scale: sum of share times
+ * |f - predicted|. */
 static double check_miss(int kind, const double *part_value, double at[3][3],
                          double miss_at[3][3])
 {
@@ -507,7 +507,7 @@ double parallelogram_integrate_within(const parallelogram_integral *integral, ra
     if (outliers && !stopped(&p)) {
         /* a feature the rule points did not see, where an outlier found it, may reach along
          * either edge's direction beyond the cells that followed it: again, with the cells
-         * along the outliers' lines cut to CUT_WIDTH */
+         * along the outliers' lines quartered down to CUT_WIDTH */
         p.cuts = outliers;
         p.outliers = NULL;
         error = 0;
