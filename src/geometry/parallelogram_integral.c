@@ -12,8 +12,10 @@
 #include "geometry/least_squares.h"
 
 /* A cell is halved across one direction only when its fourth difference there is at least
- * this many times the other's. */
+ * this many times the other's, and not when both are within FLAT_DIFFERENCE of the largest
+ * |f| it has seen. */
 #define STRIP_RATIO 4.0
+#define FLAT_DIFFERENCE 1e-9
 
 /* 3-point Gauss-Legendre on [-1, 1] */
 static const double gauss_node[3] = {-0.774596669241483377, 0, 0.774596669241483377};
@@ -382,8 +384,19 @@ static double adapt(const frame *p, cell k, double whole, const double *value, d
     } else {
         double along_s = fourth_difference(at[0][1], value[1], value[4], value[7], at[2][1]);
         double along_t = fourth_difference(at[1][0], value[3], value[4], value[5], at[1][2]);
-        split_s = can_s && !(along_t > STRIP_RATIO * along_s && can_t);
-        split_t = can_t && !(along_s > STRIP_RATIO * along_t && can_s);
+        /* both at rounding level (f linear at every point the cell has): their ratio is
+         * noise, and strips chosen by it put every rule line of a cell beside a band that
+         * a quarter split found in its mirror image (half a band lost, at a tenth of the
+         * bound) */
+        double scale = 0;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                scale = fmax(scale, fabs(at[i][j]));
+        for (int v = 0; v < 9; v++)
+            scale = fmax(scale, fabs(value[v]));
+        bool flat = along_s <= FLAT_DIFFERENCE * scale && along_t <= FLAT_DIFFERENCE * scale;
+        split_s = can_s && (flat || !(along_t > STRIP_RATIO * along_s && can_t));
+        split_t = can_t && (flat || !(along_s > STRIP_RATIO * along_t && can_s));
     }
     cell child[4];
     int children = 0, kind = SPLIT_BOTH;
@@ -430,8 +443,10 @@ static double adapt(const frame *p, cell k, double whole, const double *value, d
                                       needs_cut(p, child[m].t0, child[m].t1, false));
     bool last_level = deepest || level + 1 >= PARALLELOGRAM_MAX_LEVELS;
     double probed[4] = {0, 0, 0, 0};
-    if (c->probes && !smooth && difference <= tolerance && settled && !last_level) {
-        /* about to be accepted: the probes in each child must follow its rule points */
+    if (c->probes && !smooth && ((difference <= tolerance && settled) || last_level)) {
+        /* about to be accepted: the probes in each child must follow its rule points (at
+         * the last level too: what they miss there counts in the bound, and an outlier
+         * still starts the second pass) */
         double misses = 0;
         for (int m = 0; m < children && misses <= tolerance && !stopped(p); m++)
             if (!part_smooth[m]) {
