@@ -2052,6 +2052,8 @@ typedef struct rad_viewfactor_write_options {
     rad_viewfactor_format format;
     bool enclosure; /* View3D header's `encl` field: the rows were closed (--enclosure) */
     bool script_f;  /* View3D header's `emit` field: the values are script-F factors */
+    bool error_bounds; /* the values are the factors' error bounds (the Matrix Market
+                          comment line says so) */
 } rad_viewfactor_write_options;
 
 /* Writes the matrix of `scene`'s surfaces (matrix->n == scene->surface_count). Surfaces

@@ -299,7 +299,7 @@ static void test_writers(void)
 
     /* Matrix Market: parse it back */
     const char *mtx = test_path("out.mtx");
-    rad_viewfactor_write_options options = {RAD_VIEWFACTOR_MATRIX_MARKET, false, false};
+    rad_viewfactor_write_options options = {RAD_VIEWFACTOR_MATRIX_MARKET, false, false, false};
     CHECK(rad_viewfactor_matrix_write(scene, m, mtx, &options, &error) == RAD_OK);
     FILE *f = fopen(mtx, "r");
     CHECK(f != NULL);
@@ -337,7 +337,7 @@ static void test_writers(void)
 
     /* View3D's text layout */
     const char *v3d = test_path("out.txt");
-    options = (rad_viewfactor_write_options){RAD_VIEWFACTOR_VIEW3D, true, false};
+    options = (rad_viewfactor_write_options){RAD_VIEWFACTOR_VIEW3D, true, false, false};
     CHECK(rad_viewfactor_matrix_write(scene, m, v3d, &options, &error) == RAD_OK);
     f = fopen(v3d, "r");
     CHECK(f != NULL);

@@ -211,6 +211,44 @@ static void test_obstruction(void)
     CHECK(strstr(test_read_text(test_path("blocked-vs3.mtx")), "blocker") == NULL);
 }
 
+/* --error-bounds: each stored factor's bound, in the factors' layout; it covers the error
+ * (against the closed form unobstructed, against a run 1000 times finer behind the
+ * blocker) and meets the accuracy asked for. */
+static void test_error_bounds(void)
+{
+    test_write_file("low.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+    test_write_file("high.obj", "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 4 3 2\n");
+    test_write_file("blocker.obj",
+                    "v 0.25 0.25 0.5\nv 0.75 0.25 0.5\nv 0.75 0.75 0.5\nv 0.25 0.75 0.5\nf 1 2 3 4\n");
+    matrix open, open_bounds, blocked, fine;
+    if (!run_mtx("low.obj high.obj --error-bounds open-bounds.mtx", "open.mtx", &open) ||
+        !read_mtx(test_path("open-bounds.mtx"), &open_bounds))
+        return;
+    CHECK(strstr(test_read_text(test_path("open-bounds.mtx")), "% error bounds of the") != NULL);
+    double F = factor(&open, "low", "high"), B = factor(&open_bounds, "low", "high");
+    CHECK(B > 0 && B <= 1e-4 * F); /* the bound, not the factor, and within --accuracy */
+    CHECK(fabs(F - parallel_squares(1)) <= B);
+    CHECK_NEAR(factor(&open_bounds, "high", "low"), B, 1e-15); /* equal areas */
+    /* behind the blocker (CSV this time): the bound covers the difference from a run 1000
+     * times finer, and meets the obstructed target accuracy x sqrt(F unobstructed) */
+    if (!run_mtx("low.obj high.obj --obstruction blocker.obj --error-bounds blocked-bounds.csv",
+                 "blocked.mtx", &blocked) ||
+        !run_mtx("low.obj high.obj --obstruction blocker.obj --accuracy 1e-7", "fine.mtx", &fine))
+        return;
+    const char *csv = test_read_text(test_path("blocked-bounds.csv"));
+    double b_low_high = -1, b_high_low = -1;
+    CHECK(csv && sscanf(csv, "surface,low,high\nlow,0,%lf\nhigh,%lf,0", &b_low_high,
+                        &b_high_low) == 2);
+    double f = factor(&blocked, "low", "high"), exact = factor(&fine, "low", "high");
+    CHECK(b_low_high > 0 && b_low_high <= 1e-4 * sqrt(parallel_squares(1)));
+    CHECK(fabs(f - exact) <= b_low_high);
+    CHECK(f < 0.9 * parallel_squares(1));
+    /* the factors' own file is not the bounds' */
+    CHECK(test_run_tool("viewfactors low.obj high.obj -o same.mtx --error-bounds same.mtx") == 2);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "--error-bounds: ") != NULL);
+    CHECK(!test_file_exists(test_path("same.mtx")));
+}
+
 /* --two-sided: the middle plate of three radiates from both faces. */
 static void test_two_sided(void)
 {
@@ -390,6 +428,7 @@ int main(void)
     test_quads_and_combined();
     test_triangles();
     test_obstruction();
+    test_error_bounds();
     test_two_sided();
     test_enclosure_and_script_f();
     test_subsurface();

@@ -72,6 +72,9 @@ static const char usage_more[] =
     "                       1.3x where many shadows cross), about 13x the matrix's\n"
     "                       time on a city (default: sampled, seconds, bounds about\n"
     "                       1e-2 there)\n"
+    "  --error-bounds FILE  each stored factor's error bound (absolute, in units of F),\n"
+    "                       as -o writes the factors: Matrix Market for a .mtx name,\n"
+    "                       else CSV (the pairs no sight ray met are within 3 / N)\n"
     "  --repair-rows        trim rows that sum above 1 keeping reciprocity (symmetric\n"
     "                       scaling of A_i F_ij); reports the largest change, the share\n"
     "                       of exchange removed and the reciprocity residual\n"
@@ -102,7 +105,7 @@ enum {
     OPT_ACCURACY = OPT_OWN, OPT_MAX_RAYS, OPT_FORMAT, OPT_ENCLOSURE, OPT_SCRIPT_F,
     OPT_OBSTRUCTION, OPT_TWO_SIDED, OPT_CHECKPOINT, OPT_CHECKPOINT_INTERVAL, OPT_RESUME,
     OPT_SKY_VIEW_FACTOR, OPT_REPAIR_ROWS, OPT_REPAIR_MAX_CHANGE, OPT_REPAIR_MAX_REMOVED,
-    OPT_SIGHT_RAYS, OPT_EXACT_OCCLUDERS, OPT_SKY_EXACT, OPT_COUNT
+    OPT_SIGHT_RAYS, OPT_EXACT_OCCLUDERS, OPT_SKY_EXACT, OPT_ERROR_BOUNDS, OPT_COUNT
 };
 
 static const cli_option options[OPT_COUNT] = {
@@ -119,7 +122,8 @@ static const cli_option options[OPT_COUNT] = {
     [OPT_REPAIR_MAX_REMOVED] = {"repair-max-removed", 0, true},
     [OPT_SIGHT_RAYS] = {"sight-rays", 0, true},
     [OPT_EXACT_OCCLUDERS] = {"exact-occluders", 0, true},
-    [OPT_SKY_EXACT] = {"sky-exact", 0, false}};
+    [OPT_SKY_EXACT] = {"sky-exact", 0, false},
+    [OPT_ERROR_BOUNDS] = {"error-bounds", 0, true}};
 
 /* --repair-rows' default limits (relative change of a factor, share of exchange). */
 #define REPAIR_MAX_CHANGE 0.05
@@ -326,7 +330,7 @@ int command_viewfactors(int argc, char **argv)
             return EXIT_USAGE;
     }
     const char *output = shared.output, *stats_path = shared.stats_path;
-    rad_viewfactor_write_options write = {RAD_VIEWFACTOR_CSV, false, false};
+    rad_viewfactor_write_options write = {RAD_VIEWFACTOR_CSV, false, false, false};
     if (output)
         write.format = rad_viewfactor_format_for_path(output);
     if (args.value[OPT_FORMAT]) {
@@ -354,8 +358,14 @@ int command_viewfactors(int argc, char **argv)
     rad_row_repair_limits repair_limits = {REPAIR_MAX_CHANGE, REPAIR_MAX_REMOVED};
     if (!parse_repair_options(&args, &repair_limits))
         return EXIT_USAGE;
+    const char *bounds_path = args.value[OPT_ERROR_BOUNDS];
+    if (bounds_path && output && strcmp(bounds_path, output) == 0) {
+        cli_error("--error-bounds: '%s' is the matrix's own output (-o)", bounds_path);
+        return EXIT_USAGE;
+    }
     if (!cli_outputs_writable(
-            (const char *[]){output, stats_path, vf.checkpoint, plot_path, sky_path}, 5))
+            (const char *[]){output, stats_path, vf.checkpoint, plot_path, sky_path, bounds_path},
+            6))
         return EXIT_ERROR;
 
     rad_error error = {0};
@@ -508,6 +518,16 @@ int command_viewfactors(int argc, char **argv)
     if (sky_path &&
         rad_sky_viewfactors_write(scene, sky, sky + S, sky_path, &error) != RAD_OK)
         goto fail;
+    if (bounds_path) {
+        /* the same pattern with the bounds for values (a bound of 0 is not written, as a
+         * factor of 0 is not) */
+        rad_viewfactor_matrix bounds = *matrix;
+        bounds.value = matrix->error_bound;
+        rad_viewfactor_write_options layout = {rad_viewfactor_format_for_path(bounds_path), false,
+                                               false, true};
+        if (rad_viewfactor_matrix_write(scene, &bounds, bounds_path, &layout, &error) != RAD_OK)
+            goto fail;
+    }
     status = output ? rad_viewfactor_matrix_write(scene, matrix, output, &write, &error)
                     : rad_viewfactor_matrix_print(scene, matrix, stdout, &write, &error);
     if (status == RAD_OK)

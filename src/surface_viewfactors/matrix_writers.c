@@ -57,7 +57,7 @@ static void write_csv(const rad_scene *scene, const rad_viewfactor_matrix *m, do
 }
 
 static void write_matrix_market(const rad_scene *scene, const rad_viewfactor_matrix *m,
-                                uint32_t *number, FILE *f)
+                                bool error_bounds, uint32_t *number, FILE *f)
 {
     uint32_t count = 0;
     uint64_t nonzeros = 0;
@@ -67,7 +67,10 @@ static void write_matrix_market(const rad_scene *scene, const rad_viewfactor_mat
         for (uint64_t k = m->row_start[I]; number[I] && k < m->row_start[I + 1]; k++)
             nonzeros += number[m->column[k]] && m->value[k] != 0;
     fputs("%%MatrixMarket matrix coordinate real general\n", f);
-    fputs("% surface view factors F_IJ (row I, column J) from radiosity viewfactors\n", f);
+    fputs(error_bounds ? "% error bounds of the surface view factors F_IJ (absolute; row I, "
+                         "column J) from radiosity viewfactors\n"
+                       : "% surface view factors F_IJ (row I, column J) from radiosity viewfactors\n",
+          f);
     fputs("% surface K AREA NAME\n", f);
     for (uint32_t I = 0; I < m->n; I++)
         if (number[I])
@@ -121,7 +124,7 @@ static void write_view3d(const rad_scene *scene, const rad_viewfactor_matrix *m,
 static rad_status write_any(const rad_scene *scene, const rad_viewfactor_matrix *m, FILE *f,
                             const rad_viewfactor_write_options *options, rad_error *error)
 {
-    rad_viewfactor_write_options defaults = {RAD_VIEWFACTOR_CSV, false, false};
+    rad_viewfactor_write_options defaults = {RAD_VIEWFACTOR_CSV, false, false, false};
     if (!options)
         options = &defaults;
     if (m->n != scene->surface_count)
@@ -133,7 +136,7 @@ static rad_status write_any(const rad_scene *scene, const rad_viewfactor_matrix 
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the view-factor output");
     switch (options->format) {
     case RAD_VIEWFACTOR_MATRIX_MARKET:
-        write_matrix_market(scene, m, buffer, f); /* n uint32_t fit in n doubles */
+        write_matrix_market(scene, m, options->error_bounds, buffer, f); /* n uint32_t fit in n doubles */
         break;
     case RAD_VIEWFACTOR_VIEW3D:
         write_view3d(scene, m, options, buffer, f);
