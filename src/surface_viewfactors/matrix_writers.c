@@ -136,7 +136,8 @@ static rad_status write_any(const rad_scene *scene, const rad_viewfactor_matrix 
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the view-factor output");
     switch (options->format) {
     case RAD_VIEWFACTOR_MATRIX_MARKET:
-        write_matrix_market(scene, m, options->error_bounds, buffer, f); /* n uint32_t fit in n doubles */
+        /* n uint32_t fit in n doubles */
+        write_matrix_market(scene, m, options->error_bounds, buffer, f);
         break;
     case RAD_VIEWFACTOR_VIEW3D:
         write_view3d(scene, m, options, buffer, f);
