@@ -69,7 +69,8 @@ static void write_matrix_market(const rad_scene *scene, const rad_viewfactor_mat
     fputs("%%MatrixMarket matrix coordinate real general\n", f);
     fputs(error_bounds ? "% error bounds of the surface view factors F_IJ (absolute; row I, "
                          "column J) from radiosity viewfactors\n"
-                       : "% surface view factors F_IJ (row I, column J) from radiosity viewfactors\n",
+                       : "% surface view factors F_IJ (row I, column J) from radiosity "
+                         "viewfactors\n",
           f);
     fputs("% surface K AREA NAME\n", f);
     for (uint32_t I = 0; I < m->n; I++)
