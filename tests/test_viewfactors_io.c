@@ -243,9 +243,26 @@ static void test_error_bounds(void)
     CHECK(b_low_high > 0 && b_low_high <= 1e-4 * sqrt(parallel_squares(1)));
     CHECK(fabs(f - exact) <= b_low_high);
     CHECK(f < 0.9 * parallel_squares(1));
-    /* the factors' own file is not the bounds' */
+    CHECK_NEAR(b_high_low, b_low_high, 1e-15);
+    /* a 1 x 1 square under a 2 x 2 one: each bound belongs to its row's factor, as
+     * A_I F_IJ = A_J F_JI so A_I B_IJ = A_J B_JI (a transposed file fails this) */
+    test_write_file("big.obj",
+                    "v -0.5 -0.5 1\nv -0.5 1.5 1\nv 1.5 1.5 1\nv 1.5 -0.5 1\nf 1 2 3 4\n");
+    matrix uneven, uneven_bounds;
+    if (!run_mtx("low.obj big.obj --error-bounds uneven-bounds.mtx", "uneven.mtx", &uneven) ||
+        !read_mtx(test_path("uneven-bounds.mtx"), &uneven_bounds))
+        return;
+    double up = factor(&uneven_bounds, "low", "big"), down = factor(&uneven_bounds, "big", "low");
+    CHECK(up > 0 && up <= 1e-4 * factor(&uneven, "low", "big"));
+    CHECK_NEAR(down, up / 4, 1e-12 * up);
+    /* the factors' own file is not the bounds', however it is spelled */
     CHECK(test_run_tool("viewfactors low.obj high.obj -o same.mtx --error-bounds same.mtx") == 2);
     CHECK(strstr(test_read_text(test_path("stderr.txt")), "--error-bounds: ") != NULL);
+    CHECK(!test_file_exists(test_path("same.mtx")));
+    char command[4096];
+    snprintf(command, sizeof(command),
+             "viewfactors low.obj high.obj -o same.mtx --error-bounds '%s'", test_path("same.mtx"));
+    CHECK(test_run_tool(command) == 2);
     CHECK(!test_file_exists(test_path("same.mtx")));
 }
 

@@ -893,6 +893,33 @@ bool cli_output_writable(const char *path)
     return true;
 }
 
+/* The folder of `path` into folder[size] and its last component. */
+static const char *split_path(const char *path, char *folder, size_t size)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(folder, size, ".");
+    else if (slash == path)
+        snprintf(folder, size, "/");
+    else
+        snprintf(folder, size, "%.*s", (int)(slash - path), path);
+    return slash ? slash + 1 : path;
+}
+
+bool cli_same_output(const char *a, const char *b)
+{
+    if (strcmp(a, b) == 0)
+        return true;
+    struct stat sa, sb;
+    if (stat(a, &sa) == 0 && stat(b, &sb) == 0)
+        return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    char folder_a[4096], folder_b[4096];
+    const char *name_a = split_path(a, folder_a, sizeof(folder_a));
+    const char *name_b = split_path(b, folder_b, sizeof(folder_b));
+    return strcmp(name_a, name_b) == 0 && stat(folder_a, &sa) == 0 && stat(folder_b, &sb) == 0 &&
+           sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
 bool cli_outputs_writable(const char *const *paths, int count)
 {
     for (int k = 0; k < count; k++)

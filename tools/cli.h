@@ -601,6 +601,10 @@ bool cli_output_writable(const char *path);
  * work; false at the first that fails. */
 bool cli_outputs_writable(const char *const *paths, int count);
 
+/* Whether the two output paths name one file: the same text, the same existing file, or
+ * the same name in the same folder (./a.mtx and a.mtx; the folders must exist). */
+bool cli_same_output(const char *a, const char *b);
+
 /* The subcommands, one file each (cmd_NAME.c); argv holds the arguments after the
  * subcommand's name. Each returns the process exit code. */
 int command_render(int argc, char **argv);

@@ -359,14 +359,14 @@ int command_viewfactors(int argc, char **argv)
     if (!parse_repair_options(&args, &repair_limits))
         return EXIT_USAGE;
     const char *bounds_path = args.value[OPT_ERROR_BOUNDS];
-    if (bounds_path && output && strcmp(bounds_path, output) == 0) {
-        cli_error("--error-bounds: '%s' is the matrix's own output (-o)", bounds_path);
-        return EXIT_USAGE;
-    }
     if (!cli_outputs_writable(
             (const char *[]){output, stats_path, vf.checkpoint, plot_path, sky_path, bounds_path},
             6))
         return EXIT_ERROR;
+    if (bounds_path && output && cli_same_output(bounds_path, output)) {
+        cli_error("--error-bounds: '%s' is the matrix's own output (-o %s)", bounds_path, output);
+        return EXIT_USAGE;
+    }
 
     rad_error error = {0};
     rad_scene *scene = NULL;
@@ -518,18 +518,17 @@ int command_viewfactors(int argc, char **argv)
     if (sky_path &&
         rad_sky_viewfactors_write(scene, sky, sky + S, sky_path, &error) != RAD_OK)
         goto fail;
-    if (bounds_path) {
+    status = output ? rad_viewfactor_matrix_write(scene, matrix, output, &write, &error)
+                    : rad_viewfactor_matrix_print(scene, matrix, stdout, &write, &error);
+    if (status == RAD_OK && bounds_path) {
         /* the same pattern with the bounds for values (a bound of 0 is not written, as a
          * factor of 0 is not) */
         rad_viewfactor_matrix bounds = *matrix;
         bounds.value = matrix->error_bound;
         rad_viewfactor_write_options layout = {rad_viewfactor_format_for_path(bounds_path), false,
                                                false, true};
-        if (rad_viewfactor_matrix_write(scene, &bounds, bounds_path, &layout, &error) != RAD_OK)
-            goto fail;
+        status = rad_viewfactor_matrix_write(scene, &bounds, bounds_path, &layout, &error);
     }
-    status = output ? rad_viewfactor_matrix_write(scene, matrix, output, &write, &error)
-                    : rad_viewfactor_matrix_print(scene, matrix, stdout, &write, &error);
     if (status == RAD_OK)
         status = cli_viewfactor_plot_end(&plot, scene->source, (uint32_t)S, &error);
     if (status != RAD_OK)
