@@ -256,14 +256,17 @@ static void test_error_bounds(void)
     CHECK(up > 0 && up <= 1e-4 * factor(&uneven, "low", "big"));
     CHECK_NEAR(down, up / 4, 1e-12 * up);
     /* the factors' own file is not the bounds', however it is spelled */
-    CHECK(test_run_tool("viewfactors low.obj high.obj -o same.mtx --error-bounds same.mtx") == 2);
-    CHECK(strstr(test_read_text(test_path("stderr.txt")), "--error-bounds: ") != NULL);
+    CHECK(test_run_tool("viewfactors low.obj high.obj -o same.mtx --error-bounds same.mtx") == 1);
+    CHECK(strstr(test_read_text(test_path("stderr.txt")), "two outputs name one file") != NULL);
     CHECK(!test_file_exists(test_path("same.mtx")));
     char command[4096];
     snprintf(command, sizeof(command),
              "viewfactors low.obj high.obj -o same.mtx --error-bounds '%s'", test_path("same.mtx"));
-    CHECK(test_run_tool(command) == 2);
+    CHECK(test_run_tool(command) == 1);
     CHECK(!test_file_exists(test_path("same.mtx")));
+    /* the same for any two outputs of any command: -o and --stats */
+    CHECK(test_run_tool("viewfactors low.obj high.obj -o same.csv --stats ./same.csv") == 1);
+    CHECK(!test_file_exists(test_path("same.csv")));
 }
 
 /* --two-sided: the middle plate of three radiates from both faces. */

@@ -855,6 +855,19 @@ bool stats_write(cli_stats *stats, const char *path)
     return true;
 }
 
+/* The folder of `path` into folder[size] and its last component. */
+static const char *split_path(const char *path, char *folder, size_t size)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(folder, size, ".");
+    else if (slash == path)
+        snprintf(folder, size, "/");
+    else
+        snprintf(folder, size, "%.*s", (int)(slash - path), path);
+    return slash ? slash + 1 : path;
+}
+
 /* The folder of path must exist, be a folder and be writable, and path must not be a
  * folder: checked before hours of work. (Root writes into a read-only folder: access()
  * says so.) */
@@ -870,13 +883,7 @@ bool cli_output_writable(const char *path)
         return false;
     }
     char folder[4096];
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        snprintf(folder, sizeof(folder), ".");
-    else if (slash == path)
-        snprintf(folder, sizeof(folder), "/");
-    else
-        snprintf(folder, sizeof(folder), "%.*s", (int)(slash - path), path);
+    split_path(path, folder, sizeof(folder));
     if (stat(folder, &st) != 0) {
         cli_error("%s: cannot write: folder '%s' does not exist", path, folder);
         return false;
@@ -891,19 +898,6 @@ bool cli_output_writable(const char *path)
         return false;
     }
     return true;
-}
-
-/* The folder of `path` into folder[size] and its last component. */
-static const char *split_path(const char *path, char *folder, size_t size)
-{
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        snprintf(folder, size, ".");
-    else if (slash == path)
-        snprintf(folder, size, "/");
-    else
-        snprintf(folder, size, "%.*s", (int)(slash - path), path);
-    return slash ? slash + 1 : path;
 }
 
 bool cli_same_output(const char *a, const char *b)
@@ -925,5 +919,11 @@ bool cli_outputs_writable(const char *const *paths, int count)
     for (int k = 0; k < count; k++)
         if (paths[k] && !cli_output_writable(paths[k]))
             return false;
+    for (int k = 0; k < count; k++)
+        for (int m = k + 1; m < count; m++)
+            if (paths[k] && paths[m] && cli_same_output(paths[k], paths[m])) {
+                cli_error("%s and %s: two outputs name one file", paths[k], paths[m]);
+                return false;
+            }
     return true;
 }

@@ -597,8 +597,9 @@ bool cli_parse_checkpoint_interval(const char *value, double *seconds);
 /* Prints an error and returns false when path is a folder or its folder is not writable. */
 bool cli_output_writable(const char *path);
 
-/* cli_output_writable for each of the `count` paths that is not NULL, checked before any
- * work; false at the first that fails. */
+/* cli_output_writable for each of the `count` paths that is not NULL, and no two of them
+ * naming one file (cli_same_output), checked before any work; false at the first that
+ * fails. */
 bool cli_outputs_writable(const char *const *paths, int count);
 
 /* Whether the two output paths name one file: the same text, the same existing file, or

@@ -363,10 +363,6 @@ int command_viewfactors(int argc, char **argv)
             (const char *[]){output, stats_path, vf.checkpoint, plot_path, sky_path, bounds_path},
             6))
         return EXIT_ERROR;
-    if (bounds_path && output && cli_same_output(bounds_path, output)) {
-        cli_error("--error-bounds: '%s' is the matrix's own output (-o %s)", bounds_path, output);
-        return EXIT_USAGE;
-    }
 
     rad_error error = {0};
     rad_scene *scene = NULL;
