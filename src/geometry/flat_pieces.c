@@ -91,11 +91,26 @@ static bool separated(const flat_piece *a, const flat_piece *b, const flat_line 
     return false;
 }
 
+/* Whether flat_piece_drop_repeated may drop a corner of p, given `reach` at least the
+ * largest coordinate difference between p's corners: some corner (the last with the
+ * first too) within 1e-12 of reach of the one before it. When not, no corner is within
+ * the function's own 1e-12 of p's extent of the one before it, and it would change
+ * nothing: most cuts are spared its two passes. */
+static bool may_repeat(const flat_piece *p, double reach)
+{
+    double tiny = 1e-12 * reach;
+    for (unsigned k = 0; k < p->count; k++)
+        if (!(extent_of(p->vertex[k], p->vertex[k + 1 == p->count ? 0 : k + 1]) > tiny))
+            return true;
+    return false;
+}
+
 /* Splits `in` (no repeated corners) along the line into the part on its inner side and
- * the part outside, each with its repeated corners dropped; false when either would have more than
+ * the part outside, each with its repeated corners dropped (`reach`: at least the largest
+ * coordinate difference between in's corners); false when either would have more than
  * FLAT_PIECE_MAX_VERTICES corners. */
-static bool split_by_line(const flat_piece *in, flat_line line, flat_piece *inside,
-                          flat_piece *outside)
+static bool split_by_line(const flat_piece *in, flat_line line, double reach,
+                          flat_piece *inside, flat_piece *outside)
 {
     double d[FLAT_PIECE_MAX_VERTICES];
     for (unsigned k = 0; k < in->count; k++)
@@ -125,8 +140,10 @@ static bool split_by_line(const flat_piece *in, flat_line line, flat_piece *insi
     /* only a crossing point can repeat a corner: without one, each side keeps corners of
      * the piece in order */
     if (crossed) {
-        flat_piece_drop_repeated(inside);
-        flat_piece_drop_repeated(outside);
+        if (may_repeat(inside, reach))
+            flat_piece_drop_repeated(inside);
+        if (may_repeat(outside, reach))
+            flat_piece_drop_repeated(outside);
     }
     return true;
 }
@@ -192,8 +209,11 @@ int flat_subtract(flat_piece *pieces, unsigned count, const flat_piece *shape, d
             holes++;
             continue;
         }
-        if (boxes_apart(box_of(&pieces[k]), shape_box) || separated(&pieces[k], shape, lines))
+        flat_box box = box_of(&pieces[k]);
+        if (boxes_apart(box, shape_box) || separated(&pieces[k], shape, lines))
             continue; /* stays as it is */
+        /* every part of the piece lies in its box */
+        double reach = max_d(box.u1 - box.u0, box.v1 - box.v0);
         /* the parts outside the shape's edges in turn: the first takes the piece's own
          * slot (free once the first cut has read it), the others go past the last, or
          * into a hole an earlier piece left, or else wait for one a later piece leaves */
@@ -216,7 +236,7 @@ int flat_subtract(flat_piece *pieces, unsigned count, const flat_piece *shape, d
             if (!some_in) { /* wholly outside: all of it is left, nothing goes on */
                 piece_copy(&outside, remaining);
                 inside->count = 0;
-            } else if (!split_by_line(remaining, lines[e], inside, &outside)) {
+            } else if (!split_by_line(remaining, lines[e], reach, inside, &outside)) {
                 return -1;
             }
             remaining = inside;
