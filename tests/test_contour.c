@@ -1,11 +1,14 @@
 /*
  * test_contour.c - Lambert's contour formula against closed forms (VALIDATION.md
  * section 2): a point under the corner of a parallel rectangle, a point under the centre
- * of a polygonal disk, clipping by the point's tangent plane, and one-sidedness.
+ * of a polygonal disk, clipping by the point's tangent plane, and one-sidedness; the same
+ * formula in a plane's own frame against them.
  */
 #include <math.h>
 
+#include "core/vec3.h"
 #include "geometry/contour.h"
+#include "geometry/flat_pieces.h"
 #include "testlib.h"
 
 static const double pi = 3.14159265358979323846;
@@ -99,5 +102,29 @@ int main(void)
     /* polygon area / disk area = sin(2pi/n) n / (2 pi); compare with the disk of equal area */
     double equal_area_R = R * sqrt(360 * sin(2 * pi / 360) / (2 * pi));
     CHECK_NEAR(disk, equal_area_R * equal_area_R / (H * H + equal_area_R * equal_area_R), 1e-4);
+    /* the same in the receiving plane's own frame (contour_point_to_flat_polygon, what
+     * the shadow clipping uses): the corner rectangle's closed form, and the 3-D formula
+     * for normals tilted far enough that the tangent plane clips the rectangle */
+    for (int k = 0; k < 4; k++) {
+        double a = sizes[k][0], b = sizes[k][1], c = sizes[k][2];
+        rad_vec3 rect[4] = {{0, 0, c}, {0, b, c}, {a, b, c}, {a, 0, c}};
+        plane_frame frame = plane_frame_make(rect[0], down);
+        flat_point flat[4];
+        for (int m = 0; m < 4; m++)
+            flat[m] = plane_frame_flat(&frame, rect[m]);
+        double height = -frame.normal.z * c; /* N . (x - origin), x at the origin */
+        flat_point x = plane_frame_flat(&frame, (rad_vec3){0, 0, 0});
+        rad_vec3 n_up = {v3_dot(up, frame.u), v3_dot(up, frame.v), v3_dot(up, frame.normal)};
+        CHECK_NEAR(contour_point_to_flat_polygon(x, height, n_up, flat, 4),
+                   corner_rectangle(a, b, c), 1e-9);
+        for (int t = 0; t < 12; t++) {
+            double tilt = 0.25 * t, turn = 0.9 * t;
+            rad_vec3 n = {sin(tilt) * cos(turn), sin(tilt) * sin(turn), cos(tilt)};
+            rad_vec3 n_local = {v3_dot(n, frame.u), v3_dot(n, frame.v), v3_dot(n, frame.normal)};
+            double want = contour_point_to_polygon((rad_vec3){0, 0, 0}, n, rect, 4, down, 0);
+            CHECK_NEAR(contour_point_to_flat_polygon(x, height, n_local, flat, 4), want,
+                       1e-12 + 1e-12 * want);
+        }
+    }
     return test_finish("test_contour");
 }

@@ -11,6 +11,7 @@
 #ifndef RAD_FORMFACTOR_CONTOUR_H
 #define RAD_FORMFACTOR_CONTOUR_H
 
+#include "geometry/flat_pieces.h"
 #include "radiosity.h"
 
 /* Most vertices a polygon may have (clipping adds one). */
@@ -21,5 +22,12 @@
  * counts as in front of the polygon only beyond this distance. */
 double contour_point_to_polygon(rad_vec3 p, rad_vec3 n, const rad_vec3 *polygon,
                                 unsigned count, rad_vec3 polygon_normal, double plane_epsilon);
+
+/* The same for a polygon given in a plane's own frame (plane_frame: axes u, v, normal N,
+ * counter-clockwise in (u, v)) and a point at `height` (> 0) above the plane over x, whose
+ * unit normal n has components n_local = (n . u, n . v, n . N): no mapping to 3-D, fewer
+ * products (the shadow clipping's pieces). count <= CONTOUR_MAX_VERTICES - 1. */
+double contour_point_to_flat_polygon(flat_point x, double height, rad_vec3 n_local,
+                                     const flat_point *polygon, unsigned count);
 
 #endif

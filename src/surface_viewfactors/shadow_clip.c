@@ -196,13 +196,11 @@ static double visible_factor(const shadow_receiver *r, rad_vec3 x, rad_vec3 n,
             return -1;
         count = (unsigned)made;
     }
+    rad_vec3 n_local = v3(v3_dot(n, r->frame.u), v3_dot(n, r->frame.v), v3_dot(n, N));
     double factor = 0;
-    for (unsigned k = 0; k < count; k++) {
-        rad_vec3 corner[FLAT_PIECE_MAX_VERTICES];
-        for (unsigned m = 0; m < pieces[k].count; m++)
-            corner[m] = plane_frame_point(&r->frame, pieces[k].vertex[m]);
-        factor += contour_point_to_polygon(x, n, corner, pieces[k].count, N, plane_epsilon);
-    }
+    for (unsigned k = 0; k < count; k++)
+        factor += contour_point_to_flat_polygon(x_flat, H, n_local, pieces[k].vertex,
+                                                pieces[k].count);
     return factor;
 }
 
