@@ -88,6 +88,18 @@ int main(void)
     made = subtract_from(&unit, &touching, next, 8);
     CHECK(made == 1 && next[0].count == 4);
     CHECK_NEAR(total_area(next, made), 1, 0);
+    /* apart only across the piece's own edge (the triangle's long side), every edge of
+     * the shape crossing the piece: the triangle as it was, not cut into parts */
+    flat_piece triangle = {{{0, 0}, {1, 0}, {0, 1}}, 3};
+    flat_piece beyond = square(0.7, 0.9, 0.7, 0.9);
+    made = subtract_from(&triangle, &beyond, next, 8);
+    CHECK(made == 1 && next[0].count == 3 && next[0].vertex[1].u == 1);
+    CHECK_NEAR(total_area(next, made), 0.5, 0);
+    /* overlapping by a sliver (1e-14 of the area, at most tiny): the piece as it was */
+    flat_piece sliver = square(1 - 1e-14, 2, 0.2, 0.8);
+    made = subtract_from(&unit, &sliver, next, 8);
+    CHECK(made == 1 && next[0].count == 4);
+    CHECK_NEAR(total_area(next, made), 1, 0);
 
     /* a triangle over the square's part below y = x + 0.1, then one over its part above
      * y = x - 0.1: 0.9^2 / 2 left after the first, nothing after both */

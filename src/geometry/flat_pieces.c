@@ -67,30 +67,6 @@ static inline double side_of(flat_line line, flat_point q)
 
 static inline bool no_line(flat_line line) { return line.nu == 0 && line.nv == 0; }
 
-/* Whether `points` lie wholly on the outer side of the line (or on it). */
-static bool all_outside(flat_line line, const flat_piece *points)
-{
-    for (unsigned m = 0; m < points->count; m++)
-        if (side_of(line, points->vertex[m]) > 0)
-            return false;
-    return true;
-}
-
-/* True when the convex pieces a and b cannot overlap: an edge line of either has the
- * other wholly outside (b's lines given). */
-static bool separated(const flat_piece *a, const flat_piece *b, const flat_line *b_lines)
-{
-    for (unsigned k = 0; k < a->count; k++) {
-        flat_line line = edge_line(a->vertex[k], a->vertex[k + 1 == a->count ? 0 : k + 1]);
-        if (!no_line(line) && all_outside(line, b))
-            return true;
-    }
-    for (unsigned k = 0; k < b->count; k++)
-        if (!no_line(b_lines[k]) && all_outside(b_lines[k], a))
-            return true;
-    return false;
-}
-
 /* Whether flat_piece_drop_repeated may drop a corner of p, given `reach` at least the
  * largest coordinate difference between p's corners: some corner (the last with the
  * first too) within 1e-12 of reach of the one before it. When not, no corner is within
@@ -165,8 +141,8 @@ static flat_box box_of(const flat_piece *p)
     return box;
 }
 
-/* Boxes apart, or touching: the pieces are separated (by a line along the frame's axes),
- * as `separated` would find; most pieces and shadows are told apart so, cheaply. */
+/* Boxes apart, or touching: the pieces are separated (by a line along the frame's axes);
+ * most pieces and shadows are told apart so, cheaply. */
 static inline bool boxes_apart(flat_box a, flat_box b)
 {
     return a.u1 <= b.u0 || b.u1 <= a.u0 || a.v1 <= b.v0 || b.v1 <= a.v0;
@@ -210,16 +186,17 @@ int flat_subtract(flat_piece *pieces, unsigned count, const flat_piece *shape, d
             continue;
         }
         flat_box box = box_of(&pieces[k]);
-        if (boxes_apart(box, shape_box) || separated(&pieces[k], shape, lines))
+        if (boxes_apart(box, shape_box))
             continue; /* stays as it is */
         /* every part of the piece lies in its box */
         double reach = max_d(box.u1 - box.u0, box.v1 - box.v0);
-        /* the parts outside the shape's edges in turn: the first takes the piece's own
-         * slot (free once the first cut has read it), the others go past the last, or
-         * into a hole an earlier piece left, or else wait for one a later piece leaves */
-        flat_piece buffer[2], outside;
+        /* the parts outside the shape's edges in turn, kept aside until what is left
+         * inside every edge shows that the shape overlaps the piece at all (else the piece
+         * stays as it is: a separating line, found on the way, costs no more) */
+        flat_piece buffer[2], parts[FLAT_PIECE_MAX_VERTICES];
+        unsigned part_count = 0;
+        bool missed = false;
         const flat_piece *remaining = &pieces[k];
-        bool placed = false;
         for (unsigned e = 0; e < shape->count && remaining->count >= 3; e++) {
             if (no_line(lines[e]))
                 continue;
@@ -232,32 +209,36 @@ int flat_subtract(flat_piece *pieces, unsigned count, const flat_piece *shape, d
             }
             if (!some_out)
                 continue; /* inside this edge: all of it goes on to the next */
+            if (!some_in) {
+                missed = true; /* wholly outside: the shape misses the piece */
+                break;
+            }
             flat_piece *inside = remaining == &buffer[0] ? &buffer[1] : &buffer[0];
-            if (!some_in) { /* wholly outside: all of it is left, nothing goes on */
-                piece_copy(&outside, remaining);
-                inside->count = 0;
-            } else if (!split_by_line(remaining, lines[e], reach, inside, &outside)) {
+            flat_piece *outside = &parts[part_count];
+            if (!split_by_line(remaining, lines[e], reach, inside, outside))
                 return -1;
-            }
             remaining = inside;
-            if (outside.count < 3 || !(flat_piece_area(&outside) > tiny))
-                continue;
-            if (placed) {
-                int slot = free_slot(pieces, &made, max_pieces, &holes, &hole_from, k);
-                if (slot >= 0)
-                    piece_copy(&pieces[slot], &outside);
-                else if (waiting < FLAT_SUBTRACT_WAITING)
-                    piece_copy(&wait[waiting++], &outside);
-                else
-                    return -1;
-            } else {
-                piece_copy(&pieces[k], &outside);
-                placed = true;
-            }
+            if (outside->count >= 3 && flat_piece_area(outside) > tiny)
+                part_count++;
         }
-        if (!placed) {
+        if (missed || !(remaining->count >= 3 && flat_piece_area(remaining) > tiny))
+            continue; /* no overlap (or none above tiny): the piece stays as it is */
+        /* the first part takes the piece's own slot, the others go past the last, or
+         * into a hole an earlier piece left, or else wait for one a later piece leaves */
+        if (part_count == 0) {
             pieces[k].count = 0;
             holes++;
+            continue;
+        }
+        piece_copy(&pieces[k], &parts[0]);
+        for (unsigned m = 1; m < part_count; m++) {
+            int slot = free_slot(pieces, &made, max_pieces, &holes, &hole_from, k);
+            if (slot >= 0)
+                piece_copy(&pieces[slot], &parts[m]);
+            else if (waiting < FLAT_SUBTRACT_WAITING)
+                piece_copy(&wait[waiting++], &parts[m]);
+            else
+                return -1;
         }
     }
     unsigned kept = 0; /* the holes closed up */
