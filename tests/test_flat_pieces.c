@@ -3,8 +3,9 @@
  * (src/geometry/flat_pieces.c), against areas worked out by hand: a plane's frame maps its
  * points to (u, v) and back and keeps counter-clockwise counter-clockwise; a square less
  * a square over one of its corners leaves 3/4 of it in 2 pieces, less one in its middle a
- * frame of 4 pieces, less a covering one nothing; a shape whose box is apart, or that only
- * touches along an edge, leaves the piece as it was; of 2 triangles that cover it
+ * frame of 4 pieces, less a covering one nothing; a shape whose box is apart, that only
+ * touches along an edge, that lies apart only across the piece's own edge, or that
+ * overlaps it by a sliver of at most tiny, leaves the piece as it was; of 2 triangles that cover it
  * together, the first leaves the corner the second then covers; more pieces than there is room for fail (-1);
  * in place, a piece the shape misses stays as it was, one it covers vanishes and the
  * next piece's parts may take its slot, or wait for it when it comes later;
