@@ -5,11 +5,13 @@
  * a square over one of its corners leaves 3/4 of it in 2 pieces, less one in its middle a
  * frame of 4 pieces, less a covering one nothing; a shape whose box is apart, that only
  * touches along an edge, that lies apart only across the piece's own edge, or that
- * overlaps it by a sliver of at most tiny, leaves the piece as it was; of 2 triangles that cover it
+ * overlaps it by a sliver of at most tiny, leaves the piece as it was, as does a 15-gon
+ * the shape misses though its edge's line cuts a corner off (16 corners); of 2 triangles that cover it
  * together, the first leaves the corner the second then covers; more pieces than there is room for fail (-1);
  * in place, a piece the shape misses stays as it was, one it covers vanishes and the
  * next piece's parts may take its slot, or wait for it when it comes later;
- * corners repeated a hair apart are dropped, distinct ones kept. Not here: the shadows
+ * corners repeated a hair apart are dropped, distinct ones kept, also beside a crossing
+ * point rounded outside the piece's box. Not here: the shadows
  * cut with it (test_shadow_clip, test_shadow_join).
  */
 #include <math.h>
@@ -96,6 +98,30 @@ int main(void)
     made = subtract_from(&triangle, &beyond, next, 8);
     CHECK(made == 1 && next[0].count == 3 && next[0].vertex[1].u == 1);
     CHECK_NEAR(total_area(next, made), 0.5, 0);
+    /* a 15-gon the shape misses, though the line of the shape's first edge cuts a corner
+     * off it (16 corners, more than a piece holds): the piece as it was, not a failure */
+    flat_piece fifteen = {.count = 15};
+    for (int k = 0; k < 15; k++)
+        fifteen.vertex[k] = (flat_point){cos(2 * RAD_PI * k / 15), sin(2 * RAD_PI * k / 15)};
+    flat_piece off_corner = {{{0.99, 0.9}, {0.99, 1.0}, {0.9, 0.95}}, 3};
+    made = subtract_from(&fifteen, &off_corner, next, 4);
+    CHECK(made == 1 && next[0].count == 15 && next[0].vertex[0].u == 1);
+    /* a cut whose crossing point rounds a unit in the last place outside the piece's box,
+     * beside a corner 1e-12 of the piece's extent from the one before it: that corner is
+     * dropped, as flat_piece_drop_repeated drops it (the check before the pass that
+     * spares most cuts allows for such a crossing point) */
+    {
+        double A = -231.0248902154305, au = -123.85412263141437, B = 2.2943922411537523e-05;
+        double W = B - A, e = 1e-12 * ((au + (B - au)) - A), H = 0.3 * W;
+        flat_piece window = {{{A, 0}, {au, -0.1 * W}, {B, 0}, {B, 0.6 * H}, {A + 0.5 * W, H}, {A, e}},
+                        6};
+        double at = nextafter(B, -INFINITY);
+        flat_piece band = {{{at, -2 * H}, {at, 2 * H}, {at - 0.4 * W, 2 * H},
+                            {at - 0.4 * W, -2 * H}},
+                           4};
+        made = subtract_from(&window, &band, next, 4);
+        CHECK(made == 1 && next[0].count == 5);
+    }
     /* overlapping by a sliver (1e-14 of the area, at most tiny): the piece as it was */
     flat_piece sliver = square(1 - 1e-14, 2, 0.2, 0.8);
     made = subtract_from(&unit, &sliver, next, 8);
