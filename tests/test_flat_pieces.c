@@ -6,9 +6,9 @@
  * frame of 4 pieces, less a covering one nothing; a shape whose box is apart, that only
  * touches along an edge, that lies apart only across the piece's own edge, or that
  * overlaps it by a sliver of at most tiny, leaves the piece as it was, as does a 15-gon
- * the shape misses though its edge's line cuts a corner off (16 corners); of 2 triangles that cover it
- * together, the first leaves the corner the second then covers; more pieces than there is room for fail (-1);
- * in place, a piece the shape misses stays as it was, one it covers vanishes and the
+ * the shape misses though its edge's line cuts a corner off (16 corners); of 2 triangles
+ * that cover it together, the first leaves the corner the second then covers; more pieces
+ * than there is room for fail (-1); in place, a piece the shape misses stays as it was, one it covers vanishes and the
  * next piece's parts may take its slot, or wait for it when it comes later;
  * corners repeated a hair apart are dropped, distinct ones kept, also beside a crossing
  * point rounded outside the piece's box. Not here: the shadows
@@ -113,8 +113,8 @@ int main(void)
     {
         double A = -231.0248902154305, au = -123.85412263141437, B = 2.2943922411537523e-05;
         double W = B - A, e = 1e-12 * ((au + (B - au)) - A), H = 0.3 * W;
-        flat_piece window = {{{A, 0}, {au, -0.1 * W}, {B, 0}, {B, 0.6 * H}, {A + 0.5 * W, H}, {A, e}},
-                        6};
+        flat_piece window = {
+            {{A, 0}, {au, -0.1 * W}, {B, 0}, {B, 0.6 * H}, {A + 0.5 * W, H}, {A, e}}, 6};
         double at = nextafter(B, -INFINITY);
         flat_piece band = {{{at, -2 * H}, {at, 2 * H}, {at - 0.4 * W, 2 * H},
                             {at - 0.4 * W, -2 * H}},

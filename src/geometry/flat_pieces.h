@@ -67,11 +67,12 @@ void flat_piece_drop_repeated(flat_piece *p);
 /* Subtracts the convex `shape` (counter-clockwise) from the `count` pieces, in place
  * (room for max_pieces): each piece the shape overlaps gives way to its parts outside each
  * edge of the shape in turn, pieces of area at most `tiny` dropped; a piece the shape
- * misses, or overlaps by at most `tiny`, is kept as it is (it may move down to close the slot of one that vanished; the
- * order of the pieces is not kept; a piece of no corners counts as none). Returns how
- * many, or -1 (the pieces then undefined) when they would be more than max_pieces, when
- * more than FLAT_SUBTRACT_WAITING parts wait at once for room that later pieces leave, or
- * when a cut piece would have more than FLAT_PIECE_MAX_VERTICES corners. */
+ * misses, or overlaps by at most `tiny`, is kept as it is (it may move down to close the
+ * slot of one that vanished; the order of the pieces is not kept; a piece of no corners
+ * counts as none). Returns how many, or -1 (the pieces then undefined) when they would be
+ * more than max_pieces, when more than FLAT_SUBTRACT_WAITING parts wait at once for room
+ * that later pieces leave, or when a piece the shape meets would be cut into a part of
+ * more than FLAT_PIECE_MAX_VERTICES corners. */
 int flat_subtract(flat_piece *pieces, unsigned count, const flat_piece *shape, double tiny,
                   unsigned max_pieces);
 
