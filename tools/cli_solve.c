@@ -382,6 +382,8 @@ void cli_solved_stats(const cli_solved *s, const cli_solve *solve, cli_stats *st
     stats_integer(stats, "patch_pairs", ff->pairs);
     stats_integer(stats, "patch_pairs_facing", ff->pairs_facing);
     stats_integer(stats, "patch_pairs_refined", ff->pairs_refined);
+    stats_integer(stats, "patch_pairs_clear", ff->pairs_clear);
+    stats_integer(stats, "patch_pairs_exact", ff->pairs_exact);
     stats_integer(stats, "rays_cast", ff->rays);
     stats_number(stats, "rays_per_second", ff->seconds > 0 ? ff->rays / ff->seconds : 0);
     /* the tracer's own rate: rays per second of tracing per thread, times threads */

@@ -13,6 +13,7 @@
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "core/alloc.h"
 #include "core/error.h"
@@ -27,6 +28,14 @@
 
 /* Most pieces the smaller patch is cut into (at most EXACT_PAIRS_MAX_OCCLUDERS planes). */
 #define MAX_PIECES 16u
+
+/* A pair of groups keeps the list of the triangles that may cut its rectangles' hull when
+ * it has at most GROUP_LIST_MAX of them (then its patch pairs screen those alone, not the
+ * tree), and groups keep lists while there are at most GROUP_LISTS_MAX of them (a list
+ * entry per pair of groups). */
+#define GROUP_LIST_MAX 64u
+#define GROUP_LISTS_MAX 2048u
+#define GROUP_NOT_LISTED UINT8_MAX
 
 /* The screening tree: leaves of at most SCREEN_LEAF triangles, at most SCREEN_DEPTH deep. */
 #define SCREEN_LEAF 4u
@@ -190,13 +199,9 @@ static bool batch_may_cut(const screen_query *s, const screen_triangle *const *c
 /* Triangles gathered for one batch_may_cut. */
 #define SCREEN_CANDIDATES 32u /* bits of a uint32_t */
 
-/* False when no triangle can cut the hull of p and q (then the pair is clear). The
- * triangles that stand between the pair are gathered first: one across the centroids'
- * segment settles it without the hull's side planes, which cost more than all the rest. */
-static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, const vf_polygon *q)
+static screen_query screen_query_of(const exact_pairs *pairs, const vf_polygon *p,
+                                    const vf_polygon *q)
 {
-    if (pairs->screen_node_count == 0)
-        return false;
     screen_query s;
     s.p = p;
     s.q = q;
@@ -213,8 +218,86 @@ static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, cons
                 s.hi[a] = max_d(s.hi[a], coordinate(polygon->vertex[c], a));
             }
     }
+    return s;
+}
+
+/* The triangles gathered for one batch_may_cut. */
+typedef struct screen_batch {
     const screen_triangle *candidate[SCREEN_CANDIDATES];
-    unsigned candidate_count = 0;
+    unsigned count;
+} screen_batch;
+
+/* Triangle tt met in a screening: true when it settles that something may block. */
+static bool screen_triangle_blocks(const screen_query *s, const screen_triangle *tt,
+                                   screen_batch *batch)
+{
+    if (!may_stand_between(s, tt))
+        return false;
+    if (blocks_centroids(s, tt))
+        return true;
+    batch->candidate[batch->count++] = tt;
+    if (batch->count == SCREEN_CANDIDATES) {
+        batch->count = 0;
+        return batch_may_cut(s, batch->candidate, SCREEN_CANDIDATES);
+    }
+    return false;
+}
+
+/* False when no triangle can cut the hull of p and q (then the pair is clear). The
+ * triangles that stand between the pair are gathered first: one across the centroids'
+ * segment settles it without the hull's side planes, which cost more than all the rest. */
+static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, const vf_polygon *q)
+{
+    if (pairs->screen_node_count == 0)
+        return false;
+    screen_query s = screen_query_of(pairs, p, q);
+    screen_batch batch;
+    batch.count = 0;
+    uint32_t stack[2 * SCREEN_DEPTH + 2];
+    unsigned top = 0;
+    stack[top++] = 0;
+    while (top) {
+        const screen_node *node = &pairs->screen_nodes[stack[--top]];
+        if (box_apart(&s, node->lo, node->hi))
+            continue;
+        if (node->count) {
+            for (uint32_t t = node->first; t < node->first + node->count; t++)
+                if (screen_triangle_blocks(&s, &pairs->screen_triangles[t], &batch))
+                    return true;
+        } else {
+            stack[top++] = node->first;
+            stack[top++] = node->first + 1;
+        }
+    }
+    return batch.count > 0 && batch_may_cut(&s, batch.candidate, batch.count);
+}
+
+/* The same answer from a list of the triangles that may cut a larger hull around p and
+ * q's (their groups' rectangles'): a triangle outside that hull is outside theirs too. */
+static bool screen_listed_may_block(const exact_pairs *pairs, const vf_polygon *p,
+                                    const vf_polygon *q, const uint32_t *listed,
+                                    unsigned count)
+{
+    screen_query s = screen_query_of(pairs, p, q);
+    screen_batch batch;
+    batch.count = 0;
+    for (unsigned k = 0; k < count; k++)
+        if (screen_triangle_blocks(&s, &pairs->screen_triangles[listed[k]], &batch))
+            return true;
+    return batch.count > 0 && batch_may_cut(&s, batch.candidate, batch.count);
+}
+
+/* The triangles that may cut the hull of p and q: those standing between them that no
+ * side plane of the hull has wholly outside, into out[] (indices of screen_triangles);
+ * returns how many, or cap + 1 when there are more than cap. */
+static unsigned screen_collect(const exact_pairs *pairs, const vf_polygon *p,
+                               const vf_polygon *q, uint32_t *out, unsigned cap)
+{
+    if (pairs->screen_node_count == 0)
+        return 0;
+    screen_query s = screen_query_of(pairs, p, q);
+    uint32_t standing[GROUP_LIST_MAX];
+    unsigned count = 0;
     uint32_t stack[2 * SCREEN_DEPTH + 2];
     unsigned top = 0;
     stack[top++] = 0;
@@ -224,24 +307,40 @@ static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, cons
             continue;
         if (node->count) {
             for (uint32_t t = node->first; t < node->first + node->count; t++) {
-                const screen_triangle *tt = &pairs->screen_triangles[t];
-                if (!may_stand_between(&s, tt))
+                if (!may_stand_between(&s, &pairs->screen_triangles[t]))
                     continue;
-                if (blocks_centroids(&s, tt))
-                    return true;
-                candidate[candidate_count++] = tt;
-                if (candidate_count == SCREEN_CANDIDATES) {
-                    if (batch_may_cut(&s, candidate, candidate_count))
-                        return true;
-                    candidate_count = 0;
-                }
+                if (count == GROUP_LIST_MAX)
+                    return cap + 1;
+                standing[count++] = t;
             }
         } else {
             stack[top++] = node->first;
             stack[top++] = node->first + 1;
         }
     }
-    return candidate_count > 0 && batch_may_cut(&s, candidate, candidate_count);
+    /* the hull's side planes, an edge at a time, drop the triangles they have outside */
+    bool outside[GROUP_LIST_MAX] = {false};
+    for (unsigned edge = 0; edge < p->count + q->count; edge++) {
+        rad_vec3 normal[2];
+        double offset[2];
+        unsigned faces = occluder_hull_edge_sides(p, q, edge, s.epsilon, normal, offset);
+        for (unsigned f = 0; f < faces; f++)
+            for (unsigned k = 0; k < count; k++) {
+                const rad_vec3 *c = pairs->screen_triangles[standing[k]].corner;
+                outside[k] = outside[k] || (v3_dot(normal[f], c[0]) - offset[f] >= -s.epsilon &&
+                                            v3_dot(normal[f], c[1]) - offset[f] >= -s.epsilon &&
+                                            v3_dot(normal[f], c[2]) - offset[f] >= -s.epsilon);
+            }
+    }
+    unsigned kept = 0;
+    for (unsigned k = 0; k < count; k++) {
+        if (outside[k])
+            continue;
+        if (kept == cap)
+            return cap + 1;
+        out[kept++] = standing[k];
+    }
+    return kept;
 }
 
 rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
@@ -507,13 +606,61 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
         rad_alloc_array((size_t)made * pairs->group_words + 1, sizeof(*pairs->group_clear));
     if (!pairs->group_clear)
         goto nomem;
+    const bool listed = made <= GROUP_LISTS_MAX;
+    if (listed) {
+        pairs->group_list = rad_alloc_array(made ? made : 1, sizeof(*pairs->group_list));
+        pairs->group_list_first =
+            rad_alloc_array((size_t)made * made + 1, sizeof(*pairs->group_list_first));
+        pairs->group_list_count =
+            rad_alloc_array((size_t)made * made + 1, sizeof(*pairs->group_list_count));
+        if (!pairs->group_list || !pairs->group_list_first || !pairs->group_list_count)
+            goto nomem;
+        for (uint32_t g = 0; g < made; g++)
+            pairs->group_list[g] = NULL;
+        memset(pairs->group_list_count, GROUP_NOT_LISTED, (size_t)made * made + 1);
+    }
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads > 0 ? threads : 1)
-    for (int64_t g = 0; g < (int64_t)made; g++)
-        for (uint32_t h = (uint32_t)g + 1; h < made; h++)
-            if (rectangles_face(&rectangles[g], &rectangles[h], pairs->plane_epsilon) &&
-                !screen_may_block(pairs, &rectangles[g], &rectangles[h]))
+    for (int64_t g = 0; g < (int64_t)made; g++) {
+        uint32_t *row = NULL; /* this row's lists, one after another */
+        size_t used = 0, capacity = 0;
+        for (uint32_t h = (uint32_t)g + 1; h < made; h++) {
+            if (!rectangles_face(&rectangles[g], &rectangles[h], pairs->plane_epsilon))
+                continue;
+            if (!listed) {
+                if (!screen_may_block(pairs, &rectangles[g], &rectangles[h]))
+                    pairs->group_clear[(size_t)g * pairs->group_words + h / 64] |=
+                        UINT64_C(1) << (h % 64);
+                continue;
+            }
+            uint32_t found[GROUP_LIST_MAX];
+            unsigned count =
+                screen_collect(pairs, &rectangles[g], &rectangles[h], found, GROUP_LIST_MAX);
+            if (count == 0) {
                 pairs->group_clear[(size_t)g * pairs->group_words + h / 64] |= UINT64_C(1)
                                                                                << (h % 64);
+                continue;
+            }
+            if (count > GROUP_LIST_MAX)
+                continue; /* not listed: its pairs screen the tree */
+            if (used + count > capacity) {
+                size_t grown = capacity ? 2 * capacity : 256;
+                while (grown < used + count)
+                    grown *= 2;
+                uint32_t *bigger = rad_resize_array(row, grown, sizeof(*row));
+                if (!bigger)
+                    continue; /* not listed: its pairs screen the tree */
+                row = bigger;
+                capacity = grown;
+            }
+            memcpy(row + used, found, count * sizeof(*found));
+            size_t at = (size_t)g * made + h;
+            pairs->group_list_first[at] = (uint32_t)used;
+            pairs->group_list_count[at] = (uint8_t)count;
+            used += count;
+        }
+        if (listed)
+            pairs->group_list[g] = row;
+    }
     free(rectangles);
     return RAD_OK;
 nomem:
@@ -521,8 +668,14 @@ nomem:
     free(rectangles);
     free(pairs->group_of);
     free(pairs->group_clear);
+    free(pairs->group_list);
+    free(pairs->group_list_first);
+    free(pairs->group_list_count);
     pairs->group_of = NULL;
     pairs->group_clear = NULL;
+    pairs->group_list = NULL;
+    pairs->group_list_first = NULL;
+    pairs->group_list_count = NULL;
     pairs->group_count = 0;
     return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the groups of patches");
 }
@@ -531,10 +684,18 @@ void exact_pairs_free(exact_pairs *pairs)
 {
     occluder_tree_destroy(pairs->tree);
     free(pairs->polygons);
+    for (uint32_t g = 0; pairs->group_list && g < pairs->group_count; g++)
+        free(pairs->group_list[g]);
+    free(pairs->group_list);
+    free(pairs->group_list_first);
+    free(pairs->group_list_count);
     free(pairs->group_of);
     free(pairs->group_clear);
     pairs->group_of = NULL;
     pairs->group_clear = NULL;
+    pairs->group_list = NULL;
+    pairs->group_list_first = NULL;
+    pairs->group_list_count = NULL;
     free(pairs->screen_nodes);
     free(pairs->screen_triangles);
     pairs->tree = NULL;
@@ -604,13 +765,36 @@ static bool cut_by_occluders(const vf_polygon *outer, const shadow_occluder *occ
     return true;
 }
 
+/* Screening the pair (i, j): from its groups' list when they have one, else the tree. */
+static bool pair_may_block(const exact_pairs *pairs, uint32_t i, uint32_t j)
+{
+    const vf_polygon *p = &pairs->polygons[i], *q = &pairs->polygons[j];
+    if (pairs->group_list) {
+        uint32_t g = pairs->group_of[i], h = pairs->group_of[j];
+        if (g != EXACT_NO_GROUP && h != EXACT_NO_GROUP && g != h) {
+            if (g > h) {
+                uint32_t swap = g;
+                g = h;
+                h = swap;
+            }
+            size_t at = (size_t)g * pairs->group_count + h;
+            unsigned count = pairs->group_list_count[at];
+            if (count != GROUP_NOT_LISTED)
+                return screen_listed_may_block(pairs, p, q,
+                                               pairs->group_list[g] + pairs->group_list_first[at],
+                                               count);
+        }
+    }
+    return screen_may_block(pairs, p, q);
+}
+
 exact_outcome exact_pairs_transfer(const exact_pairs *pairs, uint32_t i, uint32_t j, bool clip,
                                    double accuracy, double *G)
 {
     const vf_polygon *p = &pairs->polygons[i], *q = &pairs->polygons[j];
     if (p->count == 0 || q->count == 0)
         return EXACT_SAMPLE;
-    if (!screen_may_block(pairs, p, q))
+    if (!pair_may_block(pairs, i, j))
         return EXACT_CLEAR;
     if (!clip)
         return EXACT_SAMPLE; /* the hull's faces might still prove it clear: not worth it */

@@ -34,6 +34,13 @@ typedef struct exact_pairs {
     uint32_t *group_of;   /* per patch, or EXACT_NO_GROUP; NULL: no groups */
     uint32_t group_count, group_words;
     uint64_t *group_clear; /* per group, group_words words: bit h of the row of g, g < h */
+    /* per pair of groups g < h that is not clear, at g x group_count + h: the triangles
+     * (indices of screen_triangles) that may cut the hull of their rectangles, in row g's
+     * list from group_list_first, group_list_count of them (UINT8_MAX: not listed, screen
+     * the tree); NULL: no lists */
+    uint32_t **group_list;
+    uint32_t *group_list_first;
+    uint8_t *group_list_count;
 } exact_pairs;
 
 #define EXACT_NO_GROUP UINT32_MAX
@@ -54,7 +61,9 @@ typedef enum exact_outcome {
  * then screens every two groups' rectangles as a pair. The hull of two patches lies in the
  * hull of their groups' rectangles, so a triangle that cuts the first cuts the second:
  * two groups found clear make each pair between them clear, and screening the pair
- * itself (which would say the same) is skipped. A folded patch has no group. */
+ * itself (which would say the same) is skipped. Two groups not found clear keep the list of
+ * the triangles that may cut their rectangles' hull, and their pairs screen only those: a
+ * triangle outside that hull is outside each pair's. A folded patch has no group. */
 rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threads,
                              rad_error *error);
 
