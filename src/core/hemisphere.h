@@ -8,6 +8,7 @@
 
 #include <math.h>
 
+#include "core/sine_cosine.h"
 #include "core/vec3.h"
 
 /* Two unit vectors completing the unit normal n to an orthonormal frame. */
@@ -27,7 +28,9 @@ static inline rad_vec3 cosine_direction(rad_vec3 n, rad_vec3 a, rad_vec3 b, doub
     double r = sqrt(u1), phi = 2 * RAD_PI * u2 + turn, c = sqrt(fmax(0, 1 - u1));
     if (cos_theta)
         *cos_theta = c;
-    return v3_add(v3_scale(n, c), v3_add(v3_scale(a, r * cos(phi)), v3_scale(b, r * sin(phi))));
+    double sine, cosine;
+    sine_cosine(phi, &sine, &cosine);
+    return v3_add(v3_scale(n, c), v3_add(v3_scale(a, r * cosine), v3_scale(b, r * sine)));
 }
 
 #endif

@@ -45,10 +45,18 @@ rad_status emitters_build(const rad_scene *scene, emitter_set *set, rad_error *e
     set->triangle = rad_alloc_array(count, sizeof(*set->triangle));
     set->cdf = rad_alloc_array(count, sizeof(*set->cdf));
     set->pdf_area_of = rad_alloc_array(scene->triangle_count, sizeof(*set->pdf_area_of));
-    if (!set->triangle || !set->cdf || !set->pdf_area_of) {
+    set->shape = rad_alloc_array(count ? count : 1, sizeof(*set->shape));
+    set->halton3 = rad_alloc_array(EMITTER_HALTON_TABLE, sizeof(*set->halton3));
+    set->halton5 = rad_alloc_array(EMITTER_HALTON_TABLE, sizeof(*set->halton5));
+    if (!set->triangle || !set->cdf || !set->pdf_area_of || !set->shape || !set->halton3 ||
+        !set->halton5) {
         free(emits);
         emitters_free(set);
         return rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u emitters", count);
+    }
+    for (uint32_t j = 0; j < EMITTER_HALTON_TABLE; j++) {
+        set->halton3[j] = rad_radical_inverse(j, 3);
+        set->halton5[j] = rad_radical_inverse(j, 5);
     }
     double total = 0;
     for (uint32_t t = 0; t < scene->triangle_count; t++) {
@@ -64,6 +72,15 @@ rad_status emitters_build(const rad_scene *scene, emitter_set *set, rad_error *e
         uint32_t t = set->triangle[k];
         double probability = (set->cdf[k] - (k ? set->cdf[k - 1] : 0)) / total;
         set->pdf_area_of[t] = probability / triangle_area(scene, t);
+        emitter_triangle *shape = &set->shape[k];
+        const rad_triangle *tri = &scene->triangles[t];
+        for (int c = 0; c < 3; c++)
+            shape->corner[c] = scene->positions[tri->vertex[c]];
+        shape->normal = v3_normalize(v3_cross(v3_sub(shape->corner[1], shape->corner[0]),
+                                              v3_sub(shape->corner[2], shape->corner[0])));
+        shape->emission = scene->materials[tri->material].emission;
+        shape->textured = material_emission_texture(scene, tri->material) != NULL;
+        shape->two_sided = triangle_two_sided(scene, t);
     }
     for (uint32_t k = 0; k < set->count; k++)
         set->cdf[k] /= total;
@@ -78,6 +95,9 @@ void emitters_free(emitter_set *set)
     free(set->triangle);
     free(set->cdf);
     free(set->pdf_area_of);
+    free(set->shape);
+    free(set->halton3);
+    free(set->halton5);
     memset(set, 0, sizeof(*set));
 }
 
@@ -98,21 +118,21 @@ uint32_t emitters_index(const emitter_set *set, double u0)
 void emitters_sample(const emitter_set *set, const rad_scene *scene, double u0, double u1,
                      double u2, emitter_sample *sample)
 {
-    uint32_t t = set->triangle[emitters_index(set, u0)];
-    const rad_triangle *tri = &scene->triangles[t];
-    rad_vec3 a = scene->positions[tri->vertex[0]], b = scene->positions[tri->vertex[1]],
-             c = scene->positions[tri->vertex[2]];
+    uint32_t k = emitters_index(set, u0);
+    uint32_t t = set->triangle[k];
+    const emitter_triangle *shape = &set->shape[k];
+    rad_vec3 a = shape->corner[0], b = shape->corner[1], c = shape->corner[2];
     double r = sqrt(u1); /* uniform in area */
     double wa = 1 - r, wb = r * (1 - u2), wc = r * u2;
     sample->point = v3(wa * a.x + wb * b.x + wc * c.x, wa * a.y + wb * b.y + wc * c.y,
                        wa * a.z + wb * b.z + wc * c.z);
-    sample->normal = v3_normalize(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+    sample->normal = shape->normal;
     sample->triangle = t;
     sample->u = wb;
     sample->v = wc;
     sample->pdf_area = set->pdf_area_of[t];
-    sample->radiance = material_emission_at(scene, t, wb, wc);
-    sample->two_sided = triangle_two_sided(scene, t);
+    sample->radiance = shape->textured ? material_emission_at(scene, t, wb, wc) : shape->emission;
+    sample->two_sided = shape->two_sided;
 }
 
 double emitter_cosine(const emitter_sample *sample, rad_vec3 wi, rad_vec3 *facing)

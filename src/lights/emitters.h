@@ -17,6 +17,7 @@
 #ifndef RAD_LIGHTS_EMITTERS_H
 #define RAD_LIGHTS_EMITTERS_H
 
+#include "core/random.h"
 #include "radiosity.h"
 
 /* The least power per unit area of an emitting triangle, as a fraction of the luminance of
@@ -25,15 +26,44 @@
  * is still sampled, rarely, so no emission goes unsampled. */
 #define EMITTER_POWER_FLOOR 1e-3
 
+/* What sampling needs of one emitting triangle, copied out of the scene once. */
+typedef struct emitter_triangle {
+    rad_vec3 corner[3];
+    rad_vec3 normal;   /* unit front normal */
+    rad_rgb emission;  /* the material's emission factor */
+    bool textured;     /* with an emission texture: the texel at each point too */
+    bool two_sided;
+} emitter_triangle;
+
 typedef struct emitter_set {
     uint32_t count;       /* emitting triangles */
     uint32_t *triangle;   /* their scene indices */
+    emitter_triangle *shape; /* per emitting triangle, in the same order */
+    /* the radical inverses in bases 3 and 5 of 0 .. EMITTER_HALTON_TABLE - 1, the light
+     * samples' Halton coordinates (rad_radical_inverse's values, looked up) */
+    double *halton3, *halton5;
     double *cdf;          /* cumulative probability, cdf[count - 1] = 1 */
     double *pdf_area_of;  /* per SCENE triangle: density per unit area, 0 for non-emitters */
     double total_power;   /* sum of area x luminance(mean L_e), floors included */
 } emitter_set;
 
+/* How many radical inverses each table holds: the light samples a render draws per pixel
+ * sample or vertex stay below it (a vertex's 1024, a rim pixel's 1024 samples of 4). */
+#define EMITTER_HALTON_TABLE 8192u
+
 rad_status emitters_build(const rad_scene *scene, emitter_set *set, rad_error *error);
+
+/* The radical inverse of j in base 3 or 5 (rad_radical_inverse), from the set's table when
+ * j is in it. */
+static inline double emitters_halton3(const emitter_set *set, uint32_t j)
+{
+    return j < EMITTER_HALTON_TABLE && set->halton3 ? set->halton3[j] : rad_radical_inverse(j, 3);
+}
+
+static inline double emitters_halton5(const emitter_set *set, uint32_t j)
+{
+    return j < EMITTER_HALTON_TABLE && set->halton5 ? set->halton5[j] : rad_radical_inverse(j, 5);
+}
 void emitters_free(emitter_set *set);
 
 typedef struct emitter_sample {

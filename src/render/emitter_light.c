@@ -40,15 +40,15 @@ static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_v
                 local = 0;
             }
             u1 = wrap(rad_radical_inverse(local, 2) + shift1);
-            u2 = wrap(rad_radical_inverse(local, 3) + shift2);
+            u2 = wrap(emitters_halton3(set, local) + shift2);
             local++;
         } else {
             /* the triangle and the point on it from one Halton point (bases 5, 2, 3): a
              * triangle chosen apart from the point's dimensions would take every other
              * Halton point, which covers only stripes of it */
-            u0 = wrap(rad_radical_inverse(j, 5) + turn);
+            u0 = wrap(emitters_halton5(set, j) + turn);
             u1 = wrap(rad_radical_inverse(j, 2) + shift1);
-            u2 = wrap(rad_radical_inverse(j, 3) + shift2);
+            u2 = wrap(emitters_halton3(set, j) + shift2);
         }
         emitter_sample light;
         emitters_sample(set, scene, u0, u1, u2, &light);
@@ -111,12 +111,17 @@ void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, r
     rad_vec3 origin = v3_add(x, v3_scale(n, leave));
     uint32_t side = (uint32_t)floor(sqrt((double)count));
     double turn = 2 * RAD_PI * rad_rng_uniform(rng);
-    for (uint32_t k = 0; k < count; k++) {
-        double u1 = rad_rng_uniform(rng), u2 = rad_rng_uniform(rng);
-        if (k < side * side) {
-            u1 = ((k % side) + u1) / side;
-            u2 = ((k / side) + u2) / side;
+    const double cell = side ? 1.0 / side : 1;
+    uint32_t k = 0;
+    for (uint32_t row = 0; row < side; row++) /* side x side strata, then the rest */
+        for (uint32_t column = 0; column < side; column++, k++) {
+            double u1 = rad_rng_uniform(rng), u2 = rad_rng_uniform(rng);
+            rad_vec3 w = cosine_direction(n, a, b, (column + u1) * cell, (row + u2) * cell, turn,
+                                          &cos_x[k]);
+            ray_set(&rays[k], origin, w, 0, INFINITY);
         }
+    for (; k < count; k++) {
+        double u1 = rad_rng_uniform(rng), u2 = rad_rng_uniform(rng);
         rad_vec3 w = cosine_direction(n, a, b, u1, u2, turn, &cos_x[k]);
         ray_set(&rays[k], origin, w, 0, INFINITY);
     }
