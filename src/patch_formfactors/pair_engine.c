@@ -111,7 +111,7 @@ int pair_engine_threads(const rad_formfactor_options *options)
 
 /* Point of the patch at unit-square coordinates (s, t): bilinear for quads, an
  * area-preserving warp for triangles. */
-static rad_vec3 patch_point(const patch_geometry *g, double s, double t)
+static inline rad_vec3 patch_point(const patch_geometry *g, double s, double t)
 {
     if (g->corner_count == 4)
         return v3(g->o.x + s * g->u.x + t * g->v.x + s * t * g->w.x,
@@ -234,14 +234,20 @@ static void make_segments(const engine *e, uint32_t i, uint32_t j, unsigned k, u
 {
     unsigned count = k * k;
     rad_rng rng = rad_rng_seed(e->seed + round, i, j);
-    uint8_t order[MAX_STRATA * MAX_STRATA];
-    for (unsigned s = 0; s < count; s++)
-        order[s] = (uint8_t)s;
+    uint8_t column[MAX_STRATA * MAX_STRATA], row[MAX_STRATA * MAX_STRATA]; /* j's strata */
+    for (unsigned t = 0, s = 0; t < k; t++)
+        for (unsigned c = 0; c < k; c++, s++) {
+            column[s] = (uint8_t)c;
+            row[s] = (uint8_t)t;
+        }
     for (unsigned s = count; s > 1; s--) { /* shuffle which stratum of j pairs with which of i */
         unsigned r = (unsigned)(((rad_rng_next(&rng) >> 32) * s) >> 32); /* uniform in [0, s) */
-        uint8_t swap = order[s - 1];
-        order[s - 1] = order[r];
-        order[r] = swap;
+        uint8_t swap = column[s - 1];
+        column[s - 1] = column[r];
+        column[r] = swap;
+        swap = row[s - 1];
+        row[s - 1] = row[r];
+        row[r] = swap;
     }
     const patch_geometry *gi = &e->geometry[i], *gj = &e->geometry[j];
     const double inv_k = 1.0 / k, to_unit = 1.0 / 4294967296.0;
@@ -250,7 +256,7 @@ static void make_segments(const engine *e, uint32_t i, uint32_t j, unsigned k, u
         for (unsigned si = 0; si < k; si++, s++) {
             /* four 32-bit jitters from two draws */
             uint64_t a = rad_rng_next(&rng), b = rad_rng_next(&rng);
-            unsigned sj = order[s] % k, tj = order[s] / k;
+            unsigned sj = column[s], tj = row[s];
             rad_vec3 p = v3_add(patch_point(gi, (si + (double)(a >> 32) * to_unit) * inv_k,
                                             (ti + (double)(a & 0xFFFFFFFFu) * to_unit) * inv_k),
                                 gi->lift);

@@ -27,13 +27,14 @@ static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_v
     rad_vec3 origin = v3_add(x, v3_scale(n, leave));
     uint32_t made = 0;
     uint32_t current = UINT32_MAX, local = 0; /* by_triangle: the triangle, its k-th point */
+    const double per_sample = 1.0 / count;
     for (uint32_t k = 0; k < count; k++) {
         uint32_t j = first + k;
         double u0, u1, u2;
         if (by_triangle) {
             /* evenly spaced choices (k + turn) / count, so each triangle gets its share of
              * consecutive samples, and its own Halton points (bases 2, 3) on it */
-            u0 = (k + turn) / count;
+            u0 = (k + turn) * per_sample;
             uint32_t t = emitters_index(set, u0);
             if (t != current) {
                 current = t;
@@ -60,12 +61,18 @@ static uint32_t light_rays(const emitter_set *set, const rad_scene *scene, rad_v
         double cos_x = v3_dot(n, wi), cos_e = emitter_cosine(&light, wi, &facing);
         if (!(cos_x > 0) || !(cos_e > 0))
             continue;
-        double p_light = light.pdf_area * r2 / cos_e; /* per solid angle */
-        double p_cosine = cosine_per_light * cos_x / RAD_PI;
         /* L cos_x / p_light times the power heuristic's p_light^2 / (p_light^2 + p_cosine^2),
-         * each density times its strategy's sample count */
-        rad_rgb value = rgb_scale(light.radiance, cos_x * p_light /
-                                                      ((p_light * p_light + p_cosine * p_cosine) * count));
+         * each density times its strategy's sample count; p_light = pdf_area r^2 / cos_e per
+         * solid angle (without cosine rays the weight is 1: L cos_x cos_e / (pdf_area r^2)) */
+        double weight;
+        if (cosine_per_light > 0) {
+            double p_light = light.pdf_area * r2 / cos_e;
+            double p_cosine = cosine_per_light * cos_x * (1 / RAD_PI);
+            weight = cos_x * p_light / ((p_light * p_light + p_cosine * p_cosine) * count);
+        } else {
+            weight = cos_x * cos_e / (light.pdf_area * r2) * per_sample;
+        }
+        rad_rgb value = rgb_scale(light.radiance, weight);
         if (rgb_is_zero(value))
             continue;
         irradiance[made] = value;

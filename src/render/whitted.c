@@ -240,7 +240,7 @@ static void shade_direct(const rt_context *ctx, rt_workspace *ws, const rad_mate
         double u0 = (i + rad_rng_uniform(&rng)) / n;
         emitter_sample es;
         emitters_sample(ctx->emitters, ctx->scene, u0, wrap(rad_radical_inverse(j, 2) + shift1),
-                        wrap(rad_radical_inverse(j, 3) + shift2), &es);
+                        wrap(emitters_halton3(ctx->emitters, j) + shift2), &es);
         if (es.triangle != block_triangle) { /* a new block: start its sequence */
             block_triangle = es.triangle;
             j = 0;
