@@ -607,16 +607,17 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
     if (!pairs->group_clear)
         goto nomem;
     const bool listed = made <= GROUP_LISTS_MAX;
+    int short_of_memory = 0;
     if (listed) {
         pairs->group_list = rad_alloc_array(made ? made : 1, sizeof(*pairs->group_list));
+        for (uint32_t g = 0; pairs->group_list && g < made; g++)
+            pairs->group_list[g] = NULL;
         pairs->group_list_first =
             rad_alloc_array((size_t)made * made + 1, sizeof(*pairs->group_list_first));
         pairs->group_list_count =
             rad_alloc_array((size_t)made * made + 1, sizeof(*pairs->group_list_count));
         if (!pairs->group_list || !pairs->group_list_first || !pairs->group_list_count)
             goto nomem;
-        for (uint32_t g = 0; g < made; g++)
-            pairs->group_list[g] = NULL;
         memset(pairs->group_list_count, GROUP_NOT_LISTED, (size_t)made * made + 1);
     }
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads > 0 ? threads : 1)
@@ -647,8 +648,11 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
                 while (grown < used + count)
                     grown *= 2;
                 uint32_t *bigger = rad_resize_array(row, grown, sizeof(*row));
-                if (!bigger)
-                    continue; /* not listed: its pairs screen the tree */
+                if (!bigger) {
+#pragma omp atomic write
+                    short_of_memory = 1;
+                    break;
+                }
                 row = bigger;
                 capacity = grown;
             }
@@ -661,6 +665,8 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
         if (listed)
             pairs->group_list[g] = row;
     }
+    if (short_of_memory)
+        goto nomem;
     free(rectangles);
     return RAD_OK;
 nomem:
@@ -668,6 +674,8 @@ nomem:
     free(rectangles);
     free(pairs->group_of);
     free(pairs->group_clear);
+    for (uint32_t g = 0; pairs->group_list && g < pairs->group_count; g++)
+        free(pairs->group_list[g]);
     free(pairs->group_list);
     free(pairs->group_list_first);
     free(pairs->group_list_count);
