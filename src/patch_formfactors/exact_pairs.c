@@ -32,7 +32,7 @@
 /* A pair of groups keeps the list of the triangles that may cut its rectangles' hull when
  * it has at most GROUP_LIST_MAX of them (then its patch pairs screen those alone, not the
  * tree), and groups keep lists while there are at most GROUP_LISTS_MAX of them (a list
- * entry per pair of groups). */
+ * entry per pair of groups: 5 bytes each, 21 MB at the most, and the lists themselves). */
 #define GROUP_LIST_MAX 64u
 #define GROUP_LISTS_MAX 2048u
 #define GROUP_NOT_LISTED UINT8_MAX
@@ -606,7 +606,13 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
         rad_alloc_array((size_t)made * pairs->group_words + 1, sizeof(*pairs->group_clear));
     if (!pairs->group_clear)
         goto nomem;
-    const bool listed = made <= GROUP_LISTS_MAX;
+    /* the lists only save time: under a memory budget (--max-memory) they are made only
+     * when at most a quarter of what is left holds them at their largest */
+    const uint64_t left = rad_memory_budget_left();
+    const uint64_t largest = (uint64_t)made * made *
+                             (sizeof(*pairs->group_list_first) + sizeof(*pairs->group_list_count) +
+                              GROUP_LIST_MAX * sizeof(uint32_t) / 2);
+    const bool listed = made <= GROUP_LISTS_MAX && (left == UINT64_MAX || largest <= left / 4);
     int short_of_memory = 0;
     if (listed) {
         pairs->group_list = rad_alloc_array(made ? made : 1, sizeof(*pairs->group_list));
