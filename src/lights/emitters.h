@@ -64,6 +64,7 @@ static inline double emitters_halton5(const emitter_set *set, uint32_t j)
 {
     return j < EMITTER_HALTON_TABLE && set->halton5 ? set->halton5[j] : rad_radical_inverse(j, 5);
 }
+
 void emitters_free(emitter_set *set);
 
 typedef struct emitter_sample {
