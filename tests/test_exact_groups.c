@@ -80,7 +80,8 @@ static void check_scene(const char *name, const rad_scene *scene, double patch_s
             bool clear = exact_pairs_group_clear(&pairs, i, j);
             CHECK(clear == exact_pairs_group_clear(&pairs, j, i)); /* symmetric */
             double G;
-            bool screened_clear = exact_pairs_transfer(&pairs, i, j, false, 1e-2, &G) == EXACT_CLEAR;
+            bool screened_clear =
+                exact_pairs_transfer(&pairs, i, j, false, 1e-2, &G) == EXACT_CLEAR;
             CHECK(screened_clear ==
                   (exact_pairs_transfer(&pairs, j, i, false, 1e-2, &G) == EXACT_CLEAR));
             if (!clear && screened_clear) /* screened from its groups' list of triangles */

@@ -115,6 +115,7 @@ static void screen_build(exact_pairs *pairs, uint32_t node, uint32_t first, uint
  * (segments that carry light run in front of both); the hull's side planes are found only
  * for a pair with a triangle that passes those (batch_may_cut). */
 typedef struct screen_query {
+    const exact_pairs *pairs;
     const vf_polygon *p, *q;
     double lo[3], hi[3];
     double epsilon;
@@ -203,6 +204,7 @@ static screen_query screen_query_of(const exact_pairs *pairs, const vf_polygon *
                                     const vf_polygon *q)
 {
     screen_query s;
+    s.pairs = pairs;
     s.p = p;
     s.q = q;
     s.epsilon = pairs->epsilon;
@@ -243,6 +245,63 @@ static bool screen_triangle_blocks(const screen_query *s, const screen_triangle 
     return false;
 }
 
+/* Walks the screening tree under the query's box: visit(context, t) for each triangle t
+ * of a leaf whose box meets it, until a visit returns true (then true). Inline, so each
+ * caller gets its visit inlined too. */
+static inline bool screen_walk(const screen_query *s, bool (*visit)(void *context, uint32_t t),
+                               void *context)
+{
+    const exact_pairs *pairs = s->pairs;
+    uint32_t stack[2 * SCREEN_DEPTH + 2];
+    unsigned top = 0;
+    stack[top++] = 0;
+    while (top) {
+        const screen_node *node = &pairs->screen_nodes[stack[--top]];
+        if (box_apart(s, node->lo, node->hi))
+            continue;
+        if (node->count) {
+            for (uint32_t t = node->first; t < node->first + node->count; t++)
+                if (visit(context, t))
+                    return true;
+        } else {
+            stack[top++] = node->first;
+            stack[top++] = node->first + 1;
+        }
+    }
+    return false;
+}
+
+/* screen_may_block's visit: the triangle settles that something may block. */
+typedef struct blocking_visit {
+    const screen_query *s;
+    screen_batch *batch;
+} blocking_visit;
+
+static bool visit_blocking(void *context, uint32_t t)
+{
+    blocking_visit *v = context;
+    return screen_triangle_blocks(v->s, &v->s->pairs->screen_triangles[t], v->batch);
+}
+
+/* screen_collect's visit: the triangles standing between the pair, true past
+ * GROUP_LIST_MAX of them. */
+typedef struct standing_visit {
+    const screen_query *s;
+    uint32_t *standing;
+    unsigned count;
+} standing_visit;
+
+static bool visit_standing(void *context, uint32_t t)
+{
+    standing_visit *v = context;
+    if (!may_stand_between(v->s, &v->s->pairs->screen_triangles[t]))
+        return false;
+    if (v->count == GROUP_LIST_MAX)
+        return true;
+    v->standing[v->count++] = t;
+    return false;
+}
+
 /* False when no triangle can cut the hull of p and q (then the pair is clear). The
  * triangles that stand between the pair are gathered first: one across the centroids'
  * segment settles it without the hull's side planes, which cost more than all the rest. */
@@ -253,22 +312,9 @@ static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, cons
     screen_query s = screen_query_of(pairs, p, q);
     screen_batch batch;
     batch.count = 0;
-    uint32_t stack[2 * SCREEN_DEPTH + 2];
-    unsigned top = 0;
-    stack[top++] = 0;
-    while (top) {
-        const screen_node *node = &pairs->screen_nodes[stack[--top]];
-        if (box_apart(&s, node->lo, node->hi))
-            continue;
-        if (node->count) {
-            for (uint32_t t = node->first; t < node->first + node->count; t++)
-                if (screen_triangle_blocks(&s, &pairs->screen_triangles[t], &batch))
-                    return true;
-        } else {
-            stack[top++] = node->first;
-            stack[top++] = node->first + 1;
-        }
-    }
+    blocking_visit visit = {&s, &batch};
+    if (screen_walk(&s, visit_blocking, &visit))
+        return true;
     return batch.count > 0 && batch_may_cut(&s, batch.candidate, batch.count);
 }
 
@@ -297,27 +343,10 @@ static unsigned screen_collect(const exact_pairs *pairs, const vf_polygon *p,
         return 0;
     screen_query s = screen_query_of(pairs, p, q);
     uint32_t standing[GROUP_LIST_MAX];
-    unsigned count = 0;
-    uint32_t stack[2 * SCREEN_DEPTH + 2];
-    unsigned top = 0;
-    stack[top++] = 0;
-    while (top) {
-        const screen_node *node = &pairs->screen_nodes[stack[--top]];
-        if (box_apart(&s, node->lo, node->hi))
-            continue;
-        if (node->count) {
-            for (uint32_t t = node->first; t < node->first + node->count; t++) {
-                if (!may_stand_between(&s, &pairs->screen_triangles[t]))
-                    continue;
-                if (count == GROUP_LIST_MAX)
-                    return cap + 1;
-                standing[count++] = t;
-            }
-        } else {
-            stack[top++] = node->first;
-            stack[top++] = node->first + 1;
-        }
-    }
+    standing_visit visit = {&s, standing, 0};
+    if (screen_walk(&s, visit_standing, &visit))
+        return cap + 1;
+    const unsigned count = visit.count;
     /* the hull's side planes, an edge at a time, drop the triangles they have outside */
     bool outside[GROUP_LIST_MAX] = {false};
     for (unsigned edge = 0; edge < p->count + q->count; edge++) {
@@ -533,6 +562,19 @@ static bool rectangles_face(const vf_polygon *a, const vf_polygon *b, double eps
     return ab && ba;
 }
 
+/* The groups' lists of triangles freed (each row's, and the tables), none left. */
+static void free_group_lists(exact_pairs *pairs)
+{
+    for (uint32_t g = 0; pairs->group_list && g < pairs->group_count; g++)
+        free(pairs->group_list[g]);
+    free(pairs->group_list);
+    free(pairs->group_list_first);
+    free(pairs->group_list_count);
+    pairs->group_list = NULL;
+    pairs->group_list_first = NULL;
+    pairs->group_list_count = NULL;
+}
+
 rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threads,
                              rad_error *error)
 {
@@ -633,20 +675,18 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
         for (uint32_t h = (uint32_t)g + 1; h < made; h++) {
             if (!rectangles_face(&rectangles[g], &rectangles[h], pairs->plane_epsilon))
                 continue;
-            if (!listed) {
-                if (!screen_may_block(pairs, &rectangles[g], &rectangles[h]))
-                    pairs->group_clear[(size_t)g * pairs->group_words + h / 64] |=
-                        UINT64_C(1) << (h % 64);
-                continue;
-            }
             uint32_t found[GROUP_LIST_MAX];
             unsigned count =
-                screen_collect(pairs, &rectangles[g], &rectangles[h], found, GROUP_LIST_MAX);
-            if (count == 0) {
+                listed ? screen_collect(pairs, &rectangles[g], &rectangles[h], found,
+                                        GROUP_LIST_MAX)
+                       : screen_may_block(pairs, &rectangles[g], &rectangles[h]);
+            if (count == 0) { /* clear */
                 pairs->group_clear[(size_t)g * pairs->group_words + h / 64] |= UINT64_C(1)
                                                                                << (h % 64);
                 continue;
             }
+            if (!listed)
+                continue;
             if (count > GROUP_LIST_MAX)
                 continue; /* not listed: its pairs screen the tree */
             if (used + count > capacity) {
@@ -680,16 +720,9 @@ nomem:
     free(rectangles);
     free(pairs->group_of);
     free(pairs->group_clear);
-    for (uint32_t g = 0; pairs->group_list && g < pairs->group_count; g++)
-        free(pairs->group_list[g]);
-    free(pairs->group_list);
-    free(pairs->group_list_first);
-    free(pairs->group_list_count);
+    free_group_lists(pairs);
     pairs->group_of = NULL;
     pairs->group_clear = NULL;
-    pairs->group_list = NULL;
-    pairs->group_list_first = NULL;
-    pairs->group_list_count = NULL;
     pairs->group_count = 0;
     return rad_fail(error, RAD_ERR_NOMEM, "out of memory for the groups of patches");
 }
@@ -698,18 +731,11 @@ void exact_pairs_free(exact_pairs *pairs)
 {
     occluder_tree_destroy(pairs->tree);
     free(pairs->polygons);
-    for (uint32_t g = 0; pairs->group_list && g < pairs->group_count; g++)
-        free(pairs->group_list[g]);
-    free(pairs->group_list);
-    free(pairs->group_list_first);
-    free(pairs->group_list_count);
+    free_group_lists(pairs);
     free(pairs->group_of);
     free(pairs->group_clear);
     pairs->group_of = NULL;
     pairs->group_clear = NULL;
-    pairs->group_list = NULL;
-    pairs->group_list_first = NULL;
-    pairs->group_list_count = NULL;
     free(pairs->screen_nodes);
     free(pairs->screen_triangles);
     pairs->tree = NULL;
