@@ -828,6 +828,79 @@ static bool pair_may_block(const exact_pairs *pairs, uint32_t i, uint32_t j)
     return screen_may_block(pairs, p, q);
 }
 
+/* exact_pairs_hidden's visit: the triangle has every corner of p strictly on one side of
+ * its plane, every corner of q strictly on the other, and every crossing of its plane by a
+ * segment from a corner of p to a corner of q strictly inside its edges. The crossings of
+ * all segments from p to q lie in the convex hull of those (the hull of p and q, cut by
+ * the plane), which then lies inside the triangle: no segment gets past it. */
+typedef struct hiding_visit {
+    const exact_pairs *pairs;
+    const vf_polygon *p, *q;
+} hiding_visit;
+
+static bool visit_hiding(void *context, uint32_t t)
+{
+    const hiding_visit *v = context;
+    const screen_triangle *tri = &v->pairs->screen_triangles[t];
+    const double margin = v->pairs->epsilon;
+    if (!(v3_length(tri->normal) > 0))
+        return false;
+    double dp[VF_MAX_VERTICES], dq[VF_MAX_VERTICES];
+    int side = 0;
+    for (unsigned k = 0; k < v->p->count; k++) {
+        dp[k] = v3_dot(tri->normal, v->p->vertex[k]) - tri->offset;
+        int s = dp[k] > margin ? 1 : dp[k] < -margin ? -1 : 0;
+        if (s == 0 || (side && s != side))
+            return false;
+        side = s;
+    }
+    for (unsigned k = 0; k < v->q->count; k++) {
+        dq[k] = v3_dot(tri->normal, v->q->vertex[k]) - tri->offset;
+        if (!(side > 0 ? dq[k] < -margin : dq[k] > margin))
+            return false;
+    }
+    for (unsigned a = 0; a < v->p->count; a++)
+        for (unsigned b = 0; b < v->q->count; b++) {
+            double wa = fabs(dq[b]), wb = fabs(dp[a]);
+            rad_vec3 x = v3_scale(v3_add(v3_scale(v->p->vertex[a], wa),
+                                         v3_scale(v->q->vertex[b], wb)),
+                                  1 / (wa + wb));
+            for (int e = 0; e < 3; e++)
+                if (!(v3_dot(tri->edge_normal[e], x) - tri->edge_offset[e] > margin))
+                    return false;
+        }
+    return true;
+}
+
+bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j)
+{
+    const vf_polygon *p = &pairs->polygons[i], *q = &pairs->polygons[j];
+    if (p->count == 0 || q->count == 0 || pairs->screen_node_count == 0)
+        return false;
+    hiding_visit visit = {pairs, p, q};
+    if (pairs->group_list) {
+        uint32_t g = pairs->group_of[i], h = pairs->group_of[j];
+        if (g != EXACT_NO_GROUP && h != EXACT_NO_GROUP && g != h) {
+            if (g > h) {
+                uint32_t swap = g;
+                g = h;
+                h = swap;
+            }
+            size_t at = (size_t)g * pairs->group_count + h;
+            unsigned count = pairs->group_list_count[at];
+            if (count != GROUP_NOT_LISTED) { /* a hiding triangle cuts the groups' hull */
+                const uint32_t *listed = pairs->group_list[g] + pairs->group_list_first[at];
+                for (unsigned k = 0; k < count; k++)
+                    if (visit_hiding(&visit, listed[k]))
+                        return true;
+                return false;
+            }
+        }
+    }
+    screen_query s = screen_query_of(pairs, p, q);
+    return screen_walk(&s, visit_hiding, &visit);
+}
+
 exact_outcome exact_pairs_transfer(const exact_pairs *pairs, uint32_t i, uint32_t j, bool clip,
                                    double accuracy, double *G)
 {

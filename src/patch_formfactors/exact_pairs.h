@@ -83,6 +83,13 @@ static inline bool exact_pairs_group_clear(const exact_pairs *pairs, uint32_t i,
     return pairs->group_clear[(size_t)g * pairs->group_words + h / 64] >> (h % 64) & 1u;
 }
 
+/* True when one triangle hides all of patch j from all of patch i: their corners lie
+ * strictly on either side of its plane, and every segment from a corner of i to a corner of
+ * j crosses it strictly inside its edges (then so does every segment between the two
+ * patches, whose crossings lie in the hull of those). A conservative proof: false says
+ * nothing. Thread-safe. */
+bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j);
+
 /* Classifies the pair (i, j); with `clip` (pairs close enough for their kernel to vary
  * fast across them) also settles a pair that few triangles obstruct, to relative
  * accuracy `accuracy`. Thread-safe. */

@@ -439,8 +439,13 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
             if (settled > 0)
                 e->sink(e->sink_data, thread, i, j, settled);
         } else if (e->exact.polygons[i].count && e->exact.polygons[j].count) {
-            /* something may block: the full set of segments at once (a first pass of four
-             * would call a pair wholly visible when a small shadow escapes all four) */
+            /* something may block: one triangle between them hides all (G = 0, no ray),
+             * else the full set of segments at once (a first pass of four would call a
+             * pair wholly visible when a small shadow escapes all four) */
+            if (exact_pairs_hidden(&e->exact, i, j)) {
+                w->pairs_exact++;
+                continue;
+            }
             if (w->refine.ray_count + e->strata * e->strata > BATCH_RAYS)
                 flush_refine(e, w, thread, i);
             batch_add(e, &w->refine, i, j, G, e->strata, 1);
