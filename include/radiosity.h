@@ -734,7 +734,8 @@ typedef struct rad_formfactor_report {
     uint64_t pairs_refined;    /* pairs whose visibility was sampled with the full set of
                                   segments */
     uint64_t pairs_clear;      /* pairs nothing can come between: no segment needed */
-    uint64_t pairs_exact;      /* close pairs settled by exact shadow clipping */
+    uint64_t pairs_exact;      /* pairs settled exactly with no segment: close pairs by
+                                  shadow clipping, others proven hidden by one triangle */
     uint64_t rays;             /* occlusion rays cast */
     double seconds;            /* wall-clock time of the whole computation */
     double tracing_seconds;    /* time spent tracing, summed over threads */
