@@ -412,6 +412,20 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
             continue;
         double distance = v3_length(v3_sub(gi->centroid, gj->centroid));
         double radii = gi->radius + gj->radius;
+        double settled;
+        exact_outcome outcome =
+            exact_pairs_group_clear(&e->exact, i, j)
+                ? EXACT_CLEAR
+                : exact_pairs_transfer(&e->exact, i, j, distance < EXACT_DISTANCE * radii,
+                                       EXACT_ACCURACY, &settled);
+        bool exact_polygons = e->exact.polygons[i].count && e->exact.polygons[j].count;
+        if (outcome == EXACT_SAMPLE && exact_polygons && exact_pairs_hidden(&e->exact, i, j)) {
+            /* one triangle between them hides all: G = 0, no ray, not even the
+             * unoccluded transfer */
+            w->pairs_facing++;
+            w->pairs_exact++;
+            continue;
+        }
         /* one-sided, from the smaller patch: its points are the finer ones relative to the
          * distance between the two */
         bool i_smaller = gi->area <= gj->area;
@@ -425,12 +439,6 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
         if (!(G > 0))
             continue;
         w->pairs_facing++;
-        double settled;
-        exact_outcome outcome =
-            exact_pairs_group_clear(&e->exact, i, j)
-                ? EXACT_CLEAR
-                : exact_pairs_transfer(&e->exact, i, j, distance < EXACT_DISTANCE * radii,
-                                       EXACT_ACCURACY, &settled);
         if (outcome == EXACT_CLEAR) {
             w->pairs_clear++;
             e->sink(e->sink_data, thread, i, j, G);
@@ -438,14 +446,9 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
             w->pairs_exact++;
             if (settled > 0)
                 e->sink(e->sink_data, thread, i, j, settled);
-        } else if (e->exact.polygons[i].count && e->exact.polygons[j].count) {
-            /* something may block: one triangle between them hides all (G = 0, no ray),
-             * else the full set of segments at once (a first pass of four would call a
-             * pair wholly visible when a small shadow escapes all four) */
-            if (exact_pairs_hidden(&e->exact, i, j)) {
-                w->pairs_exact++;
-                continue;
-            }
+        } else if (exact_polygons) {
+            /* something may block: the full set of segments at once (a first pass of four
+             * would call a pair wholly visible when a small shadow escapes all four) */
             if (w->refine.ray_count + e->strata * e->strata > BATCH_RAYS)
                 flush_refine(e, w, thread, i);
             batch_add(e, &w->refine, i, j, G, e->strata, 1);
