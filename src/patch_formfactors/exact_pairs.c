@@ -20,6 +20,7 @@
 #include "core/hemisphere.h"
 #include "core/minmax.h"
 #include "core/vec3.h"
+#include "patch_formfactors/hiding_faces.h"
 #include "surface_viewfactors/pair_transfer.h"
 #include "trace/tracer_internal.h"
 
@@ -446,6 +447,31 @@ rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
     out->screen_node_count = triangle_count ? 1 : 0;
     if (triangle_count)
         screen_build(out, 0, 0, triangle_count, 0);
+    /* the faces that may hide a pair, in the screening order: a triangle, or the convex
+     * quad it makes with a neighbour in its plane (to rounding) */
+    {
+        rad_vec3(*corners)[3] = rad_alloc_array(triangle_count ? triangle_count : 1,
+                                                 sizeof(*corners));
+        rad_vec3 *normals = rad_alloc_array(triangle_count ? triangle_count : 1,
+                                            sizeof(*normals));
+        if (!corners || !normals) {
+            free(corners);
+            free(normals);
+            status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the occluders' faces");
+            goto done;
+        }
+        for (uint32_t t = 0; t < triangle_count; t++) {
+            for (int c = 0; c < 3; c++)
+                corners[t][c] = out->screen_triangles[t].corner[c];
+            normals[t] = out->screen_triangles[t].normal;
+        }
+        status = hiding_faces_build((const rad_vec3(*)[3])corners, normals, triangle_count,
+                                    16 * DBL_EPSILON * largest, &out->hiding_faces, error);
+        free(corners);
+        free(normals);
+        if (status != RAD_OK)
+            goto done;
+    }
     for (uint32_t i = 0; i < mesh->patch_count; i++) {
         const rad_patch *patch = &mesh->patches[i];
         vf_polygon *polygon = &out->polygons[i];
@@ -738,6 +764,8 @@ void exact_pairs_free(exact_pairs *pairs)
     pairs->group_clear = NULL;
     free(pairs->screen_nodes);
     free(pairs->screen_triangles);
+    free(pairs->hiding_faces);
+    pairs->hiding_faces = NULL;
     pairs->tree = NULL;
     pairs->polygons = NULL;
     pairs->screen_nodes = NULL;
@@ -830,9 +858,10 @@ static bool pair_may_block(const exact_pairs *pairs, uint32_t i, uint32_t j)
 
 /* exact_pairs_hidden's visit: the triangle has every corner of p strictly on one side of
  * its plane, every corner of q strictly on the other, and every crossing of its plane by a
- * segment from a corner of p to a corner of q strictly inside its edges. The crossings of
- * all segments from p to q lie in the convex hull of those (the hull of p and q, cut by
- * the plane), which then lies inside the triangle: no segment gets past it. */
+ * segment from a corner of p to a corner of q strictly inside its face (hiding_faces.h:
+ * itself, or the convex quad it makes with a neighbour in its plane). The crossings of all
+ * segments from p to q lie in the convex hull of those (the hull of p and q, cut by the
+ * plane), which then lies inside the face: no segment gets past it. */
 typedef struct hiding_visit {
     const exact_pairs *pairs;
     const vf_polygon *p, *q;
@@ -842,8 +871,9 @@ static bool visit_hiding(void *context, uint32_t t)
 {
     const hiding_visit *v = context;
     const screen_triangle *tri = &v->pairs->screen_triangles[t];
+    const hiding_face *face = &v->pairs->hiding_faces[t];
     const double margin = v->pairs->epsilon;
-    if (!(v3_length(tri->normal) > 0))
+    if (!face->edges)
         return false;
     double dp[VF_MAX_VERTICES], dq[VF_MAX_VERTICES];
     int side = 0;
@@ -865,8 +895,8 @@ static bool visit_hiding(void *context, uint32_t t)
             rad_vec3 x = v3_scale(v3_add(v3_scale(v->p->vertex[a], wa),
                                          v3_scale(v->q->vertex[b], wb)),
                                   1 / (wa + wb));
-            for (int e = 0; e < 3; e++)
-                if (!(v3_dot(tri->edge_normal[e], x) - tri->edge_offset[e] > margin))
+            for (unsigned e = 0; e < face->edges; e++)
+                if (!(v3_dot(face->edge_normal[e], x) - face->edge_offset[e] > margin))
                     return false;
         }
     return true;

@@ -26,6 +26,8 @@ typedef struct exact_pairs {
     screen_node *screen_nodes;
     screen_triangle *screen_triangles;
     uint32_t screen_node_count;
+    /* per screen triangle, the convex face it hides pairs with (hiding_faces.h) */
+    struct hiding_face *hiding_faces;
     vf_polygon *polygons; /* per patch; count 0 for a folded (bulging) patch: never exact */
     double epsilon;       /* touching a pair's hull within this does not count */
     double plane_epsilon; /* in front of a plane means beyond this (scene units) */
@@ -85,9 +87,10 @@ static inline bool exact_pairs_group_clear(const exact_pairs *pairs, uint32_t i,
 
 /* True when one triangle hides all of patch j from all of patch i: their corners lie
  * strictly on either side of its plane, and every segment from a corner of i to a corner of
- * j crosses it strictly inside its edges (then so does every segment between the two
- * patches, whose crossings lie in the hull of those). A conservative proof: false says
- * nothing. Thread-safe. */
+ * j crosses it strictly inside its face (itself, or the convex quad it makes with a
+ * neighbour in its plane; then so does every segment between the two patches, whose
+ * crossings lie in the hull of those). A conservative proof: false says nothing.
+ * Thread-safe. */
 bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j);
 
 /* Classifies the pair (i, j); with `clip` (pairs close enough for their kernel to vary
