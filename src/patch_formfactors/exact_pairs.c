@@ -486,6 +486,52 @@ rad_status exact_pairs_build(const rad_mesh *mesh, const rad_tracer *occluders,
         vf_polygon_finish(polygon);
         polygon->area = patch->area;
     }
+    /* the patches a convex solid holds (the floor under a box standing on it) */
+    const convex_solids *solids = occluder_tree_solids(out->tree);
+    if (solids && solids->count > 0) {
+        out->inside_solid = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1,
+                                            sizeof(*out->inside_solid));
+        if (!out->inside_solid) {
+            status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the occluder tree");
+            goto done;
+        }
+        /* every solid's triangles' corners, to tell a polygon apart by its own plane */
+        out->solid_corner_first = rad_alloc_array((size_t)solids->count + 1,
+                                                  sizeof(*out->solid_corner_first));
+        out->solid_corner = rad_alloc_array(3 * (size_t)(triangle_count ? triangle_count : 1),
+                                            sizeof(*out->solid_corner));
+        if (!out->solid_corner_first || !out->solid_corner) {
+            status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for the occluder tree");
+            goto done;
+        }
+        for (uint32_t t = 0; t < triangle_count; t++)
+            if (solids->of_triangle[t] != UINT32_MAX)
+                out->solid_corner_first[solids->of_triangle[t] + 1] += 3;
+        for (uint32_t k = 0; k < solids->count; k++)
+            out->solid_corner_first[k + 1] += out->solid_corner_first[k];
+        /* filled from each solid's end down: [k + 1] ends at solid k's start */
+        const uint32_t total = out->solid_corner_first[solids->count];
+        for (uint32_t t = triangle_count; t-- > 0;) {
+            uint32_t k = solids->of_triangle[t];
+            if (k == UINT32_MAX)
+                continue;
+            uint32_t at = out->solid_corner_first[k + 1] - 3;
+            out->solid_corner_first[k + 1] = at;
+            for (int c = 0; c < 3; c++)
+                out->solid_corner[at + c] = positions[triangles[t].vertex[c]];
+        }
+        for (uint32_t k = 0; k < solids->count; k++)
+            out->solid_corner_first[k] = out->solid_corner_first[k + 1];
+        out->solid_corner_first[solids->count] = total;
+        for (uint32_t i = 0; i < mesh->patch_count; i++) {
+            out->inside_solid[i] = EXACT_NO_SOLID;
+            for (uint32_t k = 0; out->polygons[i].count && k < solids->count; k++)
+                if (convex_solid_holds(&solids->solids[k], &out->polygons[i], out->epsilon)) {
+                    out->inside_solid[i] = k;
+                    break;
+                }
+        }
+    }
 done:
     free(positions);
     free(triangles);
@@ -766,6 +812,12 @@ void exact_pairs_free(exact_pairs *pairs)
     free(pairs->screen_triangles);
     free(pairs->hiding_faces);
     pairs->hiding_faces = NULL;
+    free(pairs->inside_solid);
+    free(pairs->solid_corner);
+    free(pairs->solid_corner_first);
+    pairs->inside_solid = NULL;
+    pairs->solid_corner = NULL;
+    pairs->solid_corner_first = NULL;
     pairs->tree = NULL;
     pairs->polygons = NULL;
     pairs->screen_nodes = NULL;
@@ -902,11 +954,44 @@ static bool visit_hiding(void *context, uint32_t t)
     return true;
 }
 
+/* Whether polygon q lies outside convex solid k: convex_solid_apart, or, with q on the
+ * inner side of an open solid's missing face, every corner of the solid's triangles more
+ * than epsilon on one side of q's own plane (the solid, their hull, then misses it). */
+static bool solid_apart(const exact_pairs *pairs, const convex_solid *solid, uint32_t k,
+                        const vf_polygon *q)
+{
+    if (convex_solid_apart(solid, q, pairs->epsilon))
+        return true;
+    for (unsigned m = 0; solid->open && m < q->count; m++)
+        if (!(v3_dot(solid->open_normal, q->vertex[m]) - solid->open_offset < -pairs->epsilon))
+            return false;
+    uint32_t first = pairs->solid_corner_first[k], end = pairs->solid_corner_first[k + 1];
+    if (first == end)
+        return false;
+    double offset = v3_dot(q->normal, q->vertex[0]);
+    int side = 0;
+    for (uint32_t c = first; c < end; c++) {
+        double d = v3_dot(q->normal, pairs->solid_corner[c]) - offset;
+        int s = d > pairs->epsilon ? 1 : d < -pairs->epsilon ? -1 : 0;
+        if (s == 0 || (side && s != side))
+            return false;
+        side = s;
+    }
+    return true;
+}
+
 bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j)
 {
     const vf_polygon *p = &pairs->polygons[i], *q = &pairs->polygons[j];
     if (p->count == 0 || q->count == 0 || pairs->screen_node_count == 0)
         return false;
+    if (pairs->inside_solid) { /* one held by a convex solid, the other apart from it */
+        const convex_solids *solids = occluder_tree_solids(pairs->tree);
+        uint32_t held_i = pairs->inside_solid[i], held_j = pairs->inside_solid[j];
+        if ((held_i != EXACT_NO_SOLID && solid_apart(pairs, &solids->solids[held_i], held_i, q)) ||
+            (held_j != EXACT_NO_SOLID && solid_apart(pairs, &solids->solids[held_j], held_j, p)))
+            return true;
+    }
     hiding_visit visit = {pairs, p, q};
     if (pairs->group_list) {
         uint32_t g = pairs->group_of[i], h = pairs->group_of[j];

@@ -28,6 +28,11 @@ typedef struct exact_pairs {
     uint32_t screen_node_count;
     /* per screen triangle, the convex face it hides pairs with (hiding_faces.h) */
     struct hiding_face *hiding_faces;
+    /* per patch, the convex solid (the tree's, convex_solids.h) that holds it, or
+     * EXACT_NO_SOLID: a segment from it to a patch outside leaves through a face */
+    uint32_t *inside_solid;
+    rad_vec3 *solid_corner;       /* the corners of each solid's triangles, */
+    uint32_t *solid_corner_first; /* solid k's from solid_corner_first[k] to [k + 1] */
     vf_polygon *polygons; /* per patch; count 0 for a folded (bulging) patch: never exact */
     double epsilon;       /* touching a pair's hull within this does not count */
     double plane_epsilon; /* in front of a plane means beyond this (scene units) */
@@ -85,12 +90,15 @@ static inline bool exact_pairs_group_clear(const exact_pairs *pairs, uint32_t i,
     return pairs->group_clear[(size_t)g * pairs->group_words + h / 64] >> (h % 64) & 1u;
 }
 
+#define EXACT_NO_SOLID UINT32_MAX
+
 /* True when one triangle hides all of patch j from all of patch i: their corners lie
  * strictly on either side of its plane, and every segment from a corner of i to a corner of
  * j crosses it strictly inside its face (itself, or the convex quad it makes with a
  * neighbour in its plane; then so does every segment between the two patches, whose
- * crossings lie in the hull of those). A conservative proof: false says nothing.
- * Thread-safe. */
+ * crossings lie in the hull of those), or when a convex solid holds one patch and the
+ * other lies apart from it (convex_solid_holds, convex_solid_apart: the floor under a
+ * box). A conservative proof: false says nothing. Thread-safe. */
 bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j);
 
 /* Classifies the pair (i, j); with `clip` (pairs close enough for their kernel to vary

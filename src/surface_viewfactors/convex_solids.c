@@ -307,6 +307,33 @@ bool convex_solid_seen_from(const convex_solid *solid, const vf_polygon *polygon
     return true;
 }
 
+bool convex_solid_holds(const convex_solid *solid, const vf_polygon *polygon, double epsilon)
+{
+    for (unsigned k = 0; k < solid->plane_count; k++)
+        for (unsigned m = 0; m < polygon->count; m++)
+            if (!(v3_dot(solid->normal[k], polygon->vertex[m]) - solid->offset[k] < -epsilon))
+                return false;
+    for (unsigned m = 0; solid->open && m < polygon->count; m++)
+        if (!(v3_dot(solid->open_normal, polygon->vertex[m]) - solid->open_offset <= 0))
+            return false;
+    return solid->plane_count > 0;
+}
+
+bool convex_solid_apart(const convex_solid *solid, const vf_polygon *polygon, double epsilon)
+{
+    for (unsigned m = 0; solid->open && m < polygon->count; m++)
+        if (!(v3_dot(solid->open_normal, polygon->vertex[m]) - solid->open_offset < -epsilon))
+            return false;
+    for (unsigned k = 0; k < solid->plane_count; k++) {
+        bool beyond = true;
+        for (unsigned m = 0; m < polygon->count && beyond; m++)
+            beyond = v3_dot(solid->normal[k], polygon->vertex[m]) - solid->offset[k] > epsilon;
+        if (beyond)
+            return true;
+    }
+    return false;
+}
+
 bool convex_solid_face_away(rad_vec3 n, rad_vec3 corner, const vf_polygon *polygon,
                             double epsilon)
 {

@@ -70,6 +70,18 @@ void convex_solids_free(convex_solids *solids);
 bool convex_solid_seen_from(const convex_solid *solid, const vf_polygon *polygon,
                             double epsilon);
 
+/* Whether the polygon lies inside the solid: every corner more than epsilon inside each
+ * face plane, and for an open solid on the missing face's plane or on its inner side
+ * (exactly: the ground under a building, in the plane of its missing floor). A segment
+ * from such a polygon to one the solid holds apart (below) leaves it through a face: it
+ * cannot pass the missing face, whose plane it crosses at its start at most. */
+bool convex_solid_holds(const convex_solid *solid, const vf_polygon *polygon, double epsilon);
+
+/* Whether the polygon lies outside the solid: every corner more than epsilon beyond one
+ * face plane, and for an open solid every corner more than epsilon on the inner side of
+ * the missing face's plane. */
+bool convex_solid_apart(const convex_solid *solid, const vf_polygon *polygon, double epsilon);
+
 /* Whether the face with unit normal n through `corner` is turned away from every point of
  * the polygon (each corner behind its plane or on it, within epsilon). */
 bool convex_solid_face_away(rad_vec3 n, rad_vec3 corner, const vf_polygon *polygon,

@@ -327,6 +327,11 @@ static bool triangle_cuts(const hull *h, const tree_triangle *t, double epsilon)
     return !(below || above);
 }
 
+const convex_solids *occluder_tree_solids(const occluder_tree *tree)
+{
+    return tree && tree->solids.of_triangle ? &tree->solids : NULL;
+}
+
 void occluder_tree_use_solids(occluder_tree *tree, bool use) { tree->use_solids = use; }
 
 uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,

@@ -11,6 +11,7 @@
 #define RAD_VIEWFACTOR_OCCLUDER_TREE_H
 
 #include "radiosity.h"
+#include "surface_viewfactors/convex_solids.h"
 #include "surface_viewfactors/shadow_clip.h"
 #include "surface_viewfactors/vf_geometry.h"
 
@@ -25,6 +26,9 @@ typedef struct occluder_tree occluder_tree;
 rad_status occluder_tree_build(const rad_scene *scene, const uint32_t *triangle_source,
                                bool solids, occluder_tree **out, rad_error *error);
 void occluder_tree_destroy(occluder_tree *tree);
+
+/* The convex solids the build found (with `solids`), or NULL. */
+const convex_solids *occluder_tree_solids(const occluder_tree *tree);
 
 /* Whether occluder_tree_collect leaves out the faces of the solids the build found (it
  * does after a build that found them); false: every triangle that cuts the hull, for a
