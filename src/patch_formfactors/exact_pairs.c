@@ -228,6 +228,7 @@ static screen_query screen_query_of(const exact_pairs *pairs, const vf_polygon *
 typedef struct screen_batch {
     const screen_triangle *candidate[SCREEN_CANDIDATES];
     unsigned count;
+    uint32_t crossing; /* the triangle across the centroids' segment, or UINT32_MAX */
 } screen_batch;
 
 /* Triangle tt met in a screening: true when it settles that something may block. */
@@ -236,8 +237,10 @@ static bool screen_triangle_blocks(const screen_query *s, const screen_triangle 
 {
     if (!may_stand_between(s, tt))
         return false;
-    if (blocks_centroids(s, tt))
+    if (blocks_centroids(s, tt)) {
+        batch->crossing = (uint32_t)(tt - s->pairs->screen_triangles);
         return true;
+    }
     batch->candidate[batch->count++] = tt;
     if (batch->count == SCREEN_CANDIDATES) {
         batch->count = 0;
@@ -306,16 +309,20 @@ static bool visit_standing(void *context, uint32_t t)
 /* False when no triangle can cut the hull of p and q (then the pair is clear). The
  * triangles that stand between the pair are gathered first: one across the centroids'
  * segment settles it without the hull's side planes, which cost more than all the rest. */
-static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, const vf_polygon *q)
+static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, const vf_polygon *q,
+                             uint32_t *crossing)
 {
     if (pairs->screen_node_count == 0)
         return false;
     screen_query s = screen_query_of(pairs, p, q);
     screen_batch batch;
     batch.count = 0;
+    batch.crossing = UINT32_MAX;
     blocking_visit visit = {&s, &batch};
-    if (screen_walk(&s, visit_blocking, &visit))
+    if (screen_walk(&s, visit_blocking, &visit)) {
+        *crossing = batch.crossing;
         return true;
+    }
     return batch.count > 0 && batch_may_cut(&s, batch.candidate, batch.count);
 }
 
@@ -323,14 +330,17 @@ static bool screen_may_block(const exact_pairs *pairs, const vf_polygon *p, cons
  * q's (their groups' rectangles'): a triangle outside that hull is outside theirs too. */
 static bool screen_listed_may_block(const exact_pairs *pairs, const vf_polygon *p,
                                     const vf_polygon *q, const uint32_t *listed,
-                                    unsigned count)
+                                    unsigned count, uint32_t *crossing)
 {
     screen_query s = screen_query_of(pairs, p, q);
     screen_batch batch;
     batch.count = 0;
+    batch.crossing = UINT32_MAX;
     for (unsigned k = 0; k < count; k++)
-        if (screen_triangle_blocks(&s, &pairs->screen_triangles[listed[k]], &batch))
+        if (screen_triangle_blocks(&s, &pairs->screen_triangles[listed[k]], &batch)) {
+            *crossing = batch.crossing;
             return true;
+        }
     return batch.count > 0 && batch_may_cut(&s, batch.candidate, batch.count);
 }
 
@@ -747,11 +757,11 @@ rad_status exact_pairs_group(exact_pairs *pairs, const rad_mesh *mesh, int threa
         for (uint32_t h = (uint32_t)g + 1; h < made; h++) {
             if (!rectangles_face(&rectangles[g], &rectangles[h], pairs->plane_epsilon))
                 continue;
-            uint32_t found[GROUP_LIST_MAX];
+            uint32_t found[GROUP_LIST_MAX], unused;
             unsigned count =
                 listed ? screen_collect(pairs, &rectangles[g], &rectangles[h], found,
                                         GROUP_LIST_MAX)
-                       : screen_may_block(pairs, &rectangles[g], &rectangles[h]);
+                       : screen_may_block(pairs, &rectangles[g], &rectangles[h], &unused);
             if (count == 0) { /* clear */
                 pairs->group_clear[(size_t)g * pairs->group_words + h / 64] |= UINT64_C(1)
                                                                                << (h % 64);
@@ -885,8 +895,10 @@ static bool cut_by_occluders(const vf_polygon *outer, const shadow_occluder *occ
     return true;
 }
 
-/* Screening the pair (i, j): from its groups' list when they have one, else the tree. */
-static bool pair_may_block(const exact_pairs *pairs, uint32_t i, uint32_t j)
+/* Screening the pair (i, j): from its groups' list when they have one, else the tree. When
+ * a triangle across the centroids' segment settles it, *crossing says which (else it is
+ * left as it is). */
+static bool pair_may_block(const exact_pairs *pairs, uint32_t i, uint32_t j, uint32_t *crossing)
 {
     const vf_polygon *p = &pairs->polygons[i], *q = &pairs->polygons[j];
     if (pairs->group_list) {
@@ -902,10 +914,10 @@ static bool pair_may_block(const exact_pairs *pairs, uint32_t i, uint32_t j)
             if (count != GROUP_NOT_LISTED)
                 return screen_listed_may_block(pairs, p, q,
                                                pairs->group_list[g] + pairs->group_list_first[at],
-                                               count);
+                                               count, crossing);
         }
     }
-    return screen_may_block(pairs, p, q);
+    return screen_may_block(pairs, p, q, crossing);
 }
 
 /* exact_pairs_hidden's visit: the triangle has every corner of p strictly on one side of
@@ -926,6 +938,11 @@ static bool visit_hiding(void *context, uint32_t t)
     const hiding_face *face = &v->pairs->hiding_faces[t];
     const double margin = v->pairs->epsilon;
     if (!face->edges)
+        return false;
+    /* the centroids' segment crosses it too: most triangles fail this first */
+    double cp = v3_dot(tri->normal, v->p->centroid) - tri->offset;
+    double cq = v3_dot(tri->normal, v->q->centroid) - tri->offset;
+    if (!((cp > margin && cq < -margin) || (cp < -margin && cq > margin)))
         return false;
     double dp[VF_MAX_VERTICES], dq[VF_MAX_VERTICES];
     int side = 0;
@@ -980,10 +997,10 @@ static bool solid_apart(const exact_pairs *pairs, const convex_solid *solid, uin
     return true;
 }
 
-bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j)
+bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j, uint32_t crossing)
 {
     const vf_polygon *p = &pairs->polygons[i], *q = &pairs->polygons[j];
-    if (p->count == 0 || q->count == 0 || pairs->screen_node_count == 0)
+    if (p->count == 0 || q->count == 0)
         return false;
     if (pairs->inside_solid) { /* one held by a convex solid, the other apart from it */
         const convex_solids *solids = occluder_tree_solids(pairs->tree);
@@ -992,37 +1009,22 @@ bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j)
             (held_j != EXACT_NO_SOLID && solid_apart(pairs, &solids->solids[held_j], held_j, p)))
             return true;
     }
+    /* a hiding face crosses the centroids' segment: the triangle the screening found
+     * across it is the one tried (its face, a quad, covers its neighbour) */
     hiding_visit visit = {pairs, p, q};
-    if (pairs->group_list) {
-        uint32_t g = pairs->group_of[i], h = pairs->group_of[j];
-        if (g != EXACT_NO_GROUP && h != EXACT_NO_GROUP && g != h) {
-            if (g > h) {
-                uint32_t swap = g;
-                g = h;
-                h = swap;
-            }
-            size_t at = (size_t)g * pairs->group_count + h;
-            unsigned count = pairs->group_list_count[at];
-            if (count != GROUP_NOT_LISTED) { /* a hiding triangle cuts the groups' hull */
-                const uint32_t *listed = pairs->group_list[g] + pairs->group_list_first[at];
-                for (unsigned k = 0; k < count; k++)
-                    if (visit_hiding(&visit, listed[k]))
-                        return true;
-                return false;
-            }
-        }
-    }
-    screen_query s = screen_query_of(pairs, p, q);
-    return screen_walk(&s, visit_hiding, &visit);
+    return crossing != EXACT_NO_CROSSING && visit_hiding(&visit, crossing);
 }
 
 exact_outcome exact_pairs_transfer(const exact_pairs *pairs, uint32_t i, uint32_t j, bool clip,
-                                   double accuracy, double *G)
+                                   double accuracy, double *G, uint32_t *crossing)
 {
     const vf_polygon *p = &pairs->polygons[i], *q = &pairs->polygons[j];
+    uint32_t unused;
+    crossing = crossing ? crossing : &unused;
+    *crossing = EXACT_NO_CROSSING;
     if (p->count == 0 || q->count == 0)
         return EXACT_SAMPLE;
-    if (!pair_may_block(pairs, i, j))
+    if (!pair_may_block(pairs, i, j, crossing))
         return EXACT_CLEAR;
     if (!clip)
         return EXACT_SAMPLE; /* the hull's faces might still prove it clear: not worth it */

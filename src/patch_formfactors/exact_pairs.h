@@ -91,20 +91,23 @@ static inline bool exact_pairs_group_clear(const exact_pairs *pairs, uint32_t i,
 }
 
 #define EXACT_NO_SOLID UINT32_MAX
+#define EXACT_NO_CROSSING UINT32_MAX
 
-/* True when one triangle hides all of patch j from all of patch i: their corners lie
- * strictly on either side of its plane, and every segment from a corner of i to a corner of
- * j crosses it strictly inside its face (itself, or the convex quad it makes with a
- * neighbour in its plane; then so does every segment between the two patches, whose
- * crossings lie in the hull of those), or when a convex solid holds one patch and the
- * other lies apart from it (convex_solid_holds, convex_solid_apart: the floor under a
- * box). A conservative proof: false says nothing. Thread-safe. */
-bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j);
+/* True when patch j is wholly hidden from patch i: a convex solid holds one of them and
+ * the other lies apart from it (convex_solid_holds, convex_solid_apart: the floor under a
+ * box), or the screening's triangle across their centroids' segment (`crossing`, from
+ * exact_pairs_transfer) hides them: their corners lie strictly on either side of its
+ * plane, and every segment from a corner of i to a corner of j crosses it strictly inside
+ * its face (itself, or the convex quad it makes with a neighbour in its plane; then so
+ * does every segment between the two patches, whose crossings lie in the hull of those).
+ * A conservative proof: false says nothing. Thread-safe. */
+bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j, uint32_t crossing);
 
 /* Classifies the pair (i, j); with `clip` (pairs close enough for their kernel to vary
  * fast across them) also settles a pair that few triangles obstruct, to relative
- * accuracy `accuracy`. Thread-safe. */
+ * accuracy `accuracy`. *crossing (unless NULL): the triangle (of the screening) the
+ * screening found across the centroids' segment, or EXACT_NO_CROSSING. Thread-safe. */
 exact_outcome exact_pairs_transfer(const exact_pairs *pairs, uint32_t i, uint32_t j, bool clip,
-                                   double accuracy, double *G);
+                                   double accuracy, double *G, uint32_t *crossing);
 
 #endif

@@ -413,13 +413,15 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
         double distance = v3_length(v3_sub(gi->centroid, gj->centroid));
         double radii = gi->radius + gj->radius;
         double settled;
+        uint32_t crossing;
         exact_outcome outcome =
             exact_pairs_group_clear(&e->exact, i, j)
                 ? EXACT_CLEAR
                 : exact_pairs_transfer(&e->exact, i, j, distance < EXACT_DISTANCE * radii,
-                                       EXACT_ACCURACY, &settled);
+                                       EXACT_ACCURACY, &settled, &crossing);
         bool exact_polygons = e->exact.polygons[i].count && e->exact.polygons[j].count;
-        if (outcome == EXACT_SAMPLE && exact_polygons && exact_pairs_hidden(&e->exact, i, j)) {
+        if (outcome == EXACT_SAMPLE && exact_polygons &&
+            exact_pairs_hidden(&e->exact, i, j, crossing)) {
             /* one triangle between them hides all: G = 0, no ray, not even the
              * unoccluded transfer */
             w->pairs_facing++;
