@@ -158,6 +158,28 @@ static void check_scene(const char *name, const rad_scene *scene, double patch_s
     rad_mesh_destroy(mesh);
 }
 
+/* A 6 x 6 floor under a ceiling 2 up, facing each other, into an OBJ. */
+static void floor_and_ceiling(test_obj *obj)
+{
+    test_obj_add(obj, "mtllib boxes.mtl\n");
+    test_obj_object(obj, "floor", "white");
+    test_obj_rectangle(obj, 1, 0, 0, 0, 6, 6, 1);
+    test_obj_object(obj, "ceiling", "white");
+    test_obj_rectangle(obj, 1, 2, 0, 0, 6, 6, -1);
+}
+
+/* Loads the OBJ text (as `file`) and checks it. */
+static void check_obj(const char *name, const char *file, const test_obj *obj,
+                      double patch_size, uint64_t least_hidden)
+{
+    rad_error error;
+    rad_scene *scene = NULL;
+    CHECK(rad_scene_load(test_write_file(file, obj->data), NULL, &scene, &error) == RAD_OK);
+    if (scene)
+        check_scene(name, scene, patch_size, least_hidden);
+    rad_scene_destroy(scene);
+}
+
 int main(void)
 {
     rad_error error;
@@ -167,13 +189,10 @@ int main(void)
                 10000);
     rad_scene_destroy(cornell);
 
-    /* a 6 x 6 floor under a ceiling 2 up, 24 boxes between them */
+    /* 24 boxes between a floor and a ceiling */
+    test_write_file("boxes.mtl", "newmtl white\nKd 0.5 0.5 0.5\n");
     test_obj obj = {0};
-    test_obj_add(&obj, "mtllib boxes.mtl\n");
-    test_obj_object(&obj, "floor", "white");
-    test_obj_rectangle(&obj, 1, 0, 0, 0, 6, 6, 1);
-    test_obj_object(&obj, "ceiling", "white");
-    test_obj_rectangle(&obj, 1, 2, 0, 0, 6, 6, -1);
+    floor_and_ceiling(&obj);
     rad_rng rng = rad_rng_seed(5, 0, 0);
     for (int b = 0; b < 24; b++) {
         char box[16];
@@ -183,35 +202,20 @@ int main(void)
         double y = 0.3 + 1.2 * rad_rng_uniform(&rng);
         test_obj_box(&obj, x, y, z, x + 0.2, y + 0.2, z + 0.2, false);
     }
-    test_write_file("boxes.mtl", "newmtl white\nKd 0.5 0.5 0.5\n");
-    const char *path = test_write_file("boxes.obj", obj.data);
-    rad_scene *scene = NULL;
-    CHECK(rad_scene_load(path, NULL, &scene, &error) == RAD_OK);
-    if (scene)
-        check_scene("boxes between a floor and a ceiling", scene, 0.2, 1000);
-    rad_scene_destroy(scene);
+    check_obj("boxes between a floor and a ceiling", "boxes.obj", &obj, 0.2, 1000);
     free(obj.data);
 
     /* a quad folded along its diagonal between a floor and a ceiling: its two triangles
      * are not one face (a segment passes the fold where the crossing of one triangle's
      * plane lies inside the quad) */
     test_obj folded = {0};
-    test_obj_add(&folded, "mtllib boxes.mtl\n");
-    test_obj_object(&folded, "floor", "white");
-    test_obj_rectangle(&folded, 1, 0, 0, 0, 6, 6, 1);
-    test_obj_object(&folded, "ceiling", "white");
-    test_obj_rectangle(&folded, 1, 2, 0, 0, 6, 6, -1);
+    floor_and_ceiling(&folded);
     test_obj_object(&folded, "folded", "white");
     test_obj_add(&folded, "v 1 1 1\nv 5 1 1\nv 5 1 5\nv 1 1.9 5\nf %d %d %d\nf %d %d %d\n",
                  folded.vertices + 1, folded.vertices + 2, folded.vertices + 3,
                  folded.vertices + 1, folded.vertices + 3, folded.vertices + 4);
     folded.vertices += 4;
-    path = test_write_file("folded.obj", folded.data);
-    scene = NULL;
-    CHECK(rad_scene_load(path, NULL, &scene, &error) == RAD_OK);
-    if (scene)
-        check_scene("a folded quad between a floor and a ceiling", scene, 0.4, 10);
-    rad_scene_destroy(scene);
+    check_obj("a folded quad between a floor and a ceiling", "folded.obj", &folded, 0.4, 10);
     free(folded.data);
     return test_finish("test_exact_groups");
 }

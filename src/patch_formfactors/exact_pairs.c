@@ -816,22 +816,13 @@ void exact_pairs_free(exact_pairs *pairs)
     free_group_lists(pairs);
     free(pairs->group_of);
     free(pairs->group_clear);
-    pairs->group_of = NULL;
-    pairs->group_clear = NULL;
     free(pairs->screen_nodes);
     free(pairs->screen_triangles);
     free(pairs->hiding_faces);
-    pairs->hiding_faces = NULL;
     free(pairs->inside_solid);
     free(pairs->solid_corner);
     free(pairs->solid_corner_first);
-    pairs->inside_solid = NULL;
-    pairs->solid_corner = NULL;
-    pairs->solid_corner_first = NULL;
-    pairs->tree = NULL;
-    pairs->polygons = NULL;
-    pairs->screen_nodes = NULL;
-    pairs->screen_triangles = NULL;
+    *pairs = (exact_pairs){0};
 }
 
 /* The part of `in` on the side `sign` of the plane n . x = offset; false when it has more
@@ -920,49 +911,38 @@ static bool pair_may_block(const exact_pairs *pairs, uint32_t i, uint32_t j, uin
     return screen_may_block(pairs, p, q, crossing);
 }
 
-/* exact_pairs_hidden's visit: the triangle has every corner of p strictly on one side of
- * its plane, every corner of q strictly on the other, and every crossing of its plane by a
+/* Whether triangle t hides q wholly from p: every corner of p strictly on one side of its
+ * plane, every corner of q strictly on the other, and every crossing of its plane by a
  * segment from a corner of p to a corner of q strictly inside its face (hiding_faces.h:
  * itself, or the convex quad it makes with a neighbour in its plane). The crossings of all
  * segments from p to q lie in the convex hull of those (the hull of p and q, cut by the
  * plane), which then lies inside the face: no segment gets past it. */
-typedef struct hiding_visit {
-    const exact_pairs *pairs;
-    const vf_polygon *p, *q;
-} hiding_visit;
-
-static bool visit_hiding(void *context, uint32_t t)
+static bool face_hides(const exact_pairs *pairs, uint32_t t, const vf_polygon *p,
+                       const vf_polygon *q)
 {
-    const hiding_visit *v = context;
-    const screen_triangle *tri = &v->pairs->screen_triangles[t];
-    const hiding_face *face = &v->pairs->hiding_faces[t];
-    const double margin = v->pairs->epsilon;
+    const screen_triangle *tri = &pairs->screen_triangles[t];
+    const hiding_face *face = &pairs->hiding_faces[t];
+    const double margin = pairs->epsilon;
     if (!face->edges)
-        return false;
-    /* the centroids' segment crosses it too: most triangles fail this first */
-    double cp = v3_dot(tri->normal, v->p->centroid) - tri->offset;
-    double cq = v3_dot(tri->normal, v->q->centroid) - tri->offset;
-    if (!((cp > margin && cq < -margin) || (cp < -margin && cq > margin)))
         return false;
     double dp[VF_MAX_VERTICES], dq[VF_MAX_VERTICES];
     int side = 0;
-    for (unsigned k = 0; k < v->p->count; k++) {
-        dp[k] = v3_dot(tri->normal, v->p->vertex[k]) - tri->offset;
+    for (unsigned k = 0; k < p->count; k++) {
+        dp[k] = v3_dot(tri->normal, p->vertex[k]) - tri->offset;
         int s = dp[k] > margin ? 1 : dp[k] < -margin ? -1 : 0;
         if (s == 0 || (side && s != side))
             return false;
         side = s;
     }
-    for (unsigned k = 0; k < v->q->count; k++) {
-        dq[k] = v3_dot(tri->normal, v->q->vertex[k]) - tri->offset;
+    for (unsigned k = 0; k < q->count; k++) {
+        dq[k] = v3_dot(tri->normal, q->vertex[k]) - tri->offset;
         if (!(side > 0 ? dq[k] < -margin : dq[k] > margin))
             return false;
     }
-    for (unsigned a = 0; a < v->p->count; a++)
-        for (unsigned b = 0; b < v->q->count; b++) {
+    for (unsigned a = 0; a < p->count; a++)
+        for (unsigned b = 0; b < q->count; b++) {
             double wa = fabs(dq[b]), wb = fabs(dp[a]);
-            rad_vec3 x = v3_scale(v3_add(v3_scale(v->p->vertex[a], wa),
-                                         v3_scale(v->q->vertex[b], wb)),
+            rad_vec3 x = v3_scale(v3_add(v3_scale(p->vertex[a], wa), v3_scale(q->vertex[b], wb)),
                                   1 / (wa + wb));
             for (unsigned e = 0; e < face->edges; e++)
                 if (!(v3_dot(face->edge_normal[e], x) - face->edge_offset[e] > margin))
@@ -971,30 +951,13 @@ static bool visit_hiding(void *context, uint32_t t)
     return true;
 }
 
-/* Whether polygon q lies outside convex solid k: convex_solid_apart, or, with q on the
- * inner side of an open solid's missing face, every corner of the solid's triangles more
- * than epsilon on one side of q's own plane (the solid, their hull, then misses it). */
-static bool solid_apart(const exact_pairs *pairs, const convex_solid *solid, uint32_t k,
+/* Whether convex solid k (of the occluder tree) holds apart polygon q. */
+static bool solid_apart(const exact_pairs *pairs, const convex_solids *solids, uint32_t k,
                         const vf_polygon *q)
 {
-    if (convex_solid_apart(solid, q, pairs->epsilon))
-        return true;
-    for (unsigned m = 0; solid->open && m < q->count; m++)
-        if (!(v3_dot(solid->open_normal, q->vertex[m]) - solid->open_offset < -pairs->epsilon))
-            return false;
-    uint32_t first = pairs->solid_corner_first[k], end = pairs->solid_corner_first[k + 1];
-    if (first == end)
-        return false;
-    double offset = v3_dot(q->normal, q->vertex[0]);
-    int side = 0;
-    for (uint32_t c = first; c < end; c++) {
-        double d = v3_dot(q->normal, pairs->solid_corner[c]) - offset;
-        int s = d > pairs->epsilon ? 1 : d < -pairs->epsilon ? -1 : 0;
-        if (s == 0 || (side && s != side))
-            return false;
-        side = s;
-    }
-    return true;
+    uint32_t first = pairs->solid_corner_first[k];
+    return convex_solid_apart(&solids->solids[k], q, pairs->solid_corner + first,
+                              pairs->solid_corner_first[k + 1] - first, pairs->epsilon);
 }
 
 bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j, uint32_t crossing)
@@ -1005,14 +968,13 @@ bool exact_pairs_hidden(const exact_pairs *pairs, uint32_t i, uint32_t j, uint32
     if (pairs->inside_solid) { /* one held by a convex solid, the other apart from it */
         const convex_solids *solids = occluder_tree_solids(pairs->tree);
         uint32_t held_i = pairs->inside_solid[i], held_j = pairs->inside_solid[j];
-        if ((held_i != EXACT_NO_SOLID && solid_apart(pairs, &solids->solids[held_i], held_i, q)) ||
-            (held_j != EXACT_NO_SOLID && solid_apart(pairs, &solids->solids[held_j], held_j, p)))
+        if ((held_i != EXACT_NO_SOLID && solid_apart(pairs, solids, held_i, q)) ||
+            (held_j != EXACT_NO_SOLID && solid_apart(pairs, solids, held_j, p)))
             return true;
     }
     /* a hiding face crosses the centroids' segment: the triangle the screening found
      * across it is the one tried (its face, a quad, covers its neighbour) */
-    hiding_visit visit = {pairs, p, q};
-    return crossing != EXACT_NO_CROSSING && visit_hiding(&visit, crossing);
+    return crossing != EXACT_NO_CROSSING && face_hides(pairs, crossing, p, q);
 }
 
 exact_outcome exact_pairs_transfer(const exact_pairs *pairs, uint32_t i, uint32_t j, bool clip,

@@ -319,7 +319,8 @@ bool convex_solid_holds(const convex_solid *solid, const vf_polygon *polygon, do
     return solid->plane_count > 0;
 }
 
-bool convex_solid_apart(const convex_solid *solid, const vf_polygon *polygon, double epsilon)
+bool convex_solid_apart(const convex_solid *solid, const vf_polygon *polygon,
+                        const rad_vec3 *corner, uint32_t corner_count, double epsilon)
 {
     for (unsigned m = 0; solid->open && m < polygon->count; m++)
         if (!(v3_dot(solid->open_normal, polygon->vertex[m]) - solid->open_offset < -epsilon))
@@ -331,7 +332,17 @@ bool convex_solid_apart(const convex_solid *solid, const vf_polygon *polygon, do
         if (beyond)
             return true;
     }
-    return false;
+    /* the polygon's own plane, with every corner of the solid on one side of it */
+    double offset = v3_dot(polygon->normal, polygon->vertex[0]);
+    int side = 0;
+    for (uint32_t c = 0; c < corner_count; c++) {
+        double d = v3_dot(polygon->normal, corner[c]) - offset;
+        int s = d > epsilon ? 1 : d < -epsilon ? -1 : 0;
+        if (s == 0 || (side && s != side))
+            return false;
+        side = s;
+    }
+    return corner_count > 0;
 }
 
 bool convex_solid_face_away(rad_vec3 n, rad_vec3 corner, const vf_polygon *polygon,

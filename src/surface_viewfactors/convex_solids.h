@@ -77,10 +77,13 @@ bool convex_solid_seen_from(const convex_solid *solid, const vf_polygon *polygon
  * cannot pass the missing face, whose plane it crosses at its start at most. */
 bool convex_solid_holds(const convex_solid *solid, const vf_polygon *polygon, double epsilon);
 
-/* Whether the polygon lies outside the solid: every corner more than epsilon beyond one
- * face plane, and for an open solid every corner more than epsilon on the inner side of
- * the missing face's plane. */
-bool convex_solid_apart(const convex_solid *solid, const vf_polygon *polygon, double epsilon);
+/* Whether the polygon lies outside the solid: for an open solid every corner more than
+ * epsilon on the inner side of the missing face's plane, and either every corner more
+ * than epsilon beyond one face plane or every one of the solid's `corner_count` corners
+ * (its triangles' corners: the solid is their hull) more than epsilon on one side of the
+ * polygon's own plane. */
+bool convex_solid_apart(const convex_solid *solid, const vf_polygon *polygon,
+                        const rad_vec3 *corner, uint32_t corner_count, double epsilon);
 
 /* Whether the face with unit normal n through `corner` is turned away from every point of
  * the polygon (each corner behind its plane or on it, within epsilon). */
