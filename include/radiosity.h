@@ -1297,7 +1297,9 @@ double rad_system_residual(const rad_system *system, const rad_rgb *B);
  * few segments traced between the two nodes (4 first, 16 when they disagree; links
  * found fully hidden are dropped). Jacobi gathering over the links with push-pull between
  * levels alternates with refinement until nothing refines and the change is below the
- * tolerance; then a final gather at the leaves. The result is one B per mesh patch, so
+ * tolerance; then a final gather at the leaves (each leaf gathers its ancestors' links
+ * again from its own centre, far planar nodes taken by the kernel's second-order
+ * expansion, every link's shadow traced from the leaf). The result is one B per mesh patch, so
  * rad_reconstruct_vertices and rad_render display it smoothly. Deterministic: every random
  * number comes from (seed, receiver, source), every sum has a fixed order, so B is bitwise
  * the same for any thread count. */

@@ -27,6 +27,10 @@ typedef struct hnode {
     rad_vec3 lo, hi;   /* bounding box */
     double area;
     double radius;     /* bounding sphere about the centroid */
+    /* the second moment of area about the centroid, the integral of s s^T over the
+     * patches (s = point - centroid): xx, yy, zz, xy, xz, yz (floats: it enters only
+     * the far nodes' second-order term, and a node stays 168 bytes) */
+    float moment[6];
     uint32_t first, count; /* range of hier_tree.order (patches below) */
     uint32_t child[2];     /* HNODE_NONE for a leaf */
     uint32_t parent;       /* HNODE_NONE for the root */
@@ -57,6 +61,12 @@ typedef struct hier_tree {
 /* Builds the tree over every patch of the mesh. 0 on allocation failure. */
 int hier_tree_build(const rad_mesh *mesh, hier_tree *tree);
 void hier_tree_free(hier_tree *tree);
+
+/* F from the point x (unit normal nx) to the planar node q taken whole, by the kernel's
+ * second-order expansion about q's centroid (its second moment of area): the error falls
+ * as (q's radius / distance)^4. NAN where q is not wholly in front of x's plane (its
+ * centroid less than its radius above it) or x is behind q. */
+double hier_planar_node_factor(rad_vec3 x, rad_vec3 nx, const hnode *q);
 
 typedef struct hlink {
     uint32_t receiver, source;

@@ -72,6 +72,37 @@ static void bound_radius(hnode *node)
     node->radius = sqrt(r2);
 }
 
+/* m += weight x d d^T (xx, yy, zz, xy, xz, yz). */
+static void moment_add(double m[6], rad_vec3 d, double weight)
+{
+    m[0] += weight * d.x * d.x;
+    m[1] += weight * d.y * d.y;
+    m[2] += weight * d.z * d.z;
+    m[3] += weight * d.x * d.y;
+    m[4] += weight * d.x * d.z;
+    m[5] += weight * d.y * d.z;
+}
+
+/* The second moment of a patch's area about its centroid: each triangle's (area / 12
+ * times the sum of its corners' d d^T about its own centroid), moved to the patch's
+ * centroid (the parallel-axis rule). */
+static void patch_moment(const rad_mesh *mesh, const rad_patch *p, float out[6])
+{
+    double m[6] = {0, 0, 0, 0, 0, 0};
+    for (uint32_t t = 0; t + 2 < p->vertex_count; t++) {
+        rad_vec3 a = mesh->vertices[p->vertex[0]], b = mesh->vertices[p->vertex[t + 1]],
+                 c = mesh->vertices[p->vertex[t + 2]];
+        double area = 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+        rad_vec3 centre = v3_scale(v3_add(v3_add(a, b), c), 1.0 / 3);
+        moment_add(m, v3_sub(a, centre), area / 12);
+        moment_add(m, v3_sub(b, centre), area / 12);
+        moment_add(m, v3_sub(c, centre), area / 12);
+        moment_add(m, v3_sub(centre, p->centroid), area);
+    }
+    for (int k = 0; k < 6; k++)
+        out[k] = (float)m[k];
+}
+
 static void combine(hier_tree *tree, uint32_t index, bool planar)
 {
     hnode *n = &tree->nodes[index];
@@ -81,6 +112,13 @@ static void combine(hier_tree *tree, uint32_t index, bool planar)
                                                 v3_scale(c->centroid, c->area)),
                                          1.0 / n->area)
                               : v3_scale(v3_add(a->centroid, c->centroid), 0.5);
+    double m[6];
+    for (int k = 0; k < 6; k++)
+        m[k] = (double)a->moment[k] + c->moment[k];
+    moment_add(m, v3_sub(a->centroid, n->centroid), a->area);
+    moment_add(m, v3_sub(c->centroid, n->centroid), c->area);
+    for (int k = 0; k < 6; k++)
+        n->moment[k] = (float)m[k];
     n->normal = v3_add(v3_scale(a->normal, a->area), v3_scale(c->normal, c->area));
     double length = v3_length(n->normal);
     n->normal = length > 0 ? v3_scale(n->normal, 1.0 / length) : a->normal;
@@ -118,6 +156,7 @@ static uint32_t build_plane(builder *b, uint32_t *patches, uint32_t n, uint32_t 
         leaf->area = p->area;
         leaf->centroid = p->centroid;
         leaf->normal = p->normal;
+        patch_moment(b->mesh, p, leaf->moment);
         leaf->lo = leaf->hi = b->mesh->vertices[p->vertex[0]];
         for (uint32_t k = 1; k < p->vertex_count; k++) {
             rad_vec3 v = b->mesh->vertices[p->vertex[k]];
