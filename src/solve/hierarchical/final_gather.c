@@ -9,18 +9,18 @@
  * traced with segments from the leaf to the source (weighted by the kernel and the
  * source's radiosity where each ends), LEAF_SEGMENTS x `rays` a leaf dealt out in
  * proportion to each link's share of its light, at least one a link and at most `rays`.
- * Every link is traced, hidden ones too: the link's own few segments between two large nodes say
- * little about a leaf in a shadow of its own, and they decided whether the link was
- * refined, so the coarse links that stay are biased (those found open up, those found
- * hidden down). On the furnished room of `bench/room_generator 1000` (8752 patches)
+ * Every link is traced, hidden ones too: a link's own few segments between two large
+ * nodes say little about a leaf in a shadow of its own, and they decided whether the link
+ * was refined, so the coarse links that stay are biased (those found open up, those found
+ * hidden down). On the furnished room of `bench/room_generator 1000` (8752 patches),
  * keeping the links' own share for those under 1 % of a leaf's light put the ceiling above
  * the lamps' housings 3 to 4 times too bright and the room's surfaces 8.8 % RMS (by
- * region) from the dense solution; traced, 2.2 %. What comes out is a correction per leaf: this
- * irradiance minus what the ancestors' links handed down. The solver keeps it fixed and
- * sweeps again (the correction moves with B only to second order). Parallel over leaves;
- * every random number comes from (seed, leaf, source), so the result does not depend on
- * the thread count. Over MPI ranks each rank corrects its own leaves only (their
- * ancestors' links are all held there).
+ * region) from the dense solution; traced, 2.2 %. What comes out is a correction per
+ * leaf: this irradiance minus what the ancestors' links handed down. The solver keeps it
+ * fixed and sweeps again (the correction moves with B only to second order). Parallel
+ * over leaves; every random number comes from (seed, leaf, source), so the result does
+ * not depend on the thread count. Over MPI ranks each rank corrects its own leaves only
+ * (their ancestors' links are all held there).
  */
 #include <math.h>
 #include <omp.h>

@@ -15,8 +15,8 @@
  * the contour formula over the node's patches times their B, with planar subtrees seen
  * from OPEN_RATIO of their radii or more taken whole with their mean B (Barnes and Hut's
  * opening rule), by the kernel's expansion to second order about their centroid
- * (planar_node_factor). The disk A cos cos / (pi r^2 + A) it replaced is exact only on
- * the axis and low seen obliquely: the Cornell box's solution came out 0.4 % dark.
+ * (hier_planar_node_factor). The disk A cos cos / (pi r^2 + A) it replaced is exact only
+ * on the axis and low seen obliquely: the Cornell box's solution came out 0.4 % dark.
  */
 #include <math.h>
 
@@ -133,7 +133,7 @@ static double whole_node_factor(rad_vec3 x, rad_vec3 nx, const hnode *q)
 {
     if (q->planar) {
         double f = hier_planar_node_factor(x, nx, q);
-        if (f == f)
+        if (!isnan(f))
             return f;
     }
     rad_vec3 d = v3_sub(q->centroid, x);
