@@ -90,20 +90,6 @@ static bool reserve(gather_buffers *b, size_t pending, size_t rays)
     return true;
 }
 
-/* The kernel-weighted share of the segments that get through; `fallback` when none has a
- * kernel (every one ended on a face of the source turned away from its start). */
-static double visible_share(const double *kernel, const float *weight, const uint8_t *occluded,
-                            unsigned count, double fallback)
-{
-    double open = 0, all = 0;
-    for (unsigned k = 0; k < count; k++) {
-        double w = kernel[k] * weight[k];
-        all += w;
-        open += occluded[k] ? 0 : w;
-    }
-    return all > 0 ? open / all : fallback;
-}
-
 static bool gather_leaf(const final_gather_context *c, uint32_t k, gather_buffers *b,
                         rad_rgb *out, uint64_t *rays_cast)
 {
@@ -161,8 +147,8 @@ static bool gather_leaf(const final_gather_context *c, uint32_t k, gather_buffer
         at = 0;
         for (size_t m = 0; m < pending; m++) {
             const shadowed *sh = &b->pending[m];
-            double visible = visible_share(b->kernel + at, b->weight + at, b->occluded + at,
-                                           sh->rays, sh->visibility);
+            double visible = hier_visible_share(b->kernel + at, b->weight + at,
+                                                b->occluded + at, sh->rays, sh->visibility);
             rgb_add_to(&sum, rgb_scale(sh->irradiance, visible));
             at += sh->rays;
         }

@@ -135,11 +135,13 @@ void hier_occluded(const rad_tracer *occluders, const rad_ray *rays, uint32_t co
                    const uint8_t *blocked, uint8_t *occluded);
 
 /* The visible share of a link from its segments: the open ones' kernel x weight over all
- * of it (weight NULL: 1; the plain open fraction when all of it is 0). Weighting by the
- * kernel and by the source's radiosity where each segment ends keeps F x share unbiased
- * when the shadowed part of a node is nearer, farther, brighter or darker than the rest. */
+ * of it (weight NULL: 1), or `fallback` when all of it is 0 (every segment ended on a face
+ * of the source turned away from its start: counting those as the plain open fraction
+ * would say the source's own solid hides it). Weighting by the kernel and by the source's
+ * radiosity where each segment ends keeps F x share unbiased when the shadowed part of a
+ * node is nearer, farther, brighter or darker than the rest. */
 double hier_visible_share(const double *kernel, const float *weight, const uint8_t *occluded,
-                          unsigned count);
+                          unsigned count, double fallback);
 
 /* The links, in two buffers of `capacity` (the second is scratch for refinement and for
  * sorting by receiver). */

@@ -325,15 +325,13 @@ void hier_occluded(const rad_tracer *occluders, const rad_ray *rays, uint32_t co
 }
 
 double hier_visible_share(const double *kernel, const float *weight, const uint8_t *occluded,
-                          unsigned count)
+                          unsigned count, double fallback)
 {
     double open = 0, all = 0;
-    unsigned open_count = 0;
     for (unsigned k = 0; k < count; k++) {
         double w = weight ? kernel[k] * weight[k] : kernel[k];
         all += w;
         open += occluded[k] ? 0 : w;
-        open_count += !occluded[k];
     }
-    return all > 0 ? open / all : (double)open_count / count;
+    return all > 0 ? open / all : fallback;
 }
