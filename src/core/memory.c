@@ -10,6 +10,7 @@
  * monitor; the blocks Embree takes from malloc (most of a BVH under about a million
  * triangles) are then counted twice, which errs on the side of refusing.
  */
+#define _DEFAULT_SOURCE /* madvise and MADV_HUGEPAGE, beside POSIX */
 #include "core/memory.h"
 
 #include <inttypes.h>
@@ -17,6 +18,7 @@
 #include <stddef.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -216,4 +218,18 @@ bool rad_memory_budget_refusal(char *text, size_t size)
     snprintf(text, size, "--max-memory: %s more, with %s in use, would exceed the budget of %s",
              need, in_use, given);
     return true;
+}
+
+void rad_advise_huge_pages(void *p, uint64_t bytes)
+{
+#if defined(MADV_HUGEPAGE)
+    const uintptr_t huge = (uintptr_t)2 << 20;
+    uintptr_t start = ((uintptr_t)p + huge - 1) & ~(huge - 1);
+    uintptr_t end = ((uintptr_t)p + (uintptr_t)bytes) & ~(huge - 1);
+    if (p && end > start)
+        (void)madvise((void *)start, end - start, MADV_HUGEPAGE);
+#else
+    (void)p;
+    (void)bytes;
+#endif
 }

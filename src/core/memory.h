@@ -40,4 +40,10 @@ bool rad_memory_budget_allows(uint64_t bytes);
  * > 0) that would exceed the budget, checked as the allocator's requests are. */
 bool rad_memory_budget_embree(int64_t bytes, bool post);
 
+/* Asks the kernel to back the whole 2 MiB pages inside [p, p + bytes) with huge pages
+ * (transparent huge pages in "madvise" mode): a large matrix filled or read in columns
+ * then takes a page fault and a TLB entry per 2 MiB instead of per 4 KiB. Only advice:
+ * nothing happens where the kernel does not offer them. */
+void rad_advise_huge_pages(void *p, uint64_t bytes);
+
 #endif

@@ -411,6 +411,7 @@ rad_status formfactors_compute_checkpointed(const rad_mesh *mesh, const rad_trac
         free(F);
         return status;
     }
+    rad_advise_huge_pages(F, n * n * sizeof(*F));
     dense_sink sink = {F, mesh->patches, n};
     rad_formfactor_report local;
     if (!report)

@@ -34,7 +34,7 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "geometry/contour.h"
-#include "geometry/polygon_integral.h"
+#include "geometry/polygon_pair.h"
 #include "mesh/near_contacts.h"
 #include "patch_formfactors/exact_pairs.h"
 #include "trace/ray.h"
@@ -48,14 +48,11 @@
 #define NEAR_DISTANCE 3.0
 #define NEAR_QUADRATURE 4u
 /* Pairs closer than TOUCHING_DISTANCE x (sum of their radii) (neighbours across an edge,
- * a box on a floor, walls a hair apart) are integrated adaptively over the smaller patch
- * (polygon_integral.h) to TOUCHING_ACCURACY, each fan triangle split at most
- * TOUCHING_MAX_DEPTH times: seen from close by, the exact point factor steps across the
- * other patch's edges, and a step left in cells of 4^-4 of the patch costs at most about
- * 1e-2 of the pair along that edge. */
+ * a box on a floor, walls a hair apart) get the exact transfer, the double contour
+ * integral (polygon_pair.h), its adaptive edge integrals to TOUCHING_ACCURACY of the
+ * product of the two edges' lengths (the transfer to about 1e-7 relative). */
 #define TOUCHING_DISTANCE 1.0
-#define TOUCHING_ACCURACY 1e-3
-#define TOUCHING_MAX_DEPTH 4
+#define TOUCHING_ACCURACY 1e-9
 /* Close pairs (closer than EXACT_DISTANCE x the sum of their radii) that few triangles
  * obstruct are settled by exact shadow clipping (exact_pairs.h) to EXACT_ACCURACY: there
  * the kernel varies too fast across the pair for kernel-weighted segments to be right
@@ -199,32 +196,15 @@ static double transfer(const engine *e, uint32_t a, uint32_t b, bool near)
     return ga->area * sum;
 }
 
-typedef struct touching_context {
-    const patch_geometry *outer, *inner;
-    double plane_epsilon;
-} touching_context;
-
-static double touching_point_factor(void *context, rad_vec3 x)
-{
-    const touching_context *c = context;
-    return contour_point_to_polygon(x, c->outer->normal, c->inner->corner,
-                                    c->inner->corner_count, c->inner->normal,
-                                    c->plane_epsilon);
-}
-
-/* The same for a touching pair, G = A_a Fhat_ab = A_b Fhat_ba: the exact point factor
- * integrated adaptively over the smaller patch, so that rows sum to what the patches see
- * however close they are (coincident walls, a box on a floor, a shared edge). */
+/* The same for a touching pair, G = A_a Fhat_ab = A_b Fhat_ba, exactly: the double
+ * contour integral (polygon_pair.h), so that rows sum to what the patches see however
+ * close they are (coincident walls, a box on a floor, a shared edge). */
 static double touching_transfer(const engine *e, uint32_t a, uint32_t b)
 {
     const patch_geometry *ga = &e->geometry[a], *gb = &e->geometry[b];
-    touching_context c = {ga->area <= gb->area ? ga : gb, ga->area <= gb->area ? gb : ga,
-                          e->plane_epsilon};
-    polygon_integral integral = {touching_point_factor, &c, TOUCHING_MAX_DEPTH, NULL, NULL, 0,
-                                 false};
-    double bound;
-    return polygon_integrate(&integral, c.outer->corner, c.outer->corner_count,
-                             TOUCHING_ACCURACY, &bound);
+    return polygon_pair_transfer(ga->corner, ga->corner_count, ga->normal, gb->corner,
+                                 gb->corner_count, gb->normal, e->plane_epsilon,
+                                 TOUCHING_ACCURACY);
 }
 
 /* Fills k*k segments from stratified points of i to stratified points of j; `round`

@@ -1,0 +1,33 @@
+/*
+ * polygon_pair.h - the unoccluded transfer between two planar polygons, G = A_p F_pq =
+ * A_q F_qp, by the double contour integral (Stokes' theorem applied twice to the area
+ * integral of cos cos / (pi r^2); Sparrow 1963, Siegel & Howell):
+ *
+ *   G = 1/(2 pi) sum over edges e of p and f of q of (e^ . f^) int_e int_f ln r ds dt
+ *
+ * with both contours counter-clockwise seen from their fronts. Each polygon is first
+ * clipped to the front half-space of the other's plane, where the kernel's two cosines
+ * are both positive, so the formula holds for polygons that touch, share an edge or run
+ * partly behind each other. Pairs of parallel edges (a shared edge among them, where
+ * ln r is singular along the whole edge) are integrated in closed form; for the others
+ * the inner integral is in closed form and the outer one adaptive (Gauss-Kronrod 7-15
+ * points, halves until they agree). No visibility here.
+ */
+#ifndef RAD_GEOMETRY_POLYGON_PAIR_H
+#define RAD_GEOMETRY_POLYGON_PAIR_H
+
+#include "radiosity.h"
+
+/* Most corners a polygon may have (clipping adds one). */
+#define POLYGON_PAIR_MAX_VERTICES 16
+
+/* p: np corners with unit front normal p_normal, q likewise (either winding: each is
+ * traversed counter-clockwise about its own normal); np, nq <= POLYGON_PAIR_MAX_VERTICES
+ * - 1. plane_epsilon (scene units): corners within it of the other's plane count as on
+ * it. accuracy: the adaptive edge integrals' absolute tolerance, relative to the product
+ * of the two edges' lengths (1e-9 gives G to about 1e-7 relative on touching patches). */
+double polygon_pair_transfer(const rad_vec3 *p, unsigned np, rad_vec3 p_normal,
+                             const rad_vec3 *q, unsigned nq, rad_vec3 q_normal,
+                             double plane_epsilon, double accuracy);
+
+#endif
