@@ -718,7 +718,8 @@ void rad_tracer_intersect_coherent(const rad_tracer *tracer, const rad_ray *rays
 /* Form factors                                                                          */
 
 typedef struct rad_formfactor_options {
-    uint32_t quadrature;     /* each patch is split m x m for the analytic part; 0 = 1 */
+    uint32_t quadrature;     /* each patch is split m x m for the analytic part; 0 = 1; up
+                                to 3, pairs far apart take the kernel's expansion instead */
     uint32_t visibility_rays; /* rays per patch pair that something may block (rounded to
                                  a square); 0 = 16. Pairs nothing can block get none */
     uint64_t seed;            /* seeds the stratified sample points */

@@ -6,9 +6,12 @@
  * wound either way, a rectangle partly behind the other's plane (clipped), two triangles
  * meeting at a corner at an odd angle (no parallel edges: every edge pair integrated
  * numerically) against the point-to-polygon contour formula integrated over a fine
- * triangle lattice, and reciprocity.
+ * triangle lattice, and reciprocity; far apart, the kernel's second-order expansion about
+ * both centroids against the exact transfer.
  */
 #include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include "closed_forms.h"
@@ -73,6 +76,35 @@ static double lattice_transfer(const rad_vec3 *p, rad_vec3 pn, const rad_vec3 *q
         sums[level] = area * sum / ((double)m * m);
     }
     return sums[1] + (sums[1] - sums[0]) / 3; /* the midpoint rule's error falls as 1/m^2 */
+}
+
+/* A rectangle (count 4, half-sides a, b) or a triangle (count 3) centred at c in the plane
+ * with unit normal n, counter-clockwise about n. */
+static void test_polygon_in_plane(rad_vec3 c, rad_vec3 n, double a, double b, unsigned count,
+                                  rad_vec3 *out)
+{
+    rad_vec3 t = fabs(n.x) < 0.9 ? (rad_vec3){1, 0, 0} : (rad_vec3){0, 1, 0};
+    rad_vec3 u = v3_normalize(v3_cross(t, n)), v = v3_cross(n, u);
+    if (count == 4) {
+        const double s[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+        for (int k = 0; k < 4; k++)
+            out[k] = v3_add(c, v3_add(v3_scale(u, s[k][0] * a), v3_scale(v, s[k][1] * b)));
+        return;
+    }
+    out[0] = v3_add(c, v3_add(v3_scale(u, -a), v3_scale(v, -b)));
+    out[1] = v3_add(c, v3_add(v3_scale(u, a), v3_scale(v, -0.3 * b)));
+    out[2] = v3_add(c, v3_add(v3_scale(u, -0.2 * a), v3_scale(v, b)));
+}
+
+/* The largest distance from the polygon's area centroid to a corner. */
+static double test_polygon_radius(const rad_vec3 *corner, unsigned count)
+{
+    polygon_moments m;
+    polygon_moments_of(corner, count, (rad_vec3){0, 0, 1}, &m);
+    double r = 0;
+    for (unsigned k = 0; k < count; k++)
+        r = fmax(r, v3_length(v3_sub(corner[k], m.centroid)));
+    return r;
 }
 
 int main(void)
@@ -146,6 +178,65 @@ int main(void)
         CHECK(g > 0);
         CHECK_NEAR(back / g, 1, 1e-9);
         CHECK_NEAR(lattice / g, 1, 2e-4);
+    }
+    /* far apart: the second-order expansion about both centroids against the exact
+     * transfer, rectangles and triangles turned at random, 3 to 12 times the sum of their
+     * radii apart (farther, the exact transfer's own cancellation shows), each wholly in
+     * front of the other; its error falls as (R / D)^4 and the one-point rule's as
+     * (R / D)^2 */
+    {
+        uint64_t state = 12345;
+        double worst_expansion = 0, worst_point = 0;
+        unsigned cases = 0;
+        for (int trial = 0; trial < 3000; trial++) {
+            double r[8];
+            for (int k = 0; k < 8; k++) {
+                state = state * 6364136223846793005u + 1442695040888963407u;
+                r[k] = (double)(state >> 11) * 0x1p-53;
+            }
+            rad_vec3 pn = v3_normalize((rad_vec3){r[0] - 0.5, r[1] - 0.5, 1});
+            rad_vec3 qn_hint = v3_normalize((rad_vec3){r[2] - 0.5, r[3] - 0.5, r[4] - 0.5});
+            rad_vec3 p[4], q[4];
+            unsigned np = trial % 3 == 0 ? 3 : 4, nq = trial % 5 == 0 ? 3 : 4;
+            test_polygon_in_plane((rad_vec3){0, 0, 0}, pn, 0.5, 0.2 + 0.6 * r[5], np, p);
+            double distance_share = 3 + 9 * r[6] * r[6];
+            rad_vec3 direction = v3_normalize((rad_vec3){r[7] - 0.5, r[5] - 0.5, 1.2});
+            double rp = test_polygon_radius(p, np);
+            double rq_guess = 0.6;
+            rad_vec3 centre = v3_scale(direction, distance_share * (rp + rq_guess));
+            rad_vec3 qn = v3_normalize(v3_sub(qn_hint, direction));
+            test_polygon_in_plane(centre, qn, 0.4 + 0.3 * r[0], 0.35, nq, q);
+            polygon_moments mp, mq;
+            polygon_moments_of(p, np, pn, &mp);
+            polygon_moments_of(q, nq, qn, &mq);
+            double R = test_polygon_radius(p, np) + test_polygon_radius(q, nq);
+            double D = v3_length(v3_sub(mq.centroid, mp.centroid));
+            bool in_front = true;
+            for (unsigned k = 0; k < nq; k++)
+                in_front = in_front && v3_dot(pn, v3_sub(q[k], mp.centroid)) >= 0;
+            for (unsigned k = 0; k < np; k++)
+                in_front = in_front && v3_dot(qn, v3_sub(p[k], mq.centroid)) >= 0;
+            if (!in_front || D < 3 * R)
+                continue;
+            double exact = polygon_pair_transfer(p, np, pn, q, nq, qn, 0, 1e-12);
+            if (!(exact > 0))
+                continue;
+            double expanded = polygon_pair_expansion(&mp, &mq);
+            double point = mp.area * contour_point_to_polygon(mp.centroid, pn, q, nq, qn, 0);
+            /* errors on the scale of the pair's transfer seen head-on, A_p A_q / (pi D^2):
+             * relative to the value itself they grow without bound as a cosine nears 0 */
+            double head_on = mp.area * mq.area / (3.14159265358979 * D * D);
+            double scale2 = (D / R) * (D / R);
+            worst_expansion = fmax(worst_expansion,
+                                   fabs(expanded - exact) / head_on * scale2 * scale2);
+            worst_point = fmax(worst_point, fabs(point - exact) / head_on * scale2);
+            cases++;
+        }
+        printf("far pairs (%u): expansion within %.3f (R/D)^4, one point within %.3f (R/D)^2\n",
+               cases, worst_expansion, worst_point);
+        CHECK(cases > 1000);
+        CHECK(worst_expansion < 0.3);
+        CHECK(worst_point > 0.05); /* the expansion's reason to be: the rule it replaces errs */
     }
     return test_finish("test_polygon_pair");
 }

@@ -199,3 +199,69 @@ double polygon_pair_transfer(const rad_vec3 *p, unsigned np, rad_vec3 p_normal,
     double G = sign * sum / (2 * RAD_PI);
     return G > 0 ? G : 0;
 }
+
+void polygon_second_moment(const rad_vec3 *corner, unsigned count, rad_vec3 centroid,
+                           double m[6])
+{
+    for (int k = 0; k < 6; k++)
+        m[k] = 0;
+    for (unsigned t = 0; t + 2 < count; t++) {
+        rad_vec3 v[3] = {corner[0], corner[t + 1], corner[t + 2]};
+        double area = 0.5 * v3_length(v3_cross(v3_sub(v[1], v[0]), v3_sub(v[2], v[0])));
+        rad_vec3 centre = v3_scale(v3_add(v3_add(v[0], v[1]), v[2]), 1.0 / 3);
+        rad_vec3 d[4] = {v3_sub(v[0], centre), v3_sub(v[1], centre), v3_sub(v[2], centre),
+                         v3_sub(centre, centroid)};
+        for (int k = 0; k < 4; k++) {
+            double w = k < 3 ? area / 12 : area;
+            m[0] += w * d[k].x * d[k].x;
+            m[1] += w * d[k].y * d[k].y;
+            m[2] += w * d[k].z * d[k].z;
+            m[3] += w * d[k].x * d[k].y;
+            m[4] += w * d[k].x * d[k].z;
+            m[5] += w * d[k].y * d[k].z;
+        }
+    }
+}
+
+void polygon_moments_of(const rad_vec3 *corner, unsigned count, rad_vec3 normal,
+                        polygon_moments *out)
+{
+    rad_vec3 weighted = v3(0, 0, 0);
+    double area = 0;
+    for (unsigned t = 0; t + 2 < count; t++) {
+        rad_vec3 a = corner[0], b = corner[t + 1], c = corner[t + 2];
+        double piece = 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+        weighted = v3_add(weighted, v3_scale(v3_add(v3_add(a, b), c), piece / 3));
+        area += piece;
+    }
+    out->area = area;
+    out->normal = normal;
+    out->centroid = area > 0 ? v3_scale(weighted, 1 / area) : corner[0];
+    polygon_second_moment(corner, count, out->centroid, out->moment);
+}
+
+/* W v for the symmetric W given as (xx, yy, zz, xy, xz, yz). */
+static inline rad_vec3 symmetric_times(const double w[6], rad_vec3 v)
+{
+    return v3(w[0] * v.x + w[3] * v.y + w[4] * v.z, w[3] * v.x + w[1] * v.y + w[5] * v.z,
+              w[4] * v.x + w[5] * v.y + w[2] * v.z);
+}
+
+double polygon_pair_expansion(const polygon_moments *p, const polygon_moments *q)
+{
+    rad_vec3 d = v3_sub(q->centroid, p->centroid);
+    double a = v3_dot(p->normal, d), b = v3_dot(q->normal, d);
+    double rho2 = v3_dot(d, d), inverse2 = 1 / rho2;
+    double g = inverse2 * inverse2;
+    /* W = A_q M_p + A_p M_q: the second-order term is 1/2 W : grad^2 k for the kernel
+     * k(d) = -(n_p . d)(n_q . d) / (pi rho^4) */
+    double w[6];
+    for (int k = 0; k < 6; k++)
+        w[k] = q->area * p->moment[k] + p->area * q->moment[k];
+    rad_vec3 wd = symmetric_times(w, d), wnq = symmetric_times(w, q->normal);
+    double trace = w[0] + w[1] + w[2];
+    double second = 2 * g * v3_dot(p->normal, wnq) -
+                    8 * g * inverse2 * (b * v3_dot(p->normal, wd) + a * v3_dot(q->normal, wd)) +
+                    a * b * g * inverse2 * (-4 * trace + 24 * inverse2 * v3_dot(d, wd));
+    return (-p->area * q->area * a * b * g - 0.5 * second) / RAD_PI;
+}

@@ -30,4 +30,26 @@ double polygon_pair_transfer(const rad_vec3 *p, unsigned np, rad_vec3 p_normal,
                              const rad_vec3 *q, unsigned nq, rad_vec3 q_normal,
                              double plane_epsilon, double accuracy);
 
+/* The second moment of a planar polygon's area about a point (its centroid), as (xx, yy,
+ * zz, xy, xz, yz). */
+void polygon_second_moment(const rad_vec3 *corner, unsigned count, rad_vec3 centroid,
+                           double m[6]);
+
+/* A polygon as the expansion sees it. */
+typedef struct polygon_moments {
+    rad_vec3 centroid, normal;
+    double area;
+    double moment[6]; /* polygon_second_moment about the centroid */
+} polygon_moments;
+
+/* A polygon's area, area centroid, second moment about it, and the given unit normal. */
+void polygon_moments_of(const rad_vec3 *corner, unsigned count, rad_vec3 normal,
+                        polygon_moments *out);
+
+/* G for two planar polygons far apart, each wholly in front of the other: the kernel
+ * cos cos / (pi r^2) expanded to second order about both centroids (the first-order
+ * terms vanish there), G = A_p A_q k(D) + 1/2 (A_q M_p + A_p M_q) : grad^2 k(D). Its
+ * error falls as (radius / distance)^4. */
+double polygon_pair_expansion(const polygon_moments *p, const polygon_moments *q);
+
 #endif

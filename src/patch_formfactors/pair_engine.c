@@ -53,6 +53,14 @@
  * product of the two edges' lengths (the transfer to about 1e-7 relative). */
 #define TOUCHING_DISTANCE 1.0
 #define TOUCHING_ACCURACY 1e-9
+/* Pairs at NEAR_DISTANCE x (sum of their radii) or farther, each wholly in front of the
+ * other, take the kernel's second-order expansion about both centroids (polygon_pair.h)
+ * when the midpoint rule asked for is at most EXPANSION_MAX_QUADRATURE x as many points
+ * a side: measured on rectangles turned at random (test_polygon_pair), the expansion errs
+ * by under 0.14 (R / D)^4 and the one-point rule by up to 0.25 (R / D)^2 (R the sum of
+ * the radii, D the centroids' distance), so from 3 radii on it is the more accurate of
+ * the two up to 3 x 3 points, and a sixth of one contour formula's cost. */
+#define EXPANSION_MAX_QUADRATURE 3u
 /* Close pairs (closer than EXACT_DISTANCE x the sum of their radii) that few triangles
  * obstruct are settled by exact shadow clipping (exact_pairs.h) to EXACT_ACCURACY: there
  * the kernel varies too fast across the pair for kernel-weighted segments to be right
@@ -72,6 +80,7 @@ typedef struct patch_geometry {
      * triangles P = o + sqrt(s) (u + t w), which is uniform in area */
     rad_vec3 o, u, v, w;
     rad_vec3 lift; /* added to sample points: 2 x behind along the normal (folded quads) */
+    polygon_moments moments; /* for the far pairs' expansion */
 } patch_geometry;
 
 typedef struct pending_pair {
@@ -87,6 +96,7 @@ typedef struct engine {
     rad_vec3 *quadrature_points; /* m*m per patch */
     double *quadrature_weights;  /* m*m per patch, sum to 1 */
     unsigned quadrature_count;
+    bool expand_far;             /* far pairs wholly in front of each other by expansion */
     rad_vec3 *near_points;       /* the same with NEAR_QUADRATURE, for close pairs */
     double *near_weights;
     unsigned near_count;
@@ -178,6 +188,15 @@ static bool any_in_front(const patch_geometry *a, const patch_geometry *b, doubl
         if (v3_dot(a->normal, v3_sub(b->corner[k], a->corner[0])) > epsilon)
             return true;
     return false;
+}
+
+/* True when no corner of b lies behind a's plane (beyond epsilon). */
+static bool wholly_in_front(const patch_geometry *a, const patch_geometry *b, double epsilon)
+{
+    for (unsigned k = 0; k < b->corner_count; k++)
+        if (v3_dot(a->normal, v3_sub(b->corner[k], a->corner[0])) < -epsilon)
+            return false;
+    return true;
 }
 
 /* Area-weighted unoccluded factor from patch a to patch b, A_a * Fhat_ab, by the midpoint
@@ -414,6 +433,10 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
         double G;
         if (distance < TOUCHING_DISTANCE * radii)
             G = touching_transfer(e, i, j);
+        else if (e->expand_far && distance >= NEAR_DISTANCE * radii &&
+                 wholly_in_front(gi, gj, e->plane_epsilon) &&
+                 wholly_in_front(gj, gi, e->plane_epsilon))
+            G = polygon_pair_expansion(&gi->moments, &gj->moments);
         else if (i_smaller)
             G = transfer(e, i, j, distance < NEAR_DISTANCE * radii);
         else
@@ -498,6 +521,7 @@ static rad_status run(const rad_mesh *mesh, const rad_tracer *occluders,
     e.mesh = mesh;
     e.occluders = occluders;
     e.quadrature_count = m * m;
+    e.expand_far = m <= EXPANSION_MAX_QUADRATURE;
     unsigned m_near = m > NEAR_QUADRATURE ? m : NEAR_QUADRATURE;
     e.near_count = m_near * m_near;
     e.strata = strata_for(options->visibility_rays);
@@ -545,6 +569,7 @@ static rad_status run(const rad_mesh *mesh, const rad_tracer *occluders,
         g->radius = 0;
         for (unsigned k = 0; k < patch->vertex_count; k++)
             g->radius = fmax(g->radius, v3_length(v3_sub(g->corner[k], g->centroid)));
+        polygon_moments_of(g->corner, g->corner_count, g->normal, &g->moments);
         quadrature_for(g, m, &e.quadrature_points[(size_t)i * e.quadrature_count],
                        &e.quadrature_weights[(size_t)i * e.quadrature_count]);
         quadrature_for(g, m_near, &e.near_points[(size_t)i * e.near_count],

@@ -16,6 +16,7 @@
 #include "core/minmax.h"
 #include "core/tolerance.h"
 #include "core/vec3.h"
+#include "geometry/polygon_pair.h"
 #include "solve/hierarchical/hierarchy.h"
 
 typedef struct keyed {
@@ -83,22 +84,14 @@ static void moment_add(double m[6], rad_vec3 d, double weight)
     m[5] += weight * d.y * d.z;
 }
 
-/* The second moment of a patch's area about its centroid: each triangle's (area / 12
- * times the sum of its corners' d d^T about its own centroid), moved to the patch's
- * centroid (the parallel-axis rule). */
+/* The second moment of a patch's area about its centroid (polygon_second_moment). */
 static void patch_moment(const rad_mesh *mesh, const rad_patch *p, float out[6])
 {
-    double m[6] = {0, 0, 0, 0, 0, 0};
-    for (uint32_t t = 0; t + 2 < p->vertex_count; t++) {
-        rad_vec3 a = mesh->vertices[p->vertex[0]], b = mesh->vertices[p->vertex[t + 1]],
-                 c = mesh->vertices[p->vertex[t + 2]];
-        double area = 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(c, a)));
-        rad_vec3 centre = v3_scale(v3_add(v3_add(a, b), c), 1.0 / 3);
-        moment_add(m, v3_sub(a, centre), area / 12);
-        moment_add(m, v3_sub(b, centre), area / 12);
-        moment_add(m, v3_sub(c, centre), area / 12);
-        moment_add(m, v3_sub(centre, p->centroid), area);
-    }
+    rad_vec3 corner[4];
+    for (uint32_t k = 0; k < p->vertex_count && k < 4; k++)
+        corner[k] = mesh->vertices[p->vertex[k]];
+    double m[6];
+    polygon_second_moment(corner, p->vertex_count < 4 ? p->vertex_count : 4, p->centroid, m);
     for (int k = 0; k < 6; k++)
         out[k] = (float)m[k];
 }
