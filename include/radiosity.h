@@ -726,6 +726,10 @@ typedef struct rad_formfactor_options {
     int threads;              /* 0 = all cores */
     rad_progress_fn progress;
     void *progress_user;
+    const double *area;       /* NULL: F_ij = G_ij / the patch's area; else G_ij / area[i].
+                                 rad_solve_scene gives rad_patch_inputs.area (the open part
+                                 of a patch that runs under a box), whose means the inputs
+                                 hold */
 } rad_formfactor_options;
 
 /* Counts what a form-factor computation did. */
@@ -756,6 +760,9 @@ typedef struct rad_formfactor_report {
 typedef struct rad_formfactors {
     uint32_t n;
     float *F;
+    double *area; /* n: the areas the rows were made with, A_i F_ij = A_j F_ji (the
+                     patches', or rad_formfactor_options.area); rad_system_of takes these.
+                     NULL (a matrix read back from a checkpoint): the patch inputs' */
 } rad_formfactors;
 
 /* Computes every F_ij of the mesh. `occluders` is a tracer over the scene's triangles (any
@@ -793,6 +800,10 @@ typedef struct rad_formfactor_check {
 
 void rad_formfactors_check(const rad_formfactors *formfactors, const rad_mesh *mesh,
                            rad_formfactor_check *check);
+/* The same with the areas the rows were made with (rad_formfactor_options.area; NULL: the
+ * patches'), which reciprocity is measured with. */
+void rad_formfactors_check_areas(const rad_formfactors *formfactors, const rad_mesh *mesh,
+                                 const double *area, rad_formfactor_check *check);
 
 /* ------------------------------------------------------------------------------------ */
 /* View factors for engineers: surface to surface, sparse, with error bounds             */
@@ -1158,7 +1169,9 @@ bool rad_solver_from_name(const char *name, rad_solver *solver);
  * and B = S + diag(rho) F B. */
 typedef struct rad_patch_inputs {
     uint32_t n;        /* mesh->patch_count */
-    double *area;      /* A_i */
+    double *area;      /* A_i: the patch's area open to the scene (a patch running under a
+                          box standing on it: the part outside the box), and every mean
+                          over the patch below is its open part's */
     rad_rgb *albedo;   /* rho_i, in [0,1] */
     rad_rgb *exitance; /* E_i, >= 0 */
     rad_rgb *direct;   /* H_i, >= 0 (0 without light sources) */
@@ -1183,7 +1196,8 @@ typedef struct rad_system {
 } rad_system;
 
 /* The system of `inputs` and `formfactors` (NULL: F = NULL), pointing into both: nothing
- * is copied or allocated. */
+ * is copied or allocated. Its areas are the matrix's (rad_formfactors.area), so that
+ * reciprocity holds, else the inputs'. */
 rad_system rad_system_of(const rad_patch_inputs *inputs, const rad_formfactors *formfactors);
 
 /* Watching a solver converge. Every solver (rad_solve's four, rad_solve_hierarchical, and

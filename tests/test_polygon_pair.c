@@ -178,6 +178,8 @@ int main(void)
         CHECK(g > 0);
         CHECK_NEAR(back / g, 1, 1e-9);
         CHECK_NEAR(lattice / g, 1, 2e-4);
+        /* the form factors' tolerance (pair_engine.c) */
+        CHECK_NEAR(polygon_pair_transfer(p, 3, up, q, 3, qn, 0, 1e-7) / g, 1, 1e-6);
     }
     /* far apart: the second-order expansion about both centroids against the exact
      * transfer, rectangles and triangles turned at random, 3 to 12 times the sum of their

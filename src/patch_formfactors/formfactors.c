@@ -36,14 +36,17 @@ typedef struct dense_sink {
     float *F;
     const rad_patch *patches;
     size_t n;
+    const double *area; /* NULL: the patches' */
 } dense_sink;
 
 static void store_pair(void *data, int thread, uint32_t i, uint32_t j, double G)
 {
     (void)thread;
     dense_sink *sink = data;
-    sink->F[i * sink->n + j] = (float)(G / sink->patches[i].area);
-    sink->F[j * sink->n + i] = (float)(G / sink->patches[j].area);
+    double area_i = sink->area ? sink->area[i] : sink->patches[i].area;
+    double area_j = sink->area ? sink->area[j] : sink->patches[j].area;
+    sink->F[i * sink->n + j] = (float)(G / area_i);
+    sink->F[j * sink->n + i] = (float)(G / area_j);
 }
 
 /* Scales rows summing above 1 back to 1: F_ij and F_ji both by min(s_i, s_j) with
@@ -412,7 +415,7 @@ rad_status formfactors_compute_checkpointed(const rad_mesh *mesh, const rad_trac
         return status;
     }
     rad_advise_huge_pages(F, n * n * sizeof(*F));
-    dense_sink sink = {F, mesh->patches, n};
+    dense_sink sink = {F, mesh->patches, n, options ? options->area : NULL};
     rad_formfactor_report local;
     if (!report)
         report = &local;
@@ -453,6 +456,14 @@ rad_status formfactors_compute_checkpointed(const rad_mesh *mesh, const rad_trac
         free(result);
         return status;
     }
+    result->area = rad_alloc_array(n, sizeof(*result->area));
+    if (!result->area) {
+        free(F);
+        free(result);
+        return rad_fail(error, RAD_ERR_NOMEM, "out of memory for %zu patches' areas", n);
+    }
+    for (size_t i = 0; i < n; i++)
+        result->area[i] = options && options->area ? options->area[i] : mesh->patches[i].area;
     result->n = (uint32_t)n;
     result->F = F;
     *out = result;
@@ -464,6 +475,7 @@ void rad_formfactors_destroy(rad_formfactors *formfactors)
     if (!formfactors)
         return;
     free(formfactors->F);
+    free(formfactors->area);
     free(formfactors);
 }
 
@@ -472,6 +484,12 @@ void rad_formfactors_destroy(rad_formfactors *formfactors)
 
 void rad_formfactors_check(const rad_formfactors *ff, const rad_mesh *mesh,
                            rad_formfactor_check *check)
+{
+    rad_formfactors_check_areas(ff, mesh, ff->area, check);
+}
+
+void rad_formfactors_check_areas(const rad_formfactors *ff, const rad_mesh *mesh,
+                                 const double *area, rad_formfactor_check *check)
 {
     size_t n = ff->n;
     const float *F = ff->F;
@@ -488,7 +506,8 @@ void rad_formfactors_check(const rad_formfactors *ff, const rad_mesh *mesh,
                     double fij = F[i * n + j], fji = F[j * n + i];
                     if (fmax(fij, fji) <= 1e-6)
                         continue;
-                    double a = mesh->patches[i].area * fij, b = mesh->patches[j].area * fji;
+                    double a = (area ? area[i] : mesh->patches[i].area) * fij,
+                           b = (area ? area[j] : mesh->patches[j].area) * fji;
                     reciprocity = fmax(reciprocity, fabs(a - b) / fmax(a, b));
                 }
         }

@@ -18,6 +18,10 @@ typedef void (*pair_sink_fn)(void *sink, int thread, uint32_t i, uint32_t j, dou
 /* The number of threads pair_engine_run will use for these options. */
 int pair_engine_threads(const rad_formfactor_options *options);
 
+/* What a run holds besides the matrix and the mesh, at most: each patch's geometry,
+ * quadrature points and buried cells, and each thread's segment batches. */
+uint64_t pair_engine_bytes(uint32_t patches, int threads, uint32_t quadrature);
+
 /* rows: NULL for every pair, else only the pairs (i, j > i) of the rows i with rows[i]
  * (an MPI rank's share). */
 rad_status pair_engine_run(const rad_mesh *mesh, const rad_tracer *occluders,

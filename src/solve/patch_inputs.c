@@ -6,7 +6,8 @@
  * rho_i the material's; for a textured material both are averages over the patch
  * (rad_patch_materials). The scene's light sources add their direct irradiance H_i
  * (lights/patch_direct.c), and the source term S_i = E_i + rho_i H_i is what the solvers
- * take.
+ * take. A patch part of which lies buried inside a closed object (a floor under a box)
+ * takes the area of its open part, and H_i that part's mean (mesh/exposed_area.h).
  */
 #include <stdint.h>
 #include <stdlib.h>
@@ -17,6 +18,7 @@
 #include "core/rgb.h"
 #include "core/vec3.h"
 #include "lights/patch_direct.h"
+#include "mesh/exposed_area.h"
 
 void rad_patch_inputs_destroy(rad_patch_inputs *inputs)
 {
@@ -73,6 +75,20 @@ rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
                                     RAD_PI * in->exitance[i].b};
     /* the light sources' direct light, the first bounce of every solver */
     status = patch_direct_light(scene, mesh, in->direct, in->direct_sharp, error);
+    /* the exposed area: the open part of a patch that runs under a box (exposed_area.h);
+     * the means over the patch are the open part's */
+    double *share = status == RAD_OK ? rad_alloc_array(n ? n : 1, sizeof(*share)) : NULL;
+    if (status == RAD_OK && !share)
+        status = rad_fail(error, RAD_ERR_NOMEM, "out of memory for %u patches", n);
+    if (status == RAD_OK)
+        status = patch_exposed_shares(scene, mesh, share, error);
+    for (uint32_t i = 0; status == RAD_OK && i < n; i++)
+        if (share[i] < 1) {
+            in->area[i] *= share[i];
+            in->direct[i] = rgb_scale(in->direct[i], 1 / share[i]);
+            in->direct_sharp[i] = rgb_scale(in->direct_sharp[i], 1 / share[i]);
+        }
+    free(share);
     if (status != RAD_OK) {
         rad_patch_inputs_destroy(in);
         return status;
@@ -85,6 +101,8 @@ rad_status rad_patch_inputs_build(const rad_scene *scene, const rad_mesh *mesh,
 
 rad_system rad_system_of(const rad_patch_inputs *inputs, const rad_formfactors *formfactors)
 {
-    return (rad_system){inputs->n, formfactors ? formfactors->F : NULL, inputs->area,
+    /* the areas the matrix was made with (reciprocity holds with them), else the inputs' */
+    const double *area = formfactors && formfactors->area ? formfactors->area : inputs->area;
+    return (rad_system){inputs->n, formfactors ? formfactors->F : NULL, area,
                         inputs->albedo, inputs->source};
 }

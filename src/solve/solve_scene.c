@@ -20,6 +20,7 @@
 #include "core/clock.h"
 #include "core/error.h"
 #include "core/memory.h"
+#include "patch_formfactors/pair_engine.h"
 #include "solve/hierarchical/hierarchy.h"
 #include "solve/solve_checkpoint.h"
 
@@ -32,9 +33,6 @@
  * gather's, rounded up. */
 #define HIERARCHY_THREAD_BYTES ((uint64_t)2 << 20)
 
-/* What each thread of the dense form-factor computation holds besides the matrix, at
- * most (its pair buffers: 192 KB measured, rounded up). */
-#define FORMFACTOR_THREAD_BYTES ((uint64_t)256 << 10)
 
 static double seconds_now(void) { return omp_get_wtime(); }
 
@@ -91,7 +89,7 @@ static uint64_t before_matrix_bytes(const rad_scene *scene, const rad_mesh *mesh
     uint64_t inputs = o->inputs ? 0 : n * (sizeof(double) + 5 * sizeof(rad_rgb));
     uint64_t threads = o->threads > 0 ? (uint64_t)o->threads : (uint64_t)omp_get_max_threads();
     return inputs + (uint64_t)scene->triangle_count * RAD_EMBREE_BYTES_PER_TRIANGLE +
-           threads * FORMFACTOR_THREAD_BYTES;
+           pair_engine_bytes(mesh->patch_count, (int)threads, o->quadrature);
 }
 
 rad_solver rad_solve_scene_choice(const rad_mesh *mesh, const rad_scene_solve_options *options,
@@ -190,7 +188,8 @@ static rad_status solve_dense(const rad_scene *scene, const rad_mesh *mesh, cons
                         "larger --patch-size or another solver",
                         mesh->patch_count, RAD_DIRECT_MAX_PATCHES);
     rad_formfactor_options ff_options = {o->quadrature, o->visibility_rays, o->seed,
-                                         o->threads, o->progress, o->progress_user};
+                                         o->threads,    o->progress,        o->progress_user,
+                                         inputs->area};
     rad_formfactors *ff = NULL;
     double t0 = seconds_now();
     rad_status status = RAD_OK;
@@ -214,7 +213,7 @@ static rad_status solve_dense(const rad_scene *scene, const rad_mesh *mesh, cons
     }
     if (cp)
         cp->formfactors = r->formfactors;
-    rad_formfactors_check(ff, mesh, &r->check);
+    rad_formfactors_check_areas(ff, mesh, inputs->area, &r->check);
     double t1 = seconds_now();
     r->seconds_form_factors = t1 - t0;
     rad_system system = rad_system_of(inputs, ff);

@@ -58,6 +58,9 @@ typedef struct hsolver {
     const rad_mesh *mesh;
     hier_tree tree;
     const rad_rgb *emission, *albedo; /* per patch: the patch inputs' E and rho */
+    const double *open_area;    /* per patch: the inputs' area, the part not buried in a
+                                   closed object (mesh/exposed_area.h) */
+    double *node_open;          /* per node: its leaves' open area */
     rad_rgb *node_B, *gathered, *down;
     rad_rgb *correction, *scale; /* per node (leaves only): the final gather's, or NULL:
                                     a leaf gathers down x scale + correction */
@@ -96,8 +99,11 @@ static void pull(hsolver *s)
             s->node_B[k] = s->patch_B[n->patch];
             continue;
         }
-        const hnode *a = &t->nodes[n->child[0]], *b = &t->nodes[n->child[1]];
-        double wa = n->area > 0 ? a->area / n->area : 0.5, wb = n->area > 0 ? b->area / n->area : 0.5;
+        /* weighted by the open areas: a leaf's B is its open part's (leaf_radiosity), and
+         * what a node sends is what those parts send */
+        double total = s->node_open[k], oa = s->node_open[n->child[0]],
+               ob = s->node_open[n->child[1]];
+        double wa = total > 0 ? oa / total : 0.5, wb = total > 0 ? ob / total : 0.5;
         s->node_B[k] = rgb_add(rgb_scale(s->node_B[n->child[0]], wa),
                                rgb_scale(s->node_B[n->child[1]], wb));
     }
@@ -130,6 +136,11 @@ static rad_rgb leaf_radiosity(const hsolver *s, uint32_t k)
     rad_rgb h = s->down[k];
     if (s->correction) /* irradiance is never negative, however corrected */
         h = rgb_max0(rgb_add(rgb_mul(h, s->scale[k]), s->correction[k]));
+    /* a leaf part of which lies buried gathers over its whole area, the buried part
+     * nothing: its open part's irradiance is the mean over that part */
+    double area = s->tree.nodes[k].area, open = s->open_area[p];
+    if (open > 0 && open < area)
+        h = rgb_scale(h, area / open);
     return rgb_add(s->emission[p], rgb_mul(s->albedo[p], h));
 }
 
@@ -207,6 +218,7 @@ static void hsolver_free(hsolver *s)
 {
     hier_tree_free(&s->tree);
     free(s->node_B);
+    free(s->node_open);
     free(s->gathered);
     free(s->down);
     free(s->correction);
@@ -568,6 +580,14 @@ rad_status solve_hierarchical_checkpointed(const rad_mesh *mesh,
     uint32_t nodes = s.tree.node_count;
     s.emission = inputs->source; /* E + rho H: the light sources' first bounce */
     s.albedo = inputs->albedo;
+    s.open_area = inputs->area;
+    s.node_open = rad_alloc_array(nodes, sizeof(double));
+    for (uint32_t k = nodes; s.node_open && k-- > 0;) {
+        const hnode *node = &s.tree.nodes[k];
+        s.node_open[k] = node->patch != HNODE_NONE
+                             ? inputs->area[node->patch]
+                             : s.node_open[node->child[0]] + s.node_open[node->child[1]];
+    }
     s.patch_B = rad_alloc_array(n, sizeof(rad_rgb));
     s.brightness = rad_alloc_array(n, sizeof(float));
     s.node_B = rad_alloc_array(nodes, sizeof(rad_rgb));
@@ -576,7 +596,7 @@ rad_status solve_hierarchical_checkpointed(const rad_mesh *mesh,
     s.offsets = rad_alloc_array((size_t)nodes + 1, sizeof(size_t));
     if (ob.fn)
         ob.before = s.observed = rad_alloc_array(n, sizeof(rad_rgb));
-    setup = !s.patch_B || !s.node_B || !s.gathered || !s.down || !s.offsets ||
+    setup = !s.node_open || !s.patch_B || !s.node_B || !s.gathered || !s.down || !s.offsets ||
                     !s.brightness || (ob.fn && !ob.before)
                 ? rad_fail(error, RAD_ERR_NOMEM, "out of memory for the hierarchy")
                 : RAD_OK;
