@@ -89,8 +89,8 @@ static double adapt(const inner_edge *f, rad_vec3 a, rad_vec3 u, double s0, doub
     double mid = 0.5 * (s0 + s1), e0, e1;
     double left = kronrod(f, a, u, s0, mid, &e0), right = kronrod(f, a, u, mid, s1, &e1);
     double halves = left + right;
-    if (depth >= MAX_HALVINGS || fabs(halves - whole) <= tolerance)
-        return halves;
+    if (depth >= MAX_HALVINGS || !isfinite(halves) || fabs(halves - whole) <= tolerance)
+        return halves; /* (a value that is not finite would split both halves 40 deep) */
     return adapt(f, a, u, s0, mid, left, 0.5 * tolerance, depth + 1) +
            adapt(f, a, u, mid, s1, right, 0.5 * tolerance, depth + 1);
 }
