@@ -367,6 +367,25 @@ static void test_skies(void)
     rad_scene_destroy(scene);
 }
 
+/* A closed, inward-facing cube room of side 4 m, as OBJ text. */
+#define CUBE_ROOM                                                                          \
+    "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\nv 0 0 4\nv 4 0 4\nv 4 4 4\nv 0 4 4\n"          \
+    "o zlo\nf 1 2 3 4\no zhi\nf 5 8 7 6\no xlo\nf 1 4 8 5\no xhi\nf 2 6 7 3\n"           \
+    "o ylo\nf 1 5 6 2\no yhi\nf 4 3 7 8\n"
+
+/* The power absorbed, sum A (1 - rho) H over the patches' open areas, with H the total
+ * irradiance (B - E) / rho (green). */
+static double absorbed_power(const rad_mesh *mesh, const rad_patch_inputs *inputs,
+                             const rad_rgb *B)
+{
+    double absorbed = 0;
+    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        double rho = inputs->albedo[p].g;
+        absorbed += inputs->area[p] * (1 - rho) * (B[p].g - inputs->exitance[p].g) / rho;
+    }
+    return absorbed;
+}
+
 /* A closed, inward-facing cube room of side 4 m (albedo 0.5, nothing emits) with a point
  * light of intensity I at its centre: the power absorbed, sum A (1 - rho) H with H the
  * total irradiance (B - E) / rho, equals the light's flux 4 pi I. */
@@ -374,9 +393,7 @@ static void test_energy(void)
 {
     const char *room = test_write_file(
         "cube.obj",
-        "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\nv 0 0 4\nv 4 0 4\nv 4 4 4\nv 0 4 4\n"
-        "o zlo\nf 1 2 3 4\no zhi\nf 5 8 7 6\no xlo\nf 1 4 8 5\no xhi\nf 2 6 7 3\n"
-        "o ylo\nf 1 5 6 2\no yhi\nf 4 3 7 8\n");
+        CUBE_ROOM);
     rad_scene *scene = NULL;
     rad_error error;
     CHECK(rad_scene_load(room, NULL, &scene, &error) == RAD_OK);
@@ -391,11 +408,7 @@ static void test_energy(void)
                                            .tolerance = 1e-7};
         rad_scene_solve_report report;
         CHECK(rad_solve_scene(scene, mesh, &options, B, &report, &error) == RAD_OK);
-        double absorbed = 0;
-        for (uint32_t p = 0; p < mesh->patch_count; p++) {
-            double rho = inputs->albedo[p].g;
-            absorbed += mesh->patches[p].area * (1 - rho) * (B[p].g - inputs->exitance[p].g) / rho;
-        }
+        double absorbed = absorbed_power(mesh, inputs, B);
         printf("closed room, point light, %s: absorbed %.3f lm, flux %.3f lm\n",
                rad_solver_name(solvers[k]), absorbed, 4 * PI * 100);
         /* the dense solvers to 0.5 %; the hierarchical one to 1 %: it loses 0.58 % here
@@ -409,12 +422,7 @@ static void test_energy(void)
              * the dense solvers' 0.5 % (measured: -0.085 %; at 0.01, +0.26 %) */
             options.refine_threshold = 0.05;
             CHECK(rad_solve_scene(scene, mesh, &options, B, &report, &error) == RAD_OK);
-            absorbed = 0;
-            for (uint32_t p = 0; p < mesh->patch_count; p++) {
-                double rho = inputs->albedo[p].g;
-                absorbed +=
-                    mesh->patches[p].area * (1 - rho) * (B[p].g - inputs->exitance[p].g) / rho;
-            }
+            absorbed = absorbed_power(mesh, inputs, B);
             printf("closed room, point light, hierarchical, refine threshold 0.05: absorbed "
                    "%.3f lm\n",
                    absorbed);
@@ -431,15 +439,14 @@ static void test_energy(void)
  * floor's patches (each 1 x 1 m, the box 1.4 m square: its foot crosses 4 of them): the
  * floor patches running under the box take the open part's area and light
  * (mesh/exposed_area.c), so no light vanishes at the box's foot and the power absorbed,
- * over the open areas, is the flux: measured -0.05 %, held to 0.1 %. With each patch's
+ * over the open areas, is the flux: measured -0.05 % (dense) and +0.04 % (hierarchical),
+ * held to 0.1 % and 0.5 %. With each patch's
  * whole area (before) the dense solvers absorbed 0.40 % less than the flux here. */
 static void test_energy_box_on_floor(void)
 {
     const char *room = test_write_file(
         "cube_box.obj",
-        "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\nv 0 0 4\nv 4 0 4\nv 4 4 4\nv 0 4 4\n"
-        "o zlo\nf 1 2 3 4\no zhi\nf 5 8 7 6\no xlo\nf 1 4 8 5\no xhi\nf 2 6 7 3\n"
-        "o ylo\nf 1 5 6 2\no yhi\nf 4 3 7 8\n"
+        CUBE_ROOM
         "v 1.3 0 1.3\nv 2.7 0 1.3\nv 2.7 0 2.7\nv 1.3 0 2.7\n"
         "v 1.3 1.2 1.3\nv 2.7 1.2 1.3\nv 2.7 1.2 2.7\nv 1.3 1.2 2.7\n"
         "o box\nf 13 16 15 14\nf 13 14 10 9\nf 14 15 11 10\nf 15 16 12 11\nf 16 13 9 12\n");
@@ -455,22 +462,18 @@ static void test_energy_box_on_floor(void)
         partly += inputs->area[p] < mesh->patches[p].area * (1 - 1e-9);
     printf("box on the floor: %u patches partly buried\n", partly);
     CHECK(partly == 4); /* the four floor patches the foot crosses */
-    rad_solver solvers[] = {RAD_SOLVER_JACOBI, RAD_SOLVER_SHOOT};
+    rad_solver solvers[] = {RAD_SOLVER_JACOBI, RAD_SOLVER_SHOOT, RAD_SOLVER_HIERARCHICAL};
     for (size_t k = 0; k < sizeof(solvers) / sizeof(solvers[0]); k++) {
         rad_rgb *B = calloc(mesh->patch_count, sizeof(*B));
         rad_scene_solve_options options = {.solver = solvers[k], .threads = 2, .inputs = inputs,
                                            .tolerance = 1e-7, .visibility_rays = 64};
         rad_scene_solve_report report;
         CHECK(rad_solve_scene(scene, mesh, &options, B, &report, &error) == RAD_OK);
-        double absorbed = 0;
-        for (uint32_t p = 0; p < mesh->patch_count; p++) {
-            double rho = inputs->albedo[p].g;
-            absorbed += inputs->area[p] * (1 - rho) * (B[p].g - inputs->exitance[p].g) / rho;
-        }
+        double absorbed = absorbed_power(mesh, inputs, B);
         printf("closed room, box on the floor, point light, %s: absorbed %.3f lm, flux %.3f "
                "lm\n",
                rad_solver_name(solvers[k]), absorbed, 4 * PI * 100);
-        CHECK_NEAR(absorbed, 4 * PI * 100, 0.001);
+        CHECK_NEAR(absorbed, 4 * PI * 100, solvers[k] == RAD_SOLVER_HIERARCHICAL ? 0.005 : 0.001);
         free(B);
     }
     rad_patch_inputs_destroy(inputs);
