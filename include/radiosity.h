@@ -1699,8 +1699,8 @@ typedef struct rad_render_options {
     bool irradiance;
     /* How the emitters' direct light (emissive surfaces; with `scene`) reaches the image:
      * RAD_DIRECT_VERTEX (the default): computed at every mesh vertex, at a point a tenth of
-     *   the way into the vertex's patches, together with a final gather there (1600 cosine
-     *   rays meeting the solution's reflected light (B - E) / pi, or the sky), and
+     *   the way into the vertex's patches, together with a final gather there (up to 2048
+     *   cosine rays meeting the solution's reflected light (B - E) / pi, or the sky), and
      *   interpolated: the vertex shows E / pi + rho / pi (H_emitters + H_gathered); soft
      *   shadows, contact shadows and the light next to creases follow the light, not patch
      *   means. In a penumbra (a display triangle whose corners' shadow rays disagree, or

@@ -7,6 +7,7 @@
 #include <stdbool.h>
 
 #include "core/hemisphere.h"
+#include "core/scrambled_sobol.h"
 #include "core/random.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
@@ -116,21 +117,26 @@ void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, r
     rad_vec3 a, b;
     hemisphere_frame(n, &a, &b);
     rad_vec3 origin = v3_add(x, v3_scale(n, leave));
-    uint32_t side = (uint32_t)floor(sqrt((double)count));
-    double turn = 2 * RAD_PI * rad_rng_uniform(rng);
-    const double cell = side ? 1.0 / side : 1;
-    uint32_t k = 0;
-    for (uint32_t row = 0; row < side; row++) /* side x side strata, then the rest */
-        for (uint32_t column = 0; column < side; column++, k++) {
-            double u1 = rad_rng_uniform(rng), u2 = rad_rng_uniform(rng);
-            rad_vec3 w = cosine_direction(n, a, b, (column + u1) * cell, (row + u2) * cell, turn,
-                                          &cos_x[k]);
-            ray_set(&rays[k], origin, w, 0, INFINITY);
-        }
-    for (; k < count; k++) {
-        double u1 = rad_rng_uniform(rng), u2 = rad_rng_uniform(rng);
-        rad_vec3 w = cosine_direction(n, a, b, u1, u2, turn, &cos_x[k]);
-        ray_set(&rays[k], origin, w, 0, INFINITY);
+    const uint64_t seeds = rad_rng_next(rng);
+    const uint32_t seed1 = (uint32_t)seeds, seed2 = (uint32_t)(seeds >> 32);
+    /* 2^m points are a net: a grid of 2^columns x 2^rows cells holds one each, so each
+     * goes to its cell's slot and rays that follow each other leave in nearby directions
+     * (the tracer's and the gather's caches; in sequence order they jump about) */
+    const bool net = count > 0 && (count & (count - 1)) == 0;
+    unsigned m = 0;
+    while (net && (1u << m) < count)
+        m++;
+    const unsigned columns = (m + 1) / 2, rows = m / 2;
+    const double unit = 1.0 / 4294967296.0;
+    sobol_walk walk = sobol_walk_start(seed1, seed2);
+    for (uint32_t k = 0; k < count; k++) {
+        uint32_t x1, x2;
+        sobol_walk_next(&walk, &x1, &x2);
+        uint32_t slot = !net ? k
+                             : ((rows ? x2 >> (32 - rows) : 0) << columns) |
+                                   (columns ? x1 >> (32 - columns) : 0);
+        rad_vec3 w = cosine_direction(n, a, b, x1 * unit, x2 * unit, 0, &cos_x[slot]);
+        ray_set(&rays[slot], origin, w, 0, INFINITY);
     }
 }
 

@@ -56,8 +56,13 @@ uint32_t emitter_light_rays_by_triangle(const emitter_set *set, const rad_scene 
                                         double cosine_per_light, rad_ray *rays,
                                         rad_rgb *irradiance);
 
-/* `count` cosine-weighted directions around n (stratified), rays from x + n * leave, for
- * closest-hit queries against the scene's triangles; cos_x[k] receives each one's cosine. */
+/* `count` cosine-weighted directions around n, rays from x + n * leave, for closest-hit
+ * queries against the scene's triangles; cos_x[k] receives each one's cosine. The points
+ * of the unit square they map are the first `count` of the Owen-scrambled Sobol sequence
+ * (core/scrambled_sobol.h), scrambled afresh from rng: stratified at every aspect ratio.
+ * When count is a power of two each point goes to the slot of its cell in a grid of count
+ * cells (one each), so consecutive rays leave in nearby directions: in sequence order the
+ * gather's tracing and locating took 1.5 times as long. */
 void emitter_cosine_rays(rad_vec3 x, rad_vec3 n, double leave, uint32_t count, rad_rng *rng,
                          rad_ray *rays, double *cos_x);
 

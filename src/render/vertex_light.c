@@ -188,6 +188,51 @@ static void buried_from_neighbours(const rad_mesh *mesh, const uint8_t *hidden,
         }
 }
 
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The area around a vertex whose gather is given all of its rays (gather_rays_for): the
+ * GATHER_FULL_SHARE quantile of the gathering vertices' areas (vertex_frame.weight, the
+ * sum of their patches' areas): about a whole patch's vertex away from the refined parts.
+ * 0 when no vertex gathers; -1 when out of memory. */
+static double gather_full_area(const vertex_frame *frame, const vertex_parents *parents,
+                               uint32_t n)
+{
+    uint32_t count = 0;
+    for (uint32_t v = 0; v < n; v++)
+        count += frame[v].weight > 0 && !(parents && parents[v].count);
+    if (count == 0)
+        return 0;
+    double *areas = rad_alloc_array(count, sizeof(*areas));
+    if (!areas)
+        return -1;
+    uint32_t at = 0;
+    for (uint32_t v = 0; v < n; v++)
+        if (frame[v].weight > 0 && !(parents && parents[v].count))
+            areas[at++] = frame[v].weight;
+    qsort(areas, count, sizeof(*areas), compare_doubles);
+    double full = areas[(uint32_t)(GATHER_FULL_SHARE * (count - 1))];
+    free(areas);
+    return full;
+}
+
+/* Vertex v's gather rays: `most` times the square root of its area's share of `full`, up
+ * to the next power of two, at least most / GATHER_FEWEST_PART. */
+static uint32_t gather_rays_for(double area, double full, uint32_t most)
+{
+    const uint32_t fewest = most / GATHER_FEWEST_PART ? most / GATHER_FEWEST_PART : 1;
+    if (!(area < full))
+        return most;
+    double wanted = most * sqrt(area / full);
+    uint32_t rays = fewest;
+    while (rays < wanted && rays < most)
+        rays *= 2;
+    return rays < most ? rays : most;
+}
+
 rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *sharp,
                         rad_rgb *gathered, rad_error *error)
 {
@@ -230,8 +275,13 @@ rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *s
     double *cosines = rad_alloc_array((size_t)threads * cosines_per_vertex, sizeof(*cosines));
     uint32_t *buried = rad_alloc_array(n ? n : 1, sizeof(*buried));
     bool ok = frame && rays && values && blocked && cosine_rays && hits && cosines && buried;
+    double full_area = 0;
     if (ok) {
         vertex_frames(mesh, job->hidden, frame);
+        full_area = gather_full_area(frame, job->parents, n);
+        ok = full_area >= 0;
+    }
+    if (ok) {
         for (uint32_t v = 0; v < n; v++)
             buried[v] = 0;
 #pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
@@ -314,17 +364,18 @@ rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *s
             if (job->parents && job->parents[v].count)
                 continue; /* its gathered light: its parents' mean, below */
             /* the gather: E = pi / N x the sum of the radiance met by N cosine rays */
-            emitter_cosine_rays(x, nv, off, gather, &rng, cosine, cos_x);
-            gather_trace(view, cosine, gather, hit);
+            const uint32_t count = gather_rays_for(f->weight, full_area, gather);
+            emitter_cosine_rays(x, nv, off, count, &rng, cosine, cos_x);
+            gather_trace(view, cosine, count, hit);
             rad_rgb seen = {0, 0, 0};
             uint32_t backs = 0; /* rays that met the back of a one-sided surface */
-            for (uint32_t k = 0; k < gather; k++) {
+            for (uint32_t k = 0; k < count; k++) {
                 rgb_add_to(&seen, gather_seen(view, &cosine[k], &hit[k]));
                 if (hit[k].triangle != RAD_NO_HIT && !hit[k].front)
                     backs += !mesh->patches[view->patch_of[hit[k].triangle]].twin;
             }
-            gathered[v] = rgb_scale(seen, RAD_PI / gather);
-            buried[v] = backs > gather - gather / 8; /* enclosed: 7/8 of the rays */
+            gathered[v] = rgb_scale(seen, RAD_PI / count);
+            buried[v] = backs > count - count / 8; /* enclosed: 7/8 of the rays */
             if (buried[v] && job->sees) /* its light comes from its neighbours': mixed */
                 job->sees[v] = VERTEX_SEES_PART;
         }

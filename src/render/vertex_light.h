@@ -67,8 +67,9 @@ typedef struct vertex_light_job {
     const rad_mesh *mesh;
     const rad_tracer *occluders;
     const gather_view *view;     /* what the gather rays meet */
-    uint32_t gather_rays;        /* per vertex: VERTEX_GATHER_RAYS, or fewer for a
-                                    correction (a view of a change: gather.h) */
+    uint32_t gather_rays;        /* per vertex at most, a power of two: VERTEX_GATHER_RAYS,
+                                    or fewer for a correction (a view of a change:
+                                    gather.h); a vertex's share of them by its area */
     const uint8_t *hidden;       /* patches no one sees (NULL: none) */
     const vertex_parents *parents; /* per vertex (NULL: every vertex gathers) */
     uint8_t *sees;               /* out, per vertex (NULL: not asked): how much of the
@@ -82,13 +83,30 @@ typedef struct vertex_light_job {
                         every rank returns the same status */
 } vertex_light_job;
 
-/* Final-gather rays per vertex (the first gather, from the solution's patches): a square,
- * so that every ray has its stratum (40 x 40). Their noise is most of what is left of the
- * default render's error: two seeds' Cornell renders at 256 x 256 differ by 0.70 % on
- * blocks with 1024 rays, 0.52 % with 1600, 0.33 % with 4096. Against the 16384-spp
- * reference (block / pixel, render seconds on 2 cores): 1024 rays 0.838 / 1.102 %, 1.23 s;
- * 1296 0.826 / 1.062 %, 1.50 s; 1600 0.780 / 1.046 %, 1.62 s; 2025 0.774 / 1.022 %, 1.84 s. */
-#define VERTEX_GATHER_RAYS 1600u
+/* Final-gather rays per vertex (the first gather, from the solution's patches): a power of
+ * two, so that they are a net of the scrambled Sobol points (emitter_cosine_rays). Their
+ * noise is most of what is left of the default render's error. Cornell box, 256 x 256, 2
+ * threads, against the 16384-spp reference, block / pixel relative RMSE (mean of seeds 1,
+ * 2, 3), render seconds: jittered 40 x 40 strata, 1600 rays 0.497 / 0.853 %, 1.62-1.69 s
+ * (800 rays 0.795 / 0.984 %; 3200 0.476 / 0.811 %); scrambled Sobol 1024 rays 0.530 /
+ * 0.861 %, 1.25-1.37 s; 2048 0.458 / 0.810 %, 1.66-1.78 s; 4096 0.415 / 0.787 %, 2.5-2.8 s
+ * (every vertex given them all; with its share by area, below, 2048 at most: 0.472 /
+ * 0.817 % with 37 % fewer rays).
+ * The mean of three seeds' 1600-ray images reads 0.412 / 0.785 %: what is left at 4096 is
+ * the render's bias and the reference's own noise (0.09 / 0.68 %). Earlier, against an
+ * older reference: jittered 1024 rays 0.838 / 1.102 %, 1.23 s; 1296 0.826 / 1.062 %, 1.50 s;
+ * 1600 0.780 / 1.046 %, 1.62 s; 2025 0.774 / 1.022 %, 1.84 s. */
+#define VERTEX_GATHER_RAYS 2048u
+
+/* A vertex's gather takes rays in proportion to the square root of the area around it
+ * (its patches' areas summed), up to the next power of two: its noise spreads over that
+ * area, so for a given number of rays in all, the image's squared error summed over its
+ * pixels is least so. The area given all the rays (VERTEX_GATHER_RAYS, or a correction's
+ * gather_rays) is the GATHER_FULL_SHARE quantile of the gathering vertices' areas (a whole
+ * patch's vertex, next to the pieces light_refine splits); the fewest, 1/GATHER_FEWEST_PART
+ * of all. */
+#define GATHER_FULL_SHARE 0.9
+#define GATHER_FEWEST_PART 8u
 
 /* Per mesh vertex v (mesh->vertex_count values): direct[v], the emitters' direct
  * irradiance, sharp[v] the sharp sources', and gathered[v], the irradiance the view's
