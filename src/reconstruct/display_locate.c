@@ -19,8 +19,11 @@
 /* Display triangles probed per batch of rays (per thread). */
 #define PROBE_BATCH 256u
 /* A grid over a scene triangle has about this many display triangles a cell, and at most
- * MAX_SIDE cells along either side. */
-#define PER_CELL 2.0
+ * MAX_SIDE cells along either side. On the Cornell box's default render, tests a hit (its
+ * cell's triangles tried, most covering first): 2.92 at 2 a cell, 2.10 at 1, 1.66 at
+ * 0.5, 1.45 at 0.25; at 0.5 the render took 4 % less CPU time than at 2 (perf stat
+ * task-clock, 2 runs each), its peak memory the same. */
+#define PER_CELL 0.5
 #define MAX_SIDE 256u
 /* A display triangle whose box meets more cells than this is not listed (its hits are
  * traced on the display mesh): the listings stay about PER_CELL a cell. */
