@@ -74,6 +74,12 @@ typedef struct vertex_light_job {
     const vertex_parents *parents; /* per vertex (NULL: every vertex gathers) */
     uint8_t *sees;               /* out, per vertex (NULL: not asked): how much of the
                                     emitters' light its shadow rays found (VERTEX_SEES_*) */
+    bool penumbra_at_pixels;     /* with `sees`: a vertex that sees a part of the emitters'
+                                    light is shown by no interpolation (every display
+                                    triangle it is a corner of takes the emitters' light
+                                    at its pixels), so its direct light only lights the
+                                    second gather's field, and it keeps its first
+                                    1/VERTEX_SHADOW_FIRST of the light samples */
     double leave;                /* how far rays start off a surface */
     uint64_t seed;
     int threads;

@@ -52,6 +52,10 @@ typedef struct vertex_radiance_job {
     rad_rgb *without_emitters;           /* out, or NULL: per display vertex, the radiance
                                             without H_emitters (for the pixels that add
                                             their own) */
+    bool penumbra_at_pixels;             /* the caller computes the emitters' light at the
+                                            pixels of every display triangle with a corner
+                                            that sees a part of it (needs `sees`):
+                                            vertex_light_job.penumbra_at_pixels */
     double leave;                        /* how far rays start off a surface */
     bool emitters_at_hits;               /* H_emitters left out: each hit adds its own (it
                                             still lights the second gather's field) */
