@@ -86,6 +86,7 @@ rad_status near_contacts_build(const rad_mesh *mesh, double reach, double plane_
     rad_vec3 scene_lo, scene_hi;
     v3_bounds(mesh->vertices, mesh->vertex_count, &scene_lo, &scene_hi);
     rad_vec3 size = v3_sub(scene_hi, scene_lo);
+    const double diagonal = v3_length(size);
     int axis = size.x >= size.y && size.x >= size.z ? 0 : size.y >= size.z ? 1 : 2;
     for (uint32_t i = 0; i < n; i++) {
         const rad_patch *p = &mesh->patches[i];
@@ -126,7 +127,8 @@ rad_status near_contacts_build(const rad_mesh *mesh, double reach, double plane_
         }
     out->contact = rad_alloc_array(pair_count, sizeof(*out->contact));
     out->side = rad_alloc_array(pair_count, sizeof(*out->side));
-    if (!out->contact || !out->side)
+    out->box = rad_alloc_array(pair_count ? pair_count : 1, sizeof(*out->box));
+    if (!out->contact || !out->side || !out->box)
         goto nomem;
     for (uint32_t i = 0; i < n; i++)
         out->start[i + 1] = out->start[i] + count[i];
@@ -146,6 +148,22 @@ rad_status near_contacts_build(const rad_mesh *mesh, double reach, double plane_
                 below = below && d <= plane_epsilon;
             }
             out->side[c] = above && !below ? 1 : below && !above ? -1 : 0;
+            /* near_contacts_block looks from an end up to (1.01 RAD_SEGMENT_END_EPSILON
+             * + plane_epsilon / length) x the length, a segment being at most the
+             * diagonal long; twice plane_epsilon and a millionth more for rounding */
+            const rad_patch *pk = &mesh->patches[k];
+            double grow = 1.02 * RAD_SEGMENT_END_EPSILON * diagonal + 2 * plane_epsilon +
+                          1e-9 * diagonal;
+            for (int a = 0; a < 3; a++) {
+                out->box[c][a] = INFINITY;
+                out->box[c][3 + a] = -INFINITY;
+            }
+            for (unsigned v = 0; v < pk->vertex_count; v++)
+                for (int a = 0; a < 3; a++) {
+                    double x = coordinate(mesh->vertices[pk->vertex[v]], a);
+                    out->box[c][a] = fmin(out->box[c][a], x - grow);
+                    out->box[c][3 + a] = fmax(out->box[c][3 + a], x + grow);
+                }
         }
     }
     free(boxes);
@@ -168,9 +186,11 @@ void near_contacts_free(near_contacts *contacts)
     free(contacts->radius);
     free(contacts->flatness);
     free(contacts->side);
+    free(contacts->box);
     contacts->start = contacts->contact = NULL;
     contacts->offset = contacts->radius = contacts->flatness = NULL;
     contacts->side = NULL;
+    contacts->box = NULL;
 }
 
 /* Moller-Trumbore in double: the segment a + t d crosses triangle (v0, v1, v2) at some t in
@@ -267,8 +287,26 @@ static bool blocked_near(const near_contacts *contacts, uint32_t end, uint32_t o
     const rad_mesh *mesh = contacts->mesh;
     for (uint32_t c = contacts->start[end]; c < contacts->start[end + 1]; c++) {
         uint32_t k = contacts->contact[c];
+        const double *box = contacts->box[c];
+        if (a.x < box[0] || a.y < box[1] || a.z < box[2] || a.x > box[3] || a.y > box[4] ||
+            a.z > box[5])
+            continue; /* no point of k within reach of the end */
         if (k != other && may_meet(contacts, k, a, d, length, t_low, zone) &&
             crosses_patch(mesh, k, a, d, t_low, zone))
+            return true;
+    }
+    return false;
+}
+
+/* Whether point `a`, a segment's end on patch `end`, lies in the box of one of end's
+ * contacts other than `other`. */
+static bool in_a_contact_box(const near_contacts *contacts, uint32_t end, uint32_t other,
+                             rad_vec3 a)
+{
+    for (uint32_t c = contacts->start[end]; c < contacts->start[end + 1]; c++) {
+        const double *box = contacts->box[c];
+        if (contacts->contact[c] != other && a.x >= box[0] && a.y >= box[1] &&
+            a.z >= box[2] && a.x <= box[3] && a.y <= box[4] && a.z <= box[5])
             return true;
     }
     return false;
@@ -277,6 +315,12 @@ static bool blocked_near(const near_contacts *contacts, uint32_t end, uint32_t o
 bool near_contacts_block(const near_contacts *contacts, uint32_t from, uint32_t to, rad_vec3 a,
                          rad_vec3 b)
 {
+    /* most ends lie in no contact's box (on the Cornell box, 553 of 6.9 M segments are
+     * blocked here): those need no more */
+    const bool near_a = in_a_contact_box(contacts, from, to, a);
+    const bool near_b = in_a_contact_box(contacts, to, from, b);
+    if (!near_a && !near_b)
+        return false;
     rad_vec3 d = v3_sub(b, a);
     double length = v3_length(d);
     if (!(length > 2 * contacts->plane_epsilon))
@@ -284,6 +328,6 @@ bool near_contacts_block(const near_contacts *contacts, uint32_t from, uint32_t 
     double t_low = contacts->plane_epsilon / length;
     /* what the tracer leaves out, and a little more so that nothing falls between */
     double zone = fmin(0.5, 1.01 * RAD_SEGMENT_END_EPSILON + t_low);
-    return blocked_near(contacts, from, to, a, d, length, t_low, zone) ||
-           blocked_near(contacts, to, from, b, v3_scale(d, -1), length, t_low, zone);
+    return (near_a && blocked_near(contacts, from, to, a, d, length, t_low, zone)) ||
+           (near_b && blocked_near(contacts, to, from, b, v3_scale(d, -1), length, t_low, zone));
 }

@@ -168,7 +168,51 @@ typedef struct shading {
                                        hit, or the exact open light at the hit) */
     const rad_rgb *without_emitters; /* per display vertex: the radiance without the
                                         emitters' light, shown where a hit adds its own */
+    const rad_rgb (*open_nodes)[6];  /* NULL, or per display triangle whose hits take the
+                                        emitters' light (DISPLAY_OPEN_LIGHT, and with
+                                        emitters_exact DISPLAY_PENUMBRA): their unshadowed
+                                        irradiance at its corners and its edges' midpoints
+                                        (open_light_nodes) */
 } shading;
+
+/* The open light on a display triangle as the quadratic through its six nodes (corners
+ * 0, 1, 2, then the midpoints of edges 01, 12, 20) at barycentrics (1 - u - v, u, v). */
+static rad_rgb open_light_at(const rad_rgb node[6], double u, double v)
+{
+    const double b0 = 1 - u - v, b1 = u, b2 = v;
+    const double weight[6] = {b0 * (2 * b0 - 1), b1 * (2 * b1 - 1), b2 * (2 * b2 - 1),
+                              4 * b0 * b1,       4 * b1 * b2,       4 * b2 * b0};
+    rad_rgb sum = {0, 0, 0};
+    for (int k = 0; k < 6; k++)
+        rgb_add_to(&sum, rgb_scale(node[k], weight[k]));
+    return rgb_max0(sum);
+}
+
+/* For every display triangle whose hits take the emitters' light (not interpolated): the
+ * emitters' unshadowed irradiance, exact, at its six nodes, for open_light_at. The
+ * unshadowed light is smooth over a patch (the patch's plane clips the emitters alike at
+ * every point of it), and the quadratic through the nodes stands for the exact value a
+ * hit took before (Cornell box 256 x 256: the image within 1.6e-5 on blocks, 7.4e-5 a
+ * pixel, relative RMS), at a hundredth of the cost: per hit it had been a contour
+ * integral over every emitting triangle, a tenth of the pixels' time. */
+static void open_light_nodes(const emitter_set *emitters, const rad_scene *scene,
+                             const rad_mesh *mesh, const display_mesh *display,
+                             const rad_vec3 *positions, const uint8_t *emitter_way,
+                             int threads, rad_rgb (*nodes)[6])
+{
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads)
+    for (int64_t t = 0; t < (int64_t)display->triangle_count; t++) {
+        if (emitter_way[t] == DISPLAY_INTERPOLATED)
+            continue;
+        const uint32_t *v = display->triangles[t];
+        const rad_vec3 n = mesh->patches[display->patch_of[t]].normal;
+        rad_vec3 at[6] = {positions[v[0]], positions[v[1]], positions[v[2]]};
+        for (int k = 0; k < 3; k++)
+            at[3 + k] = v3_scale(v3_add(at[k], at[(k + 1) % 3]), 0.5);
+        for (int k = 0; k < 6; k++)
+            nodes[t][k] = emitter_unshadowed_irradiance(emitters, scene, at[k], n);
+    }
+}
 
 /* Whether a first sample of pixel x met a penumbra, whose light it computed itself (with
  * a little noise: its luminance tells no edge). */
@@ -302,7 +346,8 @@ static void flush_lights(const shading *sh, row_work *w)
  * `slot` is the pixel's index-th, and takes the index-th share of the triangle choice and
  * the Halton points after the previous samples', with the pixel's own shift. */
 static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3 point,
-                         const rad_patch *patch, rad_rgb factor, bool emitters)
+                         const rad_patch *patch, rad_rgb factor, bool emitters,
+                         const rad_rgb *unshadowed)
 {
     uint32_t room = (sh->lights ? sh->lights->sharp_count : 0) +
                     (emitters ? sh->emitter_samples : 0);
@@ -336,8 +381,9 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
             /* the unshadowed light exactly, shared out over the samples: those that get
              * through bring their share (none to trace where it is 0: a ceiling around a
              * lamp that hangs below it) */
-            rad_rgb open = emitter_unshadowed_irradiance(sh->emitters, sh->scene, point,
-                                                         patch->normal);
+            rad_rgb open = unshadowed ? *unshadowed
+                                      : emitter_unshadowed_irradiance(sh->emitters, sh->scene,
+                                                                      point, patch->normal);
             if (!rgb_is_zero(open)) {
                 /* in the default render's penumbrae an edge or rim sample, one of
                  * hundreds in its pixel, takes a sixteenth: its pixel's first samples have
@@ -452,10 +498,20 @@ static uint32_t shade_hits(const shading *sh, row_work *w, uint32_t count, bool 
             rad_rgb factor = rgb_scale(rgb_mul(weight, albedo), 1.0 / RAD_PI);
             if (open_light)
                 rgb_add_to(&w->sum[w->sample[r]],
-                           rgb_mul(factor, emitter_unshadowed_irradiance(
-                                               sh->emitters, sh->scene, point, hit_patch->normal)));
-            if (sharp || emitter_light)
-                queue_lights(sh, w, w->sample[r], point, hit_patch, factor, emitter_light);
+                           rgb_mul(factor,
+                                   sh->open_nodes
+                                       ? open_light_at(sh->open_nodes[triangle], hit_u, hit_v)
+                                       : emitter_unshadowed_irradiance(sh->emitters, sh->scene,
+                                                                       point,
+                                                                       hit_patch->normal)));
+            if (sharp || emitter_light) {
+                rad_rgb unshadowed;
+                const bool nodes = emitter_light && sh->open_nodes && sh->emitters_exact;
+                if (nodes)
+                    unshadowed = open_light_at(sh->open_nodes[triangle], hit_u, hit_v);
+                queue_lights(sh, w, w->sample[r], point, hit_patch, factor, emitter_light,
+                             nodes ? &unshadowed : NULL);
+            }
         }
         if (!mirrors || !sh->materials || sh->irradiance)
             continue;
@@ -629,6 +685,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
     display_locator *locator = NULL;
     uint8_t *hidden = NULL;
     rad_rgb *reflected = NULL;
+    rad_rgb (*open_nodes)[6] = NULL; /* the default render: the open light's nodes */
     uint8_t *sees = NULL, *emitter_way = NULL; /* the default render: how each display
                                                   triangle takes the emitters' light */
     rad_rgb *without_emitters = NULL;
@@ -781,6 +838,14 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                            : least == VERTEX_SEES_ALL && open_exact        ? DISPLAY_OPEN_LIGHT
                                                                            : DISPLAY_INTERPOLATED;
         }
+        if (emitter_way && open_exact) {
+            open_nodes = rad_alloc_array(display.triangle_count ? display.triangle_count : 1,
+                                         sizeof(*open_nodes));
+            if (!open_nodes)
+                goto nomem;
+            open_light_nodes(&emitters, options->scene, mesh, &display, positions, emitter_way,
+                             threads, open_nodes);
+        }
     } else if (!display_mesh_radiance_weighted(mesh, &display, shaded ? shaded : B, hidden,
                                                radiance))
         goto nomem;
@@ -882,7 +947,8 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                      emitters_exact,
                      emitter_samples, per_row,
                      edge_k * edge_k, scene_tracer,
-                     emitter_way, without_emitters};
+                     emitter_way, without_emitters,
+                     (const rad_rgb(*)[6])open_nodes};
 
     /* over several MPI ranks the rows are dealt out in turn (every pixel's random numbers
      * are its own, so each row comes out as in a serial run), then summed: every pixel is
@@ -1065,6 +1131,7 @@ done:
     free(reflected);
     free(sees);
     free(emitter_way);
+    free(open_nodes);
     free(without_emitters);
     display_mesh_free(&display);
     free(radiance);
