@@ -43,6 +43,12 @@ static void hemisphere_directions(double (*along)[3])
     }
 }
 
+/* Rays from a point are traced in two rounds: FIRST_DIRECTIONS of them, then the rest
+ * only where those found a back. A point whose first rays all meet fronts (or nothing)
+ * cannot reach BURIED_BACKS and is open: the same answer as tracing all of them, in
+ * about a third of the rays where most points are open. */
+#define FIRST_DIRECTIONS (DIRECTIONS - BURIED_BACKS + 1u)
+
 /* The points of patch p's side x side split that are not buried, traced a row of points
  * at a time; `along` holds the hemisphere's directions in the patch's frame. With `bits`,
  * cell (a, b)'s bit a * side + b is set when its point is open. */
@@ -52,31 +58,48 @@ static unsigned open_points(const rad_tracer *tracer, const rad_mesh *mesh, cons
     rad_vec3 normal = p->normal;
     rad_vec3 t = fabs(normal.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);
     rad_vec3 u = v3_normalize(v3_cross(t, normal)), w = v3_cross(normal, u);
+    rad_vec3 direction[DIRECTIONS];
+    for (unsigned d = 0; d < DIRECTIONS; d++)
+        direction[d] = v3_add(v3_scale(normal, along[d][0]),
+                              v3_add(v3_scale(u, along[d][1]), v3_scale(w, along[d][2])));
     rad_ray rays[FINE_SIDE * DIRECTIONS];
     rad_hit hits[FINE_SIDE * DIRECTIONS];
+    rad_vec3 x[FINE_SIDE];
+    unsigned backs[FINE_SIDE], again[FINE_SIDE];
     unsigned open = 0;
     for (unsigned a = 0; a < side; a++) {
         unsigned r = 0;
         for (unsigned b = 0; b < side; b++) {
-            rad_vec3 x = v3_add(cell_centre(mesh, p, side, a, b),
-                                v3_scale(normal, lift + 2 * p->behind));
-            for (unsigned d = 0; d < DIRECTIONS; d++) {
-                rad_vec3 direction =
-                    v3_add(v3_scale(normal, along[d][0]),
-                           v3_add(v3_scale(u, along[d][1]), v3_scale(w, along[d][2])));
-                ray_set(&rays[r++], x, direction, 0, INFINITY);
-            }
+            x[b] = v3_add(cell_centre(mesh, p, side, a, b), v3_scale(normal, lift + 2 * p->behind));
+            for (unsigned d = 0; d < FIRST_DIRECTIONS; d++)
+                ray_set(&rays[r++], x[b], direction[d], 0, INFINITY);
         }
         rad_tracer_intersect(tracer, rays, r, hits);
-        for (unsigned point = 0; point < side; point++) {
-            unsigned backs = 0;
-            for (unsigned d = 0; d < DIRECTIONS; d++) {
-                const rad_hit *h = &hits[point * DIRECTIONS + d];
-                backs += h->triangle != RAD_NO_HIT && !h->front;
+        unsigned more = 0; /* points whose first rays met a back: the rest of theirs */
+        for (unsigned b = 0; b < side; b++) {
+            backs[b] = 0;
+            for (unsigned d = 0; d < FIRST_DIRECTIONS; d++) {
+                const rad_hit *h = &hits[b * FIRST_DIRECTIONS + d];
+                backs[b] += h->triangle != RAD_NO_HIT && !h->front;
             }
-            open += backs < BURIED_BACKS;
-            if (bits && backs < BURIED_BACKS)
-                bits[(a * side + point) / 8] |= (uint8_t)(1u << ((a * side + point) % 8));
+            if (backs[b] > 0)
+                again[more++] = b;
+        }
+        r = 0;
+        for (unsigned k = 0; k < more; k++)
+            for (unsigned d = FIRST_DIRECTIONS; d < DIRECTIONS; d++)
+                ray_set(&rays[r++], x[again[k]], direction[d], 0, INFINITY);
+        if (r)
+            rad_tracer_intersect(tracer, rays, r, hits);
+        for (unsigned k = 0; k < more; k++)
+            for (unsigned d = 0; d < DIRECTIONS - FIRST_DIRECTIONS; d++) {
+                const rad_hit *h = &hits[k * (DIRECTIONS - FIRST_DIRECTIONS) + d];
+                backs[again[k]] += h->triangle != RAD_NO_HIT && !h->front;
+            }
+        for (unsigned b = 0; b < side; b++) {
+            open += backs[b] < BURIED_BACKS;
+            if (bits && backs[b] < BURIED_BACKS)
+                bits[(a * side + b) / 8] |= (uint8_t)(1u << ((a * side + b) % 8));
         }
     }
     return open;
