@@ -645,6 +645,80 @@ static void write_pixel(rad_image *image, uint32_t x, uint32_t y, rad_rgb sum, d
     pixel[2] = (float)(sum.b / count);
 }
 
+/* Whether a mirror ray may leave some patch (a material with Ks > 0): then any surface
+ * may show in the image. */
+static bool any_mirror(const rad_mesh *mesh, const rad_material *materials)
+{
+    if (!materials)
+        return false;
+    for (uint32_t p = 0; p < mesh->patch_count; p++) {
+        rad_rgb ks = materials[mesh->patches[p].material].specular;
+        if (ks.r > 0 || ks.g > 0 || ks.b > 0)
+            return true;
+    }
+    return false;
+}
+
+/* shown[v] for the mesh's vertices: whether a pixel may show the light at vertex v. A ray
+ * through every pixel's centre marks the patch it meets first (and a two-sided patch's
+ * twin, when it meets the back), and so are the patches that share a corner with a marked
+ * one (small pieces seen between pixel centres); every corner of a marked patch is shown,
+ * and so are the parents whose gathered light a shown vertex takes (they have lower
+ * indices). A patch seen only between pixel centres and away from those keeps its corners
+ * unshown: they gather with fewer rays, not none. False when out of memory. */
+static bool shown_vertices(const rad_mesh *mesh, const display_mesh *display,
+                           const rad_tracer *tracer, const camera_frame *frame, uint32_t W,
+                           uint32_t H, float t_near, const vertex_parents *parents, int threads,
+                           uint8_t *shown)
+{
+    uint8_t *seen = rad_alloc_array(mesh->patch_count ? mesh->patch_count : 1, 1);
+    rad_ray *rays = rad_alloc_array((size_t)threads * W, sizeof(*rays));
+    rad_hit *hits = rad_alloc_array((size_t)threads * W, sizeof(*hits));
+    bool made = seen && rays && hits;
+    if (made) {
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+        for (int64_t y = 0; y < (int64_t)H; y++) {
+            const int thread = omp_get_thread_num();
+            rad_ray *row_rays = &rays[(size_t)thread * W];
+            rad_hit *row_hits = &hits[(size_t)thread * W];
+            for (uint32_t x = 0; x < W; x++)
+                ray_set(&row_rays[x], frame->eye,
+                        v3_normalize(camera_direction(frame, x + 0.5, (double)y + 0.5, W, H)),
+                        t_near, INFINITY);
+            rad_tracer_intersect_coherent(tracer, row_rays, W, row_hits);
+            for (uint32_t x = 0; x < W; x++) {
+                if (row_hits[x].triangle == RAD_NO_HIT)
+                    continue;
+                const uint32_t p = display->patch_of[row_hits[x].triangle];
+                const uint32_t twin = mesh->patches[p].twin;
+#pragma omp atomic write
+                seen[p] = 1;
+                if (!row_hits[x].front && twin) {
+#pragma omp atomic write
+                    seen[twin - 1] = 1;
+                }
+            }
+        }
+        for (uint32_t v = 0; v < mesh->vertex_count; v++)
+            shown[v] = 0;
+        for (int ring = 0; ring < 2; ring++) { /* the patches met, then their neighbours */
+            for (uint32_t p = 0; p < mesh->patch_count; p++)
+                for (uint32_t k = 0; seen[p] && k < mesh->patches[p].vertex_count; k++)
+                    shown[mesh->patches[p].vertex[k]] = 1;
+            for (uint32_t p = 0; ring == 0 && p < mesh->patch_count; p++)
+                for (uint32_t k = 0; !seen[p] && k < mesh->patches[p].vertex_count; k++)
+                    seen[p] = shown[mesh->patches[p].vertex[k]] ? 2 : 0;
+        }
+        for (uint32_t v = mesh->vertex_count; parents && v-- > 0;)
+            for (uint32_t k = 0; shown[v] && k < parents[v].count; k++)
+                shown[parents[v].vertex[k]] = 1;
+    }
+    free(seen);
+    free(rays);
+    free(hits);
+    return made;
+}
+
 static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                               const vertex_parents *parents, const rad_camera *camera,
                               const rad_render_options *options, rad_image *image,
@@ -686,6 +760,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
     uint8_t *hidden = NULL;
     rad_rgb *reflected = NULL;
     rad_rgb (*open_nodes)[6] = NULL; /* the default render: the open light's nodes */
+    uint8_t *shown = NULL; /* per mesh vertex: a pixel may show it (NULL: every one) */
     uint8_t *sees = NULL, *emitter_way = NULL; /* the default render: how each display
                                                   triangle takes the emitters' light */
     rad_rgb *without_emitters = NULL;
@@ -790,6 +865,13 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
             pixel_emitters = &emitters;
             emitter_samples = PENUMBRA_DIRECT_SAMPLES;
         }
+        if (!any_mirror(mesh, options->materials)) {
+            shown = rad_alloc_array(mesh->vertex_count ? mesh->vertex_count : 1, 1);
+            if (!shown || !shown_vertices(mesh, &display, tracer, &frame, W, H,
+                                          (float)(RAD_CAMERA_NEAR * diagonal), parents, threads,
+                                          shown))
+                goto nomem;
+        }
         vertex_radiance_job job = {
             .mesh = mesh,
             .display = &display,
@@ -807,6 +889,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
             .sees = sees,
             .without_emitters = without_emitters,
             .penumbra_at_pixels = sees != NULL,
+            .shown = shown,
             .leave = leave,
             .emitters_at_hits = direct_light == RAD_DIRECT_PIXEL,
             .seed = options->seed,
@@ -1132,6 +1215,7 @@ done:
     free(sees);
     free(emitter_way);
     free(open_nodes);
+    free(shown);
     free(without_emitters);
     display_mesh_free(&display);
     free(radiance);

@@ -369,7 +369,12 @@ rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *s
             if (job->parents && job->parents[v].count)
                 continue; /* its gathered light: its parents' mean, below */
             /* the gather: E = pi / N x the sum of the radiance met by N cosine rays */
-            const uint32_t count = gather_rays_for(f->weight, full_area, gather);
+            uint32_t count = gather_rays_for(f->weight, full_area, gather);
+            if (job->shown && !job->shown[v]) {
+                if (job->unshown_part == 0)
+                    continue; /* no pixel shows its light */
+                count = count / job->unshown_part ? count / job->unshown_part : 1;
+            }
             emitter_cosine_rays(x, nv, off, count, &rng, cosine, cos_x);
             gather_trace(view, cosine, count, hit);
             rad_rgb seen = {0, 0, 0};

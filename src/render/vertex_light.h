@@ -74,6 +74,11 @@ typedef struct vertex_light_job {
     const vertex_parents *parents; /* per vertex (NULL: every vertex gathers) */
     uint8_t *sees;               /* out, per vertex (NULL: not asked): how much of the
                                     emitters' light its shadow rays found (VERTEX_SEES_*) */
+    const uint8_t *shown;        /* per vertex, or NULL (all): whether a pixel may show it;
+                                    a vertex none shows gathers with 1/unshown_part of its
+                                    rays (its light still lights the second gather's
+                                    field), or not at all when unshown_part is 0 */
+    uint32_t unshown_part;
     bool penumbra_at_pixels;     /* with `sees`: a vertex that sees a part of the emitters'
                                     light is shown by no interpolation (every display
                                     triangle it is a corner of takes the emitters' light
@@ -111,6 +116,11 @@ typedef struct vertex_light_job {
  * gather_rays) is the GATHER_FULL_SHARE quantile of the gathering vertices' areas (a whole
  * patch's vertex, next to the pieces light_refine splits); the fewest, 1/GATHER_FEWEST_PART
  * of all. */
+/* A vertex that no pixel shows (the render's camera rays meet none of its patches: the far
+ * faces of a box, what lies behind the camera) gathers with 1/VERTEX_UNSHOWN_PART of its
+ * rays: its light only lights the second gather's field, whose 128 rays a vertex average
+ * over many vertices. */
+#define VERTEX_UNSHOWN_PART 8u
 #define GATHER_FULL_SHARE 0.9
 #define GATHER_FEWEST_PART 8u
 

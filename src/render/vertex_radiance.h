@@ -52,6 +52,10 @@ typedef struct vertex_radiance_job {
     rad_rgb *without_emitters;           /* out, or NULL: per display vertex, the radiance
                                             without H_emitters (for the pixels that add
                                             their own) */
+    const uint8_t *shown;                /* per mesh vertex, or NULL (all): whether a pixel
+                                            may show it; one none shows gathers with
+                                            VERTEX_UNSHOWN_PART of the rays, and takes no
+                                            second gather (vertex_light_job.shown) */
     bool penumbra_at_pixels;             /* the caller computes the emitters' light at the
                                             pixels of every display triangle with a corner
                                             that sees a part of it (needs `sees`):
