@@ -127,7 +127,7 @@ rad_status near_contacts_build(const rad_mesh *mesh, double reach, double plane_
         }
     out->contact = rad_alloc_array(pair_count, sizeof(*out->contact));
     out->side = rad_alloc_array(pair_count, sizeof(*out->side));
-    out->box = rad_alloc_array(pair_count ? pair_count : 1, sizeof(*out->box));
+    out->box = rad_alloc_array(n ? n : 1, sizeof(*out->box));
     if (!out->contact || !out->side || !out->box)
         goto nomem;
     for (uint32_t i = 0; i < n; i++)
@@ -148,23 +148,25 @@ rad_status near_contacts_build(const rad_mesh *mesh, double reach, double plane_
                 below = below && d <= plane_epsilon;
             }
             out->side[c] = above && !below ? 1 : below && !above ? -1 : 0;
-            /* near_contacts_block looks from an end up to (1.01 RAD_SEGMENT_END_EPSILON
-             * + plane_epsilon / length) x the length, a segment being at most the
-             * diagonal long; twice plane_epsilon and a millionth more for rounding */
-            const rad_patch *pk = &mesh->patches[k];
-            double grow = 1.02 * RAD_SEGMENT_END_EPSILON * diagonal + 2 * plane_epsilon +
-                          1e-9 * diagonal;
-            for (int a = 0; a < 3; a++) {
-                out->box[c][a] = INFINITY;
-                out->box[c][3 + a] = -INFINITY;
-            }
-            for (unsigned v = 0; v < pk->vertex_count; v++)
-                for (int a = 0; a < 3; a++) {
-                    double x = coordinate(mesh->vertices[pk->vertex[v]], a);
-                    out->box[c][a] = fmin(out->box[c][a], x - grow);
-                    out->box[c][3 + a] = fmax(out->box[c][3 + a], x + grow);
-                }
         }
+    }
+    /* near_contacts_block looks from an end up to (1.01 RAD_SEGMENT_END_EPSILON +
+     * plane_epsilon / length) x the length, a segment being at most the diagonal long;
+     * twice plane_epsilon and a billionth of the diagonal more for rounding */
+    const double grow =
+        1.02 * RAD_SEGMENT_END_EPSILON * diagonal + 2 * plane_epsilon + 1e-9 * diagonal;
+    for (uint32_t k = 0; k < n; k++) {
+        const rad_patch *pk = &mesh->patches[k];
+        for (int a = 0; a < 3; a++) {
+            out->box[k][a] = INFINITY;
+            out->box[k][3 + a] = -INFINITY;
+        }
+        for (unsigned v = 0; v < pk->vertex_count; v++)
+            for (int a = 0; a < 3; a++) {
+                double x = coordinate(mesh->vertices[pk->vertex[v]], a);
+                out->box[k][a] = fmin(out->box[k][a], x - grow);
+                out->box[k][3 + a] = fmax(out->box[k][3 + a], x + grow);
+            }
     }
     free(boxes);
     free(count);
@@ -287,7 +289,7 @@ static bool blocked_near(const near_contacts *contacts, uint32_t end, uint32_t o
     const rad_mesh *mesh = contacts->mesh;
     for (uint32_t c = contacts->start[end]; c < contacts->start[end + 1]; c++) {
         uint32_t k = contacts->contact[c];
-        const double *box = contacts->box[c];
+        const double *box = contacts->box[k];
         if (a.x < box[0] || a.y < box[1] || a.z < box[2] || a.x > box[3] || a.y > box[4] ||
             a.z > box[5])
             continue; /* no point of k within reach of the end */
@@ -304,7 +306,7 @@ static bool in_a_contact_box(const near_contacts *contacts, uint32_t end, uint32
                              rad_vec3 a)
 {
     for (uint32_t c = contacts->start[end]; c < contacts->start[end + 1]; c++) {
-        const double *box = contacts->box[c];
+        const double *box = contacts->box[contacts->contact[c]];
         if (contacts->contact[c] != other && a.x >= box[0] && a.y >= box[1] &&
             a.z >= box[2] && a.x <= box[3] && a.y <= box[4] && a.z <= box[5])
             return true;

@@ -32,9 +32,10 @@ typedef struct near_contacts {
                              cell of a folded quad is not flat) */
     int8_t *side;         /* per contact: the side of the contact's plane the listing patch
                              lies on (+1, -1), or 0 when the plane cuts it */
-    double (*box)[6];     /* per contact: its corners' bounding box (lo x, y, z, hi x, y, z)
-                             grown by how far from a segment's end the tracer does not
-                             look, at most: an end outside it cannot meet the contact there */
+    double (*box)[6];     /* patch_count: each patch's corners' bounding box (lo x, y, z,
+                             hi x, y, z) grown by how far from a segment's end the tracer
+                             does not look, at most: an end outside a contact's box cannot
+                             meet that contact there */
     double plane_epsilon; /* a crossing must lie this far along the segment from an end */
 } near_contacts;
 
