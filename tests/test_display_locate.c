@@ -10,9 +10,6 @@
  *   - the located triangle is on the surface and side that the display tracer's hit is,
  *   - a miss is a miss for both,
  *   - at most 1 ray in 10^4 is not placed (the gather traces those on the display mesh),
- *   - runs of a gather's coherent rays (2048 cosine rays from a point, 40 runs) are
- *     placed after the last hit of their run (display_locate_after) as display_locate
- *     places each alone, all but 1 in 10^4 of them to 1e-6 in their barycentrics,
  *   - the locator holds at most DISPLAY_LOCATE_BYTES_PER_TRIANGLE a display triangle, on
  *     a long thin strip (20 x 0.4, two triangles) too.
  */
@@ -24,7 +21,6 @@
 #include "core/vec3.h"
 #include "reconstruct/display_locate.h"
 #include "reconstruct/display_mesh.h"
-#include "render/emitter_light.h"
 #include "testlib.h"
 #include "trace/ray.h"
 
@@ -108,36 +104,6 @@ static void check_scene(const char *name, const rad_scene *scene, double patch_s
         other_surface += mine->surface != theirs->surface;
         other_side += got->front != want->front;
     }
-    /* runs of a gather's coherent rays (emitter_cosine_rays, 2048 from a point): placed
-     * after the last hit of the run as display_locate places each alone */
-    uint32_t run_hits = 0, run_differ = 0;
-    for (uint32_t run = 0; run < 40; run++) {
-        rad_vec3 origin = v3(lo.x + (0.05 + 0.9 * rad_rng_uniform(&rng)) * (hi.x - lo.x),
-                             lo.y + (0.05 + 0.9 * rad_rng_uniform(&rng)) * (hi.y - lo.y),
-                             lo.z + (0.05 + 0.9 * rad_rng_uniform(&rng)) * (hi.z - lo.z));
-        double z = 2 * rad_rng_uniform(&rng) - 1, phi = 2 * RAD_PI * rad_rng_uniform(&rng);
-        double r = sqrt(fmax(0, 1 - z * z));
-        double cosines[2048];
-        emitter_cosine_rays(origin, v3(r * cos(phi), r * sin(phi), z), 0, 2048, &rng, rays,
-                            cosines);
-        rad_tracer_intersect_coherent(scene_tracer, rays, 2048, located);
-        display_locate_last last = DISPLAY_LOCATE_NO_LAST;
-        for (uint32_t k = 0; k < 2048; k++) {
-            rad_hit alone = located[k], after = located[k];
-            bool placed_alone = display_locate(locator, &alone);
-            bool placed_after = display_locate_after(locator, &after, &last);
-            CHECK(placed_alone == placed_after);
-            if (alone.triangle == RAD_NO_HIT || !placed_alone)
-                continue;
-            run_hits++;
-            run_differ += after.triangle != alone.triangle ||
-                          fabs(after.u - alone.u) > 1e-6 || fabs(after.v - alone.v) > 1e-6;
-        }
-    }
-    printf("%s: coherent runs: %u hits, %u placed otherwise after the last hit\n", name,
-           run_hits, run_differ);
-    CHECK(run_hits > 40 * 2048 / 4);
-    CHECK(run_differ <= run_hits / 10000);
     double bytes = (double)display_locator_bytes(locator) / front;
     printf("%s: %u patches, %u display triangles, %u rays: %u hits, %u not placed, "
            "farthest %.3g (stray %.3g, diagonal %.3g), %u on another surface, %u on "

@@ -435,10 +435,8 @@ static double weights_in(const located *item, double u, double v, double *b1, do
     return b0 < least ? b0 : least;
 }
 
-/* display_locate, the listing that placed the hit in *placed (UINT32_MAX: none). */
-static bool locate(const display_locator *l, rad_hit *hit, uint32_t *placed)
+bool display_locate(const display_locator *l, rad_hit *hit)
 {
-    *placed = UINT32_MAX;
     if (hit->triangle == RAD_NO_HIT)
         return true;
     const uint32_t t = hit->triangle;
@@ -447,7 +445,7 @@ static bool locate(const display_locator *l, rad_hit *hit, uint32_t *placed)
         return false;
     const double u = hit->u, v = hit->v;
     double best = -INFINITY, b1 = 0, b2 = 0;
-    uint32_t chosen = RAD_NO_HIT, listing = UINT32_MAX;
+    uint32_t chosen = RAD_NO_HIT;
     double x, y;
     grid_point(g, u, v, &x, &y);
     const uint32_t cell = l->first_cell[t] + cell_index(y, g->ny) * g->nx + cell_index(x, g->nx);
@@ -458,7 +456,6 @@ static bool locate(const display_locator *l, rad_hit *hit, uint32_t *placed)
             b1 = x1;
             b2 = x2;
             chosen = l->items[k].triangle;
-            listing = k;
             if (least >= 0)
                 break;
         }
@@ -477,33 +474,7 @@ static bool locate(const display_locator *l, rad_hit *hit, uint32_t *placed)
     hit->triangle = chosen;
     hit->u = (float)b1;
     hit->v = (float)b2;
-    *placed = listing;
     return true;
-}
-
-bool display_locate(const display_locator *l, rad_hit *hit)
-{
-    uint32_t placed;
-    return locate(l, hit, &placed);
-}
-
-bool display_locate_after(const display_locator *l, rad_hit *hit, display_locate_last *last)
-{
-    const uint32_t t = hit->triangle;
-    if (t != RAD_NO_HIT && t == last->scene_triangle) {
-        double b1, b2;
-        if (weights_in(&l->items[last->listing], hit->u, hit->v, &b1, &b2) >= 0) {
-            hit->triangle = l->items[last->listing].triangle;
-            hit->u = (float)b1;
-            hit->v = (float)b2;
-            return true;
-        }
-    }
-    uint32_t placed;
-    bool covered = locate(l, hit, &placed);
-    if (placed != UINT32_MAX)
-        *last = (display_locate_last){placed, t};
-    return covered;
 }
 
 uint64_t display_locator_bytes(const display_locator *l)

@@ -54,21 +54,6 @@ rad_status display_locator_build(const rad_scene *scene, const rad_tracer *scene
  * display triangle covers the point (the hit is then unchanged). Thread-safe. */
 bool display_locate(const display_locator *locator, rad_hit *hit);
 
-/* The display triangle that placed the last hit of a run, and its scene triangle. */
-typedef struct display_locate_last {
-    uint32_t listing, scene_triangle; /* UINT32_MAX: none yet */
-} display_locate_last;
-#define DISPLAY_LOCATE_NO_LAST ((display_locate_last){UINT32_MAX, UINT32_MAX})
-
-/* The same, trying first the display triangle that placed the last hit when this one is
- * on the same scene triangle (start a run of hits with DISPLAY_LOCATE_NO_LAST): a
- * vertex's gather rays in coherent order fall in the same display triangle one after
- * another. A point inside it is placed as display_locate would place it, up to which of
- * two triangles takes a point on their shared edge (the value interpolated there is the
- * same). */
-bool display_locate_after(const display_locator *locator, rad_hit *hit,
-                          display_locate_last *last);
-
 /* The bytes the locator holds. */
 uint64_t display_locator_bytes(const display_locator *locator);
 

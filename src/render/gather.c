@@ -13,9 +13,8 @@ void gather_trace(const gather_view *view, const rad_ray *rays, uint32_t count, 
         return;
     }
     rad_tracer_intersect_coherent(view->scene_tracer, rays, count, hits);
-    display_locate_last last = DISPLAY_LOCATE_NO_LAST; /* the rays come in coherent runs */
     for (uint32_t k = 0; k < count; k++)
-        if (!display_locate_after(view->locator, &hits[k], &last))
+        if (!display_locate(view->locator, &hits[k]))
             rad_tracer_intersect(view->tracer, &rays[k], 1, &hits[k]);
 }
 
