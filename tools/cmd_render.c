@@ -24,7 +24,7 @@ static const char usage[] =
     "Camera (default: the scene's camera, or a view of the whole scene from -z):\n"
     "  --eye X,Y,Z  --target X,Y,Z  --up X,Y,Z  --fov DEG (vertical)   --size WxH (512x512)\n"
     "  --spp N              samples per pixel, stratified, box filter (default 16, at\n"
-    "                       most 256; pixels on an edge get 64 more)\n"
+    "                       most 256; edge pixels: up to 256 more)\n"
     "  --exposure EV        PNG: scale radiance by 2^EV (default: automatic)\n"
     "  --exr-float          .exr: 32-bit float channels instead of half\n"
     "  --specular           the two-pass method: Ks > 0 surfaces mirror the lit scene\n"
