@@ -45,19 +45,23 @@ static inline double rad_rng_uniform(rad_rng *rng)
     return (double)(rad_rng_next(rng) >> 11) * (1.0 / 9007199254740992.0);
 }
 
+/* The 32 bits of j in reverse order: j's base-2 radical inverse, as a binary fraction. */
+static inline uint32_t rad_reverse_bits(uint32_t j)
+{
+    j = ((j >> 1) & 0x55555555u) | ((j & 0x55555555u) << 1);
+    j = ((j >> 2) & 0x33333333u) | ((j & 0x33333333u) << 2);
+    j = ((j >> 4) & 0x0F0F0F0Fu) | ((j & 0x0F0F0F0Fu) << 4);
+    j = ((j >> 8) & 0x00FF00FFu) | ((j & 0x00FF00FFu) << 8);
+    return (j >> 16) | (j << 16);
+}
+
 /* Radical inverse of j in base b: a coordinate of the Halton sequence, in [0, 1). In base
  * 2 the bits of j reversed, the same value exactly (every partial sum of the digits is a
  * binary fraction of at most 32 bits). */
 static inline double rad_radical_inverse(uint32_t j, uint32_t b)
 {
-    if (b == 2) {
-        j = ((j >> 1) & 0x55555555u) | ((j & 0x55555555u) << 1);
-        j = ((j >> 2) & 0x33333333u) | ((j & 0x33333333u) << 2);
-        j = ((j >> 4) & 0x0F0F0F0Fu) | ((j & 0x0F0F0F0Fu) << 4);
-        j = ((j >> 8) & 0x00FF00FFu) | ((j & 0x00FF00FFu) << 8);
-        j = (j >> 16) | (j << 16);
-        return (double)j * (1.0 / 4294967296.0);
-    }
+    if (b == 2)
+        return (double)rad_reverse_bits(j) * (1.0 / 4294967296.0);
     double inverse = 1.0 / b, scale = inverse, value = 0;
     for (; j > 0; j /= b, scale *= inverse)
         value += (j % b) * scale;

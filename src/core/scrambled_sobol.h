@@ -18,14 +18,7 @@
 
 #include <stdint.h>
 
-static inline uint32_t sobol_reverse_bits(uint32_t x)
-{
-    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
-    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
-    x = ((x >> 4) & 0x0F0F0F0Fu) | ((x & 0x0F0F0F0Fu) << 4);
-    x = ((x >> 8) & 0x00FF00FFu) | ((x & 0x00FF00FFu) << 8);
-    return (x >> 16) | (x << 16);
-}
+#include "core/random.h"
 
 /* The Laine-Karras permutation of a fraction's bits reversed: each bit flipped by a hash
  * of the bits below it (those above it in the fraction) and the seed; multiplications by
@@ -43,7 +36,7 @@ static inline uint32_t sobol_laine_karras(uint32_t reversed, uint32_t seed)
 /* Owen's scramble of the 32-bit fraction x. */
 static inline uint32_t sobol_owen_scramble(uint32_t x, uint32_t seed)
 {
-    return sobol_reverse_bits(sobol_laine_karras(sobol_reverse_bits(x), seed));
+    return rad_reverse_bits(sobol_laine_karras(rad_reverse_bits(x), seed));
 }
 
 /* The second dimension's generator: direction numbers v_1 = 1/2, v_(k+1) = v_k xor
@@ -61,7 +54,7 @@ static inline uint32_t sobol_second(uint32_t index)
 static inline void sobol_scrambled_bits(uint32_t index, uint32_t seed1, uint32_t seed2,
                                         uint32_t *x1, uint32_t *x2)
 {
-    *x1 = sobol_owen_scramble(sobol_reverse_bits(index), seed1);
+    *x1 = sobol_owen_scramble(rad_reverse_bits(index), seed1);
     *x2 = sobol_owen_scramble(sobol_second(index), seed2);
 }
 
@@ -92,8 +85,8 @@ static inline void sobol_walk_next(sobol_walk *walk, uint32_t *x1, uint32_t *x2)
         walk->second ^= r;
     }
     walk->step++;
-    *x1 = sobol_reverse_bits(sobol_laine_karras(walk->first, walk->seed1));
-    *x2 = sobol_reverse_bits(sobol_laine_karras(walk->second, walk->seed2));
+    *x1 = rad_reverse_bits(sobol_laine_karras(walk->first, walk->seed1));
+    *x2 = rad_reverse_bits(sobol_laine_karras(walk->second, walk->seed2));
 }
 
 #endif
