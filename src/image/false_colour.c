@@ -14,6 +14,7 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/order.h"
 #include "core/rgb.h"
 
 #define LEGEND_WIDTH 96u   /* pixels added on the right */
@@ -116,12 +117,6 @@ static double luminance_of(const float *p)
     return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
 }
 
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 rad_status rad_image_false_colour(const rad_image *values,
                                   const rad_false_colour_options *options, rad_image **out,
                                   rad_error *error)
@@ -147,7 +142,7 @@ rad_status rad_image_false_colour(const rad_image *values,
             if (isfinite(y) && y > 0)
                 sorted[m++] = y;
         }
-        qsort(sorted, m, sizeof(*sorted), compare_doubles);
+        qsort(sorted, m, sizeof(*sorted), rad_compare_doubles);
         high = m ? sorted[(size_t)(0.99 * (double)(m - 1))] : 1;
         low = options->logarithmic ? (m ? sorted[(size_t)(0.01 * (double)(m - 1))] : high / 100) : 0;
         free(sorted);

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 
 #include "core/alloc.h"
+#include "core/order.h"
 #include "core/rgb.h"
 
 /* Below this linear value the sRGB curve is the straight line 12.92 x (IEC 61966-2-1). */
@@ -37,12 +38,6 @@ uint8_t rad_tonemap_srgb8(double linear)
     return (uint8_t)(rad_tonemap_srgb_encode(linear) * 255 + 0.5);
 }
 
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 double rad_tonemap_auto_scale(double *luminance, size_t count)
 {
     size_t lit = 0; /* the finite values > 0, moved to the front */
@@ -51,7 +46,7 @@ double rad_tonemap_auto_scale(double *luminance, size_t count)
             luminance[lit++] = luminance[i];
     if (lit == 0)
         return 1;
-    qsort(luminance, lit, sizeof(*luminance), compare_doubles);
+    qsort(luminance, lit, sizeof(*luminance), rad_compare_doubles);
     double position = RAD_TONEMAP_AUTO_PERCENTILE * (double)(lit - 1);
     size_t below = (size_t)position;
     double fraction = position - (double)below;

@@ -9,6 +9,7 @@
 
 #include "core/alloc.h"
 #include "core/error.h"
+#include "core/order.h"
 #include "core/random.h"
 #include "core/rgb.h"
 #include "core/vec3.h"
@@ -192,12 +193,6 @@ static void buried_from_neighbours(const rad_mesh *mesh, const uint8_t *hidden,
         }
 }
 
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* The area around a vertex whose gather is given all of its rays (gather_rays_for): the
  * GATHER_FULL_SHARE quantile of the gathering vertices' areas (vertex_frame.weight, the
  * sum of their patches' areas): about a whole patch's vertex away from the refined parts.
@@ -217,7 +212,7 @@ static double gather_full_area(const vertex_frame *frame, const vertex_parents *
     for (uint32_t v = 0; v < n; v++)
         if (frame[v].weight > 0 && !(parents && parents[v].count))
             areas[at++] = frame[v].weight;
-    qsort(areas, count, sizeof(*areas), compare_doubles);
+    qsort(areas, count, sizeof(*areas), rad_compare_doubles);
     double full = areas[(uint32_t)(GATHER_FULL_SHARE * (count - 1))];
     free(areas);
     return full;
