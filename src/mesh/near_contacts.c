@@ -253,6 +253,15 @@ bool near_contacts_pair_may_block(const near_contacts *contacts, uint32_t from, 
     return may_cross(contacts, from, to) || may_cross(contacts, to, from);
 }
 
+/* Whether point a lies in patch k's grown box (near_contacts.box): else no point of k is
+ * within the reach of a segment's end at a. */
+static bool in_box(const near_contacts *contacts, uint32_t k, rad_vec3 a)
+{
+    const double *box = contacts->box[k];
+    return a.x >= box[0] && a.y >= box[1] && a.z >= box[2] && a.x <= box[3] && a.y <= box[4] &&
+           a.z <= box[5];
+}
+
 /* Can the segment a + t d, t in (t_low, zone), meet contact k? Not when the stretch where
  * it runs within k's flatness of k's plane lies outside that range, nor when k's bounding
  * sphere is farther from a than the stretch is long. Both tests are exact (k's triangles
@@ -289,11 +298,8 @@ static bool blocked_near(const near_contacts *contacts, uint32_t end, uint32_t o
     const rad_mesh *mesh = contacts->mesh;
     for (uint32_t c = contacts->start[end]; c < contacts->start[end + 1]; c++) {
         uint32_t k = contacts->contact[c];
-        const double *box = contacts->box[k];
-        if (a.x < box[0] || a.y < box[1] || a.z < box[2] || a.x > box[3] || a.y > box[4] ||
-            a.z > box[5])
-            continue; /* no point of k within reach of the end */
-        if (k != other && may_meet(contacts, k, a, d, length, t_low, zone) &&
+        if (k != other && in_box(contacts, k, a) &&
+            may_meet(contacts, k, a, d, length, t_low, zone) &&
             crosses_patch(mesh, k, a, d, t_low, zone))
             return true;
     }
@@ -305,12 +311,9 @@ static bool blocked_near(const near_contacts *contacts, uint32_t end, uint32_t o
 static bool in_a_contact_box(const near_contacts *contacts, uint32_t end, uint32_t other,
                              rad_vec3 a)
 {
-    for (uint32_t c = contacts->start[end]; c < contacts->start[end + 1]; c++) {
-        const double *box = contacts->box[contacts->contact[c]];
-        if (contacts->contact[c] != other && a.x >= box[0] && a.y >= box[1] &&
-            a.z >= box[2] && a.x <= box[3] && a.y <= box[4] && a.z <= box[5])
+    for (uint32_t c = contacts->start[end]; c < contacts->start[end + 1]; c++)
+        if (contacts->contact[c] != other && in_box(contacts, contacts->contact[c], a))
             return true;
-    }
     return false;
 }
 
