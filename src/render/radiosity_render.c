@@ -659,6 +659,16 @@ static bool any_mirror(const rad_mesh *mesh, const rad_material *materials)
     return false;
 }
 
+/* shown[v] = 1 for every corner of a patch p with seen[p], 0 for every other vertex. */
+static void mark_corners(const rad_mesh *mesh, const uint8_t *seen, uint8_t *shown)
+{
+    for (uint32_t v = 0; v < mesh->vertex_count; v++)
+        shown[v] = 0;
+    for (uint32_t p = 0; p < mesh->patch_count; p++)
+        for (uint32_t k = 0; seen[p] && k < mesh->patches[p].vertex_count; k++)
+            shown[mesh->patches[p].vertex[k]] = 1;
+}
+
 /* shown[v] for the mesh's vertices: whether a pixel may show the light at vertex v. A ray
  * through every pixel's centre marks the patch it meets first (and a two-sided patch's
  * twin, when it meets the back), and so are the patches that share a corner with a marked
@@ -699,16 +709,11 @@ static bool shown_vertices(const rad_mesh *mesh, const display_mesh *display,
                 }
             }
         }
-        for (uint32_t v = 0; v < mesh->vertex_count; v++)
-            shown[v] = 0;
-        for (int ring = 0; ring < 2; ring++) { /* the patches met, then their neighbours */
-            for (uint32_t p = 0; p < mesh->patch_count; p++)
-                for (uint32_t k = 0; seen[p] && k < mesh->patches[p].vertex_count; k++)
-                    shown[mesh->patches[p].vertex[k]] = 1;
-            for (uint32_t p = 0; ring == 0 && p < mesh->patch_count; p++)
-                for (uint32_t k = 0; !seen[p] && k < mesh->patches[p].vertex_count; k++)
-                    seen[p] = shown[mesh->patches[p].vertex[k]] ? 2 : 0;
-        }
+        mark_corners(mesh, seen, shown);
+        for (uint32_t p = 0; p < mesh->patch_count; p++) /* and the patches around those */
+            for (uint32_t k = 0; k < mesh->patches[p].vertex_count; k++)
+                seen[p] |= shown[mesh->patches[p].vertex[k]];
+        mark_corners(mesh, seen, shown);
         for (uint32_t v = mesh->vertex_count; parents && v-- > 0;)
             for (uint32_t k = 0; shown[v] && k < parents[v].count; k++)
                 shown[parents[v].vertex[k]] = 1;

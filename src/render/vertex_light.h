@@ -116,13 +116,14 @@ typedef struct vertex_light_job {
  * gather_rays) is the GATHER_FULL_SHARE quantile of the gathering vertices' areas (a whole
  * patch's vertex, next to the pieces light_refine splits); the fewest, 1/GATHER_FEWEST_PART
  * of all. */
+#define GATHER_FULL_SHARE 0.9
+#define GATHER_FEWEST_PART 8u
+
 /* A vertex that no pixel shows (the render's camera rays meet none of its patches: the far
  * faces of a box, what lies behind the camera) gathers with 1/VERTEX_UNSHOWN_PART of its
  * rays: its light only lights the second gather's field, whose 128 rays a vertex average
  * over many vertices. */
 #define VERTEX_UNSHOWN_PART 8u
-#define GATHER_FULL_SHARE 0.9
-#define GATHER_FEWEST_PART 8u
 
 /* Per mesh vertex v (mesh->vertex_count values): direct[v], the emitters' direct
  * irradiance, sharp[v] the sharp sources', and gathered[v], the irradiance the view's
