@@ -106,7 +106,10 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 /* leaves out                                                                            */
 
 #define RAD_DEFAULT_QUADRATURE 1        /* rad_formfactor_options.quadrature: 1 x 1 */
-#define RAD_DEFAULT_VISIBILITY_RAYS 16  /* rad_formfactor_options.visibility_rays */
+#define RAD_DEFAULT_VISIBILITY_RAYS 9   /* rad_formfactor_options.visibility_rays: a patch
+                                           pair's (the dense form factors) */
+#define RAD_DEFAULT_LINK_VISIBILITY_RAYS 16 /* rad_hierarchy_options.visibility_rays: a
+                                               link's, after a first 4 that disagree */
 #define RAD_DEFAULT_ACCURACY 1e-4       /* rad_viewfactor_options.accuracy */
 #define RAD_DEFAULT_MAX_RAYS 1024       /* rad_viewfactor_options.max_rays */
 #define RAD_SIGHT_RAYS_NONE UINT32_MAX  /* rad_viewfactor_options.sight_rays: none */
@@ -1509,7 +1512,8 @@ typedef struct rad_scene_solve_options {
                                   rad_solve_options and rad_hierarchy_options); 0 = 1e-4 */
     uint32_t max_iterations;   /* sweeps, or shots for shooting; 0 = the solver's default */
     uint32_t quadrature;       /* dense form factors: m x m split per patch; 0 = 1 */
-    uint32_t visibility_rays;  /* most visibility segments per patch pair or link; 0 = 16 */
+    uint32_t visibility_rays;  /* most visibility segments per patch pair or link; 0 = 9
+                                  a patch pair, 16 a link */
     double refine_threshold;   /* hierarchical: 0 = 0.25 (RAD_AUTO_REFINE_THRESHOLD when
                                   AUTO takes it for a small mesh, above) */
     uint64_t max_memory;       /* bytes the solver's large buffers may use; 0 = no budget

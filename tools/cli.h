@@ -173,9 +173,10 @@ enum {
     "                       patches, " CLI_STR(RAD_HIERARCHICAL_DEFAULT_PATCHES)              \
     " with --solver hierarchical, or the one\n"                                            \
     "                       --solution's file was solved with)\n"                           \
-    "  --visibility-rays N  most occlusion rays per patch pair or link (default "          \
-    CLI_STR(RAD_DEFAULT_VISIBILITY_RAYS) "; 4\n"                                          \
-    "                       first, all N only where those 4 disagree)\n"                   \
+    "  --visibility-rays N  most occlusion rays per patch pair (default "                  \
+    CLI_STR(RAD_DEFAULT_VISIBILITY_RAYS) ") or link ("                                     \
+    CLI_STR(RAD_DEFAULT_LINK_VISIBILITY_RAYS) ":\n"                                        \
+    "                       4 first, all N where those disagree)\n"                        \
     "  --quadrature M       M x M points per patch for the analytic form factor (default " \
     CLI_STR(RAD_DEFAULT_QUADRATURE) ")\n"                                                 \
     "  --threads N          worker threads (default: all cores)\n"                          \
