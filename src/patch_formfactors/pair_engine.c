@@ -524,9 +524,14 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
             w->pairs_exact++;
             if (settled > 0)
                 e->sink(e->sink_data, thread, i, j, settled);
-        } else if (exact_polygons) {
+        } else if (exact_polygons || partly) {
             /* something may block: the full set of segments at once (a first pass of four
-             * would call a pair wholly visible when a small shadow escapes all four) */
+             * would call a pair wholly visible when a small shadow escapes all four). So
+             * for a pair with a partly buried patch: when its first four land on the open
+             * part, the whole patch's transfer would be taken over the open part's area
+             * (the refining pass's fresh segments do not make up for it). A folded wall's
+             * factors from a floor patch that a block's corner covers a seventh of came out
+             * 5.6 % high, that patch's row 1.4 % above 1. */
             if (w->refine.ray_count + e->strata * e->strata > BATCH_RAYS)
                 flush_refine(e, w, thread, i);
             batch_add(e, &w->refine, i, j, G, e->strata, 1);
