@@ -30,11 +30,11 @@
 typedef struct display_locator display_locator;
 
 /* The bytes a display triangle that building the locator is expected to hold at its
- * peak (182 on test_display_locate's Cornell box, 214 on its long thin strip, with half a
- * display triangle a grid cell; 88 and 89 with two, before 2026-12-06;
- * test_display_locate holds every scene it builds under this): under a budget, the first
- * check. Once the listings are counted, what they need is checked against the budget
- * again. */
+ * peak (test_display_locate holds what every scene it builds keeps under this: 62 on its
+ * Cornell box and 69 on its long thin strip, the cells' listings 4-byte indices; 182 and
+ * 214 when each listing held its own copy of the map, 88 and 89 with two display
+ * triangles a cell, both before 2026-12-06): under a budget, the first check. Once the
+ * listings are counted, what they need is checked against the budget again. */
 #define DISPLAY_LOCATE_BYTES_PER_TRIANGLE 256u
 
 /* Builds the locator for the first `front` display triangles (positions: every display
