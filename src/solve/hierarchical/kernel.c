@@ -25,6 +25,7 @@
 #include "core/tolerance.h"
 #include "core/vec3.h"
 #include "geometry/contour.h"
+#include "geometry/polygon_pair.h"
 #include "solve/hierarchical/hierarchy.h"
 #include "trace/ray.h"
 
@@ -33,6 +34,10 @@
 #define TOUCHING_DISTANCE 1.0 /* and closer than this: 4 x 4 points */
 #define OPEN_RATIO 6.0 /* a planar node seen from this many of its radii or more is taken whole */
 #define MAX_SOURCE_OPENINGS 64
+/* Two planar nodes at least this many times the sum of their radii apart, each wholly in
+ * front of the other, take the kernel's second-order expansion (polygon_pair_expansion)
+ * for their link's factor, not the disk A cos cos / (pi r^2 + A), low seen obliquely. */
+#define EXPANSION_DISTANCE 3.0
 
 /* Largest signed distance of the box's corners from the plane through c with normal n. */
 static double box_front(rad_vec3 lo, rad_vec3 hi, rad_vec3 c, rad_vec3 n)
@@ -213,6 +218,20 @@ link_estimate hier_estimate(const rad_mesh *mesh, const hier_tree *tree, uint32_
     if (gap > 0)
         e.factor_bound = min_d(smaller, p->area * q->area * bound_p * bound_q / (RAD_PI * gap * gap));
     e.factor = q->area * cos_p * cos_q / (RAD_PI * r2 + q->area);
+    if (p->planar && q->planar && r >= EXPANSION_DISTANCE * (p->radius + q->radius) &&
+        v3_dot(p->normal, d) > q->radius && -v3_dot(q->normal, d) > p->radius) {
+        /* far apart, each wholly in front of the other: the kernel's expansion to second
+         * order about both centroids, as the dense form factors' far pairs */
+        polygon_moments mp = {p->centroid, p->normal, p->area, {0}};
+        polygon_moments mq = {q->centroid, q->normal, q->area, {0}};
+        for (int k = 0; k < 6; k++) {
+            mp.moment[k] = p->moment[k];
+            mq.moment[k] = q->moment[k];
+        }
+        double G = polygon_pair_expansion(&mp, &mq);
+        if (G > 0)
+            e.factor = G / p->area;
+    }
     return e;
 }
 

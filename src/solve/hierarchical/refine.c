@@ -194,8 +194,11 @@ static size_t refine_chunk(const refine_context *c, const hlink *links, const ui
         }
         bool leaves = nodes[child->receiver].patch != HNODE_NONE &&
                       nodes[child->source].patch != HNODE_NONE;
-        /* partly visible, or hidden between larger nodes (a gap the first few missed) */
-        if (visible < FIRST_RAYS && extra > 0 && (visible > 0 || !leaves)) {
+        /* partly visible, or hidden (a gap the first few missed): two patches whose first
+         * few segments were all blocked were dropped as hidden, and what the rest of their
+         * segments would have found open was lost (the Cornell box's solution 0.06 % of
+         * its mean darker for it, on the dense mesh) */
+        if (visible < FIRST_RAYS && extra > 0) {
             hier_segments(c->tree, c->seed + 1, child->receiver, child->source, extra,
                           tb->more_rays, tb->more_kernel, c->leaf_brightness, tb->more_weight,
                           tb->more_blocked);
