@@ -19,12 +19,13 @@
  *     (the sum of F_ij over the surface's patches) against the share of cosine-distributed
  *     rays from uniform points of its open part that first meet that surface, found by
  *     testing every scene triangle (an independent path: no tracer, no patches): within
- *     4 sigma of the count and 3 % of the share. Measured when it was written: 1-2.6 %
- *     low on the block a patch runs under, within 2 % elsewhere; the patch by the tall
- *     block's corner saw the red wall 5.6 % too much before.
- * Patches mostly buried are a known limit (docs/DESIGN.md, "Buried parts"): a tenth open,
- * a surface's share was off by up to 70 % (the block it runs under, too low), so they are
- * counted here, not checked.
+ *     4 sigma of the count and 3 % of the share. Measured when it was written: 64 such
+ *     patches, the largest difference 0.64 of its allowance, a surface's share 0.9 % low
+ *     on average for the block a patch runs under and 0.55 % for the rest; the patch by
+ *     the tall block's corner saw the red wall 5.6 % too much before.
+ * Patches mostly buried are a known limit (docs/DESIGN.md, "Buried parts"), counted here,
+ * not checked: every surface's share reads low, a tenth open by 3-5 %, a fiftieth open by
+ * up to 67 % (the block it runs under).
  */
 #include <math.h>
 #include <stdio.h>
@@ -35,7 +36,7 @@
 
 #define PI 3.14159265358979323846
 #define POINTS 60000u      /* Monte-Carlo rays per patch */
-#define OPEN_CHECKED 0.75  /* the patches checked: at least this share open */
+#define OPEN_CHECKED 0.3   /* the patches checked: at least this share open */
 
 /* xorshift64*: the test's own random numbers */
 static double uniform(uint64_t *state)
