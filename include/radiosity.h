@@ -109,7 +109,7 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 #define RAD_DEFAULT_VISIBILITY_RAYS 9   /* rad_formfactor_options.visibility_rays: a patch
                                            pair's (the dense form factors) */
 #define RAD_DEFAULT_LINK_VISIBILITY_RAYS 16 /* rad_hierarchy_options.visibility_rays: a
-                                               link's, after a first 4 that disagree */
+                                               link's, after a first 4 not all open */
 #define RAD_DEFAULT_ACCURACY 1e-4       /* rad_viewfactor_options.accuracy */
 #define RAD_DEFAULT_MAX_RAYS 1024       /* rad_viewfactor_options.max_rays */
 #define RAD_SIGHT_RAYS_NONE UINT32_MAX  /* rad_viewfactor_options.sight_rays: none */
@@ -1324,7 +1324,8 @@ double rad_system_residual(const rad_system *system, const rad_rgb *B);
 typedef struct rad_hierarchy_options {
     double refine_threshold;  /* BFA threshold, as a fraction of the scene's emitted power
                                  per patch; 0 = 0.25. Smaller = more links, more accurate */
-    uint32_t visibility_rays; /* segments per link when the first 4 disagree; 0 = 16 */
+    uint32_t visibility_rays; /* segments per link when the first 4 are not all open;
+                                 0 = 16 */
     double tolerance;         /* relative change of a sweep (area-weighted); 0 = 1e-4 */
     uint32_t max_iterations;  /* sweeps; 0 = 1000 */
     uint64_t max_memory;      /* bytes the link store may use (both of its buffers); 0 =

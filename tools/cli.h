@@ -176,7 +176,7 @@ enum {
     "  --visibility-rays N  most occlusion rays per patch pair (default "                  \
     CLI_STR(RAD_DEFAULT_VISIBILITY_RAYS) ") or link ("                                     \
     CLI_STR(RAD_DEFAULT_LINK_VISIBILITY_RAYS) ":\n"                                        \
-    "                       4 first, all N where those disagree)\n"                        \
+    "                       4 first, all N unless all 4 are open)\n"                       \
     "  --quadrature M       M x M points per patch for the analytic form factor (default " \
     CLI_STR(RAD_DEFAULT_QUADRATURE) ")\n"                                                 \
     "  --threads N          worker threads (default: all cores)\n"                          \

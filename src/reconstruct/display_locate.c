@@ -70,7 +70,8 @@ struct display_locator {
     uint32_t *items;      /* per cell, its display triangles: indices into placed, 4 bytes
                              each so that a cell's list shares a cache line (the maps
                              themselves, repeated in every cell, made the listings 3.6 MB
-                             on the Cornell box instead of 1.1 MB with placed) */
+                             on the Cornell box; with `placed` they and the maps take
+                             1.1 MB) */
     located *placed;      /* per (scene triangle, display triangle) pair found */
     uint32_t placed_count;
 };

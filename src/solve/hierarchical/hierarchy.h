@@ -165,7 +165,8 @@ typedef struct refine_context {
     const float *leaf_brightness;  /* B.r + B.g + B.b by leaf-order position */
     double epsilon;                /* absolute BFA threshold (power) */
     bool full_check;               /* look at settled links too */
-    unsigned visibility_rays;      /* segments for a link the first 4 found partial */
+    unsigned visibility_rays;      /* segments for a link the first 4 did not find all
+                                      open */
     uint64_t seed;
     int threads;
     const uint8_t *receiver_role;  /* per node, over MPI ranks: children received ELSEWHERE
