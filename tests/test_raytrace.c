@@ -24,9 +24,7 @@
 
 #define PI 3.14159265358979323846
 
-typedef struct vec {
-    double x, y, z;
-} vec;
+typedef rad_vec3 vec;
 
 static vec mk(double x, double y, double z) { return (vec){x, y, z}; }
 static vec sub(vec a, vec b) { return mk(a.x - b.x, a.y - b.y, a.z - b.z); }
@@ -187,16 +185,10 @@ static int sphere_hit(vec o, vec d, double *t_out, double *margin)
     int best = -1;
     double best_t = INFINITY;
     for (int t = 0; t < sphere_triangles; t++) {
-        vec a = sphere_v[sphere_t[t][0]], b = sphere_v[sphere_t[t][1]], c = sphere_v[sphere_t[t][2]];
-        vec e1 = sub(b, a), e2 = sub(c, a), pv = cross(d, e2);
-        double det = dot(e1, pv);
-        if (fabs(det) < 1e-300)
-            continue;
-        vec tv = sub(o, a);
-        double u = dot(tv, pv) / det;
-        vec qv = cross(tv, e1);
-        double v = dot(d, qv) / det, s = dot(e2, qv) / det;
-        if (u < 0 || v < 0 || u + v > 1 || s <= 0 || s >= best_t)
+        double u = 0, v = 0;
+        double s = test_ray_triangle(o, d, sphere_v[sphere_t[t][0]], sphere_v[sphere_t[t][1]],
+                                     sphere_v[sphere_t[t][2]], &u, &v);
+        if (s <= 0 || s >= best_t)
             continue;
         best = t;
         best_t = s;

@@ -149,29 +149,14 @@ static void check_canyon(double W, double H, double L)
                  "sky view factors: every one within --accuracy 0.0001 (absolute)") != NULL);
 }
 
-/* Möller-Trumbore: does the ray (o, d) hit triangle (a, b, c) at t > 1e-9? */
+/* Does the ray (o, d) hit triangle (a, b, c) at t > 1e-9 (test_ray_triangle)? */
 static bool hits(const double o[3], const double d[3], const double a[3], const double b[3],
                  const double c[3])
 {
-    double e1[3], e2[3], s[3], p[3], q[3];
-    for (int k = 0; k < 3; k++)
-        e1[k] = b[k] - a[k], e2[k] = c[k] - a[k], s[k] = o[k] - a[k];
-    p[0] = d[1] * e2[2] - d[2] * e2[1];
-    p[1] = d[2] * e2[0] - d[0] * e2[2];
-    p[2] = d[0] * e2[1] - d[1] * e2[0];
-    double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
-    if (fabs(det) < 1e-15)
-        return false;
-    double u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det;
-    if (u < 0 || u > 1)
-        return false;
-    q[0] = s[1] * e1[2] - s[2] * e1[1];
-    q[1] = s[2] * e1[0] - s[0] * e1[2];
-    q[2] = s[0] * e1[1] - s[1] * e1[0];
-    double v = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
-    if (v < 0 || u + v > 1)
-        return false;
-    return (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det > 1e-9;
+    const rad_vec3 at = {a[0], a[1], a[2]}, bt = {b[0], b[1], b[2]}, ct = {c[0], c[1], c[2]};
+    double t = test_ray_triangle((rad_vec3){o[0], o[1], o[2]}, (rad_vec3){d[0], d[1], d[2]},
+                                 at, bt, ct, NULL, NULL);
+    return t > 1e-9 && t < INFINITY;
 }
 
 /* The share of cosine-distributed rays from uniform points of quad 0 (flat, facing +z)

@@ -433,3 +433,28 @@ uint32_t *test_ply_triangles(const char *name, uint32_t *count)
     free(bytes);
     return triangles;
 }
+
+static rad_vec3 minus(rad_vec3 a, rad_vec3 b) { return (rad_vec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
+static double inner(rad_vec3 a, rad_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static rad_vec3 outer(rad_vec3 a, rad_vec3 b)
+{
+    return (rad_vec3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
+double test_ray_triangle(rad_vec3 o, rad_vec3 d, rad_vec3 a, rad_vec3 b, rad_vec3 c, double *u,
+                         double *v)
+{
+    rad_vec3 e1 = minus(b, a), e2 = minus(c, a), p = outer(d, e2);
+    double det = inner(e1, p);
+    if (!(fabs(det) > 1e-300))
+        return INFINITY;
+    rad_vec3 s = minus(o, a), q = outer(s, e1);
+    double bu = inner(s, p) / det, bv = inner(d, q) / det;
+    if (!(bu >= 0 && bv >= 0 && bu + bv <= 1))
+        return INFINITY;
+    if (u)
+        *u = bu;
+    if (v)
+        *v = bv;
+    return inner(e2, q) / det;
+}

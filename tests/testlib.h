@@ -48,6 +48,14 @@ void test_fail(const char *file, int line, const char *format, ...)
                       v_, e_, t_);                                                         \
     } while (0)
 
+/* The tests' own ray-triangle test (Moller-Trumbore, either side, double precision), an
+ * oracle apart from the library's tracers: the distance t along d at which the ray from o
+ * meets triangle (a, b, c), and the hit's barycentrics u (b's weight) and v (c's) when
+ * not NULL; INFINITY when it misses or the ray runs in the triangle's plane. t may be 0 or
+ * less: each caller keeps the hits past its own least distance. */
+double test_ray_triangle(rad_vec3 o, rad_vec3 d, rad_vec3 a, rad_vec3 b, rad_vec3 c, double *u,
+                         double *v);
+
 /* Prints "name: N checks, M failed" and returns 0 when nothing failed. */
 int test_finish(const char *name);
 
