@@ -21,6 +21,7 @@
 #include "lights/direct_light.h"
 #include "reconstruct/display_mesh.h"
 #include "render/emitter_light.h"
+#include "render/emitter_shadows.h"
 #include "lights/emitters.h"
 #include "trace/ray.h"
 
@@ -67,6 +68,7 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
     if (capacity < EMITTER_SAMPLES)
         capacity = EMITTER_SAMPLES;
     emitter_set emitters = {0};
+    emitter_shadows *shadows = NULL;
     rad_patch_inputs *built = NULL;
     const rad_patch_inputs *inputs = options->inputs;
     rad_rgb *reflected = NULL;
@@ -111,6 +113,8 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
     if (!display_mesh_radiance(mesh, &display, reflected, radiance))
         goto nomem;
     status = emitters_build(scene, &emitters, error);
+    if (status == RAD_OK) /* their light exactly, where it can be */
+        status = emitter_shadows_build(scene, &emitters, &shadows, error);
     if (status != RAD_OK)
         goto done;
     /* the front patches' triangles (twins come after them, and so do their display
@@ -137,7 +141,11 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
         for (uint32_t q = 0; q < k; q++)
             if (!b->blocked[q])
                 rgb_add_to(&sum, b->value[q]);
-        if (emitters.count) {
+        rad_rgb behind;
+        if (shadows &&
+            emitter_shadows_irradiance(shadows, v3_add(x, v3_scale(n, lights.leave)), n, &behind)) {
+            rgb_add_to(&sum, behind); /* the emitters' direct light, exactly */
+        } else if (emitters.count) {
             /* the emitters' direct light: light samples and cosine rays, MIS-weighted */
             double shift1 = rad_rng_uniform(&rng), shift2 = rad_rng_uniform(&rng);
             k = emitter_light_rays_mis(&emitters, scene, x, n, lights.leave, EMITTER_SAMPLES,
@@ -211,6 +219,7 @@ done:
     rad_tracer_destroy(surfaces);
     rad_tracer_destroy(occluders);
     display_mesh_free(&display);
+    emitter_shadows_destroy(shadows);
     emitters_free(&emitters);
     rad_patch_inputs_destroy(built);
     free(reflected);

@@ -36,6 +36,7 @@
 #include "lights/direct_light.h"
 #include "render/camera.h"
 #include "render/emitter_light.h"
+#include "render/emitter_shadows.h"
 #include "render/gather.h"
 #include "render/light_refine.h"
 #include "lights/emitters.h"
@@ -173,6 +174,8 @@ typedef struct shading {
                                         emitters_exact DISPLAY_PENUMBRA): their unshadowed
                                         irradiance at its corners and its edges' midpoints
                                         (open_light_nodes) */
+    const emitter_shadows *shadows;  /* NULL, or with emitters_exact: their light behind
+                                        every occluder, exactly (no shadow rays) */
 } shading;
 
 /* The open light on a display triangle as the quadratic through its six nodes (corners
@@ -384,7 +387,13 @@ static void queue_lights(const shading *sh, row_work *w, uint32_t slot, rad_vec3
             rad_rgb open = unshadowed ? *unshadowed
                                       : emitter_unshadowed_irradiance(sh->emitters, sh->scene,
                                                                       point, patch->normal);
-            if (!rgb_is_zero(open)) {
+            rad_rgb shadowed;
+            if (!rgb_is_zero(open) && sh->shadows &&
+                emitter_shadows_irradiance(sh->shadows, v3_add(point, v3_scale(patch->normal, leave)),
+                                           patch->normal, &shadowed)) {
+                /* the light behind every occluder, exactly: nothing to trace */
+                rgb_add_to(&w->sum[slot], rgb_mul(shadowed, factor));
+            } else if (!rgb_is_zero(open)) {
                 /* in the default render's penumbrae an edge or rim sample, one of
                  * hundreds in its pixel, takes a sixteenth: its pixel's first samples have
                  * the full number, and together they follow on from those along the same
@@ -770,6 +779,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                                                   triangle takes the emitters' light */
     rad_rgb *without_emitters = NULL;
     const emitter_set *pixel_emitters = NULL; /* those whose light some pixels compute */
+    emitter_shadows *shadows = NULL; /* their light exactly, where it can be */
     bool agreed = false; /* every rank has passed ranks_agree (collective over MPI ranks) */
     status = display_mesh_build(mesh, true, &display, error);
     if (status != RAD_OK)
@@ -799,6 +809,8 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
         direct_light = RAD_DIRECT_SOLUTION;
     if (direct_light == RAD_DIRECT_PIXEL || direct_light == RAD_DIRECT_VERTEX) {
         status = emitters_build(options->scene, &emitters, error);
+        if (status == RAD_OK) /* their light exactly, where it can be */
+            status = emitter_shadows_build(options->scene, &emitters, &shadows, error);
         if (status == RAD_OK)
             status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, options->scene,
                                                  &scene_tracer, error);
@@ -885,6 +897,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
             .lookup = lookup,
             .irradiance = options->irradiance,
             .emitters = &emitters,
+            .shadows = shadows,
             .scene_tracer = scene_tracer,
             .view = &view,
             .sharp = lights_ptr && lights.sharp_count > 0 ? lights_ptr : NULL,
@@ -1036,7 +1049,7 @@ static rad_status render_mesh(const rad_mesh *mesh, const rad_rgb *B,
                      emitter_samples, per_row,
                      edge_k * edge_k, scene_tracer,
                      emitter_way, without_emitters,
-                     (const rad_rgb(*)[6])open_nodes};
+                     (const rad_rgb(*)[6])open_nodes, emitters_exact ? shadows : NULL};
 
     /* over several MPI ranks the rows are dealt out in turn (every pixel's random numbers
      * are its own, so each row comes out as in a serial run), then summed: every pixel is
@@ -1214,6 +1227,7 @@ done:
     rad_tracer_destroy(tracer);
     rad_tracer_destroy(scene_tracer);
     display_locator_destroy(locator);
+    emitter_shadows_destroy(shadows);
     emitters_free(&emitters);
     free(hidden);
     free(reflected);

@@ -20,6 +20,7 @@
 
 #include "lights/emitters.h"
 #include "radiosity.h"
+#include "render/emitter_shadows.h"
 #include "render/gather.h"
 
 /* A vertex's point: this share of the way to its patches' mean centre. On a crease or a
@@ -61,6 +62,8 @@ typedef struct vertex_parents {
 typedef struct vertex_light_job {
     const emitter_set *emitters; /* their direct light, traced against `occluders` (the
                                     scene's triangles); empty: none */
+    const emitter_shadows *shadows; /* NULL, or their light behind every occluder exactly
+                                       (then no shadow rays where it can be had) */
     const light_set *sharp;      /* NULL, or the sharp sources (point, spot, luminaire,
                                     sun: one shadow ray each) */
     const rad_scene *scene;

@@ -133,6 +133,7 @@ rad_status vertex_radiance(const vertex_radiance_job *job, rad_rgb *radiance,
         goto done;
     vertex_light_job light = {
         .emitters = job->emitters,
+        .shadows = job->shadows,
         .sharp = job->sharp,
         .scene = job->scene,
         .mesh = mesh,
@@ -227,6 +228,7 @@ rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh 
     rad_tracer *tracer = NULL, *scene_tracer = NULL;
     display_locator *locator = NULL;
     emitter_set emitters = {0};
+    emitter_shadows *shadows = NULL;
     light_set lights;
     rad_status status = RAD_OK;
     if (!positions || !hidden || !reflected) {
@@ -241,6 +243,8 @@ rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh 
                                display_mesh_front_triangles(mesh, display), &tracer, error);
     if (status == RAD_OK)
         status = emitters_build(scene, &emitters, error);
+    if (status == RAD_OK)
+        status = emitter_shadows_build(scene, &emitters, &shadows, error);
     if (status == RAD_OK)
         status = rad_tracer_create_for_scene(RAD_TRACER_EMBREE, scene, &scene_tracer, error);
     if (status != RAD_OK)
@@ -270,6 +274,7 @@ rad_status vertex_radiance_of_solution(const rad_mesh *mesh, const display_mesh 
         .scene = scene,
         .inputs = inputs,
         .emitters = &emitters,
+        .shadows = shadows,
         .scene_tracer = scene_tracer,
         .view = &view,
         .sharp = any_lights && lights.sharp_count > 0 ? &lights : NULL,
@@ -284,6 +289,7 @@ done:
     rad_tracer_destroy(tracer);
     rad_tracer_destroy(scene_tracer);
     display_locator_destroy(locator);
+    emitter_shadows_destroy(shadows);
     emitters_free(&emitters);
     free(positions);
     free(hidden);

@@ -40,6 +40,7 @@ typedef struct vertex_radiance_job {
     const patch_material_lookup *lookup; /* NULL, or its textured patches hold irradiance */
     bool irradiance;                     /* every vertex holds irradiance */
     const emitter_set *emitters;
+    const emitter_shadows *shadows;      /* NULL, or their light exactly (emitter_shadows.h) */
     const rad_tracer *scene_tracer;      /* the scene's triangles */
     const gather_view *view;             /* what the gather rays meet */
     const light_set *sharp;              /* NULL, or the scene's sharp sources */

@@ -334,17 +334,12 @@ const convex_solids *occluder_tree_solids(const occluder_tree *tree)
 
 void occluder_tree_use_solids(occluder_tree *tree, bool use) { tree->use_solids = use; }
 
-uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
-                               const vf_polygon *q, double epsilon, shadow_occluder *out,
-                               uint32_t max)
+/* The triangles that may cut hull h (built for p and q), as occluder_tree_collect. */
+static uint32_t collect_in(const occluder_tree *tree, const hull *h, const vf_polygon *p,
+                           const vf_polygon *q, double epsilon, shadow_occluder *out,
+                           uint32_t max)
 {
-    if (tree->node_count == 0)
-        return 0;
     uint32_t found = 0;
-    hull h;
-    make_hull(&h, p, q, epsilon);
-    h.exclude[0] = p->source;
-    h.exclude[1] = q->source;
     /* a convex solid's faces turned away from p (or, if p cannot see it so, from q) cast
      * no shadow its other faces do not: the last solid met and the polygon it is seen
      * from (NULL: all its faces) */
@@ -355,12 +350,12 @@ uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
     stack[top++] = 0;
     while (top) {
         const tree_node *node = &tree->nodes[stack[--top]];
-        if (box_outside(&h, node, epsilon))
+        if (box_outside(h, node, epsilon))
             continue;
         if (node->count) {
             for (uint32_t t = node->first; t < node->first + node->count; t++) {
                 const tree_triangle *tt = &tree->triangles[t];
-                if (!triangle_cuts(&h, tt, epsilon))
+                if (!triangle_cuts(h, tt, epsilon))
                     continue;
                 if (tt->solid != UINT32_MAX && tree->use_solids) {
                     if (tt->solid != last_solid) {
@@ -384,4 +379,64 @@ uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
         }
     }
     return found;
+}
+
+uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
+                               const vf_polygon *q, double epsilon, shadow_occluder *out,
+                               uint32_t max)
+{
+    if (tree->node_count == 0)
+        return 0;
+    hull h;
+    make_hull(&h, p, q, epsilon);
+    h.exclude[0] = p->source;
+    h.exclude[1] = q->source;
+    return collect_in(tree, &h, p, q, epsilon, out, max);
+}
+
+uint32_t occluder_tree_collect_from_point(const occluder_tree *tree, rad_vec3 x, rad_vec3 n,
+                                          const vf_polygon *q, double epsilon,
+                                          shadow_occluder *out, uint32_t max)
+{
+    if (tree->node_count == 0)
+        return 0;
+    /* the pyramid of x and q: q's plane, x's, and one plane through x and each edge of q
+     * (q convex, x in front of it), with outward normals */
+    hull h;
+    h.corner_count = 0;
+    h.corner[h.corner_count++] = x;
+    for (unsigned k = 0; k < q->count; k++)
+        h.corner[h.corner_count++] = q->vertex[k];
+    for (int a = 0; a < 3; a++) {
+        h.lo[a] = INFINITY;
+        h.hi[a] = -INFINITY;
+        for (unsigned k = 0; k < h.corner_count; k++) {
+            h.lo[a] = fmin(h.lo[a], axis(h.corner[k], a));
+            h.hi[a] = fmax(h.hi[a], axis(h.corner[k], a));
+        }
+    }
+    h.plane_count = 0;
+    h.normal[h.plane_count] = v3_scale(n, -1);
+    h.offset[h.plane_count++] = -v3_dot(n, x);
+    h.normal[h.plane_count] = v3_scale(q->normal, -1);
+    h.offset[h.plane_count++] = -v3_dot(q->normal, q->vertex[0]);
+    for (unsigned k = 0; k < q->count; k++) {
+        rad_vec3 a = q->vertex[k], b = q->vertex[(k + 1) % q->count];
+        rad_vec3 side = v3_cross(v3_sub(b, a), v3_sub(x, a));
+        double length = v3_length(side);
+        if (!(length > 0))
+            continue; /* x on the edge's line: the other planes bound the pyramid */
+        side = v3_scale(side, 1 / length);
+        double offset = v3_dot(side, a);
+        if (v3_dot(side, q->centroid) - offset > 0) { /* turned inward: turn it round */
+            side = v3_scale(side, -1);
+            offset = -offset;
+        }
+        h.normal[h.plane_count] = side;
+        h.offset[h.plane_count++] = offset;
+    }
+    h.exclude[0] = h.exclude[1] = q->source;
+    vf_polygon point = {.count = 1, .normal = n, .centroid = x, .source = q->source};
+    point.vertex[0] = x;
+    return collect_in(tree, &h, &point, q, epsilon, out, max);
 }

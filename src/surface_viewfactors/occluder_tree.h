@@ -62,4 +62,12 @@ uint32_t occluder_tree_collect(const occluder_tree *tree, const vf_polygon *p,
                                const vf_polygon *q, double epsilon, shadow_occluder *out,
                                uint32_t max);
 
+/* The same for the pyramid of a point x (unit normal n: only what lies in front of its
+ * plane counts) and a convex polygon q whose front faces x: the triangles that may block a
+ * segment from x to q, for the exact light from q at x (shadow_visible_factor). q's own
+ * triangles (q->source) are left out. */
+uint32_t occluder_tree_collect_from_point(const occluder_tree *tree, rad_vec3 x, rad_vec3 n,
+                                          const vf_polygon *q, double epsilon,
+                                          shadow_occluder *out, uint32_t max);
+
 #endif
