@@ -484,11 +484,16 @@ static void row(const engine *e, thread_work *w, int thread, uint32_t i)
          * wall, is not among the occluders found, and such rows came out up to 3.4 once
          * divided) */
         bool partly = e->partly_buried && (e->partly_buried[i] || e->partly_buried[j]);
+        /* a pair EXACT_DISTANCE apart or more is not screened: its segments, which it
+         * gets in any case unless screening proves it clear, say as much (all of them
+         * open: G itself, exactly) at less cost: pair_engine.c's header */
+        const bool close = distance < EXACT_DISTANCE * radii;
+        crossing = EXACT_NO_CROSSING;
         exact_outcome outcome =
-            !partly && exact_pairs_group_clear(&e->exact, i, j)
-                ? EXACT_CLEAR
-                : exact_pairs_transfer(&e->exact, i, j, distance < EXACT_DISTANCE * radii,
-                                       EXACT_ACCURACY, &settled, &crossing);
+            !partly && exact_pairs_group_clear(&e->exact, i, j) ? EXACT_CLEAR
+            : close ? exact_pairs_transfer(&e->exact, i, j, true, EXACT_ACCURACY, &settled,
+                                           &crossing)
+                    : EXACT_SAMPLE;
         if (partly && (outcome == EXACT_CLEAR || outcome == EXACT_SETTLED))
             outcome = EXACT_SAMPLE;
         bool exact_polygons = e->exact.polygons[i].count && e->exact.polygons[j].count;
