@@ -106,7 +106,7 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, double fraction);
 /* leaves out                                                                            */
 
 #define RAD_DEFAULT_QUADRATURE 1        /* rad_formfactor_options.quadrature: 1 x 1 */
-#define RAD_DEFAULT_VISIBILITY_RAYS 9   /* rad_formfactor_options.visibility_rays: a patch
+#define RAD_DEFAULT_VISIBILITY_RAYS 4   /* rad_formfactor_options.visibility_rays: a patch
                                            pair's (the dense form factors) */
 #define RAD_DEFAULT_LINK_VISIBILITY_RAYS 16 /* rad_hierarchy_options.visibility_rays: a
                                                link's, after a first 4 not all open */

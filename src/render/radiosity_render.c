@@ -68,6 +68,9 @@
  * 0.368 / 0.416 % (64 with LIGHT_BATCH 4096 instead of 65536: 1.89 s, the same image).
  * test_contact_shadow's profile, the largest difference from the exact one: 2.29 % of the
  * open floor with 32 (past its 2 %), 1.94 % with 64. */
+/* Where the emitters' light behind the occluders is exact (emitter_shadows.h) a
+ * penumbra's hit takes that instead, with no shadow ray: these samples serve scenes past
+ * its limits. */
 #define PENUMBRA_DIRECT_SAMPLES 64u
 /* In a penumbra an edge or rim sample (the extra samples of a pixel, 256 or 1280 of
  * them) takes this share of a first sample's emitter samples: 64 each had made a

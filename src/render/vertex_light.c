@@ -30,6 +30,8 @@
  * 10,878 lit vertices, 3.4 M shadow rays fewer; 256 x 256, seeds 1-3, block / pixel
  * 0.472 / 0.817 % -> 0.474 / 0.817 %, the render about 0.1 s shorter (4 interleaved runs:
  * 1.30, 1.40, 1.27, 1.63 -> 1.22, 1.16, 1.18, 1.32 s). */
+/* (Where the light behind the occluders is exact, emitter_shadows.h, a vertex takes that
+ * instead and none of these samples.) */
 #define VERTEX_SHADOW_FIRST 8u
 /* With the emitters' light exact behind the occluders (emitter_shadows.h), a vertex sees
  * none of it below this share of the unshadowed light and all of it above 1 - the
