@@ -67,7 +67,7 @@ static emitter_shadows *shadows_of(const rad_scene *scene, emitter_set *set)
 static double green_at(const emitter_shadows *shadows, rad_vec3 x, rad_vec3 n, bool *ok)
 {
     rad_rgb e = {-1, -1, -1};
-    *ok = emitter_shadows_irradiance(shadows, x, n, &e);
+    *ok = emitter_shadows_irradiance(shadows, x, n, EMITTER_SHADOWS_MAX_OCCLUDERS, &e);
     return e.g;
 }
 
@@ -248,7 +248,8 @@ static void limits(void)
     bool ok = true;
     rad_rgb untouched = {-1, -1, -1};
     if (shadows)
-        ok = emitter_shadows_irradiance(shadows, v3(0, LIFT, 0), v3(0, 1, 0), &untouched);
+        ok = emitter_shadows_irradiance(shadows, v3(0, LIFT, 0), v3(0, 1, 0),
+                                        EMITTER_SHADOWS_MAX_OCCLUDERS, &untouched);
     CHECK(shadows && !ok && untouched.g == -1); /* 200 triangles in the way: sample */
     emitter_shadows_destroy(shadows);
     emitters_free(&set);

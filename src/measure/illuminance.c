@@ -143,7 +143,8 @@ rad_status rad_illuminance(const rad_scene *scene, const rad_mesh *mesh, const r
                 rgb_add_to(&sum, b->value[q]);
         rad_rgb behind;
         if (shadows &&
-            emitter_shadows_irradiance(shadows, v3_add(x, v3_scale(n, lights.leave)), n, &behind)) {
+            emitter_shadows_irradiance(shadows, v3_add(x, v3_scale(n, lights.leave)), n,
+                                       EMITTER_SHADOWS_MAX_OCCLUDERS, &behind)) {
             rgb_add_to(&sum, behind); /* the emitters' direct light, exactly */
         } else if (emitters.count) {
             /* the emitters' direct light: light samples and cosine rays, MIS-weighted */

@@ -150,18 +150,19 @@ done:
 }
 
 bool emitter_shadows_irradiance(const emitter_shadows *shadows, rad_vec3 x, rad_vec3 n,
-                                rad_rgb *irradiance)
+                                uint32_t most, rad_rgb *irradiance)
 {
+    if (most > EMITTER_SHADOWS_MAX_OCCLUDERS)
+        most = EMITTER_SHADOWS_MAX_OCCLUDERS;
     shadow_occluder occluders[EMITTER_SHADOWS_MAX_OCCLUDERS];
     rad_rgb sum = {0, 0, 0};
     for (uint32_t k = 0; k < shadows->count; k++) {
         const vf_polygon *light = &shadows->light[k];
         if (!(v3_dot(light->normal, v3_sub(x, light->vertex[0])) > shadows->epsilon))
             continue; /* behind the light, or in its plane */
-        uint32_t found = occluder_tree_collect_from_point(
-            shadows->tree, x, n, light, shadows->epsilon, occluders,
-            EMITTER_SHADOWS_MAX_OCCLUDERS);
-        if (found > EMITTER_SHADOWS_MAX_OCCLUDERS)
+        uint32_t found = occluder_tree_collect_from_point(shadows->tree, x, n, light,
+                                                          shadows->epsilon, occluders, most);
+        if (found > most)
             return false;
         double F = shadow_visible_factor(x, n, light, occluders, found, shadows->epsilon);
         if (F < 0)

@@ -40,9 +40,12 @@ void emitter_shadows_destroy(emitter_shadows *shadows);
 
 /* The emitters' irradiance at x (unit normal n; only light from in front of its plane
  * counts) with every occluder in place, into *irradiance; false (and *irradiance
- * untouched) when too many occluders or pieces make it a case for sampling.
+ * untouched) when more than `most` occluders (at most EMITTER_SHADOWS_MAX_OCCLUDERS) stand
+ * between x and one emitting polygon, or the pieces are too many: a case for sampling.
+ * The cost grows with the occluders: a few microseconds for ten of them, about what 64
+ * shadow rays cost, so a caller with a cheaper way (radiosity_render.c) asks for fewer.
  * Thread-safe. */
 bool emitter_shadows_irradiance(const emitter_shadows *shadows, rad_vec3 x, rad_vec3 n,
-                                rad_rgb *irradiance);
+                                uint32_t most, rad_rgb *irradiance);
 
 #endif

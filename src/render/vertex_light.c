@@ -30,15 +30,12 @@
  * 10,878 lit vertices, 3.4 M shadow rays fewer; 256 x 256, seeds 1-3, block / pixel
  * 0.472 / 0.817 % -> 0.474 / 0.817 %, the render about 0.1 s shorter (4 interleaved runs:
  * 1.30, 1.40, 1.27, 1.63 -> 1.22, 1.16, 1.18, 1.32 s). */
-/* (Where the light behind the occluders is exact, emitter_shadows.h, a vertex takes that
- * instead and none of these samples.) */
+/* A vertex whose first samples disagree takes the light behind the occluders exactly
+ * where it can be had (emitter_shadows.h) instead of the rest: on a furnished room of
+ * 9,942 triangles exact light at every vertex had cost 0.4-1 s more than these samples;
+ * where they agree they are cheaper. */
 #define VERTEX_SHADOW_FIRST 8u
-/* With the emitters' light exact behind the occluders (emitter_shadows.h), a vertex sees
- * none of it below this share of the unshadowed light and all of it above 1 - the
- * other: the two differ by rounding alone there (the contour integrals of the whole
- * polygon and of its triangles). */
-#define EXACT_SEES_NONE 1e-9
-#define EXACT_SEES_ALL 1e-9
+
 #define VERTEX_RANK_CHUNK 64u       /* over ranks: vertices dealt out in turn, this many at
                                        a time */
 /* Over ranks, what each vertex's light is shared as: direct, sharp, gathered (3 doubles
@@ -312,26 +309,15 @@ rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *s
             rad_vec3 x = v3_add(mesh->vertices[v], v3_scale(f->inward, VERTEX_INWARD / f->weight));
             double off = 2 * f->behind + job->leave;
             rad_rgb sum = {0, 0, 0};
-            rad_rgb behind; /* the exact light */
-            const rad_vec3 lifted = v3_add(x, v3_scale(nv, off));
-            if (exact && job->shadows &&
-                emitter_shadows_irradiance(job->shadows, lifted, nv, &behind)) {
-                /* the light behind every occluder, exactly; what it sees, from its share
-                 * of the unshadowed light */
-                sum = behind;
-                if (job->sees) {
-                    double open = rgb_luminance(
-                        emitter_unshadowed_irradiance(set, scene, lifted, nv));
-                    double got = rgb_luminance(behind);
-                    job->sees[v] = !(got > EXACT_SEES_NONE * open)      ? VERTEX_SEES_NONE
-                                   : got >= (1 - EXACT_SEES_ALL) * open ? VERTEX_SEES_ALL
-                                                                        : VERTEX_SEES_PART;
-                }
-            } else if (exact) {
+            if (exact) {
                 /* the unshadowed light exactly, times the share of the samples' that gets
                  * through; a first 1/VERTEX_SHADOW_FIRST of them (each triangle's first
-                 * Halton points) all through or all blocked settles it */
+                 * Halton points) all through or all blocked settles it; else the light
+                 * behind the occluders exactly (emitter_shadows.h), where it can be had,
+                 * or all the samples */
                 uint32_t tried = samples / VERTEX_SHADOW_FIRST, count = 0, through = 0;
+                rad_rgb behind;
+                bool settled = false;
                 for (int round = 0; round < 2; round++) {
                     count = emitter_light_rays_by_triangle(set, scene, x, nv, off, tried, turn,
                                                            shift1, shift2, 0, light, value);
@@ -340,12 +326,22 @@ rad_status vertex_light(const vertex_light_job *job, rad_rgb *direct, rad_rgb *s
                     through = 0;
                     for (uint32_t k = 0; k < count; k++)
                         through += !shadowed[k];
-                    if (tried == samples || through == 0 || through == count ||
-                        job->penumbra_at_pixels)
+                    if (tried == samples || through == 0 || through == count)
+                        break;
+                    if (job->shadows &&
+                        emitter_shadows_irradiance(job->shadows, v3_add(x, v3_scale(nv, off)),
+                                                   nv, EMITTER_SHADOWS_MAX_OCCLUDERS,
+                                                   &behind)) {
+                        settled = true;
+                        break;
+                    }
+                    if (job->penumbra_at_pixels)
                         break;
                     tried = samples;
                 }
-                for (uint32_t k = 0; k < count; k++)
+                if (settled)
+                    sum = behind;
+                for (uint32_t k = 0; !settled && k < count; k++)
                     if (!shadowed[k])
                         rgb_add_to(&sum, value[k]);
                 if (job->sees)
