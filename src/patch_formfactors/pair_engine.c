@@ -49,7 +49,8 @@
 #define BATCH_RAYS 4096u           /* rays traced per call */
 #define FIRST_STRATA 2u            /* first pass: 2 x 2 segments per pair */
 /* A close pair (under EXACT_DISTANCE x the sum of the radii) that screening leaves to
- * sampling, and a pair with a partly buried patch, take at least CLOSE_STRATA^2 segments:
+ * sampling, and a pair with a partly buried patch, take at least CLOSE_STRATA^2 segments
+ * (a folded patch's close pair once its first pass of 2 x 2 disagrees):
  * there the kernel and the visibility change fastest across the pair, and a buried
  * patch's row is divided by its open share, so only the segments that land on its open
  * part count. With the default 2 x 2 (--visibility-rays 4) for them, two floor patches

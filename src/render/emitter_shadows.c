@@ -160,6 +160,12 @@ bool emitter_shadows_irradiance(const emitter_shadows *shadows, rad_vec3 x, rad_
         const vf_polygon *light = &shadows->light[k];
         if (!(v3_dot(light->normal, v3_sub(x, light->vertex[0])) > shadows->epsilon))
             continue; /* behind the light, or in its plane */
+        bool above = false; /* some of it above x's horizon: else it lights nothing here,
+                               and its (flat) pyramid need not be walked */
+        for (unsigned c = 0; c < light->count && !above; c++)
+            above = v3_dot(n, v3_sub(light->vertex[c], x)) > shadows->epsilon;
+        if (!above)
+            continue;
         uint32_t found = occluder_tree_collect_from_point(shadows->tree, x, n, light,
                                                           shadows->epsilon, occluders, most);
         if (found > most)
