@@ -45,15 +45,6 @@ static double rectangle_factor(double px, double pz, double x0, double x1, doubl
            corner_factor(x1 - px, z0 - pz, c) + corner_factor(x0 - px, z0 - pz, c);
 }
 
-static rad_scene *load(const char *name)
-{
-    rad_scene *scene = NULL;
-    rad_error error;
-    if (rad_scene_load(test_path(name), NULL, &scene, &error) != RAD_OK)
-        test_fail(__FILE__, __LINE__, "%s: %s", name, error.message);
-    return scene;
-}
-
 /* The scene's emitters and their exact shadows (NULL when there are none). */
 static emitter_shadows *shadows_of(const rad_scene *scene, emitter_set *set)
 {
@@ -69,6 +60,23 @@ static double green_at(const emitter_shadows *shadows, rad_vec3 x, rad_vec3 n, b
     rad_rgb e = {-1, -1, -1};
     *ok = emitter_shadows_irradiance(shadows, x, n, EMITTER_SHADOWS_MAX_OCCLUDERS, &e);
     return e.g;
+}
+
+/* A scene's start: its materials and the grey floor y = 0, x and z in [-2, 2]. */
+static void begin_scene(test_obj *t)
+{
+    test_obj_add(t, "mtllib shadows.mtl\n");
+    test_obj_object(t, "floor", "grey");
+    test_obj_rectangle(t, 1, 0, -2, -2, 2, 2, 1);
+}
+
+/* The lamp (LAMP_HALF, LAMP_HEIGHT, facing down); writes the scene as `name`. */
+static void end_scene(test_obj *t, const char *name)
+{
+    test_obj_object(t, "lamp", "light");
+    test_obj_rectangle(t, 1, LAMP_HEIGHT, -LAMP_HALF, -LAMP_HALF, LAMP_HALF, LAMP_HALF, -1);
+    test_write_file(name, t->data);
+    free(t->data);
 }
 
 static void write_materials(void)
@@ -88,16 +96,11 @@ static void write_materials(void)
 static void parallel_plate(void)
 {
     test_obj t = {0};
-    test_obj_add(&t, "mtllib shadows.mtl\n");
-    test_obj_object(&t, "floor", "grey");
-    test_obj_rectangle(&t, 1, 0, -2, -2, 2, 2, 1);
+    begin_scene(&t);
     test_obj_object(&t, "plate", "grey");
     test_obj_rectangle(&t, 1, PLATE_HEIGHT, -PLATE_HALF, -PLATE_HALF, PLATE_HALF, PLATE_HALF, 1);
-    test_obj_object(&t, "lamp", "light");
-    test_obj_rectangle(&t, 1, LAMP_HEIGHT, -LAMP_HALF, -LAMP_HALF, LAMP_HALF, LAMP_HALF, -1);
-    test_write_file("plate.obj", t.data);
-    free(t.data);
-    rad_scene *scene = load("plate.obj");
+    end_scene(&t, "plate.obj");
+    rad_scene *scene = test_load_scene("plate.obj");
     emitter_set set = {0};
     emitter_shadows *shadows = shadows_of(scene, &set);
     CHECK(shadows != NULL);
@@ -181,9 +184,7 @@ static double counted_irradiance(const rad_scene *scene, rad_vec3 x, rad_vec3 n,
 static void box_and_tilted_plate(void)
 {
     test_obj t = {0};
-    test_obj_add(&t, "mtllib shadows.mtl\n");
-    test_obj_object(&t, "floor", "grey");
-    test_obj_rectangle(&t, 1, 0, -2, -2, 2, 2, 1);
+    begin_scene(&t);
     test_obj_object(&t, "box", "grey");
     test_obj_box(&t, -0.625, 0, -0.3125, -0.125, 0.75, 0.1875, false);
     test_obj_object(&t, "tilted", "grey");
@@ -192,11 +193,8 @@ static void box_and_tilted_plate(void)
                      "v 0.125 1.25 0.1875\n");
     test_obj_add(&t, "f %d %d %d %d\n", base + 1, base + 2, base + 3, base + 4);
     t.vertices += 4;
-    test_obj_object(&t, "lamp", "light");
-    test_obj_rectangle(&t, 1, LAMP_HEIGHT, -LAMP_HALF, -LAMP_HALF, LAMP_HALF, LAMP_HALF, -1);
-    test_write_file("box.obj", t.data);
-    free(t.data);
-    rad_scene *scene = load("box.obj");
+    end_scene(&t, "box.obj");
+    rad_scene *scene = test_load_scene("box.obj");
     emitter_set set = {0};
     emitter_shadows *shadows = shadows_of(scene, &set);
     CHECK(shadows != NULL);
@@ -228,9 +226,7 @@ static void box_and_tilted_plate(void)
 static void limits(void)
 {
     test_obj t = {0};
-    test_obj_add(&t, "mtllib shadows.mtl\n");
-    test_obj_object(&t, "floor", "grey");
-    test_obj_rectangle(&t, 1, 0, -2, -2, 2, 2, 1);
+    begin_scene(&t);
     test_obj_object(&t, "grid", "grey");
     for (int i = 0; i < 10; i++)
         for (int j = 0; j < 10; j++) {
@@ -238,11 +234,8 @@ static void limits(void)
             test_obj_rectangle(&t, 1, 1.0, z - 0.015625, x - 0.015625, z + 0.015625,
                                x + 0.015625, 1);
         }
-    test_obj_object(&t, "lamp", "light");
-    test_obj_rectangle(&t, 1, LAMP_HEIGHT, -LAMP_HALF, -LAMP_HALF, LAMP_HALF, LAMP_HALF, -1);
-    test_write_file("grid.obj", t.data);
-    free(t.data);
-    rad_scene *scene = load("grid.obj");
+    end_scene(&t, "grid.obj");
+    rad_scene *scene = test_load_scene("grid.obj");
     emitter_set set = {0};
     emitter_shadows *shadows = shadows_of(scene, &set);
     bool ok = true;
@@ -263,7 +256,7 @@ static void limits(void)
     test_write_file("two_sided.obj", u.data);
     free(u.data);
     rad_error error;
-    scene = load("two_sided.obj");
+    scene = test_load_scene("two_sided.obj");
     CHECK(rad_scene_set_surface_flags(scene, "lamp", RAD_SURFACE_TWO_SIDED, &error) == RAD_OK);
     {
         set = (emitter_set){0};
@@ -292,7 +285,7 @@ static void limits(void)
                                -0.4 + 0.1 * j, -0.4 + 0.1 * i, -1);
     test_write_file("tiles.obj", w.data);
     free(w.data);
-    scene = load("tiles.obj");
+    scene = test_load_scene("tiles.obj");
     set = (emitter_set){0};
     shadows = shadows_of(scene, &set);
     CHECK(set.count > EMITTER_ANALYTIC_MAX && shadows == NULL);

@@ -268,15 +268,6 @@ static bool solve_faces(const char *name, const rad_scene *scene, rad_rgb mean[6
     return ok;
 }
 
-static rad_scene *load(const char *name)
-{
-    rad_scene *scene = NULL;
-    rad_error error;
-    if (rad_scene_load(test_path(name), NULL, &scene, &error) != RAD_OK)
-        test_fail(__FILE__, __LINE__, "%s: %s", name, error.message);
-    return scene;
-}
-
 static const rad_material *surface_material(const rad_scene *scene, const char *surface)
 {
     for (uint32_t s = 0; s < scene->surface_count; s++)
@@ -335,7 +326,7 @@ static void same_solution_in_every_format(void)
     write_stl();
     write_gltf_files();
     rad_rgb reference[6], got[6];
-    rad_scene *obj = load("box.obj");
+    rad_scene *obj = test_load_scene("box.obj");
     if (!obj || !solve_faces("box.obj", obj, reference))
         return;
     check_box_materials(obj);
@@ -348,7 +339,7 @@ static void same_solution_in_every_format(void)
 
     const char *gltf_names[2] = {"box.gltf", "box.glb"};
     for (int k = 0; k < 2; k++) {
-        rad_scene *scene = load(gltf_names[k]);
+        rad_scene *scene = test_load_scene(gltf_names[k]);
         if (!scene)
             continue;
         check_box_materials(scene);
@@ -359,7 +350,7 @@ static void same_solution_in_every_format(void)
     }
 
     /* STL: no materials: everything starts at the default grey; materials set by name */
-    rad_scene *stl = load("box.stl");
+    rad_scene *stl = test_load_scene("box.stl");
     if (stl) {
         const rad_material *m = surface_material(stl, "left");
         CHECK(m && m->albedo.r == RAD_DEFAULT_ALBEDO && m->emission.r == 0);
@@ -427,7 +418,7 @@ static void set_fbx_property(const char *name, const char *key, const char *valu
 static void exported_formats(void)
 {
     rad_rgb reference[6], got[6];
-    rad_scene *obj = load("box.obj");
+    rad_scene *obj = test_load_scene("box.obj");
     if (!obj || !solve_faces("box.obj", obj, reference)) {
         rad_scene_destroy(obj);
         return;
@@ -438,7 +429,7 @@ static void exported_formats(void)
     for (int k = 0; k < 2; k++) {
         if (!export_obj(formats[k][0], formats[k][1]))
             continue;
-        rad_scene *scene = load(formats[k][1]);
+        rad_scene *scene = test_load_scene(formats[k][1]);
         if (scene && k == 0)
             CHECK(scene->unit_metres == 1); /* Collada: metres unless it says otherwise */
         if (scene && solve_faces(formats[k][1], scene, got)) {
@@ -466,7 +457,7 @@ static void exported_formats(void)
             fputs(up + strlen("<up_axis>Y_UP</up_axis>"), file);
             fclose(file);
         }
-        rad_scene *cm = load("box-cm.dae");
+        rad_scene *cm = test_load_scene("box-cm.dae");
         if (cm) {
             CHECK(cm->unit_metres == 1);
             CHECK(cm->up.y == 1);
@@ -490,7 +481,7 @@ static void exported_formats(void)
         return;
     set_fbx_property("box.fbx", "\"UpAxis\"", "2");
     set_fbx_property("box.fbx", "\"UnitScaleFactor\"", "100");
-    rad_scene *fbx = load("box.fbx");
+    rad_scene *fbx = test_load_scene("box.fbx");
     if (!fbx)
         return;
     CHECK(fbx->up.x == 0 && fbx->up.y == 0 && fbx->up.z == 1);
@@ -535,7 +526,7 @@ static void ply_matches_obj(void)
     fclose(obj);
     fclose(ply);
     rad_rgb reference[6], got[6];
-    rad_scene *a = load("open.obj"), *b = load("open.ply");
+    rad_scene *a = test_load_scene("open.obj"), *b = test_load_scene("open.ply");
     if (a && b && solve_faces("open.obj", a, reference)) {
         CHECK(b->surface_count == 1 && strcmp(b->surfaces[0].name, "open") == 0);
         CHECK(b->materials[b->triangles[0].material].albedo.g == RAD_DEFAULT_ALBEDO);
@@ -597,7 +588,7 @@ static void emissive_strength(void)
              "\"type\":\"SCALAR\"}]}",
              length, uri);
     test_write_file("strength.gltf", json);
-    rad_scene *scene = load("strength.gltf");
+    rad_scene *scene = test_load_scene("strength.gltf");
     if (!scene)
         return;
     const rad_material *a = surface_material(scene, "a"), *b = surface_material(scene, "b");

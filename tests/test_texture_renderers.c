@@ -41,15 +41,6 @@ static void write_stripes(const char *name, uint32_t width, uint32_t split, unsi
     test_write_png(name, width, 1, rgb);
 }
 
-static rad_scene *load(const char *name)
-{
-    rad_scene *scene = NULL;
-    rad_error error;
-    if (rad_scene_load(test_path(name), NULL, &scene, &error) != RAD_OK)
-        test_fail(__FILE__, __LINE__, "%s: %s", name, error.message);
-    return scene;
-}
-
 static double mean_green(const rad_image *image)
 {
     double sum = 0;
@@ -123,7 +114,7 @@ static void textured_furnace(void)
     test_write_file("cube.mtl", "newmtl glow\nKd 1 1 1\nmap_Kd grey188.png\n"
                                 "Ke 2 2 2\nmap_Ke grey188.png\n");
     write_textured_cube("cube.obj", "cube.mtl");
-    rad_scene *scene = load("cube.obj");
+    rad_scene *scene = test_load_scene("cube.obj");
     if (!scene)
         return;
     CHECK(scene->texture_count == 1);
@@ -179,7 +170,7 @@ static void whitted_texel_ratio(void)
                                    "newmtl lamp\nKd 0 0 0\nKe 5 5 5\n");
     write_lamp_floor("painted.obj", "whitted.mtl", "painted");
     write_lamp_floor("white.obj", "whitted.mtl", "white");
-    rad_scene *painted = load("painted.obj"), *white = load("white.obj");
+    rad_scene *painted = test_load_scene("painted.obj"), *white = test_load_scene("white.obj");
     if (!painted || !white) {
         rad_scene_destroy(painted);
         rad_scene_destroy(white);
@@ -251,7 +242,7 @@ static void emission_seen_directly(double fold)
              "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
              1 - fold);
     test_write_file("glow.obj", obj);
-    rad_scene *scene = load("glow.obj");
+    rad_scene *scene = test_load_scene("glow.obj");
     if (!scene)
         return;
     CHECK(rad_scene_has_emitter(scene));
@@ -365,7 +356,7 @@ static void floor_under_half_light(bool two_rectangles)
     test_write_file("nee.mtl", "newmtl floor\nKd 0.8 0.8 0.8\n"
                                "newmtl glow\nKd 0 0 0\nKe 3 3 3\nmap_Ke black_white.png\n");
     test_write_file("nee.obj", obj);
-    rad_scene *scene = load("nee.obj");
+    rad_scene *scene = test_load_scene("nee.obj");
     if (!scene)
         return;
     rad_error error;
@@ -474,7 +465,7 @@ static void solve_exitance(void)
                                  "v 0 0 0\nv 0 0 2\nv 2 0 2\nv 2 0 0\n"
                                  "vt 0 0\nvt 0 1\nvt 1 1\nvt 1 0\n"
                                  "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n");
-    rad_scene *scene = load("patch.obj");
+    rad_scene *scene = test_load_scene("patch.obj");
     rad_mesh *mesh = NULL;
     rad_patch_inputs *inputs = NULL;
     rad_error error;

@@ -58,6 +58,15 @@ const char *test_path(const char *name)
     return buffer;
 }
 
+rad_scene *test_load_scene(const char *name)
+{
+    rad_scene *scene = NULL;
+    rad_error error;
+    if (rad_scene_load(test_path(name), NULL, &scene, &error) != RAD_OK)
+        test_fail(__FILE__, __LINE__, "%s: %s", name, error.message);
+    return scene;
+}
+
 const char *test_write_file(const char *name, const char *text)
 {
     const char *path = test_path(name);

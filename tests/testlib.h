@@ -65,6 +65,10 @@ const char *test_tmpdir(void);
 /* Path inside the scratch folder (static buffer rotated among 8). */
 const char *test_path(const char *name);
 
+/* Loads the scene file `name` of the scratch folder (rad_scene_load, no options); fails the
+ * test (and returns NULL) when it cannot. */
+rad_scene *test_load_scene(const char *name);
+
 /* Writes text to a file in the scratch folder; returns its path. */
 const char *test_write_file(const char *name, const char *text);
 
