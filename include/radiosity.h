@@ -902,6 +902,9 @@ typedef struct rad_viewfactor_report {
                                     exact_pairs + sampled_pairs */
     uint64_t exact_pairs;        /* of those, up to exact_occluders triangles in between:
                                     their shadows clipped exactly */
+    uint64_t roomy_pairs;        /* of the exact pairs, those clipped on a second try with
+                                    room for more visible pieces a point and more work (a
+                                    large polygon behind hundreds of triangles) */
     uint64_t sampled_pairs;      /* of those, more occluders (or too many shadow pieces):
                                     visibility sampled */
     uint64_t unseen_pairs;       /* sampled pairs whose last round of segments was all

@@ -544,6 +544,7 @@ int command_viewfactors(int argc, char **argv)
     stats_integer(&stats, "unseen_pairs", report.unseen_pairs);
     stats_integer(&stats, "capped_pairs", report.capped_pairs);
     stats_integer(&stats, "short_pairs", report.short_pairs);
+    stats_integer(&stats, "roomy_pairs", report.roomy_pairs);
     stats_integer(&stats, "exact_occluders", report.exact_occluders);
     stats_integer(&stats, "rays_cast", report.rays);
     stats_integer(&stats, "unmet_pairs", report.unmet_pairs);
@@ -599,12 +600,14 @@ int command_viewfactors(int argc, char **argv)
     }
     exit_code = cli_finish(&stats, stats_path,
                            "%zu surfaces, %s%llu polygon pairs (%llu unobstructed exact, "
-                           "%llu obstructed exact, %llu sampled of which %llu saw nothing, "
+                           "%llu obstructed exact (%llu on a second try), %llu sampled of which "
+                           "%llu saw nothing, "
                            "%llu proven hidden), %llu rays%s, %llu non-zero factors, %.2f s: "
                            "wrote %s",
                            S, unmet, (unsigned long long)report.polygon_pairs,
                            (unsigned long long)report.unobstructed_pairs,
                            (unsigned long long)report.exact_pairs,
+                           (unsigned long long)report.roomy_pairs,
                            (unsigned long long)report.sampled_pairs,
                            (unsigned long long)report.unseen_pairs,
                            (unsigned long long)report.hidden_pairs,

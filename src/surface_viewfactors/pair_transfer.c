@@ -53,6 +53,9 @@ typedef struct outer_context {
     bool edge_check;         /* polygon_integral.edge_check */
     bool strips;             /* a parallelogram outer polygon by parallelogram_integral.h */
     uint64_t work_left;      /* occluder clippings this pair may still spend */
+    flat_piece *pieces;      /* NULL: room for SHADOW_MAX_PIECES visible pieces a point on
+                                the stack; else room for max_pieces here */
+    unsigned max_pieces;
     bool failed;             /* too many pieces somewhere, or the work budget ran out */
     struct cull_levels *cull; /* NULL: unobstructed, no occluders */
 } outer_context;
@@ -224,8 +227,11 @@ static inline double point_factor(outer_context *c, rad_vec3 x)
         return 0;
     }
     c->work_left -= count;
-    double factor = shadow_receiver_factor(c->receiver, x, c->normal, c->casters, index, count,
-                                           c->plane_epsilon);
+    double factor = c->pieces ? shadow_receiver_factor_in(c->receiver, x, c->normal, c->casters,
+                                                          index, count, c->plane_epsilon,
+                                                          c->pieces, c->max_pieces)
+                              : shadow_receiver_factor(c->receiver, x, c->normal, c->casters,
+                                                       index, count, c->plane_epsilon);
     if (factor < 0) {
         c->failed = true;
         return 0;
@@ -273,8 +279,9 @@ double pair_unobstructed(const vf_polygon *p, const vf_polygon *q, double accura
 static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                              const shadow_occluder *occluders, const shadow_polygon *joined,
                              uint32_t count, double accuracy, double absolute,
-                             double plane_epsilon, uint64_t work_budget, int min_depth,
-                             bool edge_check, bool strips, double *value, double *bound)
+                             double plane_epsilon, uint64_t work_budget, flat_piece *pieces,
+                             unsigned max_pieces, int min_depth, bool edge_check, bool strips,
+                             double *value, double *bound)
 {
     const vf_polygon *outer = p->area <= q->area ? p : q, *inner = outer == p ? q : p;
     if (count > PAIR_EXACT_MAX_OCCLUDERS)
@@ -301,6 +308,8 @@ static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                        .edge_check = edge_check,
                        .strips = strips,
                        .work_left = work_budget,
+                       .pieces = pieces,
+                       .max_pieces = max_pieces,
                        .cull = &levels};
     *value = integrate_outer(&c, outer, accuracy, absolute, bound);
     return !c.failed;
@@ -316,7 +325,23 @@ bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
         return false;
     uint32_t count = shadow_join_occluders(occluders, occluder_count, joined);
     return obstructed_exact(p, q, NULL, joined, count, accuracy, absolute, plane_epsilon,
-                            work_budget, OBSTRUCTED_MIN_DEPTH, true, true, value, bound);
+                            work_budget, NULL, 0, OBSTRUCTED_MIN_DEPTH, true, true, value,
+                            bound);
+}
+
+bool pair_obstructed_exact_roomy(const vf_polygon *p, const vf_polygon *q,
+                                 const shadow_occluder *occluders, uint32_t occluder_count,
+                                 double accuracy, double absolute, double plane_epsilon,
+                                 uint64_t work_budget, pair_workspace *workspace, double *value,
+                                 double *bound)
+{
+    shadow_polygon joined[PAIR_EXACT_MAX_OCCLUDERS];
+    if (occluder_count > PAIR_EXACT_MAX_OCCLUDERS)
+        return false;
+    uint32_t count = shadow_join_occluders(occluders, occluder_count, joined);
+    return obstructed_exact(p, q, NULL, joined, count, accuracy, absolute, plane_epsilon,
+                            work_budget, workspace->pieces, PAIR_ROOMY_PIECES,
+                            OBSTRUCTED_MIN_DEPTH, true, true, value, bound);
 }
 
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
@@ -324,7 +349,7 @@ bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                            double accuracy, double plane_epsilon, double *value, double *bound)
 {
     return obstructed_exact(p, q, occluders, NULL, occluder_count, accuracy, 0, plane_epsilon,
-                            EXACT_WORK_BUDGET, 0, false, false, value, bound);
+                            EXACT_WORK_BUDGET, NULL, 0, 0, false, false, value, bound);
 }
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)
@@ -333,11 +358,12 @@ bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays)
     workspace->rays = rad_alloc_array(max_rays, sizeof(rad_ray));
     workspace->occluded = rad_alloc_array(max_rays, 1);
     workspace->weight = rad_alloc_array(max_rays, sizeof(double));
+    workspace->pieces = rad_alloc_array(PAIR_ROOMY_PIECES, sizeof(flat_piece));
     workspace->last_p = workspace->last_q = NULL;
     workspace->last_occluders = NULL;
     workspace->last_stream = 0;
     workspace->last_rounds = 0;
-    return workspace->rays && workspace->occluded && workspace->weight;
+    return workspace->rays && workspace->occluded && workspace->weight && workspace->pieces;
 }
 
 void pair_workspace_free(pair_workspace *workspace)
@@ -345,6 +371,7 @@ void pair_workspace_free(pair_workspace *workspace)
     free(workspace->rays);
     free(workspace->occluded);
     free(workspace->weight);
+    free(workspace->pieces);
 }
 
 /* One round: PAIR_REPLICATES independent stratified sets of k x k segments (k a power of

@@ -95,7 +95,13 @@ typedef struct pair_round {
     uint32_t rays;
 } pair_round;
 
-/* Scratch space of one thread: the occluders of a pair and its sampled visibility. */
+/* Visible pieces a point of pair_obstructed_exact_roomy may break its receiver into: a
+ * ground tile behind some 300 triangles of the 22k-surface generated city breaks into
+ * more than SHADOW_MAX_PIECES at some points. */
+#define PAIR_ROOMY_PIECES 1024u
+
+/* Scratch space of one thread: the occluders of a pair, its sampled visibility, and room
+ * for the visible pieces of pair_obstructed_exact_roomy. */
 typedef struct pair_workspace {
     shadow_occluder occluders[PAIR_EXACT_MAX_OCCLUDERS];
     rad_ray *rays;
@@ -108,9 +114,19 @@ typedef struct pair_workspace {
     uint64_t last_stream;
     unsigned last_rounds;
     pair_round last_round[PAIR_MAX_ROUNDS];
+    flat_piece *pieces; /* room for PAIR_ROOMY_PIECES */
 } pair_workspace;
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays);
+
+/* pair_obstructed_exact_within with room for PAIR_ROOMY_PIECES visible pieces a point (the
+ * workspace's) rather than SHADOW_MAX_PIECES: the try after that gave up on a pair behind
+ * hundreds of triangles. */
+bool pair_obstructed_exact_roomy(const vf_polygon *p, const vf_polygon *q,
+                                 const shadow_occluder *occluders, uint32_t occluder_count,
+                                 double accuracy, double absolute, double plane_epsilon,
+                                 uint64_t work_budget, pair_workspace *workspace, double *value,
+                                 double *bound);
 void pair_workspace_free(pair_workspace *workspace);
 
 typedef struct pair_visibility {

@@ -173,8 +173,10 @@ static const shadow_caster *caster_of(const occluder_list *list, uint32_t k,
     return scratch;
 }
 
+/* pieces: room for max_pieces visible pieces. */
 static double visible_factor(const shadow_receiver *r, rad_vec3 x, rad_vec3 n,
-                             const occluder_list *occluders, double plane_epsilon)
+                             const occluder_list *occluders, double plane_epsilon,
+                             flat_piece *pieces, unsigned max_pieces)
 {
     rad_vec3 N = r->frame.normal;
     double H = v3_dot(N, x) - r->offset;
@@ -182,7 +184,6 @@ static double visible_factor(const shadow_receiver *r, rad_vec3 x, rad_vec3 n,
         return 0;
     /* the shadows are cut from the receiver in its plane's own coordinates */
     flat_point x_flat = plane_frame_flat(&r->frame, x);
-    flat_piece pieces[SHADOW_MAX_PIECES];
     unsigned count = 1;
     pieces[0] = r->whole;
     for (uint32_t k = 0; k < occluders->count && count > 0; k++) {
@@ -191,7 +192,7 @@ static double visible_factor(const shadow_receiver *r, rad_vec3 x, rad_vec3 n,
         if (!project_shadow(x_flat, H, caster_of(occluders, k, r, plane_epsilon, &scratch),
                             &shadow))
             continue;
-        int made = flat_subtract(pieces, count, &shadow, r->tiny, SHADOW_MAX_PIECES);
+        int made = flat_subtract(pieces, count, &shadow, r->tiny, max_pieces);
         if (made < 0)
             return -1;
         count = (unsigned)made;
@@ -211,7 +212,8 @@ double shadow_visible_factor(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
     shadow_receiver r;
     shadow_receiver_prepare(receiver, &r);
     occluder_list list = {NULL, occluders, NULL, NULL, occluder_count};
-    return visible_factor(&r, x, n, &list, plane_epsilon);
+    flat_piece pieces[SHADOW_MAX_PIECES];
+    return visible_factor(&r, x, n, &list, plane_epsilon, pieces, SHADOW_MAX_PIECES);
 }
 
 double shadow_visible_factor_polygons(rad_vec3 x, rad_vec3 n, const vf_polygon *receiver,
@@ -221,7 +223,8 @@ double shadow_visible_factor_polygons(rad_vec3 x, rad_vec3 n, const vf_polygon *
     shadow_receiver r;
     shadow_receiver_prepare(receiver, &r);
     occluder_list list = {NULL, NULL, occluders, NULL, occluder_count};
-    return visible_factor(&r, x, n, &list, plane_epsilon);
+    flat_piece pieces[SHADOW_MAX_PIECES];
+    return visible_factor(&r, x, n, &list, plane_epsilon, pieces, SHADOW_MAX_PIECES);
 }
 
 double shadow_receiver_factor(const shadow_receiver *receiver, rad_vec3 x, rad_vec3 n,
@@ -229,7 +232,17 @@ double shadow_receiver_factor(const shadow_receiver *receiver, rad_vec3 x, rad_v
                               uint32_t count, double plane_epsilon)
 {
     occluder_list list = {casters, NULL, NULL, index, count};
-    return visible_factor(receiver, x, n, &list, plane_epsilon);
+    flat_piece pieces[SHADOW_MAX_PIECES];
+    return visible_factor(receiver, x, n, &list, plane_epsilon, pieces, SHADOW_MAX_PIECES);
+}
+
+double shadow_receiver_factor_in(const shadow_receiver *receiver, rad_vec3 x, rad_vec3 n,
+                                 const shadow_caster *casters, const uint32_t *index,
+                                 uint32_t count, double plane_epsilon, flat_piece *pieces,
+                                 unsigned max_pieces)
+{
+    occluder_list list = {casters, NULL, NULL, index, count};
+    return visible_factor(receiver, x, n, &list, plane_epsilon, pieces, max_pieces);
 }
 
 /* Sine of the turn below which a corner of a joined occluder counts as straight (dropped)

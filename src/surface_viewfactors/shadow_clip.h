@@ -75,6 +75,13 @@ double shadow_receiver_factor(const shadow_receiver *receiver, rad_vec3 x, rad_v
                               const shadow_caster *casters, const uint32_t *index,
                               uint32_t count, double plane_epsilon);
 
+/* The same with room for max_pieces visible pieces in `pieces` (rather than
+ * SHADOW_MAX_PIECES on the stack): -1 only past max_pieces. */
+double shadow_receiver_factor_in(const shadow_receiver *receiver, rad_vec3 x, rad_vec3 n,
+                                 const shadow_caster *casters, const uint32_t *index,
+                                 uint32_t count, double plane_epsilon, flat_piece *pieces,
+                                 unsigned max_pieces);
+
 /* The occluding triangles joined where they can be, into `out` (room for `count`): two
  * join when they share an edge (the same corners, bit for bit), lie in one plane and their
  * union is convex with at most VF_MAX_VERTICES corners (straight corners dropped, to 1e-12
