@@ -63,6 +63,10 @@
  * 16). */
 #define SKY_PAIR_WORK_BUDGET (4u * PAIR_EXACT_WORK_BUDGET)
 
+/* The work of a tile's second try (pair_obstructed_exact_roomy), as a multiple of the
+ * first's. */
+#define SKY_ROOMY_WORK 4u
+
 /* Occluders are cut this far (times the polygon's size) above its plane (lift_occluders). */
 #define SKY_LIFT 1e-6
 
@@ -472,8 +476,9 @@ static double sample_sky(const sky_context *c, const vf_polygon *p, uint32_t pi,
  * visible, clipped exactly as a pair of the matrix is (pair_obstructed_exact_within:
  * joined where they share an edge, culled per cell of p's splitting), to the looser of
  * the relative accuracy and `absolute`; false when more than exact_occluders triangles
- * (after lifting) stand in the hull, the visible part breaks into too many pieces or the
- * clipping needs more than SKY_PAIR_WORK_BUDGET: the tile is then sampled. */
+ * (after lifting) stand in the hull, or when the visible part breaks into too many pieces
+ * or the clipping needs more than SKY_PAIR_WORK_BUDGET, and again with room for
+ * PAIR_ROOMY_PIECES pieces and SKY_ROOMY_WORK times the work: the tile is then sampled. */
 static bool pair_tile(const sky_context *c, const vf_polygon *p, sky_workspace *w,
                       const vf_polygon *tile, double absolute, uint32_t *collected,
                       double *value, double *bound)
@@ -490,8 +495,14 @@ static bool pair_tile(const sky_context *c, const vf_polygon *p, sky_workspace *
         *value = pair_unobstructed(p, tile, 0.25 * c->accuracy, c->eps, bound);
         return true;
     }
-    return pair_obstructed_exact_within(p, tile, w->lifted, count, c->accuracy, absolute,
-                                        c->eps, SKY_PAIR_WORK_BUDGET, value, bound);
+    if (pair_obstructed_exact_within(p, tile, w->lifted, count, c->accuracy, absolute, c->eps,
+                                     SKY_PAIR_WORK_BUDGET, value, bound))
+        return true;
+    /* too many visible pieces at a point, or out of work: once more with room for more
+     * (as the matrix's pairs) */
+    return pair_obstructed_exact_roomy(p, tile, w->lifted, count, c->accuracy, absolute, c->eps,
+                                       SKY_ROOMY_WORK * SKY_PAIR_WORK_BUDGET, &w->pair, value,
+                                       bound);
 }
 
 /* The transfer from polygon p (index pi) to the sky, with its error bound in *bound. */
