@@ -34,7 +34,7 @@
 
 /* Splits of a parallelogram's cells in either direction, at most: the cull callback's
  * levels run to twice this. */
-#define PARALLELOGRAM_MAX_SPLITS 8
+#define PARALLELOGRAM_MAX_SPLITS 10
 #define PARALLELOGRAM_MAX_LEVELS (2 * PARALLELOGRAM_MAX_SPLITS + 1)
 
 /* As polygon_integral.cell, for the cell with corners corner[0 .. 4) (a parallelogram,
