@@ -118,6 +118,7 @@ typedef struct pair_workspace {
 } pair_workspace;
 
 bool pair_workspace_init(pair_workspace *workspace, uint32_t max_rays);
+void pair_workspace_free(pair_workspace *workspace);
 
 /* pair_obstructed_exact_within with room for PAIR_ROOMY_PIECES visible pieces a point (the
  * workspace's) rather than SHADOW_MAX_PIECES: the try after that gave up on a pair behind
@@ -127,7 +128,6 @@ bool pair_obstructed_exact_roomy(const vf_polygon *p, const vf_polygon *q,
                                  double accuracy, double absolute, double plane_epsilon,
                                  uint64_t work_budget, pair_workspace *workspace, double *value,
                                  double *bound);
-void pair_workspace_free(pair_workspace *workspace);
 
 typedef struct pair_visibility {
     double fraction; /* visible fraction in [0, 1] */
