@@ -282,8 +282,6 @@ static double monte_carlo_crowd(uint32_t rays, double *sigma)
         double x = rad_rng_uniform(&rng), y = rad_rng_uniform(&rng);
         double u = rad_rng_uniform(&rng), phi = 2 * pi * rad_rng_uniform(&rng);
         double radius = sqrt(u), up = sqrt(1 - u);
-        if (!(up > 0))
-            continue; /* grazing: escapes */
         double cx = x + 0.15 * radius * cos(phi) / up, cy = y + 0.15 * radius * sin(phi) / up;
         bool blocked = false;
         if (cx >= 0 && cx < 1 && cy >= 0 && cy < 1) {

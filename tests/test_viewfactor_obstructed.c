@@ -604,6 +604,8 @@ static void check_occluder_grid(int columns, int rows, uint32_t exact_occluders)
     grid_columns = columns;
     grid_rows = rows;
     CHECK(columns * rows <= 160);
+    if (columns * rows > 160)
+        return;
     for (int i = 0; i < columns; i++)
         for (int j = 0; j < rows; j++) {
             double *b = box[rows * i + j], pitch_x = 1.0 / columns, pitch_y = 1.0 / rows;

@@ -14,8 +14,8 @@
 #include "geometry/flat_pieces.h"
 #include "surface_viewfactors/vf_geometry.h"
 
-/* Most convex pieces the visible part may break into before the caller falls back to
- * sampling. */
+/* Most convex pieces the visible part may break into on the stack; past them the caller
+ * tries again with more room (shadow_receiver_factor_in) or samples. */
 #define SHADOW_MAX_PIECES 48
 
 typedef struct shadow_occluder {
@@ -76,7 +76,7 @@ double shadow_receiver_factor(const shadow_receiver *receiver, rad_vec3 x, rad_v
                               uint32_t count, double plane_epsilon);
 
 /* The same with room for max_pieces visible pieces in `pieces` (rather than
- * SHADOW_MAX_PIECES on the stack): -1 only past max_pieces. */
+ * SHADOW_MAX_PIECES on the stack): -1 past max_pieces or as flat_subtract says. */
 double shadow_receiver_factor_in(const shadow_receiver *receiver, rad_vec3 x, rad_vec3 n,
                                  const shadow_caster *casters, const uint32_t *index,
                                  uint32_t count, double plane_epsilon, flat_piece *pieces,

@@ -272,15 +272,17 @@ static double polygon_pair(const engine *e, uint32_t pi, uint32_t qi, pair_works
                                                         &visible, &error);
         counts->roomy_pairs += roomy;
         double finer, finer_error;
+        /* the redo, with more room when the first try's room did not do (its finer cells
+         * may break into more pieces) */
         if (exact && error > target &&
-            (roomy ? pair_obstructed_exact_roomy(p, q, w->occluders, occluders,
-                                                 0.25 * e->accuracy, 0.125 * target, eps,
-                                                 4 * ROOMY_WORK * PAIR_EXACT_WORK_BUDGET, w,
-                                                 &finer, &finer_error)
-                   : pair_obstructed_exact_within(p, q, w->occluders, occluders,
-                                                  0.25 * e->accuracy, 0.125 * target, eps,
-                                                  4 * PAIR_EXACT_WORK_BUDGET, &finer,
-                                                  &finer_error)) &&
+            ((!roomy && pair_obstructed_exact_within(p, q, w->occluders, occluders,
+                                                     0.25 * e->accuracy, 0.125 * target, eps,
+                                                     4 * PAIR_EXACT_WORK_BUDGET, &finer,
+                                                     &finer_error)) ||
+             pair_obstructed_exact_roomy(p, q, w->occluders, occluders, 0.25 * e->accuracy,
+                                         0.125 * target, eps,
+                                         4 * ROOMY_WORK * PAIR_EXACT_WORK_BUDGET, w, &finer,
+                                         &finer_error)) &&
             finer_error < error) {
             visible = finer;
             error = finer_error;
