@@ -79,8 +79,8 @@ bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
  * kinks where its image leaves the receiver refine to the deepest level). A second try
  * (pair_obstructed_exact_roomy) gets a multiple of it, and with up to PAIR_ROOMY_PIECES
  * pieces a clipping may cost up to 20 times one of the first try's: such pairs are few
- * (56 of the 22k city's 1.07 M, none taking 50 ms), but their time is bounded only by
- * that. */
+ * (56 of the 22k city's 1.07 M, none taking 50 ms given the room from the start), but
+ * their time is bounded only by that. */
 #define PAIR_EXACT_WORK_BUDGET 262144u
 
 /* The most triangles in between that a pair can get exact shadow clipping behind (the

@@ -53,7 +53,8 @@
 
 
 /* The work a pair's second exact try may spend, as a multiple of the first's (on the
- * 22k-surface generated city none of its 56 second tries took 50 ms). */
+ * 22k-surface generated city, given that room from the start, none of the 56 pairs that
+ * need it took 50 ms). */
 #define ROOMY_WORK 16u
 
 typedef struct pair_counts {
