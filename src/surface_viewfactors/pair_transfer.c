@@ -61,8 +61,7 @@ typedef struct outer_context {
     bool edge_check;         /* polygon_integral.edge_check */
     bool strips;             /* a parallelogram outer polygon by parallelogram_integral.h */
     uint64_t work_left;      /* occluder clippings this pair may still spend */
-    flat_piece *pieces;      /* NULL: room for SHADOW_MAX_PIECES visible pieces a point on
-                                the stack; else room for max_pieces here */
+    flat_piece *pieces;      /* room for max_pieces visible pieces a point */
     unsigned max_pieces;
     bool failed;             /* too many pieces somewhere, or the work budget ran out */
     struct cull_levels *cull; /* NULL: unobstructed, no occluders */
@@ -235,11 +234,8 @@ static inline double point_factor(outer_context *c, rad_vec3 x)
         return 0;
     }
     c->work_left -= count;
-    double factor = c->pieces ? shadow_receiver_factor_in(c->receiver, x, c->normal, c->casters,
-                                                          index, count, c->plane_epsilon,
-                                                          c->pieces, c->max_pieces)
-                              : shadow_receiver_factor(c->receiver, x, c->normal, c->casters,
-                                                       index, count, c->plane_epsilon);
+    double factor = shadow_receiver_factor(c->receiver, x, c->normal, c->casters, index, count,
+                                           c->plane_epsilon, c->pieces, c->max_pieces);
     if (factor < 0) {
         c->failed = true;
         return 0;
@@ -304,6 +300,11 @@ static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
                               &casters[k]);
     }
     cull_levels levels;
+    flat_piece stack_pieces[SHADOW_MAX_PIECES];
+    if (!pieces) {
+        pieces = stack_pieces;
+        max_pieces = SHADOW_MAX_PIECES;
+    }
     outer_context c = {.normal = outer->normal,
                        .inner = inner,
                        .plane_epsilon = plane_epsilon,
@@ -325,18 +326,30 @@ static bool obstructed_exact(const vf_polygon *p, const vf_polygon *q,
     return !c.failed;
 }
 
-bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
-                                  const shadow_occluder *occluders, uint32_t occluder_count,
-                                  double accuracy, double absolute, double plane_epsilon,
-                                  uint64_t work_budget, double *value, double *bound)
+/* pair_obstructed_exact_within with room for max_pieces pieces in `pieces` (NULL: the
+ * stack's SHADOW_MAX_PIECES). */
+static bool joined_exact(const vf_polygon *p, const vf_polygon *q,
+                         const shadow_occluder *occluders, uint32_t occluder_count,
+                         double accuracy, double absolute, double plane_epsilon,
+                         uint64_t work_budget, flat_piece *pieces, unsigned max_pieces,
+                         double *value, double *bound)
 {
     shadow_polygon joined[PAIR_EXACT_MAX_OCCLUDERS];
     if (occluder_count > PAIR_EXACT_MAX_OCCLUDERS)
         return false;
     uint32_t count = shadow_join_occluders(occluders, occluder_count, joined);
     return obstructed_exact(p, q, NULL, joined, count, accuracy, absolute, plane_epsilon,
-                            work_budget, NULL, 0, OBSTRUCTED_MIN_DEPTH, true, true, value,
-                            bound);
+                            work_budget, pieces, max_pieces, OBSTRUCTED_MIN_DEPTH, true, true,
+                            value, bound);
+}
+
+bool pair_obstructed_exact_within(const vf_polygon *p, const vf_polygon *q,
+                                  const shadow_occluder *occluders, uint32_t occluder_count,
+                                  double accuracy, double absolute, double plane_epsilon,
+                                  uint64_t work_budget, double *value, double *bound)
+{
+    return joined_exact(p, q, occluders, occluder_count, accuracy, absolute, plane_epsilon,
+                        work_budget, NULL, 0, value, bound);
 }
 
 bool pair_obstructed_exact_roomy(const vf_polygon *p, const vf_polygon *q,
@@ -345,13 +358,8 @@ bool pair_obstructed_exact_roomy(const vf_polygon *p, const vf_polygon *q,
                                  uint64_t work_budget, pair_workspace *workspace, double *value,
                                  double *bound)
 {
-    shadow_polygon joined[PAIR_EXACT_MAX_OCCLUDERS];
-    if (occluder_count > PAIR_EXACT_MAX_OCCLUDERS)
-        return false;
-    uint32_t count = shadow_join_occluders(occluders, occluder_count, joined);
-    return obstructed_exact(p, q, NULL, joined, count, accuracy, absolute, plane_epsilon,
-                            work_budget, workspace->pieces, PAIR_ROOMY_PIECES,
-                            OBSTRUCTED_MIN_DEPTH, true, true, value, bound);
+    return joined_exact(p, q, occluders, occluder_count, accuracy, absolute, plane_epsilon,
+                        work_budget, workspace->pieces, PAIR_ROOMY_PIECES, value, bound);
 }
 
 bool pair_obstructed_exact(const vf_polygon *p, const vf_polygon *q,

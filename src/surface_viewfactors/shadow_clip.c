@@ -229,17 +229,8 @@ double shadow_visible_factor_polygons(rad_vec3 x, rad_vec3 n, const vf_polygon *
 
 double shadow_receiver_factor(const shadow_receiver *receiver, rad_vec3 x, rad_vec3 n,
                               const shadow_caster *casters, const uint32_t *index,
-                              uint32_t count, double plane_epsilon)
-{
-    occluder_list list = {casters, NULL, NULL, index, count};
-    flat_piece pieces[SHADOW_MAX_PIECES];
-    return visible_factor(receiver, x, n, &list, plane_epsilon, pieces, SHADOW_MAX_PIECES);
-}
-
-double shadow_receiver_factor_in(const shadow_receiver *receiver, rad_vec3 x, rad_vec3 n,
-                                 const shadow_caster *casters, const uint32_t *index,
-                                 uint32_t count, double plane_epsilon, flat_piece *pieces,
-                                 unsigned max_pieces)
+                              uint32_t count, double plane_epsilon, flat_piece *pieces,
+                              unsigned max_pieces)
 {
     occluder_list list = {casters, NULL, NULL, index, count};
     return visible_factor(receiver, x, n, &list, plane_epsilon, pieces, max_pieces);

@@ -15,7 +15,7 @@
 #include "surface_viewfactors/vf_geometry.h"
 
 /* Most convex pieces the visible part may break into on the stack; past them the caller
- * tries again with more room (shadow_receiver_factor_in) or samples. */
+ * tries again with more room (shadow_receiver_factor's) or samples. */
 #define SHADOW_MAX_PIECES 48
 
 typedef struct shadow_occluder {
@@ -70,17 +70,12 @@ void shadow_caster_prepare(const shadow_receiver *receiver, const rad_vec3 *corn
 
 /* The factor from x to what of the receiver the casters index[0 .. count) (NULL: the first
  * count) leave visible; the same as shadow_visible_factor behind the occluders they were
- * made from. */
+ * made from, with room for max_pieces visible pieces in `pieces` (shadow_visible_factor
+ * has SHADOW_MAX_PIECES on the stack): -1 past max_pieces, or as flat_subtract says. */
 double shadow_receiver_factor(const shadow_receiver *receiver, rad_vec3 x, rad_vec3 n,
                               const shadow_caster *casters, const uint32_t *index,
-                              uint32_t count, double plane_epsilon);
-
-/* The same with room for max_pieces visible pieces in `pieces` (rather than
- * SHADOW_MAX_PIECES on the stack): -1 past max_pieces or as flat_subtract says. */
-double shadow_receiver_factor_in(const shadow_receiver *receiver, rad_vec3 x, rad_vec3 n,
-                                 const shadow_caster *casters, const uint32_t *index,
-                                 uint32_t count, double plane_epsilon, flat_piece *pieces,
-                                 unsigned max_pieces);
+                              uint32_t count, double plane_epsilon, flat_piece *pieces,
+                              unsigned max_pieces);
 
 /* The occluding triangles joined where they can be, into `out` (room for `count`): two
  * join when they share an edge (the same corners, bit for bit), lie in one plane and their
