@@ -302,12 +302,55 @@ static bool join_occluders(shadow_polygon *a, const shadow_polygon *b)
     return false;
 }
 
+/* An occluder's bounding box: two that share an edge have boxes that touch. */
+typedef struct join_box {
+    rad_vec3 lo, hi;
+} join_box;
+
+static join_box box_of_polygon(const shadow_polygon *p)
+{
+    join_box box = {p->vertex[0], p->vertex[0]};
+    for (unsigned k = 1; k < p->count; k++) {
+        box.lo = v3(fmin(box.lo.x, p->vertex[k].x), fmin(box.lo.y, p->vertex[k].y),
+                    fmin(box.lo.z, p->vertex[k].z));
+        box.hi = v3(fmax(box.hi.x, p->vertex[k].x), fmax(box.hi.y, p->vertex[k].y),
+                    fmax(box.hi.z, p->vertex[k].z));
+    }
+    return box;
+}
+
+/* join_occluders on out[a] and out[b], tried only when their boxes touch (a shared edge's
+ * corners, equal bit for bit, lie in both): most pairs of a pair's occluders are told
+ * apart by six comparisons instead of every edge against every edge, which took 8 % of
+ * the 22k-surface city's time. */
+static bool try_join(shadow_polygon *out, join_box *box, uint32_t a, uint32_t b)
+{
+    if (!box) /* more occluders than the boxes' room (an emitter's triangles) */
+        return join_occluders(&out[a], &out[b]);
+    const join_box *x = &box[a], *y = &box[b];
+    if (x->hi.x < y->lo.x || y->hi.x < x->lo.x || x->hi.y < y->lo.y || y->hi.y < x->lo.y ||
+        x->hi.z < y->lo.z || y->hi.z < x->lo.z)
+        return false;
+    if (!join_occluders(&out[a], &out[b]))
+        return false;
+    box[a] = (join_box){v3(fmin(x->lo.x, y->lo.x), fmin(x->lo.y, y->lo.y), fmin(x->lo.z, y->lo.z)),
+                        v3(fmax(x->hi.x, y->hi.x), fmax(x->hi.y, y->hi.y), fmax(x->hi.z, y->hi.z))};
+    return true;
+}
+
+/* Room for the boxes of as many occluders as an exact pair takes. */
+#define JOIN_BOXES RAD_MAX_EXACT_OCCLUDERS
+
 uint32_t shadow_join_occluders(const shadow_occluder *triangles, uint32_t count,
                                shadow_polygon *out)
 {
+    join_box room[JOIN_BOXES];
+    join_box *box = count <= JOIN_BOXES ? room : NULL;
     for (uint32_t k = 0; k < count; k++) {
         out[k].count = 3;
         memcpy(out[k].vertex, triangles[k].corner, 3 * sizeof(rad_vec3));
+        if (box)
+            box[k] = box_of_polygon(&out[k]);
     }
     /* Joins, each time, the first pair (a, b) in order that joins, until none does; the
      * scan does not start again from (0, 1) after each join. Before row a every pair is
@@ -318,16 +361,22 @@ uint32_t shadow_join_occluders(const shadow_occluder *triangles, uint32_t count,
     uint32_t a = 0;
     while (a < count) {
         uint32_t b = a + 1;
-        while (b < count && !join_occluders(&out[a], &out[b]))
+        while (b < count && !try_join(out, box, a, b))
             b++;
         if (b == count) {
             a++;
             continue;
         }
-        out[b] = out[--count];
+        --count;
+        out[b] = out[count];
+        if (box)
+            box[b] = box[count];
         for (uint32_t x = 0; x < a;) {
-            if (join_occluders(&out[x], &out[a])) {
-                out[a] = out[--count];
+            if (try_join(out, box, x, a)) {
+                --count;
+                out[a] = out[count];
+                if (box)
+                    box[a] = box[count];
                 a = x;
                 x = 0;
             } else {
