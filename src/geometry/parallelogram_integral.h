@@ -20,9 +20,11 @@
  * values along either direction, check each cell about to be accepted: f at the probes in
  * it against its rule points' biquadratic, the misses counted as error. A probe far
  * outside its cell's range marks a feature the rule points did not see (light through a
- * slit), and the integral is made again with the cells along that probe's two lines
- * quartered down to 1/32. This takes the place of forced splits (min_splits), which only
- * narrowed the gaps between the lines all rule points lie on, at the price of every cell.
+ * slit), and the integral is made again with 64 more probes along each of that probe's
+ * two lines, which a band through it along either edge holds (cells across the lines are
+ * quartered rather than halved down to 1/32, and split only where f misses them). This
+ * takes the place of forced splits (min_splits), which only narrowed the gaps between the
+ * lines all rule points lie on, at the price of every cell.
  */
 #ifndef RAD_GEOMETRY_PARALLELOGRAM_INTEGRAL_H
 #define RAD_GEOMETRY_PARALLELOGRAM_INTEGRAL_H
