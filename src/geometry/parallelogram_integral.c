@@ -251,8 +251,8 @@ static double biquadratic_at(cell k, const double *value, double s, double t)
 
 /* f at the probe (s, t), known or found (*known, NaN until then); the first probe f is
  * found at in a cell tells the callback that the cell's points are the next. */
-static double probe_value(const frame *p, cell k, int level, int slot, int parent_slot,
-                          bool *told, double *known, double s, double t)
+static double probe_f(const frame *p, cell k, int level, int slot, int parent_slot, bool *told,
+                      double *known, double s, double t)
 {
     if (!isnan(*known))
         return *known;
@@ -296,7 +296,7 @@ static double line_probes_miss(const frame *p, cell k, const double *value, int 
                     continue;
                 double s = along == 0 ? fixed : run, t = along == 0 ? run : fixed;
                 double unkept = NAN;
-                double f = probe_value(p, k, level, slot, parent_slot, told,
+                double f = probe_f(p, k, level, slot, parent_slot, told,
                                        known ? &known[along][m] : &unkept, s, t);
                 sum += fabs(f - biquadratic_at(k, value, s, t)) * share;
             }
@@ -328,7 +328,7 @@ static double probe_miss(const frame *p, cell k, const double *value, int level,
         double s = probe_s(i), t = probe_t(i);
         if (s < k.s0 || s >= k.s1 || t < k.t0 || t >= k.t1)
             continue;
-        double f = probe_value(p, k, level, slot, parent_slot, &told, &p->probe_value[i], s, t);
+        double f = probe_f(p, k, level, slot, parent_slot, &told, &p->probe_value[i], s, t);
         sum += fabs(f - biquadratic_at(k, value, s, t)) * share;
         double beyond = fmax(f - hi, lo - f) - (hi - lo);
         if (p->outliers && beyond * share * p->jacobian > OUTLIER_SHARE * tolerance)
