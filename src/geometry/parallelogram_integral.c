@@ -213,8 +213,8 @@ static void check_compute(void)
  *     integral with a bound of 5 %). (Before, every cell within 1/PROBES of the lines was
  *     quartered down to 1/32 whether f was smooth there or not: the 5 % of the 1k city's
  *     pairs with an outlier took a third of its time. Line probes weighing 1/PROBES of a
- *     strip instead, as if no band were wider than the lattice's spacing, left 10 pairs of
- *     it with errors up to 3.4 times their bounds, against runs 1000 times finer.)
+ *     strip instead, as if no band were wider than the lattice's spacing, left 10 more of
+ *     its factors outside their bounds, by up to 3.4 times, against runs 100 times finer.)
  */
 #define PROBES 55
 #define PROBE_GENERATOR 34
@@ -297,7 +297,7 @@ static double line_probes_miss(const frame *p, cell k, const double *value, int 
                 double s = along == 0 ? fixed : run, t = along == 0 ? run : fixed;
                 double unkept = NAN;
                 double f = probe_f(p, k, level, slot, parent_slot, told,
-                                       known ? &known[along][m] : &unkept, s, t);
+                                   known ? &known[along][m] : &unkept, s, t);
                 sum += fabs(f - biquadratic_at(k, value, s, t)) * share;
             }
         }
