@@ -349,9 +349,9 @@ static double probe_miss(const frame *p, cell k, const double *value, int level,
 
 static bool holds_line(const frame *p, cell k)
 {
-    if (!(k.s1 - k.s0 > QUARTER_WIDTH && k.t1 - k.t0 > QUARTER_WIDTH))
+    if (!p->lines || !(k.s1 - k.s0 > QUARTER_WIDTH && k.t1 - k.t0 > QUARTER_WIDTH))
         return false;
-    for (int i = 0; p->lines >> i; i++)
+    for (int i = 0; i < PROBES; i++)
         if (p->lines >> i & 1) {
             double s = probe_s(i), t = probe_t(i);
             if ((s >= k.s0 && s < k.s1) || (t >= k.t0 && t < k.t1))
